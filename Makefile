@@ -1,0 +1,46 @@
+# serialkin — the two set-up commands of the README:
+#   make run    reproduce the chapter into out/chapter/report.html
+#   make test   the whole test suite (peers and headless-browser tests included)
+# Each creates .venv when missing and installs the project into it.
+
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP_RUN  := $(VENV)/.stamp-run
+STAMP_TEST := $(VENV)/.stamp-test
+
+.PHONY: run test lint bench browser-deps clean
+
+$(PY):
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+
+$(STAMP_RUN): pyproject.toml | $(PY)
+	$(PY) -m pip install --quiet -e .
+	touch $@
+
+$(STAMP_TEST): pyproject.toml | $(PY)
+	$(PY) -m pip install --quiet -e ".[dev,bench]"
+	touch $@ $(STAMP_RUN)
+
+run: $(STAMP_RUN)
+	$(VENV)/bin/serialkin chapter --out out/chapter
+
+# Headless Chromium for the viewer tests (Debian packages). Failure is not fatal:
+# the browser tests then skip and say why.
+browser-deps:
+	@command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1 || \
+	  ( (apt-get update -qq && apt-get install -y -qq chromium chromium-driver >/dev/null) \
+	    || echo "browser-deps: could not install chromium; browser tests will be skipped" )
+
+test: $(STAMP_TEST) browser-deps
+	$(PY) -m pytest -n 2 --dist loadfile
+
+lint: $(STAMP_TEST)
+	$(VENV)/bin/ruff check src tests benchmarks examples
+
+bench: $(STAMP_TEST)
+	$(PY) benchmarks/run_all.py
+
+clean:
+	rm -rf $(VENV) out .pytest_cache

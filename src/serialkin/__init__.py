@@ -1,0 +1,18 @@
+"""serialkin: kinematics of serial robot manipulators.
+
+Quick start::
+
+    import numpy as np
+    import serialkin as sk
+
+    robot = sk.models.puma560()
+    T = robot.fk(np.zeros(robot.n))        # (4, 4) tool pose
+    J = robot.jacobian(np.zeros(robot.n))  # (6, n), rows [v; ω]
+"""
+
+from serialkin import errors, spatial
+from serialkin.errors import SerialkinError
+from serialkin.model import DHLink, Joint, Robot
+
+__all__ = ["DHLink", "Joint", "Robot", "SerialkinError", "errors", "spatial"]
+__version__ = "0.1.0"

@@ -1,0 +1,149 @@
+"""Validation helpers used at the public boundary.
+
+Each ``check_*`` function coerces its argument to ``float64`` where that is natural,
+checks shape and finiteness, and raises :class:`~serialkin.errors.InputError` (a
+``ValueError``) or :class:`~serialkin.errors.InputTypeError` (a ``TypeError``) with a
+message that names the argument, what was expected and what came. Kernels never
+validate: they trust what these functions let through.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable, Sequence
+
+import numpy as np
+
+from serialkin.errors import InputError, InputTypeError
+
+#: Tolerance used to decide whether a matrix is a rotation (max |RᵀR − I| and |det R − 1|).
+ROTATION_TOL = 1e-6
+
+
+def _describe(x: object) -> str:
+    if isinstance(x, np.ndarray):
+        return f"an array of shape {x.shape} and dtype {x.dtype}"
+    return f"{type(x).__name__} {x!r}"[:120]
+
+
+def as_float_array(x: object, name: str, *, ndim: int | None = None) -> np.ndarray:
+    """Return ``x`` as a finite float64 array, or raise naming ``name``.
+
+    Args:
+        x: array-like of real numbers.
+        name: the argument's name, used in error messages.
+        ndim: required number of dimensions, or None for any.
+
+    Raises:
+        InputTypeError: ``x`` is not numeric (strings, objects, complex numbers).
+        InputError: wrong number of dimensions, or NaN/inf entries.
+    """
+    if isinstance(x, np.ndarray) and x.dtype == np.float64:
+        a = x
+    else:
+        try:
+            a = np.asarray(x)
+        except (TypeError, ValueError) as exc:  # ragged lists
+            raise InputTypeError(f"{name} must be an array of real numbers, got {_describe(x)}") from exc
+        if a.dtype.kind not in "biuf":
+            raise InputTypeError(
+                f"{name} must be an array of real numbers, got {_describe(x)}"
+            )
+        a = a.astype(np.float64)
+    if ndim is not None and a.ndim != ndim:
+        raise InputError(f"{name} must have {ndim} dimension(s), got shape {a.shape}")
+    if not np.isfinite(a).all():
+        bad = np.argwhere(~np.isfinite(a))[0]
+        raise InputError(
+            f"{name} must be finite, got {a[tuple(bad)]} at index {tuple(int(i) for i in bad)}"
+        )
+    return a
+
+
+def as_vector(x: object, name: str, size: int | Sequence[int]) -> np.ndarray:
+    """Return ``x`` as a finite float64 vector of the given size (or one of several sizes)."""
+    a = as_float_array(x, name)
+    sizes = (size,) if isinstance(size, int) else tuple(size)
+    if a.ndim != 1 or a.shape[0] not in sizes:
+        want = " or ".join(str(s) for s in sizes)
+        raise InputError(f"{name} must be a vector of {want} values, got shape {a.shape}")
+    return a
+
+
+def check_last_dims(a: np.ndarray, name: str, shape: tuple[int, ...]) -> np.ndarray:
+    """Check that the trailing dimensions of ``a`` equal ``shape`` (leading ones are a batch)."""
+    k = len(shape)
+    if a.ndim < k or a.shape[a.ndim - k :] != shape:
+        dims = "x".join(str(s) for s in shape)
+        raise InputError(
+            f"{name} must have shape (..., {', '.join(map(str, shape))}) ({dims} matrices or "
+            f"a batch of them), got shape {a.shape}"
+        )
+    return a
+
+
+def check_rotation(R: object, name: str = "R", tol: float = ROTATION_TOL) -> np.ndarray:
+    """Check that ``R`` is a (batch of) rotation matrix: shape (..., 3, 3), RᵀR = I (eq 7), det R = +1."""
+    a = check_last_dims(as_float_array(R, name), name, (3, 3))
+    err = np.abs(np.swapaxes(a, -1, -2) @ a - np.eye(3)).max(initial=0.0)
+    if err > tol:
+        raise InputError(
+            f"{name} is not orthonormal: max |RᵀR − I| = {err:.3g} exceeds {tol:g}"
+        )
+    det = np.linalg.det(a) if a.size else np.ones(0)
+    if np.any(np.abs(det - 1.0) > tol):
+        raise InputError(f"{name} is not a proper rotation: det R = {np.min(det):.6g}, expected +1")
+    return a
+
+
+def check_transform(T: object, name: str = "T", tol: float = ROTATION_TOL) -> np.ndarray:
+    """Check that ``T`` is a (batch of) homogeneous rigid transform, shape (..., 4, 4) (eq 9).
+
+    The last row must be ``[0, 0, 0, 1]`` and the upper-left 3x3 block a rotation.
+    """
+    a = check_last_dims(as_float_array(T, name), name, (4, 4))
+    if np.abs(a[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max(initial=0.0) > tol:
+        raise InputError(f"{name} is not a homogeneous transform: its last row must be [0, 0, 0, 1]")
+    check_rotation(a[..., :3, :3], f"the rotation block of {name}", tol)
+    return a
+
+
+def check_choice(value: object, name: str, choices: Iterable[str]) -> str:
+    """Check that ``value`` is one of ``choices``; the error lists them and the nearest match."""
+    options = list(choices)
+    if not isinstance(value, str) or value not in options:
+        near = difflib.get_close_matches(str(value), options, n=1)
+        hint = f" Did you mean {near[0]!r}?" if near else ""
+        raise InputError(
+            f"unknown {name} {value!r}; expected one of: {', '.join(map(repr, options))}.{hint}"
+        )
+    return value
+
+
+def check_positive(value: object, name: str, *, allow_zero: bool = False) -> float:
+    """Check that ``value`` is a finite real number > 0 (or >= 0 with ``allow_zero``)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InputTypeError(f"{name} must be a real number, got {_describe(value)}")
+    v = float(value)
+    if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
+        want = ">= 0" if allow_zero else "> 0"
+        raise InputError(f"{name} must be a finite number {want}, got {value!r}")
+    return v
+
+
+def check_int(value: object, name: str, *, minimum: int = 0) -> int:
+    """Check that ``value`` is an integer >= ``minimum``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise InputTypeError(f"{name} must be an integer, got {_describe(value)}")
+    if value < minimum:
+        raise InputError(f"{name} must be >= {minimum}, got {value}")
+    return int(value)
+
+
+def as_generator(seed: None | int | np.random.Generator) -> np.random.Generator:
+    """Return a numpy Generator for ``seed`` (None: fresh entropy; int: reproducible)."""
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if seed is None or (isinstance(seed, (int, np.integer)) and not isinstance(seed, bool)):
+        return np.random.default_rng(seed)
+    raise InputTypeError(f"seed must be None, an int or a numpy Generator, got {_describe(seed)}")

@@ -1,0 +1,1 @@
+"""The chapter's worked examples, reproduced into an HTML report (``serialkin chapter``)."""

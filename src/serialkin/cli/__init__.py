@@ -1,0 +1,1 @@
+"""The ``serialkin`` command line (click)."""

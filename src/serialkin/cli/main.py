@@ -1,0 +1,60 @@
+"""Entry point of the ``serialkin`` command line.
+
+Built on click (well kept, composable subcommands, ``--help`` for free). Each subcommand
+lives in its own module of this package and is registered on :data:`cli` here.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="serialkin")
+def cli() -> None:
+    """serialkin: kinematics of serial robot manipulators.
+
+    \b
+    Examples:
+      serialkin chapter --out out/chapter
+      serialkin models
+    """
+
+
+@cli.command()
+@click.option("--out", "out", default="out/chapter", show_default=True,
+              type=click.Path(file_okay=False), help="Output folder for report.html and figures.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
+@click.option("--section", "sections", multiple=True,
+              help="Build only this section (repeatable), e.g. --section forward.")
+def chapter(out: str, quiet: bool, sections: tuple[str, ...]) -> None:
+    """Reproduce the chapter's worked examples into an HTML report.
+
+    \b
+    Example:
+      serialkin chapter --out out/chapter
+    """
+    from serialkin.chapter.report import SECTION_MODULES, build_report
+
+    unknown = [s for s in sections if s not in SECTION_MODULES]
+    if unknown:
+        raise click.BadParameter(
+            f"unknown section(s) {', '.join(unknown)}; expected: {', '.join(SECTION_MODULES)}",
+            param_hint="--section",
+        )
+    try:
+        path = build_report(out, quiet=quiet, sections=sections or None)
+    except OSError as exc:
+        raise click.ClickException(f"cannot write the report to {out!r}: {exc}") from exc
+    click.echo(f"wrote {path}")
+
+
+def main() -> None:
+    """Console entry point."""
+    cli(prog_name="serialkin")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

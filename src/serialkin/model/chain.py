@@ -1,0 +1,64 @@
+"""The one internal chain representation that feeds every kernel.
+
+:func:`compile_chain` turns joints in general form (:class:`~serialkin.model.joint.Joint`)
+plus base and tool transforms into the arrays documented in
+:mod:`serialkin.kinematics._kernels`. Standard DH, modified DH, general axes and URDF
+all end here, so every algorithm serves every robot.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from serialkin.model.joint import JOINT_TYPES, Joint
+
+
+@dataclass(frozen=True, eq=False)
+class Chain:
+    """Compiled chain arrays (read-only).
+
+    Attributes:
+        F: (n+1, 4, 4) fixed transforms between joint motions, base and tool included.
+        L: (n+1, 4, 4) link-frame offsets (L[0] is the base).
+        meta: (n, 5) axis x, y, z, type (0 R, 1 P), offset.
+    """
+
+    F: np.ndarray
+    L: np.ndarray
+    meta: np.ndarray
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return self.meta.shape[0]
+
+
+def compile_chain(joints: Sequence[Joint], base: np.ndarray, tool: np.ndarray) -> Chain:
+    """Compile joints ``A_i = P_i·M_i·Q_i`` with base and tool into kernel arrays.
+
+    ``T = base · Π_i (P_i · M_i(q_i) · Q_i) · tool`` (eq 11) is regrouped as
+    ``F[0]·M_1·F[1]···M_n·F[n]`` with ``F[0] = base·P_1``, ``F[i] = Q_i·P_{i+1}`` and
+    ``F[n] = Q_n·tool``.
+    """
+    n = len(joints)
+    F = np.empty((n + 1, 4, 4))
+    L = np.empty((n + 1, 4, 4))
+    meta = np.empty((n, 5))
+    L[0] = base
+    if n == 0:
+        F[0] = base @ tool
+    else:
+        F[0] = base @ joints[0].origin
+    for i, j in enumerate(joints):
+        meta[i, :3] = j.axis
+        meta[i, 3] = JOINT_TYPES[j.type]
+        meta[i, 4] = j.offset
+        L[i + 1] = j.post
+        nxt = joints[i + 1].origin if i + 1 < n else tool
+        F[i + 1] = j.post @ nxt
+    for a in (F, L, meta):
+        a.setflags(write=False)
+    return Chain(F=np.ascontiguousarray(F), L=np.ascontiguousarray(L), meta=meta)

@@ -1,0 +1,148 @@
+"""Denavit–Hartenberg tables (chapter section 3.2), standard and modified (Craig).
+
+Standard DH (the chapter's convention, eqs 13-16)::
+
+    A_i = Rz(θ_i) · Tz(d_i) · Tx(a_i) · Rx(α_i)
+
+Modified DH (Craig): row *i* holds a_{i-1}, α_{i-1}, d_i, θ_i and::
+
+    A_i = Rx(α_{i-1}) · Tx(a_{i-1}) · Rz(θ_i) · Tz(d_i)
+
+For a revolute joint θ_i = q_i + theta (``theta`` is the constant offset); for a
+prismatic joint d_i = q_i + d. Lengths in metres, angles in radians.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from serialkin.errors import RobotDefinitionError
+from serialkin.model.joint import Joint, check_limits, normalize_joint_type
+from serialkin.spatial.transforms import make_transform, rotx, rotz
+
+CONVENTIONS = ("standard", "modified")
+_FIELDS = ("a", "alpha", "d", "theta")
+
+
+@dataclass(frozen=True)
+class DHLink:
+    """One row of a DH table.
+
+    Attributes:
+        a: link length [m] (a_i standard; a_{i-1} modified).
+        alpha: link twist [rad] (α_i standard; α_{i-1} modified).
+        d: link offset [m]; the constant part of d_i for a prismatic joint.
+        theta: joint angle offset [rad]; the constant θ_i for a prismatic joint.
+        type: 'R' revolute or 'P' prismatic.
+        qlim: (lower, upper) joint limits [rad or m].
+        name: joint name.
+    """
+
+    a: float = 0.0
+    alpha: float = 0.0
+    d: float = 0.0
+    theta: float = 0.0
+    type: str = "R"
+    qlim: tuple[float, float] = (-np.inf, np.inf)
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        where = f"DH row {self.name!r}" if self.name else "DH row"
+        for f in _FIELDS:
+            v = getattr(self, f)
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+                raise RobotDefinitionError(f"{where}: field {f!r} must be a number, got {v!r}")
+            if not np.isfinite(v):
+                raise RobotDefinitionError(f"{where}: field {f!r} must be finite, got {v!r}")
+            object.__setattr__(self, f, float(v))
+        object.__setattr__(self, "type", normalize_joint_type(self.type, where))
+        object.__setattr__(self, "qlim", check_limits(self.qlim, where))
+
+
+def link_transform(link: DHLink, q: float, convention: str = "standard") -> np.ndarray:
+    """The DH link matrix A_i(q) (eq 12) evaluated directly from the DH formula, (4, 4).
+
+    Used as an independent reference in tests and in the symbolic derivation; the fast
+    path is the compiled kernel.
+    """
+    theta = link.theta + (q if link.type == "R" else 0.0)
+    d = link.d + (q if link.type == "P" else 0.0)
+    Rz, Rx = make_transform(rotz(theta)), make_transform(rotx(link.alpha))
+    Tz, Tx = make_transform(p=[0, 0, d]), make_transform(p=[link.a, 0, 0])
+    if convention == "standard":
+        return Rz @ Tz @ Tx @ Rx
+    return Rx @ Tx @ Rz @ Tz
+
+
+def parse_dh_rows(links: Sequence[object], where: str = "links") -> list[DHLink]:
+    """Turn DHLink objects or mappings {a, alpha, d, theta, type, qlim, name} into DHLinks.
+
+    Raises:
+        RobotDefinitionError: a row is not a mapping, misses a field or has an unknown one.
+    """
+    if isinstance(links, (str, bytes)) or not isinstance(links, Sequence):
+        raise RobotDefinitionError(f"{where} must be a list of DH rows, got {type(links).__name__}")
+    if len(links) == 0:
+        raise RobotDefinitionError(f"{where} is empty; a robot needs at least one joint")
+    rows: list[DHLink] = []
+    allowed = set(_FIELDS) | {"type", "qlim", "name", "sigma", "joint"}
+    for i, row in enumerate(links):
+        if isinstance(row, DHLink):
+            rows.append(row)
+            continue
+        if not isinstance(row, Mapping):
+            raise RobotDefinitionError(
+                f"{where}[{i}] must be a mapping with fields a, alpha, d, theta, got {row!r}"
+            )
+        missing = [f for f in _FIELDS if f not in row]
+        if missing:
+            raise RobotDefinitionError(f"{where}[{i}] is missing field(s) {', '.join(missing)}")
+        unknown = sorted(set(row) - allowed)
+        if unknown:
+            raise RobotDefinitionError(
+                f"{where}[{i}] has unknown field(s) {', '.join(unknown)}; allowed: "
+                f"{', '.join(sorted(allowed))}"
+            )
+        jt = row.get("type", row.get("joint", "R"))
+        name = str(row.get("name", f"joint{i + 1}"))
+        rows.append(
+            DHLink(
+                a=row["a"],
+                alpha=row["alpha"],
+                d=row["d"],
+                theta=row["theta"],
+                type=jt,
+                qlim=tuple(row.get("qlim", (-np.inf, np.inf))),
+                name=name,
+            )
+        )
+    return rows
+
+
+def dh_to_joints(rows: Sequence[DHLink], convention: str) -> list[Joint]:
+    """Express DH rows as general joints ``A = origin · M(q + offset) · post``."""
+    joints = []
+    for i, r in enumerate(rows):
+        name = r.name or f"joint{i + 1}"
+        Tz = make_transform(p=[0.0, 0.0, r.d])
+        Tx = make_transform(p=[r.a, 0.0, 0.0])
+        Rx = make_transform(rotx(r.alpha))
+        Rz = make_transform(rotz(r.theta))
+        if convention == "standard":
+            if r.type == "R":
+                origin, post, offset = np.eye(4), Tz @ Tx @ Rx, r.theta
+            else:
+                origin, post, offset = Rz, Tx @ Rx, r.d
+        else:
+            if r.type == "R":
+                origin, post, offset = Rx @ Tx @ Tz, np.eye(4), r.theta
+            else:
+                origin, post, offset = Rx @ Tx @ Rz, np.eye(4), r.d
+        joints.append(
+            Joint(axis=np.array([0.0, 0.0, 1.0]), type=r.type, origin=origin, post=post,
+                  offset=offset, qlim=r.qlim, name=name)
+        )
+    return joints

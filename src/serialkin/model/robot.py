@@ -1,0 +1,394 @@
+"""The :class:`Robot`: a serial chain of revolute and prismatic joints (section 3).
+
+A robot is immutable. However it was described (standard or modified DH table, general
+joint axes, URDF), it holds one compiled :class:`~serialkin.model.chain.Chain` that the
+kernels of :mod:`serialkin.kinematics` evaluate.
+
+Conventions: joint vectors ``q`` have shape (..., n) [rad for revolute, m for prismatic];
+poses are 4x4 homogeneous transforms of the end-effector (tool) in the world frame
+(``T_world_ee``, base transform included); twists and Jacobian rows are ordered
+``[vx, vy, vz, wx, wy, wz]``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from serialkin._checks import (
+    as_float_array,
+    as_generator,
+    check_choice,
+    check_int,
+    check_transform,
+)
+from serialkin.errors import InputError, RobotDefinitionError
+from serialkin.kinematics import _kernels as K
+from serialkin.model.chain import compile_chain
+from serialkin.model.dh import CONVENTIONS, DHLink, dh_to_joints, parse_dh_rows
+from serialkin.model.joint import Joint
+
+if TYPE_CHECKING:
+    from serialkin.ik.result import IKResult
+
+#: Named task-row selections for manipulability and condition number.
+TASK_ROWS: dict[str, tuple[int, ...]] = {
+    "full": (0, 1, 2, 3, 4, 5),
+    "position": (0, 1, 2),
+    "orientation": (3, 4, 5),
+    "planar": (0, 1),
+    "planar_pose": (0, 1, 5),
+}
+
+
+class Robot:
+    """A serial manipulator with ``n`` joints.
+
+    Build one with :meth:`from_dh`, :meth:`from_joints`, :meth:`from_urdf` or take one
+    from :mod:`serialkin.models`.
+
+    Attributes:
+        name: the robot's name.
+        n: number of joints (degrees of freedom).
+        joints: tuple of :class:`~serialkin.model.joint.Joint` in general form.
+        dh: tuple of :class:`~serialkin.model.dh.DHLink` when built from a DH table, else None.
+        convention: 'standard' or 'modified' for DH robots, else None.
+        base: (4, 4) world-from-base transform.
+        tool: (4, 4) last-link-from-tool transform.
+        qlim: (n, 2) joint limits [rad or m], ±inf where unlimited.
+    """
+
+    def __init__(
+        self,
+        joints: Sequence[Joint],
+        *,
+        base: object = None,
+        tool: object = None,
+        name: str = "robot",
+        dh: Sequence[DHLink] | None = None,
+        convention: str | None = None,
+        source: str = "",
+    ) -> None:
+        if len(joints) == 0:
+            raise RobotDefinitionError("a robot needs at least one joint")
+        for i, j in enumerate(joints):
+            if not isinstance(j, Joint):
+                raise RobotDefinitionError(f"joints[{i}] must be a Joint, got {type(j).__name__}")
+        self.name = str(name)
+        self.joints = tuple(joints)
+        self.n = len(joints)
+        self.base = np.eye(4) if base is None else check_transform(base, "base").copy()
+        self.tool = np.eye(4) if tool is None else check_transform(tool, "tool").copy()
+        self.dh = tuple(dh) if dh is not None else None
+        self.convention = convention
+        self.source = source
+        self.qlim = np.array([j.qlim for j in joints], dtype=float)
+        self.joint_types = tuple(j.type for j in joints)
+        self.joint_names = tuple(j.name or f"joint{i + 1}" for i, j in enumerate(joints))
+        if len(set(self.joint_names)) != self.n:
+            raise RobotDefinitionError(f"joint names must be unique, got {self.joint_names}")
+        for a in (self.base, self.tool, self.qlim):
+            a.setflags(write=False)
+        self.chain = compile_chain(self.joints, self.base, self.tool)
+        self._F, self._L, self._meta = self.chain.F, self.chain.L, self.chain.meta
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def from_dh(
+        cls,
+        links: Sequence[DHLink | Mapping[str, Any]],
+        convention: str = "standard",
+        *,
+        base: object = None,
+        tool: object = None,
+        name: str = "robot",
+        source: str = "",
+    ) -> Robot:
+        """Build a robot from a DH table (section 3.2).
+
+        Args:
+            links: rows as :class:`DHLink` or mappings with fields ``a, alpha, d, theta``
+                and optional ``type`` ('R'/'P'), ``qlim`` (lower, upper), ``name``.
+            convention: 'standard' (A = Rz(θ)Tz(d)Tx(a)Rx(α), the chapter's) or
+                'modified' (Craig: A = Rx(α)Tx(a)Rz(θ)Tz(d)).
+            base: (4, 4) world-from-base transform.
+            tool: (4, 4) transform from the last DH frame to the tool.
+            name: robot name.
+            source: where the parameters come from (shown by ``serialkin models``).
+
+        Raises:
+            RobotDefinitionError: missing/unknown field, unknown joint type, lower > upper.
+            InputError: unknown convention, base/tool not rigid transforms.
+        """
+        check_choice(convention, "convention", CONVENTIONS)
+        rows = parse_dh_rows(links)
+        joints = dh_to_joints(rows, convention)
+        return cls(joints, base=base, tool=tool, name=name, dh=rows, convention=convention,
+                   source=source)
+
+    @classmethod
+    def from_joints(
+        cls,
+        joints: Sequence[Joint],
+        *,
+        base: object = None,
+        tool: object = None,
+        name: str = "robot",
+        source: str = "",
+    ) -> Robot:
+        """Build a robot from joints in general form (fixed transform + axis), as URDF does."""
+        return cls(joints, base=base, tool=tool, name=name, source=source)
+
+    @classmethod
+    def from_urdf(cls, path_or_string: str, base_link: str | None = None,
+                  tip_link: str | None = None) -> Robot:
+        """Build a robot from a URDF file or string (see :mod:`serialkin.model.urdf`)."""
+        from serialkin.model.urdf import robot_from_urdf
+
+        return robot_from_urdf(path_or_string, base_link=base_link, tip_link=tip_link)
+
+    def to_urdf(self) -> str:
+        """This robot's kinematics as a URDF string (see :mod:`serialkin.model.urdf`)."""
+        from serialkin.model.urdf import robot_to_urdf
+
+        return robot_to_urdf(self)
+
+    def with_tool(self, tool: object) -> Robot:
+        """A copy of this robot with another tool transform (4, 4)."""
+        return Robot(self.joints, base=self.base, tool=tool, name=self.name, dh=self.dh,
+                     convention=self.convention, source=self.source)
+
+    def with_base(self, base: object) -> Robot:
+        """A copy of this robot with another base transform (4, 4)."""
+        return Robot(self.joints, base=base, tool=self.tool, name=self.name, dh=self.dh,
+                     convention=self.convention, source=self.source)
+
+    def with_limits(self, qlim: object) -> Robot:
+        """A copy of this robot with other joint limits, shape (n, 2) [rad or m]."""
+        lim = as_float_array(qlim, "qlim") if not np.isinf(np.asarray(qlim, float)).any() \
+            else np.asarray(qlim, float)
+        if lim.shape != (self.n, 2):
+            raise InputError(f"qlim must have shape ({self.n}, 2), got {lim.shape}")
+        joints = [Joint(axis=j.axis, type=j.type, origin=j.origin, post=j.post, offset=j.offset,
+                        qlim=tuple(lim[i]), name=j.name) for i, j in enumerate(self.joints)]
+        dh = None
+        if self.dh is not None:
+            dh = [DHLink(a=r.a, alpha=r.alpha, d=r.d, theta=r.theta, type=r.type,
+                         qlim=tuple(lim[i]), name=r.name) for i, r in enumerate(self.dh)]
+        return Robot(joints, base=self.base, tool=self.tool, name=self.name, dh=dh,
+                     convention=self.convention, source=self.source)
+
+    # ------------------------------------------------------------------ validation
+    def check_q(self, q: object, name: str = "q") -> np.ndarray:
+        """Return ``q`` as a finite float64 array of shape (..., n), or raise naming it."""
+        a = as_float_array(q, name)
+        if a.ndim == 0 or a.shape[-1] != self.n:
+            got = f"{a.shape[-1]} values" if a.ndim else "a scalar"
+            raise InputError(
+                f"{name} has {got} but robot {self.name!r} has {self.n} joints "
+                f"(expected shape (..., {self.n}), got {a.shape})"
+            )
+        return a
+
+    def _nonfinite(self, q: np.ndarray, name: str = "q") -> InputError:
+        return InputError(f"{name} must be finite, got {q}")
+
+    @property
+    def is_planar(self) -> bool:
+        """True when the tool moves in the world xy plane only (rows vz, wx, wy of J vanish)."""
+        J = self.jacobian(self.random_q(3, seed=0))
+        return bool(np.allclose(J[:, [2, 3, 4]], 0.0, atol=1e-9))
+
+    # ------------------------------------------------------------------ kinematics
+    def fk(self, q: object) -> np.ndarray:
+        """Forward kinematics: the tool pose in the world frame (eqs 10-11).
+
+        ``T = base · A_1(q_1) ··· A_n(q_n) · tool``.
+
+        Args:
+            q: joint values, shape (n,) or (..., n) [rad / m].
+
+        Returns:
+            (4, 4) or (..., 4, 4) homogeneous transforms.
+        """
+        if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (self.n,):
+            T = np.empty((4, 4))
+            if K.fk_checked(q, self._F, self._meta, T):
+                return T
+            raise self._nonfinite(q)
+        a = self.check_q(q)
+        if a.ndim == 1:
+            T = np.empty((4, 4))
+            K.fk_into(np.ascontiguousarray(a), self._F, self._meta, T)
+            return T
+        flat = np.ascontiguousarray(a.reshape(-1, self.n))
+        out = np.empty((flat.shape[0], 4, 4))
+        K.fk_batch(flat, self._F, self._meta, out)
+        return out.reshape(a.shape[:-1] + (4, 4))
+
+    def fk_all(self, q: object) -> np.ndarray:
+        """Every link frame ``world_T_i`` for i = 0..n (frame 0 is the base; no tool), eq 11.
+
+        Args:
+            q: joint values, shape (..., n).
+
+        Returns:
+            (..., n+1, 4, 4). For a standard-DH robot these are the DH frames 0..n.
+        """
+        a = self.check_q(q)
+        flat = np.ascontiguousarray(a.reshape(-1, self.n))
+        out = np.empty((flat.shape[0], self.n + 1, 4, 4))
+        if flat.shape[0] == 1:
+            K.fk_all_into(flat[0], self._F, self._L, self._meta, out[0])
+        else:
+            K.fk_all_batch(flat, self._F, self._L, self._meta, out)
+        return out.reshape(a.shape[:-1] + (self.n + 1, 4, 4))
+
+    def jacobian(
+        self,
+        q: object,
+        frame: str = "base",
+        *,
+        link: int | None = None,
+        point: object = None,
+    ) -> np.ndarray:
+        """Geometric Jacobian (eqs 33-36), rows (vx, vy, vz, wx, wy, wz).
+
+        Column i is ``[z_i × (p − o_i); z_i]`` for a revolute joint and ``[z_i; 0]`` for a
+        prismatic one, where ``z_i``, ``o_i`` are joint i's axis and origin in the world
+        frame and ``p`` the reference point.
+
+        Args:
+            q: joint values, shape (..., n).
+            frame: 'base' (world coordinates) or 'ee' (both blocks rotated into the tool
+                frame, ``blockdiag(Rᵀ, Rᵀ) J``).
+            link: None for the tool point; else a link frame index 0..n, and the Jacobian
+                is that of ``point`` fixed on that link (joints beyond it give zero columns).
+            point: (3,) point in the link frame's coordinates [m] (default its origin).
+
+        Returns:
+            (6, n) or (..., 6, n).
+        """
+        if frame == "base" and link is None and type(q) is np.ndarray \
+                and q.dtype == np.float64 and q.shape == (self.n,):
+            J = np.empty((6, self.n))
+            if K.jacobian_checked(q, self._F, self._meta, J, np.empty((4, 4))):
+                return J
+            raise self._nonfinite(q)
+        check_choice(frame, "frame", ("base", "ee"))
+        a = self.check_q(q)
+        flat = np.ascontiguousarray(a.reshape(-1, self.n))
+        N = flat.shape[0]
+        J = np.empty((N, 6, self.n))
+        T = np.empty((N, 4, 4))
+        if link is None:
+            if point is not None:
+                raise InputError("point is given without link; pass link=k (0..n) as well")
+            K.jacobian_batch(flat, self._F, self._meta, J, T)
+        else:
+            k = check_int(link, "link")
+            if k > self.n:
+                raise InputError(f"link must be in 0..{self.n}, got {k}")
+            p = np.zeros(3) if point is None else as_float_array(point, "point", ndim=1)
+            if p.shape != (3,):
+                raise InputError(f"point must have 3 values, got shape {p.shape}")
+            P = np.empty((N, 3))
+            K.point_jacobian_batch(flat, self._F, self._L, self._meta, k, p, J, P)
+            if frame == "ee":
+                T = self.fk_all(flat)[:, k]
+        if frame == "ee":
+            Rt = np.swapaxes(T[:, :3, :3], -1, -2)
+            J = np.concatenate([Rt @ J[:, :3], Rt @ J[:, 3:]], axis=1)
+        return J.reshape(a.shape[:-1] + (6, self.n))
+
+    def jacobian_planar(self, q: object, orientation: bool = False) -> np.ndarray:
+        """Planar task Jacobian (eqs 30-32 and 38): rows (vx, vy) or (vx, vy, wz), (..., 2|3, n)."""
+        rows = [0, 1, 5] if orientation else [0, 1]
+        return self.jacobian(q)[..., rows, :]
+
+    def jacobian_analytic(self, q: object, rep: str = "rpy") -> np.ndarray:
+        """Analytical Jacobian (eq 29) for an orientation representation (see
+        :func:`serialkin.kinematics.analytic.jacobian_analytic`)."""
+        from serialkin.kinematics.analytic import jacobian_analytic
+
+        return jacobian_analytic(self, q, rep)
+
+    def _task_jacobian(self, q: object, task: str | Sequence[int]) -> np.ndarray:
+        if isinstance(task, str):
+            rows = TASK_ROWS[check_choice(task, "task", TASK_ROWS)]
+        else:
+            rows = tuple(check_int(r, "task row") for r in task)
+            if not rows or max(rows) > 5:
+                raise InputError(f"task rows must be a nonempty subset of 0..5, got {task!r}")
+        return self.jacobian(q)[..., list(rows), :]
+
+    def manipulability(self, q: object, task: str | Sequence[int] = "full") -> np.ndarray | float:
+        """Yoshikawa manipulability ``w = sqrt(det(J Jᵀ))`` (eq 43) of the task Jacobian.
+
+        Args:
+            q: joint values, shape (..., n).
+            task: rows of J that form the task: 'full', 'position', 'orientation',
+                'planar' (vx, vy), 'planar_pose' (vx, vy, wz) or a list of row indices.
+
+        Returns:
+            float or (...) array; 0 at singular configurations (and when n < m).
+        """
+        J = self._task_jacobian(q, task)
+        det = np.linalg.det(J @ np.swapaxes(J, -1, -2))
+        w = np.sqrt(np.maximum(det, 0.0))
+        return float(w) if w.ndim == 0 else w
+
+    def condition_number(self, q: object, task: str | Sequence[int] = "full") -> np.ndarray | float:
+        """Condition number σ_max/σ_min of the task Jacobian (inf at singularities)."""
+        J = self._task_jacobian(q, task)
+        s = np.linalg.svd(J, compute_uv=False)
+        with np.errstate(divide="ignore"):
+            c = np.where(s[..., -1] > 1e-15 * s[..., 0], s[..., 0] / s[..., -1], np.inf)
+        return float(c) if c.ndim == 0 else c
+
+    # ------------------------------------------------------------------ joint space
+    def random_q(self, size: int | tuple[int, ...] | None = None,
+                 seed: None | int | np.random.Generator = None) -> np.ndarray:
+        """Uniform random configurations inside the joint limits, shape (n,) or (*size, n).
+
+        Unlimited revolute joints sample [-π, π], unlimited prismatic joints [-1, 1] m.
+        """
+        rng = as_generator(seed)
+        lo, hi = self.sampling_limits().T
+        shape = (() if size is None else (size,) if isinstance(size, int) else tuple(size))
+        return lo + (hi - lo) * rng.random(shape + (self.n,))
+
+    def sampling_limits(self) -> np.ndarray:
+        """Joint limits with infinite bounds replaced by ±π (revolute) or ±1 m (prismatic), (n, 2)."""
+        lim = self.qlim.copy()
+        default = np.array([np.pi if t == "R" else 1.0 for t in self.joint_types])
+        lim[:, 0] = np.where(np.isfinite(lim[:, 0]), lim[:, 0], -default)
+        lim[:, 1] = np.where(np.isfinite(lim[:, 1]), lim[:, 1], default)
+        return lim
+
+    def within_limits(self, q: object, tol: float = 0.0) -> np.ndarray | bool:
+        """True where ``q`` (..., n) lies inside the joint limits (with tolerance ``tol``)."""
+        a = self.check_q(q)
+        ok = np.all((a >= self.qlim[:, 0] - tol) & (a <= self.qlim[:, 1] + tol), axis=-1)
+        return bool(ok) if ok.ndim == 0 else ok
+
+    # ------------------------------------------------------------------ inverse kinematics
+    def ik(self, target: object, method: str = "lm", **options: Any) -> IKResult:
+        """Inverse kinematics by any method (see :func:`serialkin.ik.solve`)."""
+        from serialkin.ik import solve
+
+        return solve(self, target, method=method, **options)
+
+    def ik_all(self, target: object, **options: Any) -> np.ndarray:
+        """Every closed-form IK solution inside the limits (see :func:`serialkin.ik.analytic.ik_all`)."""
+        from serialkin.ik.analytic import ik_all
+
+        return ik_all(self, target, **options)
+
+    # ------------------------------------------------------------------ display
+    def __repr__(self) -> str:
+        types = "".join(self.joint_types)
+        conv = f", {self.convention} DH" if self.convention else ""
+        return f"Robot({self.name!r}, n={self.n}, joints={types}{conv})"

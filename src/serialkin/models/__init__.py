@@ -1,0 +1,1 @@
+"""Built-in robot models (the zoo)."""
