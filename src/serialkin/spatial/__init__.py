@@ -1,6 +1,7 @@
-"""Rigid-body motion: rotations, homogeneous transforms and orientation representations (section 2)."""
+"""Rigid-body motion (section 2): rotations, transforms, orientation representations."""
 
 from serialkin._checks import check_rotation, check_transform
+from serialkin.spatial.pose import pose_distance, pose_error
 from serialkin.spatial.transforms import (
     inv_transform,
     make_transform,
@@ -18,6 +19,8 @@ __all__ = [
     "check_transform",
     "inv_transform",
     "make_transform",
+    "pose_distance",
+    "pose_error",
     "rotx",
     "roty",
     "rotz",
