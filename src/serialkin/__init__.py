@@ -10,9 +10,9 @@ Quick start::
     J = robot.jacobian(np.zeros(robot.n))  # (6, n), rows [v; ω]
 """
 
-from serialkin import errors, spatial
+from serialkin import errors, models, spatial
 from serialkin.errors import SerialkinError
 from serialkin.model import DHLink, Joint, Robot
 
-__all__ = ["DHLink", "Joint", "Robot", "SerialkinError", "errors", "spatial"]
+__all__ = ["DHLink", "Joint", "Robot", "SerialkinError", "errors", "models", "spatial"]
 __version__ = "0.1.0"

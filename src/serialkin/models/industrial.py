@@ -1,0 +1,172 @@
+"""Industrial and research arms from published DH tables.
+
+Each model names its source in ``robot.source``. Lengths in metres, angles in radians,
+joint limits from the manufacturer's data sheet or the cited paper.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from serialkin.model.dh import DHLink
+from serialkin.model.robot import Robot
+from serialkin.spatial.transforms import make_transform
+
+_DEG = math.pi / 180.0
+_INCH = 0.0254
+
+# Unimation PUMA 560, standard DH. Kinematic parameters: P. Corke and B. Armstrong-Hélouvry,
+# "A search for consensus among model parameters reported for the PUMA 560 robot",
+# ICRA 1994; d1 = 26.45 in (mounting surface to shoulder axis) and joint limits (Wang &
+# Chen, IEEE Trans. RA 7(4), 1991) as in P. Corke's Robotics Toolbox model.
+PUMA560_SOURCE = (
+    "Corke & Armstrong-Helouvry, ICRA 1994 (consensus PUMA 560 parameters); d1 = 26.45 in "
+    "pedestal and limits per Wang & Chen 1991, as in Corke's Robotics Toolbox"
+)
+
+# Stanford arm (Scheinman), standard DH with a prismatic third joint: R. P. Paul,
+# "Robot Manipulators: Mathematics, Programming and Control", MIT Press 1981, as in
+# P. Corke's Robotics Toolbox ``Stanford`` model (stroke 12-50 in).
+STANFORD_SOURCE = (
+    "R. P. Paul, Robot Manipulators (MIT Press 1981), Stanford arm; values as in "
+    "Corke's Robotics Toolbox"
+)
+
+# Universal Robots UR5 (CB3), standard DH: Universal Robots support article "DH
+# parameters for calculations of kinematics and dynamics"; limits ±360° (UR5 data sheet).
+UR5_SOURCE = "Universal Robots, 'DH parameters for calculations of kinematics and dynamics' (UR5)"
+
+# Franka Emika Panda, modified (Craig) DH exactly as published by Franka in the FCI
+# documentation ("Robot and interface specifications": DH table and joint limits); the
+# flange row (a = 0, d = 0.107, α = 0, θ = 0) is the tool transform.
+PANDA_SOURCE = "Franka Control Interface docs, 'Robot and interface specifications' (modified DH)"
+
+# KUKA LBR iiwa 7 R800, standard DH: link offsets 340/400/400/126 mm from the KUKA data
+# sheet, frame assignment as in Faria, Ferreira, Erlhagen, Monteiro, Bicho, "Position-based
+# kinematics for 7-DoF serial manipulators with global configuration control, joint limit
+# and singularity avoidance", Mechanism and Machine Theory 121 (2018); limits ±170/120/175°
+# from the KUKA LBR iiwa 7 R800 data sheet.
+IIWA7_SOURCE = (
+    "KUKA LBR iiwa 7 R800 data sheet (lengths, limits); DH frames per Faria et al., "
+    "Mech. Mach. Theory 121 (2018)"
+)
+
+
+def _rows(a, alpha, d, theta, qlim_deg, types=None) -> list[DHLink]:
+    n = len(a)
+    types = types or ["R"] * n
+    return [
+        DHLink(a=a[i], alpha=alpha[i], d=d[i], theta=theta[i], type=types[i],
+               qlim=tuple(qlim_deg[i]), name=f"q{i + 1}")
+        for i in range(n)
+    ]
+
+
+def puma560() -> Robot:
+    """Build the Unimation PUMA 560, 6R, standard DH (source in ``robot.source``).
+
+    ====  =======  ======  ========  ==============
+    Link  a [m]    α       d [m]     limits [deg]
+    ====  =======  ======  ========  ==============
+    1     0        π/2     0.6718    ±160
+    2     0.4318   0       0         -45 .. 225
+    3     0.0203   -π/2    0.15005   -225 .. 45
+    4     0        π/2     0.4318    -110 .. 170
+    5     0        -π/2    0         ±100
+    6     0        0       0         ±266
+    ====  =======  ======  ========  ==============
+    """
+    h = math.pi / 2
+    lim = np.array([[-160, 160], [-45, 225], [-225, 45], [-110, 170], [-100, 100],
+                    [-266, 266]]) * _DEG
+    rows = _rows(a=[0.0, 0.4318, 0.0203, 0.0, 0.0, 0.0],
+                 alpha=[h, 0.0, -h, h, -h, 0.0],
+                 d=[26.45 * _INCH, 0.0, 0.15005, 0.4318, 0.0, 0.0],
+                 theta=[0.0] * 6, qlim_deg=lim)
+    return Robot.from_dh(rows, "standard", name="puma560", source=PUMA560_SOURCE)
+
+
+def stanford() -> Robot:
+    """Build the Stanford arm, RRPRRR (joint 3 prismatic, q3 in metres), standard DH.
+
+    ====  =======  ======  ==============  ==============
+    Link  a [m]    α       d [m]           θ
+    ====  =======  ======  ==============  ==============
+    1     0        -π/2    0.412           q1
+    2     0        π/2     0.154           q2
+    3     0.0203   0       q3 (0.30-1.27)  -π/2
+    4     0        -π/2    0               q4
+    5     0        π/2     0               q5
+    6     0        0       0.263           q6
+    ====  =======  ======  ==============  ==============
+    """
+    h = math.pi / 2
+    lim = [(-170 * _DEG, 170 * _DEG), (-170 * _DEG, 170 * _DEG), (12 * _INCH, 50 * _INCH),
+           (-170 * _DEG, 170 * _DEG), (-90 * _DEG, 90 * _DEG), (-170 * _DEG, 170 * _DEG)]
+    rows = _rows(a=[0.0, 0.0, 0.0203, 0.0, 0.0, 0.0],
+                 alpha=[-h, h, 0.0, -h, h, 0.0],
+                 d=[0.412, 0.154, 0.0, 0.0, 0.0, 0.263],
+                 theta=[0.0, 0.0, -h, 0.0, 0.0, 0.0],
+                 qlim_deg=lim, types=["R", "R", "P", "R", "R", "R"])
+    return Robot.from_dh(rows, "standard", name="stanford", source=STANFORD_SOURCE)
+
+
+def ur5() -> Robot:
+    """Build the Universal Robots UR5, 6R, standard DH as published by Universal Robots.
+
+    a = (0, -0.425, -0.39225, 0, 0, 0) m, d = (0.089159, 0, 0, 0.10915, 0.09465, 0.0823) m,
+    α = (π/2, 0, 0, π/2, -π/2, 0); every joint ±360°.
+    """
+    h = math.pi / 2
+    lim = [(-2 * math.pi, 2 * math.pi)] * 6
+    rows = _rows(a=[0.0, -0.425, -0.39225, 0.0, 0.0, 0.0],
+                 alpha=[h, 0.0, 0.0, h, -h, 0.0],
+                 d=[0.089159, 0.0, 0.0, 0.10915, 0.09465, 0.0823],
+                 theta=[0.0] * 6, qlim_deg=lim)
+    return Robot.from_dh(rows, "standard", name="UR5", source=UR5_SOURCE)
+
+
+def panda() -> Robot:
+    """Build the Franka Emika Panda, 7R, modified (Craig) DH with the flange as tool.
+
+    ======  =========  =====  ======  =================
+    Joint   a [m]      d [m]  α       limits [rad]
+    ======  =========  =====  ======  =================
+    1       0          0.333  0       ±2.8973
+    2       0          0      -π/2    ±1.7628
+    3       0          0.316  π/2     ±2.8973
+    4       0.0825     0      π/2     -3.0718 .. -0.0698
+    5       -0.0825    0.384  -π/2    ±2.8973
+    6       0          0      π/2     -0.0175 .. 3.7525
+    7       0.088      0      π/2     ±2.8973
+    flange  0          0.107  0       (tool transform)
+    ======  =========  =====  ======  =================
+    """
+    h = math.pi / 2
+    lim = [(-2.8973, 2.8973), (-1.7628, 1.7628), (-2.8973, 2.8973), (-3.0718, -0.0698),
+           (-2.8973, 2.8973), (-0.0175, 3.7525), (-2.8973, 2.8973)]
+    rows = _rows(a=[0.0, 0.0, 0.0, 0.0825, -0.0825, 0.0, 0.088],
+                 alpha=[0.0, -h, h, h, -h, h, h],
+                 d=[0.333, 0.0, 0.316, 0.0, 0.384, 0.0, 0.0],
+                 theta=[0.0] * 7, qlim_deg=lim)
+    flange = make_transform(p=[0.0, 0.0, 0.107])
+    return Robot.from_dh(rows, "modified", tool=flange, name="panda", source=PANDA_SOURCE)
+
+
+def iiwa7() -> Robot:
+    """Build the KUKA LBR iiwa 7 R800, 7R, standard DH; the tool is the media flange (d7 = 0.126 m).
+
+    d = (0.340, 0, 0.400, 0, 0.400, 0, 0.126) m, a = 0,
+    α = (-π/2, π/2, π/2, -π/2, -π/2, π/2, 0); limits ±170, ±120, ±170, ±120, ±170, ±120,
+    ±175 degrees.
+    """
+    h = math.pi / 2
+    lim = np.array([[-170, 170], [-120, 120], [-170, 170], [-120, 120], [-170, 170],
+                    [-120, 120], [-175, 175]]) * _DEG
+    rows = _rows(a=[0.0] * 7,
+                 alpha=[-h, h, h, -h, -h, h, 0.0],
+                 d=[0.340, 0.0, 0.400, 0.0, 0.400, 0.0, 0.126],
+                 theta=[0.0] * 7, qlim_deg=lim)
+    return Robot.from_dh(rows, "standard", name="iiwa7", source=IIWA7_SOURCE)
