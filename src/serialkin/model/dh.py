@@ -146,3 +146,66 @@ def dh_to_joints(rows: Sequence[DHLink], convention: str) -> list[Joint]:
                   offset=offset, qlim=r.qlim, name=name)
         )
     return joints
+
+
+def standard_to_modified(
+    rows: Sequence[DHLink], base: object = None, tool: object = None
+) -> tuple[list[DHLink], np.ndarray, np.ndarray]:
+    """Rewrite a standard DH table as a modified (Craig) one with the same tool pose.
+
+    The standard product ``Π Rz(θ_i)Tz(d_i)Tx(a_i)Rx(α_i)`` regroups, because Tx(a)
+    and Rx(α) commute, as ``Π Rx(α_{i-1})Tx(a_{i-1})Rz(θ_i)Tz(d_i) · Tx(a_n)Rx(α_n)``
+    with a_0 = α_0 = 0: modified row i takes (a_{i-1}, α_{i-1}) from standard row i-1
+    and keeps (d_i, θ_i, type, qlim, name); the last row's Tx(a_n)Rx(α_n) moves into
+    the tool. Intermediate link frames differ (each modified frame i sits at joint
+    axis i), the end-effector pose does not.
+
+    Args:
+        rows: standard DH rows.
+        base: (4, 4) world-from-base transform (kept), default identity.
+        tool: (4, 4) tool transform of the standard robot, default identity.
+
+    Returns:
+        (modified rows, base (4, 4), tool (4, 4)) for ``Robot.from_dh(rows, "modified",
+        base=base, tool=tool)``.
+    """
+    rows = parse_dh_rows(rows, "rows")
+    B = np.eye(4) if base is None else np.asarray(base, dtype=float).copy()
+    T = np.eye(4) if tool is None else np.asarray(tool, dtype=float)
+    out = []
+    prev_a, prev_alpha = 0.0, 0.0
+    for r in rows:
+        out.append(DHLink(a=prev_a, alpha=prev_alpha, d=r.d, theta=r.theta, type=r.type,
+                          qlim=r.qlim, name=r.name))
+        prev_a, prev_alpha = r.a, r.alpha
+    last = make_transform(rotx(prev_alpha), [prev_a, 0.0, 0.0])
+    return out, B, last @ T
+
+
+def modified_to_standard(
+    rows: Sequence[DHLink], base: object = None, tool: object = None
+) -> tuple[list[DHLink], np.ndarray, np.ndarray]:
+    """Rewrite a modified (Craig) DH table as a standard one with the same tool pose.
+
+    The inverse regrouping of :func:`standard_to_modified`: the first row's
+    Rx(α_0)Tx(a_0) moves into the base, standard row i takes (a, α) from modified row
+    i+1, and the last standard row has a = α = 0.
+
+    Args:
+        rows: modified DH rows.
+        base: (4, 4) world-from-base transform of the modified robot, default identity.
+        tool: (4, 4) tool transform (kept), default identity.
+
+    Returns:
+        (standard rows, base (4, 4), tool (4, 4)).
+    """
+    rows = parse_dh_rows(rows, "rows")
+    B = np.eye(4) if base is None else np.asarray(base, dtype=float)
+    T = np.eye(4) if tool is None else np.asarray(tool, dtype=float).copy()
+    first = make_transform(rotx(rows[0].alpha), [rows[0].a, 0.0, 0.0])
+    out = []
+    for i, r in enumerate(rows):
+        nxt = rows[i + 1] if i + 1 < len(rows) else None
+        out.append(DHLink(a=nxt.a if nxt else 0.0, alpha=nxt.alpha if nxt else 0.0, d=r.d,
+                          theta=r.theta, type=r.type, qlim=r.qlim, name=r.name))
+    return out, B @ first, T
