@@ -84,6 +84,8 @@ class Robot:
         self.dh = tuple(dh) if dh is not None else None
         self.convention = convention
         self.source = source
+        #: link names (base..tip) when known, e.g. from a URDF; else None.
+        self.link_names: tuple[str, ...] | None = None
         self.qlim = np.array([j.qlim for j in joints], dtype=float)
         self.joint_types = tuple(j.type for j in joints)
         self.joint_names = tuple(j.name or f"joint{i + 1}" for i, j in enumerate(joints))

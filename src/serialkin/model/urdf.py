@@ -1,0 +1,309 @@
+"""URDF import and export (kinematics only; meshes are never loaded).
+
+Parsing uses the standard library's :mod:`xml.etree.ElementTree`: URDF is plain XML, the
+parser is well kept and adds no dependency. The serial chain between ``base_link`` and
+``tip_link`` is extracted; fixed joints are merged into the neighbouring transforms
+(those before the first moving joint into its origin, those after the last into the tool).
+
+URDF conventions: a joint's ``<origin xyz rpy>`` is the pose of the joint frame in the
+parent link frame with ``R = Rz(yaw)·Ry(pitch)·Rx(roll)``; the motion is about/along
+``<axis xyz>`` (default x) in the joint frame; the child link frame is the joint frame
+after the motion. That is exactly :class:`~serialkin.model.joint.Joint` with
+``origin`` = the URDF origin and ``post`` = identity.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from serialkin.errors import NotSupportedError, RobotDefinitionError
+from serialkin.model.joint import Joint
+from serialkin.spatial.transforms import make_transform, rotx, roty, rotz
+
+_MOVING = {"revolute": "R", "continuous": "R", "prismatic": "P"}
+_UNSUPPORTED = {"floating", "planar"}
+
+
+@dataclass
+class _UJoint:
+    name: str
+    type: str
+    parent: str
+    child: str
+    origin: np.ndarray
+    axis: np.ndarray
+    lower: float
+    upper: float
+    unsupported: str = ""
+
+
+def _floats(text: str | None, count: int, default: tuple[float, ...], where: str) -> np.ndarray:
+    if text is None:
+        return np.array(default, dtype=float)
+    parts = text.split()
+    try:
+        vals = np.array([float(p) for p in parts])
+    except ValueError as exc:
+        raise RobotDefinitionError(f"{where}: expected {count} numbers, got {text!r}") from exc
+    if vals.shape != (count,) or not np.isfinite(vals).all():
+        raise RobotDefinitionError(f"{where}: expected {count} finite numbers, got {text!r}")
+    return vals
+
+
+def rpy_to_matrix(rpy: np.ndarray) -> np.ndarray:
+    """URDF rotation ``Rz(yaw)·Ry(pitch)·Rx(roll)`` for ``rpy = (roll, pitch, yaw)`` [rad]."""
+    return rotz(rpy[2]) @ roty(rpy[1]) @ rotx(rpy[0])
+
+
+def _origin(el: ET.Element | None, where: str) -> np.ndarray:
+    if el is None:
+        return np.eye(4)
+    xyz = _floats(el.get("xyz"), 3, (0.0, 0.0, 0.0), f"{where} <origin xyz>")
+    rpy = _floats(el.get("rpy"), 3, (0.0, 0.0, 0.0), f"{where} <origin rpy>")
+    return make_transform(rpy_to_matrix(rpy), xyz)
+
+
+def _read_xml(path_or_string: str | os.PathLike[str]) -> tuple[ET.Element, str]:
+    text = str(path_or_string)
+    if text.lstrip().startswith("<"):
+        source, data = "<string>", text
+    else:
+        path = Path(text)
+        if not path.is_file():
+            raise RobotDefinitionError(f"URDF file {text!r} does not exist")
+        source, data = str(path), path.read_text(encoding="utf-8")
+    try:
+        root = ET.fromstring(data)
+    except ET.ParseError as exc:
+        line, col = exc.position
+        raise RobotDefinitionError(
+            f"{source}: malformed XML at line {line}, column {col}: {exc}"
+        ) from exc
+    if root.tag != "robot":
+        raise RobotDefinitionError(f"{source}: the root element must be <robot>, got <{root.tag}>")
+    return root, source
+
+
+def _parse_joint(el: ET.Element, source: str) -> _UJoint:
+    name = el.get("name")
+    if not name:
+        raise RobotDefinitionError(f"{source}: a <joint> has no name attribute")
+    where = f"{source}: joint {name!r}"
+    jtype = el.get("type")
+    if jtype is None:
+        raise RobotDefinitionError(f"{where} has no type attribute")
+    unsupported = ""
+    if jtype in _UNSUPPORTED:
+        unsupported = (f"{where} is of type {jtype!r}, which is not supported (serial chains "
+                       "of revolute, continuous, prismatic and fixed joints)")
+    elif el.find("mimic") is not None:
+        unsupported = f"{where} has a <mimic> element; mimic joints are not supported"
+    if jtype not in _MOVING and jtype != "fixed" and not unsupported:
+        raise RobotDefinitionError(
+            f"{where} has unknown type {jtype!r}; expected revolute, continuous, prismatic or fixed"
+        )
+    parent, child = el.find("parent"), el.find("child")
+    if parent is None or parent.get("link") is None:
+        raise RobotDefinitionError(f"{where} has no <parent link=...>")
+    if child is None or child.get("link") is None:
+        raise RobotDefinitionError(f"{where} has no <child link=...>")
+    axis = _floats(el.find("axis").get("xyz") if el.find("axis") is not None else None, 3,
+                   (1.0, 0.0, 0.0), f"{where} <axis xyz>")
+    if jtype in _MOVING and np.linalg.norm(axis) < 1e-12:
+        raise RobotDefinitionError(f"{where} has a zero <axis xyz>; expected a nonzero 3-vector")
+    lower, upper = -np.inf, np.inf
+    lim = el.find("limit")
+    if jtype in ("revolute", "prismatic") and lim is not None:
+        lower = float(_floats(lim.get("lower"), 1, (-np.inf,), f"{where} <limit lower>")[0]) \
+            if lim.get("lower") is not None else -np.inf
+        upper = float(_floats(lim.get("upper"), 1, (np.inf,), f"{where} <limit upper>")[0]) \
+            if lim.get("upper") is not None else np.inf
+        if lower > upper:
+            raise RobotDefinitionError(
+                f"{where}: <limit> lower {lower:g} is greater than upper {upper:g}"
+            )
+    return _UJoint(name, jtype, parent.get("link"), child.get("link"),
+                   _origin(el.find("origin"), where), axis, lower, upper, unsupported)
+
+
+def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | None = None,
+                    tip_link: str | None = None):
+    """Build a :class:`~serialkin.Robot` from the serial chain of a URDF.
+
+    Args:
+        path_or_string: a URDF file path, or the XML text itself.
+        base_link: link whose frame is the robot's base (default: the tree's root).
+        tip_link: link whose frame is the tool (default: the single leaf).
+
+    Returns:
+        Robot with one joint per moving (revolute, continuous, prismatic) URDF joint,
+        limits read (continuous: unlimited), joint names kept, ``link_names`` set.
+
+    Raises:
+        RobotDefinitionError: malformed XML (with line), a joint referring to a missing link,
+            a loop, a branching tree without ``tip_link``, a zero axis, lower > upper.
+        NotSupportedError: mimic, floating or planar joints on the chain.
+    """
+    from serialkin.model.robot import Robot
+
+    root, source = _read_xml(path_or_string)
+    links = [el.get("name") for el in root.findall("link")]
+    if any(n is None for n in links):
+        raise RobotDefinitionError(f"{source}: a <link> has no name attribute")
+    link_set = set(links)
+    if len(link_set) != len(links):
+        raise RobotDefinitionError(f"{source}: duplicate link names")
+    joints = [_parse_joint(el, source) for el in root.findall("joint")]
+    by_child: dict[str, _UJoint] = {}
+    children: dict[str, list[str]] = {n: [] for n in links}
+    for j in joints:
+        for role, link in (("parent", j.parent), ("child", j.child)):
+            if link not in link_set:
+                raise RobotDefinitionError(
+                    f"{source}: joint {j.name!r} refers to {role} link {link!r}, "
+                    "which does not exist"
+                )
+        if j.child in by_child:
+            raise RobotDefinitionError(
+                f"{source}: link {j.child!r} is the child of two joints "
+                f"({by_child[j.child].name!r} and {j.name!r}); the description has a loop"
+            )
+        by_child[j.child] = j
+        children[j.parent].append(j.child)
+    roots = [n for n in links if n not in by_child]
+    if len(roots) != 1:
+        raise RobotDefinitionError(
+            f"{source}: expected one root link, found {len(roots)}"
+            + (f" ({', '.join(roots)})" if roots else "; the joints form a loop")
+        )
+    base = base_link or roots[0]
+    if base not in link_set:
+        raise RobotDefinitionError(f"{source}: base_link {base!r} is not a link of the robot")
+    if tip_link is None:
+        leaves = [n for n in links if not children[n] and n != base]
+        below = [n for n in leaves if _is_below(n, base, by_child)]
+        if len(below) != 1:
+            raise RobotDefinitionError(
+                f"{source}: the tree below {base!r} branches into {len(below)} leaves "
+                f"({', '.join(below)}); pass tip_link= one of them"
+            )
+        tip = below[0]
+    else:
+        tip = tip_link
+        if tip not in link_set:
+            raise RobotDefinitionError(f"{source}: tip_link {tip!r} is not a link of the robot")
+    chain: list[_UJoint] = []
+    link = tip
+    seen = {tip}
+    while link != base:
+        if link not in by_child:
+            raise RobotDefinitionError(
+                f"{source}: tip_link {tip!r} is not below base_link {base!r}"
+            )
+        j = by_child[link]
+        chain.append(j)
+        link = j.parent
+        if link in seen:
+            raise RobotDefinitionError(f"{source}: the joints form a loop at link {link!r}")
+        seen.add(link)
+    chain.reverse()
+    for j in chain:
+        if j.unsupported:
+            raise NotSupportedError(j.unsupported)
+    out: list[Joint] = []
+    link_names = [base]
+    fixed = np.eye(4)
+    for j in chain:
+        if j.type == "fixed":
+            fixed = fixed @ j.origin
+            continue
+        out.append(Joint(axis=j.axis, type=_MOVING[j.type], origin=fixed @ j.origin,
+                         qlim=(j.lower, j.upper), name=j.name))
+        link_names.append(j.child)
+        fixed = np.eye(4)
+    if not out:
+        raise RobotDefinitionError(
+            f"{source}: no moving joint between {base!r} and {tip!r}"
+        )
+    robot = Robot(out, tool=fixed, name=root.get("name") or "urdf_robot",
+                  source=f"URDF {source} ({base} -> {tip})")
+    robot.link_names = tuple(link_names) + ((tip,) if link_names[-1] != tip else ())
+    return robot
+
+
+def _is_below(link: str, base: str, by_child: dict[str, _UJoint]) -> bool:
+    seen = set()
+    while link != base:
+        if link not in by_child or link in seen:
+            return False
+        seen.add(link)
+        link = by_child[link].parent
+    return True
+
+
+def _fmt(v: float) -> str:
+    return repr(float(v))
+
+
+def _origin_xml(T: np.ndarray) -> str:
+    import warnings
+
+    from scipy.spatial.transform import Rotation
+
+    with warnings.catch_warnings():  # at gimbal lock scipy picks roll = 0: still exact
+        warnings.simplefilter("ignore", UserWarning)
+        rpy = Rotation.from_matrix(T[:3, :3]).as_euler("xyz")  # extrinsic xyz = Rz·Ry·Rx
+    xyz = " ".join(_fmt(v) for v in T[:3, 3])
+    return f'<origin xyz="{xyz}" rpy="{" ".join(_fmt(v) for v in rpy)}"/>'
+
+
+def robot_to_urdf(robot) -> str:
+    """The robot's kinematics as a URDF string (no geometry, no inertia).
+
+    Joint *i*'s origin is the chain's fixed transform before its motion (``chain.F[i-1]``,
+    base included for the first joint) composed with the joint offset, so that
+    :func:`robot_from_urdf` reproduces the same forward kinematics; the tool becomes a
+    fixed joint to a link named ``tool``. Infinite revolute limits export as
+    ``continuous`` joints.
+    """
+    from scipy.spatial.transform import Rotation
+
+    F, meta = robot.chain.F, robot.chain.meta
+    names = getattr(robot, "link_names", None)
+    if names is None or len(names) < robot.n + 1:
+        names = ["base_link"] + [f"link{i + 1}" for i in range(robot.n)]
+    lines = ['<?xml version="1.0"?>', f'<robot name="{robot.name}">']
+    lines += [f'  <link name="{n}"/>' for n in names[: robot.n + 1]]
+    lines.append('  <link name="tool"/>')
+    for i, j in enumerate(robot.joints):
+        M = np.eye(4)
+        if j.type == "R":
+            M[:3, :3] = Rotation.from_rotvec(meta[i, :3] * j.offset).as_matrix()
+        else:
+            M[:3, 3] = meta[i, :3] * j.offset
+        origin = F[i] @ M
+        lo, hi = j.qlim
+        if j.type == "R" and not (np.isfinite(lo) or np.isfinite(hi)):
+            jtype, limit = "continuous", ""
+        else:
+            jtype = "revolute" if j.type == "R" else "prismatic"
+            lo_s = _fmt(lo if np.isfinite(lo) else -1e9)
+            hi_s = _fmt(hi if np.isfinite(hi) else 1e9)
+            limit = f'<limit lower="{lo_s}" upper="{hi_s}" effort="0" velocity="0"/>'
+        axis = " ".join(_fmt(v) for v in meta[i, :3])
+        lines.append(
+            f'  <joint name="{robot.joint_names[i]}" type="{jtype}">'
+            f'<parent link="{names[i]}"/><child link="{names[i + 1]}"/>'
+            f'{_origin_xml(origin)}<axis xyz="{axis}"/>{limit}</joint>'
+        )
+    lines.append(
+        f'  <joint name="tool_fixed" type="fixed"><parent link="{names[robot.n]}"/>'
+        f'<child link="tool"/>{_origin_xml(F[robot.n])}</joint>'
+    )
+    lines.append("</robot>")
+    return "\n".join(lines) + "\n"
