@@ -1,0 +1,472 @@
+"""matplotlib figures of a robot in a configuration, its target path and obstacles.
+
+A robot is drawn as its *skeleton*: a polyline through the origins of the link frames
+``world_T_i`` (i = 0..n, eq 11, from :meth:`~serialkin.Robot.fk_all`) and the tool point
+(:meth:`~serialkin.Robot.fk`), with a marker on every joint axis and, optionally, the
+link frames as RGB triads (x red, y green, z blue). Planar robots
+(:attr:`~serialkin.Robot.is_planar`) are drawn in the world xy plane on ordinary 2D axes,
+every other robot on 3D axes.
+
+Obstacles are duck-typed so that the classes of :mod:`serialkin.redundancy.obstacles` and
+plain dicts both work: anything with a ``center`` (or ``centre``) and a ``radius`` is a
+circle (2D) or a sphere (3D); with a ``height`` too it is a vertical cylinder (the chapter's
+Figure 10 model, drawn as a circle in 2D); with two end points (``a``/``b``, ``p0``/``p1``
+or ``start``/``end``) and a ``radius`` it is a capsule.
+
+Lengths are in metres, angles in radians. matplotlib is imported lazily inside the
+functions, so importing :mod:`serialkin` never requires it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from serialkin._checks import as_float_array, check_positive
+from serialkin.errors import InputError, InputTypeError
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from serialkin.model.robot import Robot
+
+__all__ = [
+    "Obstacle",
+    "as_obstacle",
+    "is_3d_axes",
+    "joint_positions",
+    "plot_obstacles",
+    "plot_path",
+    "plot_robot",
+    "robot_points",
+    "robot_scale",
+]
+
+#: ``gid`` of the skeleton line drawn by :func:`plot_robot` (lets callers and tests find it).
+LINKS_GID = "serialkin-links"
+#: ``gid`` of the joint markers drawn by :func:`plot_robot`.
+JOINTS_GID = "serialkin-joints"
+#: ``gid`` prefix of the frame triads drawn by :func:`plot_robot`.
+FRAMES_GID = "serialkin-frame"
+#: ``gid`` of an obstacle artist drawn by :func:`plot_obstacles`.
+OBSTACLE_GID = "serialkin-obstacle"
+#: ``gid`` of the path drawn by :func:`plot_path`.
+PATH_GID = "serialkin-path"
+
+
+# ---------------------------------------------------------------------- geometry helpers
+def robot_points(robot: Robot, q: object) -> np.ndarray:
+    """Return the skeleton polyline: link-frame origins 0..n then the tool point.
+
+    Args:
+        robot: the robot.
+        q: joint values, shape (n,) or (..., n) [rad / m].
+
+    Returns:
+        (n+2, 3) or (..., n+2, 3) points in the world frame [m]: rows 0..n are the origins
+        of ``world_T_i`` (eq 11; row 0 is the base) and the last row is the tool point
+        (translation of :meth:`Robot.fk`).
+    """
+    a = robot.check_q(q)
+    frames = robot.fk_all(a)[..., :3, 3]
+    tool = robot.fk(a)[..., None, :3, 3]
+    return np.concatenate([frames, tool], axis=-2)
+
+
+def joint_positions(robot: Robot, q: object) -> np.ndarray:
+    """Points on the joint axes: the origin of the frame right after each joint motion.
+
+    Link frame i is ``(pose after M_i) · L[i]`` (see :mod:`serialkin.kinematics._kernels`),
+    so the joint frame is ``world_T_i · L[i]⁻¹``. For a standard-DH robot this is the
+    origin of DH frame i-1, where joint i's axis z_{i-1} passes.
+
+    Args:
+        robot: the robot.
+        q: joint values, shape (n,) or (..., n).
+
+    Returns:
+        (n, 3) or (..., n, 3) joint positions in the world frame [m].
+    """
+    a = robot.check_q(q)
+    T = robot.fk_all(a)[..., 1:, :, :]
+    Linv = np.linalg.inv(robot.chain.L[1:])
+    return (T @ Linv)[..., :3, 3]
+
+
+def robot_scale(robot: Robot) -> float:
+    """Return a length scale of the robot [m]: an upper bound on its reach from the base.
+
+    Sum of the translations of the fixed chain transforms (``F``, ``L``) plus the largest
+    finite prismatic travel; at least 1e-3. Used to size frame triads and axis limits.
+    """
+    F, L = robot.chain.F, robot.chain.L
+    total = float(np.linalg.norm(F[1:, :3, 3], axis=-1).sum())
+    total += float(np.linalg.norm(L[1:, :3, 3], axis=-1).sum())
+    for i, t in enumerate(robot.joint_types):
+        if t == "P":
+            lim = np.abs(robot.qlim[i])
+            finite = lim[np.isfinite(lim)]
+            total += float(finite.max()) if finite.size else 1.0
+    return max(total, 1e-3)
+
+
+def is_3d_axes(ax: Any) -> bool:
+    """Return True when ``ax`` is a mplot3d ``Axes3D``."""
+    return getattr(ax, "name", "") == "3d"
+
+
+def _new_axes(three_d: bool) -> Axes:
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(6.0, 5.0))
+    if three_d:
+        return fig.add_subplot(projection="3d")
+    return fig.add_subplot()
+
+
+def _resolve_axes(robot: Robot, ax: Any, planar: bool | None) -> tuple[Any, bool]:
+    """Pick or create the axes; return (axes, draw in 2D)."""
+    if ax is None:
+        two_d = robot.is_planar if planar is None else bool(planar)
+        return _new_axes(not two_d), two_d
+    three_d = is_3d_axes(ax)
+    if planar is not None and bool(planar) == three_d:
+        want = "2D" if planar else "3D"
+        got = "3D" if three_d else "2D"
+        raise InputError(f"planar={planar} asks for {want} drawing but ax is a {got} axes")
+    return ax, not three_d
+
+
+def _set_equal_3d(ax: Any, pts: np.ndarray, margin: float) -> None:
+    """Equal-scale 3D limits around ``pts`` (k, 3), merged with what is already drawn."""
+    lo = pts.min(axis=0) - margin
+    hi = pts.max(axis=0) + margin
+    if getattr(ax, "_serialkin_box", None) is not None:
+        olo, ohi = ax._serialkin_box
+        lo, hi = np.minimum(lo, olo), np.maximum(hi, ohi)
+    ax._serialkin_box = (lo, hi)
+    centre = (lo + hi) / 2
+    half = float((hi - lo).max()) / 2
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(centre[2] - half, centre[2] + half)
+    ax.set_box_aspect((1.0, 1.0, 1.0))
+
+
+# ---------------------------------------------------------------------- the robot
+def plot_robot(
+    robot: Robot,
+    q: object,
+    ax: Any = None,
+    *,
+    frames: bool = False,
+    color: Any = "C0",
+    alpha: float = 1.0,
+    label: str | None = None,
+    planar: bool | None = None,
+    linewidth: float = 2.5,
+    frame_scale: float | None = None,
+) -> Axes:
+    """Draw the robot in configuration ``q``.
+
+    The links are one polyline through the link-frame origins ``world_T_i``, i = 0..n
+    (eq 11), and the tool point ``world_T_ee`` (eqs 10-11), in that order; the joints are
+    round markers on their axes (:func:`joint_positions`), the base a square marker.
+
+    Args:
+        robot: the robot.
+        q: joint values, shape (n,) [rad / m].
+        ax: matplotlib axes to draw into; a new figure is made when None (2D for a planar
+            robot, 3D otherwise).
+        frames: also draw every link frame and the tool frame as an RGB triad.
+        color: matplotlib colour of links and joint markers.
+        alpha: opacity in [0, 1].
+        label: legend label for the links.
+        planar: force 2D (True, world xy plane) or 3D (False) drawing; None follows
+            ``ax`` when given, else :attr:`Robot.is_planar`.
+        linewidth: link line width [points].
+        frame_scale: triad axis length [m] (default 8 % of :func:`robot_scale`).
+
+    Returns:
+        The axes drawn into. The link line has ``gid='serialkin-links'``, the joint
+        markers ``'serialkin-joints'``, the triads ``'serialkin-frame-<i>'``.
+
+    Raises:
+        InputError: wrong number of joint values, non-finite values, ``planar``
+            contradicting ``ax``, ``alpha`` outside [0, 1].
+    """
+    qv = robot.check_q(q)
+    if qv.ndim != 1:
+        raise InputError(f"q must be one configuration of shape ({robot.n},), got {qv.shape}")
+    alpha = float(alpha)
+    if not 0.0 <= alpha <= 1.0:
+        raise InputError(f"alpha must be in [0, 1], got {alpha}")
+    ax, two_d = _resolve_axes(robot, ax, planar)
+    pts = robot_points(robot, qv)
+    joints = joint_positions(robot, qv)
+    scale = robot_scale(robot)
+    tri = 0.08 * scale if frame_scale is None else check_positive(frame_scale, "frame_scale")
+    dims = 2 if two_d else 3
+
+    ax.plot(*pts[:, :dims].T, "-", color=color, alpha=alpha, lw=linewidth, label=label,
+            gid=LINKS_GID, solid_capstyle="round")
+    ax.plot(*joints[:, :dims].T, "o", color=color, alpha=alpha, ms=6, mfc="white",
+            mew=1.8, gid=JOINTS_GID)
+    ax.plot(*pts[:1, :dims].T, "s", color="0.2", alpha=alpha, ms=8, gid="serialkin-base")
+    ax.plot(*pts[-1:, :dims].T, "o", color=color, alpha=alpha, ms=4, gid="serialkin-tool")
+    if frames:
+        Ts = list(robot.fk_all(qv)) + [robot.fk(qv)]
+        for i, T in enumerate(Ts):
+            _draw_triad(ax, T, tri, two_d, alpha, f"{FRAMES_GID}-{i}")
+    if two_d:
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.autoscale_view()
+    else:
+        _set_equal_3d(ax, pts, 0.1 * scale)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_zlabel("z [m]")
+    return ax
+
+
+def _draw_triad(ax: Any, T: np.ndarray, size: float, two_d: bool, alpha: float, gid: str) -> None:
+    """Draw frame T's x, y, z axes (red, green, blue) of length ``size``."""
+    o = T[:3, 3]
+    for k, c in enumerate(("tab:red", "tab:green", "tab:blue")):
+        e = o + size * T[:3, k]
+        if two_d:
+            if k == 2:
+                continue
+            ax.plot([o[0], e[0]], [o[1], e[1]], "-", color=c, alpha=alpha, lw=1.5, gid=gid)
+        else:
+            ax.plot([o[0], e[0]], [o[1], e[1]], [o[2], e[2]], "-", color=c, alpha=alpha,
+                    lw=1.5, gid=gid)
+
+
+# ---------------------------------------------------------------------- obstacles and paths
+@dataclass(frozen=True)
+class Obstacle:
+    """A normalised obstacle shape for drawing.
+
+    Attributes:
+        kind: 'sphere' (circle in 2D), 'cylinder' (vertical, axis along world z, centred at
+            ``center``; a circle in 2D) or 'capsule' (segment a-b swept by ``radius``).
+        center: (3,) centre [m] (capsule: midpoint of a-b).
+        radius: radius [m].
+        height: cylinder height [m] (None: infinite, drawn as tall as the view).
+        a: (3,) capsule start point [m] or None.
+        b: (3,) capsule end point [m] or None.
+    """
+
+    kind: str
+    center: np.ndarray
+    radius: float
+    height: float | None = None
+    a: np.ndarray | None = None
+    b: np.ndarray | None = None
+
+
+_ENDPOINT_NAMES = (("a", "b"), ("p0", "p1"), ("start", "end"), ("p1", "p2"))
+
+
+def _field(obj: object, names: Sequence[str]) -> Any:
+    for name in names:
+        if isinstance(obj, Mapping):
+            if name in obj:
+                return obj[name]
+        elif hasattr(obj, name):
+            return getattr(obj, name)
+    return None
+
+
+def _point3(value: object, name: str) -> np.ndarray:
+    p = as_float_array(value, name)
+    if p.shape == (2,):
+        p = np.append(p, 0.0)
+    if p.shape != (3,):
+        raise InputError(f"{name} must have 2 or 3 coordinates, got shape {p.shape}")
+    return p
+
+
+def as_obstacle(obj: object, name: str = "obstacle") -> Obstacle:
+    """Normalise an obstacle object or dict to :class:`Obstacle`.
+
+    Accepted fields (attributes or mapping keys): ``center``/``centre``/``position`` (2 or 3
+    coordinates; z = 0 when 2), ``radius`` (> 0), optional ``height`` (vertical cylinder),
+    optional capsule end points ``a``/``b`` (or ``p0``/``p1``, ``start``/``end``), optional
+    ``kind``/``shape`` ('circle', 'sphere', 'cylinder', 'capsule').
+
+    Raises:
+        InputTypeError: ``obj`` has no radius.
+        InputError: bad coordinates or a non-positive radius.
+    """
+    if isinstance(obj, Obstacle):
+        return obj
+    radius = _field(obj, ("radius", "r"))
+    if radius is None:
+        raise InputTypeError(
+            f"{name} must have a 'radius' and a 'center' (or capsule end points 'a', 'b'), "
+            f"got {type(obj).__name__} {obj!r}"[:200]
+        )
+    r = check_positive(radius, f"{name}.radius")
+    kind = _field(obj, ("kind", "shape"))
+    kind = str(kind).lower() if isinstance(kind, str) else None
+    for na, nb in _ENDPOINT_NAMES:
+        pa, pb = _field(obj, (na,)), _field(obj, (nb,))
+        if pa is not None and pb is not None and not isinstance(pa, (int, float, str)):
+            a = _point3(pa, f"{name}.{na}")
+            b = _point3(pb, f"{name}.{nb}")
+            return Obstacle("capsule", (a + b) / 2, r, None, a, b)
+    centre = _field(obj, ("center", "centre", "position", "c"))
+    if centre is None:
+        raise InputTypeError(f"{name} has a radius but no 'center': {obj!r}"[:200])
+    c = _point3(centre, f"{name}.center")
+    height = _field(obj, ("height", "h"))
+    if height is not None:
+        h = float(height)
+        return Obstacle("cylinder", c, r, h if np.isfinite(h) else None)
+    if kind == "cylinder":
+        return Obstacle("cylinder", c, r, None)
+    return Obstacle("sphere", c, r)
+
+
+def plot_obstacles(
+    ax: Any,
+    obstacles: Iterable[object],
+    *,
+    color: Any = "tab:gray",
+    alpha: float = 0.35,
+    edgecolor: Any = "0.25",
+    influence: float | None = None,
+) -> Any:
+    """Draw obstacles: circles/capsule outlines on 2D axes, surfaces on 3D axes.
+
+    Args:
+        ax: 2D or 3D matplotlib axes.
+        obstacles: iterable of obstacle objects or dicts (see :func:`as_obstacle`).
+        color: face colour.
+        alpha: face opacity.
+        edgecolor: outline colour (2D).
+        influence: if given, also draw a dashed circle of radius ``radius + influence``
+            (the distance of influence, Figure 10) in 2D [m].
+
+    Returns:
+        The axes. Every obstacle artist has ``gid='serialkin-obstacle'``.
+    """
+    from matplotlib.patches import Circle, Polygon
+
+    obs = [as_obstacle(o, f"obstacles[{i}]") for i, o in enumerate(obstacles)]
+    three_d = is_3d_axes(ax)
+    for o in obs:
+        if not three_d:
+            if o.kind == "capsule":
+                outline = _stadium(np.asarray(o.a)[:2], np.asarray(o.b)[:2], o.radius)
+                ax.add_patch(Polygon(outline, closed=True, fc=color, ec=edgecolor, alpha=alpha,
+                                     gid=OBSTACLE_GID))
+            else:
+                ax.add_patch(Circle(tuple(o.center[:2]), o.radius, fc=color, ec=edgecolor,
+                                    alpha=alpha, gid=OBSTACLE_GID))
+                if influence is not None:
+                    ax.add_patch(Circle(tuple(o.center[:2]), o.radius + float(influence),
+                                        fill=False, ec=edgecolor, ls="--", lw=0.8,
+                                        gid=OBSTACLE_GID + "-influence"))
+            continue
+        X, Y, Z = _surface(o)
+        ax.plot_surface(X, Y, Z, color=color, alpha=alpha, linewidth=0, gid=OBSTACLE_GID)
+        pts = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
+        _set_equal_3d(ax, pts, 0.0)
+    if not three_d:
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.autoscale_view()
+    return ax
+
+
+def _stadium(a: np.ndarray, b: np.ndarray, r: float, k: int = 24) -> np.ndarray:
+    """Outline (2k+2, 2) of the planar capsule around segment a-b."""
+    d = b - a
+    ang = float(np.arctan2(d[1], d[0])) if np.linalg.norm(d) > 0 else 0.0
+    t1 = np.linspace(ang - np.pi / 2, ang + np.pi / 2, k + 1)
+    t2 = t1 + np.pi
+    arc_b = b + r * np.stack([np.cos(t1), np.sin(t1)], axis=1)
+    arc_a = a + r * np.stack([np.cos(t2), np.sin(t2)], axis=1)
+    return np.vstack([arc_b, arc_a])
+
+
+def _surface(o: Obstacle, k: int = 20) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mesh grids (X, Y, Z) of a sphere, vertical cylinder or capsule."""
+    u = np.linspace(0, 2 * np.pi, k + 1)
+    if o.kind == "sphere":
+        v = np.linspace(0, np.pi, k // 2 + 1)
+        X = o.center[0] + o.radius * np.outer(np.cos(u), np.sin(v))
+        Y = o.center[1] + o.radius * np.outer(np.sin(u), np.sin(v))
+        Z = o.center[2] + o.radius * np.outer(np.ones_like(u), np.cos(v))
+        return X, Y, Z
+    if o.kind == "cylinder":
+        h = o.height if o.height is not None else 4.0 * o.radius
+        z = o.center[2] + np.array([-h / 2, h / 2])
+        X = o.center[0] + o.radius * np.outer(np.cos(u), np.ones(2))
+        Y = o.center[1] + o.radius * np.outer(np.sin(u), np.ones(2))
+        Z = np.outer(np.ones_like(u), z)
+        return X, Y, Z
+    # capsule: a tube along a-b closed by two hemispheres, parametrised along the axis
+    a, b = np.asarray(o.a, dtype=float), np.asarray(o.b, dtype=float)
+    axis = b - a
+    length = float(np.linalg.norm(axis))
+    e = axis / length if length > 0 else np.array([0.0, 0.0, 1.0])
+    helper = np.array([1.0, 0.0, 0.0]) if abs(e[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    n1 = np.cross(e, helper)
+    n1 /= np.linalg.norm(n1)
+    n2 = np.cross(e, n1)
+    v = np.linspace(-np.pi / 2, np.pi / 2, k // 2 + 1)
+    # along-axis offset: hemisphere at a (v<0), cylinder, hemisphere at b (v>0)
+    s = np.concatenate([o.radius * np.sin(v[v < 0]), [0.0, length],
+                        length + o.radius * np.sin(v[v > 0])])
+    rad = np.concatenate([o.radius * np.cos(v[v < 0]), [o.radius, o.radius],
+                          o.radius * np.cos(v[v > 0])])
+    P = (a[None, None, :] + s[None, :, None] * e
+         + rad[None, :, None] * (np.cos(u)[:, None, None] * n1 + np.sin(u)[:, None, None] * n2))
+    return P[..., 0], P[..., 1], P[..., 2]
+
+
+def plot_path(
+    ax: Any,
+    points: object,
+    *,
+    color: Any = "tab:green",
+    label: str | None = "target path",
+    linewidth: float = 1.5,
+    linestyle: str = "-",
+) -> Any:
+    """Draw a target path (the chapter's green curve of Figures 8, 11, 12).
+
+    Args:
+        ax: 2D or 3D axes.
+        points: (k, 2) or (k, 3) path points [m]; on 2D axes only x, y are used, on 3D
+            axes 2D points get z = 0.
+        color: line colour.
+        label: legend label.
+        linewidth: line width [points].
+        linestyle: matplotlib line style.
+
+    Returns:
+        The axes; the line has ``gid='serialkin-path'``.
+    """
+    P = as_float_array(points, "points", ndim=2)
+    if P.shape[1] not in (2, 3):
+        raise InputError(f"points must have shape (k, 2) or (k, 3), got {P.shape}")
+    if is_3d_axes(ax):
+        if P.shape[1] == 2:
+            P = np.hstack([P, np.zeros((P.shape[0], 1))])
+        ax.plot(P[:, 0], P[:, 1], P[:, 2], linestyle, color=color, lw=linewidth, label=label,
+                gid=PATH_GID)
+        _set_equal_3d(ax, P, 0.0)
+    else:
+        ax.plot(P[:, 0], P[:, 1], linestyle, color=color, lw=linewidth, label=label,
+                gid=PATH_GID)
+        ax.set_aspect("equal", adjustable="datalim")
+    return ax
