@@ -28,10 +28,11 @@ PUMA560_SOURCE = (
 
 # Stanford arm (Scheinman), standard DH with a prismatic third joint: R. P. Paul,
 # "Robot Manipulators: Mathematics, Programming and Control", MIT Press 1981, as in
-# P. Corke's Robotics Toolbox ``Stanford`` model (stroke 12-50 in).
+# P. Corke's Robotics Toolbox ``Stanford`` model (stroke 12-50 in); d6 = 0.263 m as in the
+# MATLAB toolbox's stanford.m (the Python toolbox sets d6 = 0, ending at the wrist centre).
 STANFORD_SOURCE = (
     "R. P. Paul, Robot Manipulators (MIT Press 1981), Stanford arm; values as in "
-    "Corke's Robotics Toolbox"
+    "Corke's Robotics Toolbox for MATLAB (stanford.m, d6 = 0.263 m to the flange)"
 )
 
 # Universal Robots UR5 (CB3), standard DH: Universal Robots support article "DH
