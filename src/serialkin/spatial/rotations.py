@@ -87,9 +87,10 @@ def matrix_to_rpy(R: object, *, check: bool = True) -> np.ndarray:
     """
     a = check_rotation(R, "R") if check else np.asarray(R, dtype=np.float64)
     r00, r10, r20 = a[..., 0, 0], a[..., 1, 0], a[..., 2, 0]
-    yaw = np.where(np.hypot(r00, r10) > GIMBAL_TOL, np.arctan2(r10, r00), 0.0)
+    cp = np.hypot(r00, r10)  # = r'00 = |cos pitch| (≥ 0 keeps pitch in [−π/2, π/2])
+    yaw = np.where(cp > GIMBAL_TOL, np.arctan2(r10, r00), 0.0)
     cy, sy = np.cos(yaw), np.sin(yaw)
-    pitch = np.arctan2(-r20, cy * r00 + sy * r10)
+    pitch = np.arctan2(-r20, cp)
     roll = np.arctan2(
         sy * a[..., 0, 2] - cy * a[..., 1, 2], cy * a[..., 1, 1] - sy * a[..., 0, 1]
     )
@@ -126,9 +127,10 @@ def matrix_to_zyz(R: object, *, check: bool = True) -> np.ndarray:
     """
     a = check_rotation(R, "R") if check else np.asarray(R, dtype=np.float64)
     r02, r12 = a[..., 0, 2], a[..., 1, 2]
-    phi = np.where(np.hypot(r02, r12) > GIMBAL_TOL, np.arctan2(r12, r02), 0.0)
+    st = np.hypot(r02, r12)  # = r'02 = |sin theta| (≥ 0 keeps theta in [0, π])
+    phi = np.where(st > GIMBAL_TOL, np.arctan2(r12, r02), 0.0)
     cf, sf = np.cos(phi), np.sin(phi)
-    theta = np.arctan2(cf * r02 + sf * r12, a[..., 2, 2])
+    theta = np.arctan2(st, a[..., 2, 2])
     psi = np.arctan2(cf * a[..., 1, 0] - sf * a[..., 0, 0], cf * a[..., 1, 1] - sf * a[..., 0, 1])
     return np.stack([phi, theta, psi], axis=-1)
 
