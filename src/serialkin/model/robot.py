@@ -33,6 +33,28 @@ from serialkin.model.joint import Joint
 if TYPE_CHECKING:
     from serialkin.ik.result import IKResult
 
+_F64 = np.dtype(np.float64)
+_ENTRY: dict[str, Any] = {}
+
+
+def _entry(name: str, *example: np.ndarray) -> Any:
+    """Compiled entry point of kernel ``name`` for exactly the types of ``example``.
+
+    Calling it skips numba's per-call type dispatch (about 0.2 µs). The fast paths below
+    call it only with C-contiguous float64 arrays of the right dimensions, the types it
+    was compiled for.
+    """
+    fn = _ENTRY.get(name)
+    if fn is None:
+        import numba
+
+        dispatcher = getattr(K, name)
+        dispatcher(*example)
+        sig = tuple(numba.typeof(a) for a in example)
+        fn = _ENTRY[name] = dispatcher.overloads[sig].entry_point
+    return fn
+
+
 #: Named task-row selections for manipulability and condition number.
 TASK_ROWS: dict[str, tuple[int, ...]] = {
     "full": (0, 1, 2, 3, 4, 5),
@@ -95,6 +117,7 @@ class Robot:
             a.setflags(write=False)
         self.chain = compile_chain(self.joints, self.base, self.tool)
         self._F, self._L, self._meta = self.chain.F, self.chain.L, self.chain.meta
+        self._qshape = (self.n,)
 
     # ------------------------------------------------------------------ constructors
     @classmethod
@@ -215,9 +238,11 @@ class Robot:
         Returns:
             (4, 4) or (..., 4, 4) homogeneous transforms.
         """
-        if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (self.n,):
+        if type(q) is np.ndarray and q.dtype is _F64 and q.shape == self._qshape \
+                and q.flags.c_contiguous:
             T = np.empty((4, 4))
-            if K.fk_checked(q, self._F, self._meta, T):
+            fk = _ENTRY.get("fk_checked") or _entry("fk_checked", q, self._F, self._meta, T)
+            if fk(q, self._F, self._meta, T):
                 return T
             raise self._nonfinite(q)
         a = self.check_q(q)
@@ -273,10 +298,13 @@ class Robot:
         Returns:
             (6, n) or (..., 6, n).
         """
-        if frame == "base" and link is None and type(q) is np.ndarray \
-                and q.dtype == np.float64 and q.shape == (self.n,):
+        if type(q) is np.ndarray and q.dtype is _F64 and q.shape == self._qshape \
+                and link is None and frame == "base" and q.flags.c_contiguous:
             J = np.empty((6, self.n))
-            if K.jacobian_checked(q, self._F, self._meta, J, np.empty((4, 4))):
+            T = np.empty((4, 4))
+            jac = _ENTRY.get("jacobian_checked") or _entry(
+                "jacobian_checked", q, self._F, self._meta, J, T)
+            if jac(q, self._F, self._meta, J, T):
                 return J
             raise self._nonfinite(q)
         check_choice(frame, "frame", ("base", "ee"))
