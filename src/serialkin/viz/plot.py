@@ -99,12 +99,13 @@ def joint_positions(robot: Robot, q: object) -> np.ndarray:
 def robot_scale(robot: Robot) -> float:
     """Return a length scale of the robot [m]: an upper bound on its reach from the base.
 
-    Sum of the translations of the fixed chain transforms (``F``, ``L``) plus the largest
-    finite prismatic travel; at least 1e-3. Used to size frame triads and axis limits.
+    The tool lies within ``Σ_{i>=1} |t(F[i])|`` plus the prismatic travel of the first
+    joint's frame (eq 11: ``T = F[0]·M_1·F[1]···M_n·F[n]``), where ``t`` is the
+    translation; a prismatic joint adds its largest finite limit (1 m when unlimited).
+    At least 1e-3. Used to size frame triads, markers and views.
     """
-    F, L = robot.chain.F, robot.chain.L
+    F = robot.chain.F
     total = float(np.linalg.norm(F[1:, :3, 3], axis=-1).sum())
-    total += float(np.linalg.norm(L[1:, :3, 3], axis=-1).sum())
     for i, t in enumerate(robot.joint_types):
         if t == "P":
             lim = np.abs(robot.qlim[i])
