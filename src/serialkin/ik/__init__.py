@@ -1,1 +1,24 @@
-"""Inverse kinematics: closed-form and numerical solvers behind one interface."""
+"""Inverse kinematics: closed-form and numerical solvers behind one interface.
+
+Use ``robot.ik(target, method="lm", ...)`` or :func:`solve`; every method returns an
+:class:`IKResult`. :data:`METHODS` maps each method name to its
+:class:`~serialkin.ik.registry.MethodSpec`; :func:`available_methods` lists the names.
+
+Adding a method family: write a module ``serialkin/ik/<family>_methods.py`` that calls
+:func:`~serialkin.ik.registry.register_method` at import; it is discovered automatically.
+"""
+
+from serialkin.ik.registry import METHODS, MethodSpec, available_methods, register_method
+from serialkin.ik.result import IKResult
+from serialkin.ik.solver import DEFAULT_TOL, IKProblem, solve
+
+__all__ = [
+    "DEFAULT_TOL",
+    "IKProblem",
+    "IKResult",
+    "METHODS",
+    "MethodSpec",
+    "available_methods",
+    "register_method",
+    "solve",
+]

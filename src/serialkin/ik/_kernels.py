@@ -1,0 +1,569 @@
+"""Compiled IK loop for the Jacobian family (numba, ``cache=True``).
+
+One general kernel, :func:`solve_one`, runs every Jacobian-based method (chapter section
+5.3) selected by a method code, including restarts, the iteration budget, stagnation
+detection and joint-limit projection; :func:`solve_batch` runs it over N targets across
+the cores (``prange``). It is built on the only FK/Jacobian implementation
+(``serialkin.kinematics._kernels.jacobian_into`` and ``fk_into``) and the only
+pose-error implementation
+(:func:`serialkin.spatial._kernels.pose_error_into`).
+
+Notation (shapes): n joints; ``e`` (6,) the pose error ``[p_t − p; log(R_t Rᵀ)^∨]``
+(world frame); ``w`` (6,) the task weights (0 drops a coordinate); ``r = √w ⊙ e`` and
+``Jw = diag(√w) J`` the weighted residual and Jacobian, so the cost is
+``E = ½ Σ w_i e_i² = ½ rᵀr`` and a step ``Δq`` solves ``Jw Δq ≈ r`` (eq 39 read as
+``Δx = J Δq``).
+
+Method codes and steps:
+
+* ``TRANSPOSE`` — ``Δq = α Jwᵀ r`` with the step length of Buss (2004) / Wolovich & Elliott
+  (1984), ``α = ⟨r, Jw Jwᵀ r⟩ / |Jw Jwᵀ r|²`` (the exact minimiser of the linearised
+  residual along the gradient).
+* ``PINV`` — ``Δq = Jw⁺ r`` (eq 40, Moore-Penrose pseudoinverse by SVD, singular values
+  below ``rcond·σ_max`` dropped), then scaled so that ``max |Δq_i| ≤ max_step``.
+* ``DLS`` — ``Δq = Jwᵀ (Jw Jwᵀ + λ² I)⁻¹ r`` (eq 46 as corrected in the errata), fixed λ.
+* ``LM`` — Levenberg-Marquardt with adaptive damping μ and a gain-ratio test
+  (Madsen, Nielsen & Tingleff 2004, §3.2): ``(JwᵀJw + μI) Δq = Jwᵀ r``; a step is
+  accepted when the cost decreases (ρ > 0), then ``μ ← μ·max(1/3, 1 − (2ρ − 1)³)``,
+  otherwise ``μ ← μ·ν, ν ← 2ν``.
+* ``LM_WAMPLER`` / ``LM_CHAN`` / ``LM_SUGIHARA`` — ``(JwᵀJw + W_N) Δq = Jwᵀ r`` with
+  ``W_N = λ I`` (Wampler 1986), ``W_N = λ E I`` (Chan & Lawrence 1988) and
+  ``W_N = E I + λ I`` (Sugihara 2011); every step is taken.
+* ``SDLS`` — selectively damped least squares (Buss & Kim 2005): each singular
+  direction's contribution is clamped by ``γ_i = min(1, N_i/M_i)·γ_max`` and the total
+  by ``γ_max``, with the position and orientation rows as the two "end effectors".
+* ``NEWTON`` — Newton-Raphson (eq 41 in n dimensions): the full step ``Δq = Jw⁺ r``,
+  then backtracking (halving) until the cost decreases.
+* ``GAUSS_NEWTON`` — ``Δq = (JwᵀJw)⁺ Jwᵀ r`` from the normal equations, full step.
+
+Joint limits (``respect`` true): after every step each joint is projected onto its
+range — a revolute joint is first shifted by a multiple of 2π if that brings it inside
+(same pose), else set to the nearer limit on the circle; a prismatic joint is clamped.
+A step that leaves the range is therefore replaced by its projection (projected
+iteration). Unlimited revolute joints are wrapped into [-π, π) at the end.
+
+Stagnation: an attempt ends when the cost has not halved within ``window``
+iterations (or becomes non-finite); the solver then restarts from a configuration drawn
+uniformly inside the (sampling) limits by a per-target splitmix64 stream. The returned
+q is that of the best attempt (lowest cost), so it is always finite.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from serialkin.kinematics._kernels import fk_into, jacobian_into
+from serialkin.spatial._kernels import pose_error_into
+
+TRANSPOSE = 0
+PINV = 1
+DLS = 2
+LM = 3
+LM_WAMPLER = 4
+LM_CHAN = 5
+LM_SUGIHARA = 6
+SDLS = 7
+NEWTON = 8
+GAUSS_NEWTON = 9
+
+#: Indices into the ``params`` array.
+P_DAMPING = 0  # λ (DLS, Wampler, Chan, Sugihara) or initial τ (LM)
+P_WINDOW = 1  # stagnation window [iterations]
+P_MAX_STEP = 2  # max |Δq_i| (PINV) or γ_max (SDLS) [rad / m]
+P_RCOND = 3  # relative cut-off for singular values (PINV, NEWTON, GAUSS_NEWTON)
+N_PARAMS = 4
+
+#: Layout of the ``info`` output (float64, length N_INFO).
+I_SUCCESS = 0
+I_ITERATIONS = 1
+I_POS_ERR = 2
+I_ORI_ERR = 3
+I_RESTARTS = 4
+I_COST = 5
+N_INFO = 6
+
+TWO_PI = 2.0 * math.pi
+
+
+# ---------------------------------------------------------------- random stream
+@njit(cache=True, inline="always")
+def _next_u64(state):
+    """splitmix64: advance ``state`` (uint64[1]) and return the next 64-bit output."""
+    state[0] = state[0] + np.uint64(0x9E3779B97F4A7C15)
+    z = state[0]
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+@njit(cache=True)
+def random_q_into(state, slo, shi, q):
+    """Uniform configuration in the box [slo, shi] (n,) into ``q``, from the stream ``state``."""
+    for i in range(q.shape[0]):
+        u = float(_next_u64(state) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+        q[i] = slo[i] + (shi[i] - slo[i]) * u
+
+
+# ---------------------------------------------------------------- joint limits
+@njit(cache=True)
+def project_into(q, lo, hi, revolute):
+    """Project ``q`` (n,) onto the joint ranges [lo, hi], in place (see module docstring)."""
+    for i in range(q.shape[0]):
+        x = q[i]
+        if x >= lo[i] and x <= hi[i]:
+            continue
+        if revolute[i] and math.isfinite(lo[i]):
+            y = lo[i] + (x - lo[i]) % TWO_PI  # same angle, in [lo, lo + 2π)
+            if y <= hi[i]:
+                q[i] = y
+            elif y - hi[i] <= lo[i] + TWO_PI - y:
+                q[i] = hi[i]
+            else:
+                q[i] = lo[i]
+        elif x < lo[i]:
+            q[i] = lo[i]
+        else:
+            q[i] = hi[i]
+
+
+@njit(cache=True)
+def normalize_into(q, lo, hi, revolute):
+    """Tidy a final q in place without changing the pose.
+
+    Revolute joints without limits are wrapped into [-π, π); a revolute joint outside
+    its range is shifted by a multiple of 2π when that brings it inside.
+    """
+    for i in range(q.shape[0]):
+        if not revolute[i]:
+            continue
+        if not math.isfinite(lo[i]) or not math.isfinite(hi[i]):
+            q[i] = (q[i] + math.pi) % TWO_PI - math.pi
+        elif q[i] < lo[i] or q[i] > hi[i]:
+            y = lo[i] + (q[i] - lo[i]) % TWO_PI
+            if y <= hi[i]:
+                q[i] = y
+
+
+# ---------------------------------------------------------------- small dense algebra
+@njit(cache=True)
+def _chol_solve(A, b, x, m):
+    """Solve A x = b for the leading m×m block of the SPD matrix A (destroyed); False if not PD."""
+    for j in range(m):
+        s = A[j, j]
+        for k in range(j):
+            s -= A[j, k] * A[j, k]
+        if not s > 0.0:
+            return False
+        d = math.sqrt(s)
+        A[j, j] = d
+        for i in range(j + 1, m):
+            t = A[i, j]
+            for k in range(j):
+                t -= A[i, k] * A[j, k]
+            A[i, j] = t / d
+    for i in range(m):
+        t = b[i]
+        for k in range(i):
+            t -= A[i, k] * x[k]
+        x[i] = t / A[i, i]
+    for i in range(m - 1, -1, -1):
+        t = x[i]
+        for k in range(i + 1, m):
+            t -= A[k, i] * x[k]
+        x[i] = t / A[i, i]
+    return True
+
+
+@njit(cache=True, inline="always")
+def _cost(e, w):
+    """E = ½ Σ w_i e_i²."""
+    c = 0.0
+    for i in range(6):
+        c += w[i] * e[i] * e[i]
+    return 0.5 * c
+
+
+@njit(cache=True, inline="always")
+def _errors(e, w):
+    """(position error [m], orientation error [rad]) over the selected coordinates."""
+    p = 0.0
+    o = 0.0
+    for i in range(3):
+        if w[i] > 0.0:
+            p += e[i] * e[i]
+        if w[i + 3] > 0.0:
+            o += e[i + 3] * e[i + 3]
+    return math.sqrt(p), math.sqrt(o)
+
+
+@njit(cache=True, inline="always")
+def _weigh(J, e, sw, Jw, r):
+    """Jw = diag(√w) J and r = √w ⊙ e."""
+    n = J.shape[1]
+    for i in range(6):
+        r[i] = sw[i] * e[i]
+        for j in range(n):
+            Jw[i, j] = sw[i] * J[i, j]
+
+
+@njit(cache=True, inline="always")
+def _normal(Jw, r, A, g):
+    """A = Jwᵀ Jw (n×n) and g = Jwᵀ r (n,)."""
+    n = Jw.shape[1]
+    for i in range(n):
+        s = 0.0
+        for k in range(6):
+            s += Jw[k, i] * r[k]
+        g[i] = s
+        for j in range(i, n):
+            s = 0.0
+            for k in range(6):
+                s += Jw[k, i] * Jw[k, j]
+            A[i, j] = s
+            A[j, i] = s
+
+
+@njit(cache=True)
+def _pinv_step(M, rhs, dq, rcond):
+    """Dq = M⁺ rhs by SVD (singular values below rcond·σ_max dropped); M is (m, n)."""
+    U, s, Vt = np.linalg.svd(M, full_matrices=False)
+    n = M.shape[1]
+    for j in range(n):
+        dq[j] = 0.0
+    if s.shape[0] == 0 or not s[0] > 0.0:
+        return
+    cut = rcond * s[0]
+    for k in range(s.shape[0]):
+        if s[k] <= cut:
+            continue
+        a = 0.0
+        for i in range(M.shape[0]):
+            a += U[i, k] * rhs[i]
+        a /= s[k]
+        for j in range(n):
+            dq[j] += a * Vt[k, j]
+
+
+@njit(cache=True)
+def _sdls_step(Jw, r, dq, gamma_max):
+    """Selectively damped least squares step (Buss & Kim 2005), two 3-row blocks."""
+    U, s, Vt = np.linalg.svd(Jw, full_matrices=False)
+    n = Jw.shape[1]
+    rho = np.empty(n)
+    for j in range(n):
+        a = 0.0
+        b = 0.0
+        for i in range(3):
+            a += Jw[i, j] * Jw[i, j]
+            b += Jw[i + 3, j] * Jw[i + 3, j]
+        rho[j] = math.sqrt(a) + math.sqrt(b)
+        dq[j] = 0.0
+    if s.shape[0] == 0 or not s[0] > 0.0:
+        return
+    phi = np.empty(n)
+    for k in range(s.shape[0]):
+        if s[k] <= 1e-12 * s[0]:
+            continue
+        alpha = 0.0
+        a = 0.0
+        b = 0.0
+        for i in range(3):
+            a += U[i, k] * U[i, k]
+            b += U[i + 3, k] * U[i + 3, k]
+        for i in range(6):
+            alpha += U[i, k] * r[i]
+        N = math.sqrt(a) + math.sqrt(b)
+        M = 0.0
+        for j in range(n):
+            M += abs(Vt[k, j]) * rho[j]
+        M /= s[k]
+        gamma = gamma_max * min(1.0, N / M) if M > 0.0 else gamma_max
+        big = 0.0
+        for j in range(n):
+            phi[j] = alpha / s[k] * Vt[k, j]
+            big = max(big, abs(phi[j]))
+        scale = gamma / big if big > gamma else 1.0
+        for j in range(n):
+            dq[j] += scale * phi[j]
+    big = 0.0
+    for j in range(n):
+        big = max(big, abs(dq[j]))
+    if big > gamma_max:
+        for j in range(n):
+            dq[j] *= gamma_max / big
+
+
+@njit(cache=True, inline="always")
+def _limit_step(dq, max_step):
+    """Scale dq so that max |dq_i| ≤ max_step (direction kept)."""
+    big = 0.0
+    for j in range(dq.shape[0]):
+        big = max(big, abs(dq[j]))
+    if big > max_step:
+        for j in range(dq.shape[0]):
+            dq[j] *= max_step / big
+
+
+# ---------------------------------------------------------------- one attempt
+@njit(cache=True)
+def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol, max_iter,
+             q, J, T, e, Jw, r, A, g, dq, qn, Jn, Tn, en, M6, y6):
+    """Iterate ``method`` from q (n,) in place; return (iterations, converged, cost).
+
+    On return q, J, T, e describe the final (last accepted) configuration.
+    """
+    n = q.shape[0]
+    window = int(params[P_WINDOW])
+    jacobian_into(q, F, meta, J, T)
+    pose_error_into(T, Tt, e)
+    cost = _cost(e, w)
+    ref_cost = cost
+    ref_it = 0
+    mu = -1.0
+    nu = 2.0
+    for it in range(max_iter):
+        pe, oe = _errors(e, w)
+        if pe <= tol and oe <= tol:
+            return it, True, cost
+        if not math.isfinite(cost):
+            return it, False, cost
+        if cost < 0.5 * ref_cost:
+            ref_cost = cost
+            ref_it = it
+        elif it - ref_it > window:
+            return it, False, cost
+        _weigh(J, e, sw, Jw, r)
+        if method == LM:
+            _normal(Jw, r, A, g)
+            if mu < 0.0:
+                d = 0.0
+                for i in range(n):
+                    d = max(d, A[i, i])
+                mu = params[P_DAMPING] * max(d, 1e-12)
+            for i in range(n):
+                A[i, i] += mu
+            if not _chol_solve(A, g, dq, n):
+                mu *= nu
+                nu *= 2.0
+                continue
+            # predicted decrease of the (projected) step: gᵀh − ½ hᵀ JwᵀJw h = ½ hᵀ(μh + g)
+            for i in range(n):
+                qn[i] = q[i] + dq[i]
+            if respect:
+                project_into(qn, lo, hi, revolute)
+            jacobian_into(qn, F, meta, Jn, Tn)
+            pose_error_into(Tn, Tt, en)
+            cost_n = _cost(en, w)
+            lin = 0.0
+            for i in range(6):
+                s = 0.0
+                for j in range(n):
+                    s += Jw[i, j] * (qn[j] - q[j])
+                lin += (r[i] - s) * (r[i] - s)
+            pred = cost - 0.5 * lin
+            rho = (cost - cost_n) / pred if pred > 0.0 else -1.0
+            if rho > 0.0 and math.isfinite(cost_n):
+                q[:] = qn
+                J[:, :] = Jn
+                T[:, :] = Tn
+                e[:] = en
+                cost = cost_n
+                t = 2.0 * rho - 1.0
+                mu *= max(1.0 / 3.0, 1.0 - t * t * t)
+                nu = 2.0
+            else:
+                mu *= nu
+                nu *= 2.0
+                if mu > 1e20:
+                    return it + 1, False, cost
+            continue
+        # ---- methods that always take their step
+        if method == TRANSPOSE:
+            for j in range(n):
+                s = 0.0
+                for i in range(6):
+                    s += Jw[i, j] * r[i]
+                g[j] = s
+            num = 0.0
+            den = 0.0
+            for i in range(6):
+                v = 0.0
+                for j in range(n):
+                    v += Jw[i, j] * g[j]
+                num += r[i] * v
+                den += v * v
+            alpha = num / den if den > 0.0 else 0.0
+            for j in range(n):
+                dq[j] = alpha * g[j]
+        elif method == DLS:
+            lam2 = params[P_DAMPING] * params[P_DAMPING]
+            for i in range(6):
+                for k in range(i, 6):
+                    s = 0.0
+                    for j in range(n):
+                        s += Jw[i, j] * Jw[k, j]
+                    M6[i, k] = s
+                    M6[k, i] = s
+                M6[i, i] += lam2
+            if not _chol_solve(M6, r, y6, 6):
+                return it, False, cost
+            for j in range(n):
+                s = 0.0
+                for i in range(6):
+                    s += Jw[i, j] * y6[i]
+                dq[j] = s
+        elif method == LM_WAMPLER or method == LM_CHAN or method == LM_SUGIHARA:
+            _normal(Jw, r, A, g)
+            lam = params[P_DAMPING]
+            if method == LM_WAMPLER:
+                wn = lam
+            elif method == LM_CHAN:
+                wn = lam * cost
+            else:
+                wn = cost + lam
+            for i in range(n):
+                A[i, i] += wn
+            if not _chol_solve(A, g, dq, n):
+                return it, False, cost
+        elif method == PINV or method == NEWTON:
+            _pinv_step(Jw, r, dq, params[P_RCOND])
+            if method == PINV:
+                _limit_step(dq, params[P_MAX_STEP])
+        elif method == GAUSS_NEWTON:
+            _normal(Jw, r, A, g)
+            _pinv_step(A, g, dq, params[P_RCOND])
+        elif method == SDLS:
+            _sdls_step(Jw, r, dq, params[P_MAX_STEP])
+        step = 1.0
+        for _ls in range(12 if method == NEWTON else 1):
+            for j in range(n):
+                qn[j] = q[j] + step * dq[j]
+            if respect:
+                project_into(qn, lo, hi, revolute)
+            if method != NEWTON:
+                break
+            fk_into(qn, F, meta, Tn)
+            pose_error_into(Tn, Tt, en)
+            if _cost(en, w) < cost:
+                break
+            step *= 0.5
+        q[:] = qn
+        jacobian_into(q, F, meta, J, T)
+        pose_error_into(T, Tt, e)
+        cost = _cost(e, w)
+    pe, oe = _errors(e, w)
+    return max_iter, (pe <= tol and oe <= tol), cost
+
+
+@njit(cache=True)
+def solve_one(F, meta, Tt, w, lo, hi, slo, shi, revolute, respect, q0, use_q0, method, params,
+              tol, max_iter, restarts, seed, q_out, info):
+    """Solve one target with restarts; write the best q into ``q_out`` (n,) and ``info``.
+
+    Args:
+        F: (n+1, 4, 4) chain fixed transforms (see :mod:`serialkin.kinematics._kernels`).
+        meta: (n, 5) chain joint data.
+        Tt: (4, 4) target pose.
+        w: (6,) task weights.
+        lo: (n,) lower joint limits (-inf allowed).
+        hi: (n,) upper joint limits (+inf allowed).
+        slo: (n,) lower bounds of the (finite) sampling box for restarts.
+        shi: (n,) upper bounds of the sampling box.
+        revolute: (n,) bool, True for revolute joints.
+        respect: project onto the limits after every step.
+        q0: (n,) first start configuration, read when ``use_q0``.
+        use_q0: start the first attempt from q0 (else from the random stream).
+        method: method code (``TRANSPOSE`` ... ``GAUSS_NEWTON``).
+        params: (N_PARAMS,) method parameters (``P_*``).
+        tol: tolerance on both the position [m] and orientation [rad] errors.
+        max_iter: iterations per attempt.
+        restarts: extra attempts allowed.
+        seed: uint64 seed of this target's random stream.
+        q_out: (n,) output, the best configuration found.
+        info: (N_INFO,) output, see ``I_*``.
+    """
+    n = meta.shape[0]
+    J = np.empty((6, n))
+    T = np.empty((4, 4))
+    e = np.empty(6)
+    Jw = np.empty((6, n))
+    r = np.empty(6)
+    A = np.empty((n, n))
+    g = np.empty(n)
+    dq = np.empty(n)
+    qn = np.empty(n)
+    Jn = np.empty((6, n))
+    Tn = np.empty((4, 4))
+    en = np.empty(6)
+    M6 = np.empty((6, 6))
+    y6 = np.empty(6)
+    q = np.empty(n)
+    be = np.empty(6)
+    sw = np.empty(6)
+    for i in range(6):
+        sw[i] = math.sqrt(w[i])
+    state = np.empty(1, dtype=np.uint64)
+    state[0] = seed
+    total = 0
+    success = False
+    used = 0
+    # fallback best: the first start configuration (finite, inside the limits)
+    if use_q0:
+        q_out[:] = q0
+    else:
+        state_copy = np.empty(1, dtype=np.uint64)
+        state_copy[0] = seed
+        random_q_into(state_copy, slo, shi, q_out)
+    if respect:
+        project_into(q_out, lo, hi, revolute)
+    fk_into(q_out, F, meta, T)
+    pose_error_into(T, Tt, be)
+    best_cost = _cost(be, w)
+    for attempt in range(restarts + 1):
+        used = attempt
+        if attempt == 0 and use_q0:
+            q[:] = q0
+        else:
+            random_q_into(state, slo, shi, q)
+        if respect:
+            project_into(q, lo, hi, revolute)
+        its, ok, cost = _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params,
+                                 tol, max_iter, q, J, T, e, Jw, r, A, g, dq, qn, Jn, Tn, en,
+                                 M6, y6)
+        total += its
+        finite = math.isfinite(cost)
+        for i in range(n):
+            if not math.isfinite(q[i]):
+                finite = False
+        if finite and (ok or cost < best_cost):
+            best_cost = cost
+            q_out[:] = q
+            be[:] = e
+        if ok:
+            success = True
+            break
+    normalize_into(q_out, lo, hi, revolute)
+    pe, oe = _errors(be, w)
+    info[I_SUCCESS] = 1.0 if success else 0.0
+    info[I_ITERATIONS] = total
+    info[I_POS_ERR] = pe
+    info[I_ORI_ERR] = oe
+    info[I_RESTARTS] = used
+    info[I_COST] = best_cost
+
+
+@njit(cache=True, parallel=True)
+def solve_batch(F, meta, Tt, w, lo, hi, slo, shi, revolute, respect, Q0, use_q0, method, params,
+                tol, max_iter, restarts, seed, Q_out, info):
+    """:func:`solve_one` for N targets ``Tt`` (N, 4, 4) across the cores.
+
+    ``Q0`` (N, n) start configurations (read when ``use_q0``), ``Q_out`` (N, n) and
+    ``info`` (N, N_INFO) outputs. Every target uses the same random stream ``seed``, so a
+    batch solve returns exactly what the single solves with that seed return.
+    """
+    for k in prange(Tt.shape[0]):
+        solve_one(F, meta, Tt[k], w, lo, hi, slo, shi, revolute, respect, Q0[k], use_q0, method,
+                  params, tol, max_iter, restarts, seed, Q_out[k], info[k])

@@ -1,0 +1,141 @@
+"""The IK method registry: method name → :class:`MethodSpec`.
+
+A method is registered once, at import of the module that implements it, with
+:func:`register_method`. Modules of :mod:`serialkin.ik` whose name ends in ``_methods``
+(e.g. ``jacobian_methods.py``) are imported automatically the first time the registry is
+read, so adding a file that follows that convention is all a new family needs.
+
+Two kinds of methods share the same skeleton (:mod:`serialkin.ik.solver`):
+
+* compiled methods (``kernel_code`` set): the whole loop — iterations, restarts,
+  stagnation, limits — runs in :mod:`serialkin.ik._kernels`;
+* Python methods (``attempt`` set): the method supplies one attempt from a start
+  configuration; the shared Python loop in :func:`serialkin.ik.solver.run_attempts` owns
+  restarts, seeding, the iteration budget, success test and the result.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from serialkin._checks import check_choice
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from serialkin.ik.solver import IKProblem
+
+#: Signature of a Python method's attempt: ``attempt(problem, q_start, max_iter, options)``
+#: returns ``(q, iterations)``. ``q`` (n,) must be finite and, when
+#: ``problem.respect_limits``, inside the limits (use ``problem.project``); the attempt
+#: should stop early when it converges (``problem.converged``) or stagnates.
+AttemptFn = Callable[["IKProblem", "np.ndarray", int, Mapping[str, Any]], tuple["np.ndarray", int]]
+
+
+@dataclass(frozen=True)
+class MethodSpec:
+    """Description of one IK method.
+
+    Attributes:
+        name: the method name users pass as ``method=``.
+        family: 'jacobian', 'optimization', 'heuristic' or 'analytic'.
+        summary: one line for listings (``serialkin ik --list``, ``compare``).
+        limits: how the method respects joint limits (one sentence).
+        targets: the target kinds it accepts ('pose', 'position', 'planar',
+            'planar_pose').
+        max_iter: default iteration budget per attempt.
+        restarts: default number of restarts from random configurations.
+        options: method-specific keyword options and their defaults.
+        kernel_code: method code of the compiled kernel, or None for a Python method.
+        attempt: the Python attempt function (see :data:`AttemptFn`), or None.
+        solve: a callable that solves one target entirely on its own,
+            ``solve(robot, problem, q0, options) -> (q, success, iterations, reason)``
+            with ``problem`` an :class:`~serialkin.ik.solver.IKProblem` and ``q0`` (n,)
+            or None
+            (used by the closed-form method, which needs neither restarts nor
+            iterations), or None.
+    """
+
+    name: str
+    family: str
+    summary: str
+    limits: str
+    targets: tuple[str, ...] = ("pose", "position", "planar", "planar_pose")
+    max_iter: int = 100
+    restarts: int = 50
+    options: Mapping[str, Any] = field(default_factory=dict)
+    kernel_code: int | None = None
+    attempt: AttemptFn | None = None
+    solve: Callable[..., Any] | None = None
+
+    def __post_init__(self) -> None:
+        if (self.kernel_code is None) + (self.attempt is None) + (self.solve is None) != 2:
+            raise ValueError(
+                f"method {self.name!r} needs exactly one of kernel_code, attempt, solve"
+            )
+
+
+_REGISTRY: dict[str, MethodSpec] = {}
+_DISCOVERED = False
+
+
+def register_method(spec: MethodSpec) -> MethodSpec:
+    """Add a method to the registry (replacing one of the same name) and return it."""
+    _REGISTRY[spec.name] = spec
+    return spec
+
+
+def _discover() -> None:
+    """Import every ``serialkin.ik.*_methods`` module once (they register themselves)."""
+    global _DISCOVERED
+    if _DISCOVERED:
+        return
+    _DISCOVERED = True
+    import serialkin.ik as pkg
+
+    for info in pkgutil.iter_modules(pkg.__path__):
+        if info.name.endswith("_methods"):
+            importlib.import_module(f"serialkin.ik.{info.name}")
+
+
+class _MethodTable(Mapping[str, MethodSpec]):
+    """Read-only, lazily populated view of the registry (``serialkin.ik.METHODS``)."""
+
+    def __getitem__(self, name: str) -> MethodSpec:
+        _discover()
+        return _REGISTRY[name]
+
+    def __iter__(self) -> Iterator[str]:
+        _discover()
+        return iter(sorted(_REGISTRY))
+
+    def __len__(self) -> int:
+        _discover()
+        return len(_REGISTRY)
+
+    def __repr__(self) -> str:
+        return f"METHODS({', '.join(self)})"
+
+
+#: All registered methods, name → :class:`MethodSpec` (read-only mapping).
+METHODS: Mapping[str, MethodSpec] = _MethodTable()
+
+
+def available_methods() -> tuple[str, ...]:
+    """Names of every registered IK method, sorted."""
+    return tuple(METHODS)
+
+
+def get_method(name: object) -> MethodSpec:
+    """The :class:`MethodSpec` registered as ``name``.
+
+    Raises:
+        InputError: unknown name; the message lists the available methods.
+    """
+    _discover()
+    check_choice(name, "method", sorted(_REGISTRY))
+    return _REGISTRY[name]  # type: ignore[index]

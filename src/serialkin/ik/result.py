@@ -1,0 +1,86 @@
+"""The one result type every inverse-kinematics method returns.
+
+A failed solve is a result, not an exception: ``success`` is False, ``reason`` says why
+and ``q`` holds the best attempt (lowest residual), which is always finite and, with
+``respect_limits=True``, inside the joint limits.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class IKResult:
+    """Outcome of :func:`serialkin.ik.solve` (and ``robot.ik``).
+
+    For one target the fields are scalars and ``q`` has shape (n,). For a batch of N
+    targets every field except ``method`` is an array with leading dimension N
+    (``q`` (N, n), ``success`` (N,) bool, ``reason`` (N,) str, ...).
+
+    Attributes:
+        q: joint values [rad / m]: the solution, or the best attempt when ``success`` is
+            False.
+        success: True when the position error and the orientation error (of the task
+            coordinates selected by the mask) are both within the tolerance and, with
+            ``respect_limits``, q lies inside the joint limits.
+        iterations: iterations used in total, over every attempt.
+        position_error: ``|p_target − p(q)|`` over the selected position coordinates [m].
+        orientation_error: ``|log(R_target R(q)ᵀ)|`` over the selected orientation
+            coordinates [rad].
+        reason: '' on success, else a sentence saying why the solve failed.
+        restarts: how many times the solver restarted from a new random configuration.
+        method: name of the method that produced the result.
+    """
+
+    q: np.ndarray
+    success: bool | np.ndarray
+    iterations: int | np.ndarray
+    position_error: float | np.ndarray
+    orientation_error: float | np.ndarray
+    reason: str | np.ndarray
+    restarts: int | np.ndarray
+    method: str
+
+    @property
+    def batch(self) -> bool:
+        """True when this result holds a batch of solves (``q`` has two dimensions)."""
+        return np.ndim(self.q) == 2
+
+    def __len__(self) -> int:
+        """Number of solves in a batch result (1 for a single solve)."""
+        return int(np.shape(self.q)[0]) if self.batch else 1
+
+    def __getitem__(self, k: int) -> IKResult:
+        """The k-th solve of a batch result, as a single result."""
+        if not self.batch:
+            raise TypeError("a single IKResult cannot be indexed; only batch results can")
+        return IKResult(
+            q=np.asarray(self.q)[k].copy(),
+            success=bool(np.asarray(self.success)[k]),
+            iterations=int(np.asarray(self.iterations)[k]),
+            position_error=float(np.asarray(self.position_error)[k]),
+            orientation_error=float(np.asarray(self.orientation_error)[k]),
+            reason=str(np.asarray(self.reason)[k]),
+            restarts=int(np.asarray(self.restarts)[k]),
+            method=self.method,
+        )
+
+    def __repr__(self) -> str:
+        if self.batch:
+            ok = np.asarray(self.success)
+            return (
+                f"IKResult(method={self.method!r}, batch of {ok.size}: {int(ok.sum())} solved, "
+                f"max position error {np.max(self.position_error, initial=0.0):.3g} m, "
+                f"max orientation error {np.max(self.orientation_error, initial=0.0):.3g} rad)"
+            )
+        q = np.array2string(np.asarray(self.q), precision=4, separator=", ")
+        tail = "" if self.success else f", reason={self.reason!r}"
+        return (
+            f"IKResult(method={self.method!r}, success={bool(self.success)}, q={q}, "
+            f"iterations={self.iterations}, restarts={self.restarts}, "
+            f"position_error={self.position_error:.3g} m, "
+            f"orientation_error={self.orientation_error:.3g} rad{tail})"
+        )

@@ -1,0 +1,401 @@
+"""The shared IK skeleton: one entry point, one loop, one result.
+
+:func:`solve` (what ``robot.ik`` calls) validates the arguments, looks the method up in
+the registry and runs it:
+
+* compiled methods (the Jacobian family) run entirely in
+  :func:`serialkin.ik._kernels.solve_one` / :func:`~serialkin.ik._kernels.solve_batch`;
+* Python methods supply one attempt and :func:`run_attempts` owns the rest.
+
+Both follow the same semantics:
+
+* **attempts** — the first attempt starts from ``q0`` (or, without one, from a random
+  configuration); when an attempt fails to converge or stagnates, the solver restarts
+  from a configuration drawn uniformly inside the joint limits (unlimited revolute joints:
+  [-π, π]; unlimited prismatic joints: [-1, 1] m), at most ``restarts`` times;
+* **budget** — at most ``max_iter`` iterations per attempt, so at most
+  ``(restarts + 1)·max_iter`` in total: a solve always ends;
+* **tolerance** — success when the position error [m] and the orientation error [rad]
+  of the selected task coordinates are both ≤ ``tol`` (default :data:`DEFAULT_TOL`), and
+  q is inside the limits when ``respect_limits``;
+* **randomness** — one splitmix64 stream per target seeded from ``seed``: the same seed
+  gives the same answer, and a batch returns exactly what the single solves return;
+* **failure** — ``success=False``, a ``reason``, and the best attempt's q (lowest cost),
+  always finite.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from serialkin._checks import check_int
+from serialkin.errors import InputError, InputTypeError
+from serialkin.ik import _kernels as K
+from serialkin.ik.registry import MethodSpec, get_method
+from serialkin.ik.result import IKResult
+from serialkin.ik.target import Target, check_q0, check_tol, parse_target
+from serialkin.kinematics import _kernels as FK
+from serialkin.model.robot import Robot
+from serialkin.spatial import _kernels as SK
+
+#: Default tolerance on the position [m] and orientation [rad] errors.
+DEFAULT_TOL = 1e-9
+
+_MASK64 = (1 << 64) - 1
+
+
+@dataclass(frozen=True, eq=False)
+class IKProblem:
+    """One target for one robot, as Python methods see it.
+
+    Attributes:
+        robot: the robot.
+        T_target: (4, 4) target pose (world frame).
+        weights: (6,) task-coordinate weights ``w`` of ``[vx, vy, vz, wx, wy, wz]``.
+        kind: target kind ('pose', 'position', 'planar', 'planar_pose').
+        tol: tolerance on the position [m] and orientation [rad] errors.
+        respect_limits: whether q must stay inside the joint limits.
+        lower, upper: (n,) projection bounds (the joint limits, or ±inf when
+            ``respect_limits`` is False).
+        revolute: (n,) bool, True for revolute joints.
+    """
+
+    robot: Robot
+    T_target: np.ndarray
+    weights: np.ndarray
+    kind: str
+    tol: float
+    respect_limits: bool
+    lower: np.ndarray
+    upper: np.ndarray
+    revolute: np.ndarray
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return self.robot.n
+
+    @property
+    def selected(self) -> np.ndarray:
+        """(6,) booleans: task coordinates that count."""
+        return self.weights > 0.0
+
+    def pose(self, q: np.ndarray) -> np.ndarray:
+        """Tool pose (4, 4) at ``q`` (n,) (trusted, finite float64)."""
+        T = np.empty((4, 4))
+        FK.fk_into(np.ascontiguousarray(q, dtype=np.float64), self.robot.chain.F,
+                   self.robot.chain.meta, T)
+        return T
+
+    def error(self, q: np.ndarray) -> np.ndarray:
+        """Unweighted pose error ``e = [p_t − p; log(R_t Rᵀ)^∨]`` (6,) at ``q`` [m; rad]."""
+        e = np.empty(6)
+        SK.pose_error_into(self.pose(q), self.T_target, e)
+        return e
+
+    def jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Geometric Jacobian (6, n) and pose (4, 4) at ``q``."""
+        J = np.empty((6, self.n))
+        T = np.empty((4, 4))
+        FK.jacobian_into(np.ascontiguousarray(q, dtype=np.float64), self.robot.chain.F,
+                         self.robot.chain.meta, J, T)
+        return J, T
+
+    def cost(self, q: np.ndarray) -> float:
+        """Cost ``E = ½ Σ w_i e_i²`` at ``q``."""
+        e = self.error(q)
+        return 0.5 * float(np.dot(self.weights, e * e))
+
+    def errors(self, q: np.ndarray) -> tuple[float, float]:
+        """(position error [m], orientation error [rad]) over the selected coordinates."""
+        e = self.error(q)
+        sel = self.selected
+        return (float(np.linalg.norm(e[:3][sel[:3]])), float(np.linalg.norm(e[3:][sel[3:]])))
+
+    def converged(self, q: np.ndarray) -> bool:
+        """True when both errors are within ``tol``."""
+        p, o = self.errors(q)
+        return p <= self.tol and o <= self.tol
+
+    def project(self, q: np.ndarray) -> np.ndarray:
+        """A copy of q projected onto the joint ranges (unchanged without limits).
+
+        Revolute joints are shifted by 2π when that brings them inside, else set to the
+        nearer limit; prismatic joints are clamped.
+        """
+        out = np.array(q, dtype=np.float64)
+        if self.respect_limits:
+            K.project_into(out, self.lower, self.upper, self.revolute)
+        return out
+
+
+def _stream_seed(seed: object) -> int:
+    """A uint64 stream seed from ``seed`` (None: fresh OS entropy; int; Generator)."""
+    if seed is None:
+        return int.from_bytes(os.urandom(8), "little")
+    if isinstance(seed, np.random.Generator):
+        return int(seed.integers(0, 2**63, dtype=np.int64))
+    if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+        return int(seed) & _MASK64
+    raise InputTypeError(
+        f"seed must be None, an int or a numpy Generator, got {type(seed).__name__} {seed!r}"
+    )
+
+
+def _options(spec: MethodSpec, options: Mapping[str, Any]) -> dict[str, Any]:
+    """Method options merged over the method's defaults; unknown names raise."""
+    unknown = sorted(set(options) - set(spec.options))
+    if unknown:
+        accepted = ", ".join(sorted(spec.options)) or "none"
+        raise InputError(
+            f"unknown option(s) {unknown} for method {spec.name!r}; its options are: {accepted} "
+            "(common ones: q0, mask, tol, max_iter, restarts, seed, respect_limits)"
+        )
+    return {**spec.options, **options}
+
+
+def _limits(robot: Robot, respect_limits: bool) -> tuple[np.ndarray, ...]:
+    lo = np.ascontiguousarray(robot.qlim[:, 0], dtype=np.float64)
+    hi = np.ascontiguousarray(robot.qlim[:, 1], dtype=np.float64)
+    samp = robot.sampling_limits()
+    slo = np.ascontiguousarray(samp[:, 0])
+    shi = np.ascontiguousarray(samp[:, 1])
+    revolute = np.array([t == "R" for t in robot.joint_types])
+    return lo, hi, slo, shi, revolute
+
+
+def failure_reason(pos_err: float, ori_err: float, tol: float, attempts: int,
+                   iterations: int, kind: str) -> str:
+    """The sentence reported when a solve fails."""
+    what = f"position error {pos_err:.3g} m"
+    if kind in ("pose", "planar_pose"):
+        what += f", orientation error {ori_err:.3g} rad"
+    return (
+        f"no configuration within tol={tol:g} found in {attempts} attempt(s) and {iterations} "
+        f"iterations (best: {what}); the target may be out of reach, reachable only outside "
+        "the joint limits, or need more restarts / iterations"
+    )
+
+
+def run_attempts(spec: MethodSpec, problem: IKProblem, q0: np.ndarray | None, max_iter: int,
+                 restarts: int, seed: int, options: Mapping[str, Any]) -> tuple:
+    """The shared loop for Python methods: attempts from q0 / seeded random starts.
+
+    Returns ``(q, success, iterations, position_error, orientation_error, reason,
+    restarts_used)`` for one target.
+    """
+    robot = problem.robot
+    samp = robot.sampling_limits()
+    slo = np.ascontiguousarray(samp[:, 0])
+    shi = np.ascontiguousarray(samp[:, 1])
+    state = np.array([seed], dtype=np.uint64)
+    best_q = None
+    best_cost = np.inf
+    total = 0
+    used = 0
+    success = False
+    for attempt in range(restarts + 1):
+        used = attempt
+        if attempt == 0 and q0 is not None:
+            start = q0.copy()
+        else:
+            start = np.empty(robot.n)
+            K.random_q_into(state, slo, shi, start)
+        start = problem.project(start)
+        if best_q is None:
+            best_q, best_cost = start, problem.cost(start)
+        q, its = spec.attempt(problem, start, max_iter, options)
+        q = np.asarray(q, dtype=np.float64)
+        total += min(int(its), max_iter)
+        if q.shape != (robot.n,) or not np.isfinite(q).all():
+            continue
+        if problem.respect_limits:
+            q = problem.project(q)
+        cost = problem.cost(q)
+        ok = problem.converged(q)
+        if ok or cost < best_cost:
+            best_q, best_cost = q, cost
+        if ok:
+            success = True
+            break
+    q = np.ascontiguousarray(best_q, dtype=np.float64)
+    lo, hi, _, _, revolute = _limits(robot, problem.respect_limits)
+    K.normalize_into(q, lo, hi, revolute)
+    pe, oe = problem.errors(q)
+    reason = "" if success else failure_reason(pe, oe, problem.tol, used + 1, total, problem.kind)
+    return q, success, total, pe, oe, reason, used
+
+
+def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
+    """Kernel parameter vector from a compiled method's options."""
+    from serialkin._checks import check_positive
+
+    p = np.zeros(K.N_PARAMS)
+    p[K.P_DAMPING] = check_positive(opts.get("damping", 1e-3), "damping", allow_zero=True)
+    p[K.P_WINDOW] = check_int(opts.get("stall_window", 20), "stall_window", minimum=1)
+    p[K.P_MAX_STEP] = check_positive(opts.get("max_step", 0.5), "max_step")
+    p[K.P_RCOND] = check_positive(opts.get("rcond", 1e-10), "rcond")
+    return p
+
+
+def solve(
+    robot: Robot,
+    target: object,
+    method: str = "lm",
+    *,
+    q0: object = None,
+    mask: object = None,
+    tol: float | None = None,
+    max_iter: int | None = None,
+    restarts: int | None = None,
+    seed: None | int | np.random.Generator = None,
+    respect_limits: bool = True,
+    **options: Any,
+) -> IKResult:
+    """Inverse kinematics of ``robot`` for ``target`` by ``method``.
+
+    Args:
+        robot: the robot.
+        target: (4, 4) pose, 3-vector position, planar (x, y) / (x, y, φ) for planar
+            robots, or a batch of these ((N, 4, 4), (N, 3), (N, 2)); see
+            :mod:`serialkin.ik.target`.
+        method: a name from :func:`serialkin.ik.available_methods` (default 'lm').
+        q0: initial guess (n,), or for a batch (n,) or (N, n); default a random
+            configuration from the seeded stream.
+        mask: 6 booleans / weights for ``[vx, vy, vz, wx, wy, wz]`` (default: those the
+            target defines).
+        tol: tolerance on position [m] and orientation [rad] errors, > 0
+            (default :data:`DEFAULT_TOL`).
+        max_iter: iterations per attempt (default per method).
+        restarts: restarts from random configurations allowed (default per method).
+        seed: None, int or numpy Generator for the random starts.
+        respect_limits: keep q inside the joint limits (each method documents how).
+        **options: method-specific options (see ``METHODS[name].options``).
+
+    Returns:
+        :class:`IKResult`; for a batch target, with arrays.
+
+    Raises:
+        InputError: a malformed target, mask, tolerance or q0, an unknown method (the
+            message lists the available ones) or an unknown option. A failed solve is
+            not an error: it returns ``success=False`` with a ``reason``.
+    """
+    spec = get_method(method)
+    if not isinstance(robot, Robot):
+        raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    tgt = parse_target(robot, target, mask)
+    if tgt.kind not in spec.targets:
+        raise InputError(
+            f"method {spec.name!r} does not accept {tgt.kind} targets; it accepts "
+            f"{', '.join(spec.targets)}"
+        )
+    tol_v = DEFAULT_TOL if tol is None else check_tol(tol)
+    iters = spec.max_iter if max_iter is None else check_int(max_iter, "max_iter", minimum=1)
+    nrest = spec.restarts if restarts is None else check_int(restarts, "restarts", minimum=0)
+    if not isinstance(respect_limits, (bool, np.bool_)):
+        raise InputTypeError(f"respect_limits must be True or False, got {respect_limits!r}")
+    opts = _options(spec, options)
+    n_targets = tgt.T.shape[0] if tgt.batch else None
+    q0a = None if q0 is None else check_q0(robot, q0, n_targets, bool(respect_limits))
+    stream = _stream_seed(seed)
+    if spec.kernel_code is not None:
+        return _solve_compiled(robot, tgt, spec, q0a, tol_v, iters, nrest, stream,
+                               bool(respect_limits), opts)
+    return _solve_python(robot, tgt, spec, q0a, tol_v, iters, nrest, stream,
+                         bool(respect_limits), opts)
+
+
+def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | None,
+                    tol: float, max_iter: int, restarts: int, seed: int, respect: bool,
+                    opts: Mapping[str, Any]) -> IKResult:
+    lo, hi, slo, shi, revolute = _limits(robot, respect)
+    params = _method_params(spec, opts)
+    F, meta = robot.chain.F, robot.chain.meta
+    n = robot.n
+    seed64 = np.uint64(seed)
+    if not tgt.batch:
+        q = np.empty(n)
+        info = np.empty(K.N_INFO)
+        K.solve_one(F, meta, tgt.T, tgt.weights, lo, hi, slo, shi, revolute, respect,
+                    q0 if q0 is not None else np.zeros(n), q0 is not None, spec.kernel_code,
+                    params, tol, max_iter, restarts, seed64, q, info)
+        return _result_single(robot, tgt, spec, q, info, tol)
+    N = tgt.T.shape[0]
+    Q = np.empty((N, n))
+    info = np.empty((N, K.N_INFO))
+    Q0 = q0 if q0 is not None else np.zeros((N, n))
+    K.solve_batch(F, meta, tgt.T, tgt.weights, lo, hi, slo, shi, revolute, respect, Q0,
+                  q0 is not None, spec.kernel_code, params, tol, max_iter, restarts, seed64, Q,
+                  info)
+    return _result_batch(robot, tgt, spec, Q, info, tol, respect)
+
+
+def _result_single(robot: Robot, tgt: Target, spec: MethodSpec, q: np.ndarray,
+                   info: np.ndarray, tol: float) -> IKResult:
+    ok = bool(info[K.I_SUCCESS])
+    pe, oe = float(info[K.I_POS_ERR]), float(info[K.I_ORI_ERR])
+    its, used = int(info[K.I_ITERATIONS]), int(info[K.I_RESTARTS])
+    reason = "" if ok else failure_reason(pe, oe, tol, used + 1, its, tgt.kind)
+    return IKResult(q=q, success=ok, iterations=its, position_error=pe, orientation_error=oe,
+                    reason=reason, restarts=used, method=spec.name)
+
+
+def _result_batch(robot: Robot, tgt: Target, spec: MethodSpec, Q: np.ndarray,
+                  info: np.ndarray, tol: float, respect: bool) -> IKResult:
+    ok = info[:, K.I_SUCCESS] > 0.5
+    its = info[:, K.I_ITERATIONS].astype(np.int64)
+    used = info[:, K.I_RESTARTS].astype(np.int64)
+    pe, oe = info[:, K.I_POS_ERR].copy(), info[:, K.I_ORI_ERR].copy()
+    reasons = np.array(
+        ["" if ok[k] else failure_reason(pe[k], oe[k], tol, used[k] + 1, its[k], tgt.kind)
+         for k in range(Q.shape[0])],
+        dtype=object,
+    ).astype(str)
+    return IKResult(q=Q, success=ok, iterations=its, position_error=pe, orientation_error=oe,
+                    reason=reasons, restarts=used, method=spec.name)
+
+
+def _problem(robot: Robot, T: np.ndarray, tgt: Target, tol: float, respect: bool) -> IKProblem:
+    lo, hi, _, _, revolute = _limits(robot, respect)
+    if not respect:
+        lo = np.full(robot.n, -np.inf)
+        hi = np.full(robot.n, np.inf)
+    return IKProblem(robot=robot, T_target=np.ascontiguousarray(T), weights=tgt.weights,
+                     kind=tgt.kind, tol=tol, respect_limits=respect, lower=lo, upper=hi,
+                     revolute=revolute)
+
+
+def _solve_python(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | None,
+                  tol: float, max_iter: int, restarts: int, seed: int, respect: bool,
+                  opts: Mapping[str, Any]) -> IKResult:
+    Ts = tgt.T[None] if not tgt.batch else tgt.T
+    rows = []
+    for k in range(Ts.shape[0]):
+        problem = _problem(robot, Ts[k], tgt, tol, respect)
+        qk = None if q0 is None else (q0 if q0.ndim == 1 else q0[k])
+        if spec.attempt is not None:
+            rows.append(run_attempts(spec, problem, qk, max_iter, restarts, seed, opts))
+        else:
+            q, ok, its, reason = spec.solve(robot, problem, qk, opts)
+            q = np.asarray(q, dtype=np.float64)
+            pe, oe = problem.errors(q)
+            rows.append((q, bool(ok), int(its), pe, oe, "" if ok else str(reason), 0))
+    if not tgt.batch:
+        q, ok, its, pe, oe, reason, used = rows[0]
+        return IKResult(q=q, success=ok, iterations=its, position_error=pe,
+                        orientation_error=oe, reason=reason, restarts=used, method=spec.name)
+    return IKResult(
+        q=np.array([r[0] for r in rows]),
+        success=np.array([r[1] for r in rows], dtype=bool),
+        iterations=np.array([r[2] for r in rows], dtype=np.int64),
+        position_error=np.array([r[3] for r in rows]),
+        orientation_error=np.array([r[4] for r in rows]),
+        reason=np.array([r[5] for r in rows], dtype=object).astype(str),
+        restarts=np.array([r[6] for r in rows], dtype=np.int64),
+        method=spec.name,
+    )
