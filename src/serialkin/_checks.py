@@ -44,7 +44,9 @@ def as_float_array(x: object, name: str, *, ndim: int | None = None) -> np.ndarr
         try:
             a = np.asarray(x)
         except (TypeError, ValueError) as exc:  # ragged lists
-            raise InputTypeError(f"{name} must be an array of real numbers, got {_describe(x)}") from exc
+            raise InputTypeError(
+                f"{name} must be an array of real numbers, got {_describe(x)}"
+            ) from exc
         if a.dtype.kind not in "biuf":
             raise InputTypeError(
                 f"{name} must be an array of real numbers, got {_describe(x)}"
@@ -83,7 +85,7 @@ def check_last_dims(a: np.ndarray, name: str, shape: tuple[int, ...]) -> np.ndar
 
 
 def check_rotation(R: object, name: str = "R", tol: float = ROTATION_TOL) -> np.ndarray:
-    """Check that ``R`` is a (batch of) rotation matrix: shape (..., 3, 3), RᵀR = I (eq 7), det R = +1."""
+    """Check that ``R`` is a rotation (batch): shape (..., 3, 3), RᵀR = I (eq 7), det R = 1."""
     a = check_last_dims(as_float_array(R, name), name, (3, 3))
     err = np.abs(np.swapaxes(a, -1, -2) @ a - np.eye(3)).max(initial=0.0)
     if err > tol:
@@ -103,7 +105,9 @@ def check_transform(T: object, name: str = "T", tol: float = ROTATION_TOL) -> np
     """
     a = check_last_dims(as_float_array(T, name), name, (4, 4))
     if np.abs(a[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max(initial=0.0) > tol:
-        raise InputError(f"{name} is not a homogeneous transform: its last row must be [0, 0, 0, 1]")
+        raise InputError(
+            f"{name} is not a homogeneous transform: its last row must be [0, 0, 0, 1]"
+        )
     check_rotation(a[..., :3, :3], f"the rotation block of {name}", tol)
     return a
 

@@ -181,7 +181,8 @@ def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
         f"<style>{_CSS}</style></head><body>"
         "<h1>Kinematics of Serial Manipulators — reproduced by serialkin</h1>"
         "<p>Every number and figure below is computed by serialkin when this report is "
-        "built (<code>serialkin chapter</code>); the corrected equations of the ERRATA are used.</p>"
+        "built (<code>serialkin chapter</code>); the corrected equations of the ERRATA "
+        "are used.</p>"
         f"<ol>{toc}</ol>{body}</body></html>"
     )
     path = out / "report.html"

@@ -14,7 +14,7 @@ import click
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="serialkin")
 def cli() -> None:
-    """serialkin: kinematics of serial robot manipulators.
+    r"""serialkin: kinematics of serial robot manipulators.
 
     \b
     Examples:
@@ -30,7 +30,7 @@ def cli() -> None:
 @click.option("--section", "sections", multiple=True,
               help="Build only this section (repeatable), e.g. --section forward.")
 def chapter(out: str, quiet: bool, sections: tuple[str, ...]) -> None:
-    """Reproduce the chapter's worked examples into an HTML report.
+    r"""Reproduce the chapter's worked examples into an HTML report.
 
     \b
     Example:

@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit, prange
 
 REVOLUTE = 0
@@ -61,6 +60,13 @@ def _apply_joint(T, meta_i, qi):
         return
     c = math.cos(x)
     s = math.sin(x)
+    if ax == 0.0 and ay == 0.0 and az == 1.0:  # z axis (every DH joint): only 2 columns change
+        for r in range(3):
+            t0 = T[r, 0]
+            t1 = T[r, 1]
+            T[r, 0] = t0 * c + t1 * s
+            T[r, 1] = t1 * c - t0 * s
+        return
     v = 1.0 - c
     r00 = c + ax * ax * v
     r01 = ax * ay * v - az * s
@@ -220,7 +226,7 @@ def all_finite(x):
 
 @njit(cache=True)
 def fk_checked(q, F, meta, T):
-    """:func:`fk_into` preceded by a finiteness check of q; returns False (T untouched) on NaN/inf."""
+    """Run :func:`fk_into` after a finiteness check of q; False (T untouched) on NaN/inf."""
     if not all_finite(q):
         return False
     fk_into(q, F, meta, T)

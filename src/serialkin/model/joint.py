@@ -84,7 +84,9 @@ class Joint:
         axis = as_vector(self.axis, f"{where} axis", 3)
         norm = float(np.linalg.norm(axis))
         if norm < 1e-12:
-            raise RobotDefinitionError(f"{where}: the joint axis is zero; expected a nonzero 3-vector")
+            raise RobotDefinitionError(
+                f"{where}: the joint axis is zero; expected a nonzero 3-vector"
+            )
         object.__setattr__(self, "type", jt)
         object.__setattr__(self, "axis", axis / norm)
         object.__setattr__(self, "origin", check_transform(self.origin, f"{where} origin").copy())

@@ -175,7 +175,7 @@ class Robot:
         return robot_from_urdf(path_or_string, base_link=base_link, tip_link=tip_link)
 
     def to_urdf(self) -> str:
-        """This robot's kinematics as a URDF string (see :mod:`serialkin.model.urdf`)."""
+        """Return the robot's kinematics as a URDF string (see :mod:`serialkin.model.urdf`)."""
         from serialkin.model.urdf import robot_to_urdf
 
         return robot_to_urdf(self)
@@ -339,8 +339,10 @@ class Robot:
         return self.jacobian(q)[..., rows, :]
 
     def jacobian_analytic(self, q: object, rep: str = "rpy") -> np.ndarray:
-        """Analytical Jacobian (eq 29) for an orientation representation (see
-        :func:`serialkin.kinematics.analytic.jacobian_analytic`)."""
+        """Analytical Jacobian (eq 29) for an orientation representation.
+
+        See :func:`serialkin.kinematics.analytic.jacobian_analytic`.
+        """
         from serialkin.kinematics.analytic import jacobian_analytic
 
         return jacobian_analytic(self, q, rep)
@@ -391,7 +393,7 @@ class Robot:
         return lo + (hi - lo) * rng.random(shape + (self.n,))
 
     def sampling_limits(self) -> np.ndarray:
-        """Joint limits with infinite bounds replaced by ±π (revolute) or ±1 m (prismatic), (n, 2)."""
+        """Joint limits, (n, 2), infinite bounds replaced by ±π (revolute) or ±1 m (prismatic)."""
         lim = self.qlim.copy()
         default = np.array([np.pi if t == "R" else 1.0 for t in self.joint_types])
         lim[:, 0] = np.where(np.isfinite(lim[:, 0]), lim[:, 0], -default)
@@ -412,7 +414,7 @@ class Robot:
         return solve(self, target, method=method, **options)
 
     def ik_all(self, target: object, **options: Any) -> np.ndarray:
-        """Every closed-form IK solution inside the limits (see :func:`serialkin.ik.analytic.ik_all`)."""
+        """Every closed-form IK solution inside the limits (see ``serialkin.ik.analytic``)."""
         from serialkin.ik.analytic import ik_all
 
         return ik_all(self, target, **options)
