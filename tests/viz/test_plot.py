@@ -173,3 +173,36 @@ def test_plot_path_2d_and_3d(planar3, spatial4):
     np.testing.assert_allclose(np.c_[x, y, z], np.c_[P, np.zeros(7)])
     with pytest.raises(InputError, match="points"):
         plot_path(ax, np.zeros((3, 4)))
+
+
+def test_redundancy_obstacle_classes():
+    """The redundancy helper's Circle/Sphere/Capsule and their to_dict() forms are drawn."""
+    obstacles = pytest.importorskip("serialkin.redundancy.obstacles")
+    circle = obstacles.Circle(center=[0.4, 0.1], radius=0.05, influence=0.03)
+    sphere = obstacles.Sphere(center=[0.1, 0.2, 0.3], radius=0.07)
+    capsule = obstacles.Capsule(a=[0, 0, 0], b=[0.2, 0, 0.1], radius=0.02)
+    for src in (circle, circle.to_dict()):
+        ob = as_obstacle(src)
+        assert ob.kind == "cylinder" and ob.height is None and ob.influence == 0.03
+        np.testing.assert_allclose(ob.center, [0.4, 0.1, 0.0])
+    for src in (sphere, sphere.to_dict()):
+        assert as_obstacle(src).kind == "sphere"
+    for src in (capsule, capsule.to_dict()):
+        ob = as_obstacle(src)
+        assert ob.kind == "capsule"
+        np.testing.assert_allclose(ob.b, [0.2, 0, 0.1])
+
+
+def test_influence_rings(planar3):
+    """influence=True adds a dashed ring at radius + the obstacle's own influence."""
+    ax = plot_robot(planar3, np.zeros(3))
+    plot_obstacles(ax, [dict(center=[0.5, 0.5], radius=0.1, influence=0.04),
+                        dict(center=[0.0, 0.5], radius=0.1)], influence=True)
+    rings = [p for p in ax.patches if p.get_gid() == "serialkin-obstacle-influence"]
+    assert len(rings) == 1 and rings[0].radius == pytest.approx(0.14)
+
+
+def test_unknown_kind_rejected():
+    """An unknown obstacle kind names the field and the valid kinds."""
+    with pytest.raises(InputError, match="kind must be one of"):
+        as_obstacle(dict(center=[0, 0, 0], radius=1.0, kind="cube"))

@@ -55,7 +55,7 @@ def test_trajectory_path_obstacles_in_data(planar3):
     """Trajectory rows, 2D path points (z = 0) and obstacles reach the page data."""
     Q = planar3.random_q(6, seed=3)
     path = np.c_[np.linspace(0, 1, 5), np.linspace(0, 0.5, 5)]
-    obs = [dict(center=[0.5, 0.5], radius=0.1), dict(center=[0, 1, 0], radius=0.2, height=0.5)]
+    obs = [dict(center=[0.5, 0.5, 0.0], radius=0.1), dict(center=[0, 1], radius=0.2, height=0.5)]
     data = viewer_data(planar3, trajectory=Q, path_points=path, obstacles=obs)
     np.testing.assert_array_equal(np.array(data["trajectory"]), Q)
     assert data["q"] == Q[0].tolist()

@@ -255,13 +255,15 @@ class Obstacle:
     """A normalised obstacle shape for drawing.
 
     Attributes:
-        kind: 'sphere' (circle in 2D), 'cylinder' (vertical, axis along world z, centred at
-            ``center``; a circle in 2D) or 'capsule' (segment a-b swept by ``radius``).
+        kind: 'sphere', 'cylinder' (vertical, axis along world z, centred at ``center``;
+            a circle in 2D) or 'capsule' (segment a-b swept by ``radius``).
         center: (3,) centre [m] (capsule: midpoint of a-b).
         radius: radius [m].
-        height: cylinder height [m] (None: infinite, drawn as tall as the view).
+        height: cylinder height [m] (None: infinite, drawn as tall as the scene needs).
         a: (3,) capsule start point [m] or None.
         b: (3,) capsule end point [m] or None.
+        influence: distance of influence beyond the surface [m] (Figure 10), 0 if none.
+        name: label.
     """
 
     kind: str
@@ -270,9 +272,15 @@ class Obstacle:
     height: float | None = None
     a: np.ndarray | None = None
     b: np.ndarray | None = None
+    influence: float = 0.0
+    name: str = ""
 
 
 _ENDPOINT_NAMES = (("a", "b"), ("p0", "p1"), ("start", "end"), ("p1", "p2"))
+#: Integer ``kind`` codes of :mod:`serialkin.redundancy.obstacles` (circle, sphere, capsule).
+_KIND_CODES = {0: "cylinder", 1: "sphere", 2: "capsule"}
+_KIND_NAMES = {"circle": "cylinder", "cylinder": "cylinder", "sphere": "sphere",
+               "ball": "sphere", "capsule": "capsule"}
 
 
 def _field(obj: object, names: Sequence[str]) -> Any:
@@ -294,17 +302,40 @@ def _point3(value: object, name: str) -> np.ndarray:
     return p
 
 
+def _kind_of(obj: object, name: str) -> str | None:
+    """Shape named by a ``kind``/``type``/``shape`` field (string or integer code)."""
+    value = _field(obj, ("kind", "type", "shape"))
+    if value is None or isinstance(value, bool):
+        return None
+    if isinstance(value, (int, np.integer)):
+        kind = _KIND_CODES.get(int(value))
+    elif isinstance(value, str):
+        kind = _KIND_NAMES.get(value.strip().lower())
+    else:
+        return None
+    if kind is None:
+        raise InputError(
+            f"{name}.kind must be one of {', '.join(_KIND_NAMES)} (or code 0, 1, 2), "
+            f"got {value!r}"
+        )
+    return kind
+
+
 def as_obstacle(obj: object, name: str = "obstacle") -> Obstacle:
     """Normalise an obstacle object or dict to :class:`Obstacle`.
 
+    Works with :mod:`serialkin.redundancy.obstacles` (``Circle``/``Cylinder``: an infinite
+    vertical cylinder; ``Sphere``; ``Capsule``), their ``to_dict()`` form and plain dicts.
     Accepted fields (attributes or mapping keys): ``center``/``centre``/``position`` (2 or 3
-    coordinates; z = 0 when 2), ``radius`` (> 0), optional ``height`` (vertical cylinder),
-    optional capsule end points ``a``/``b`` (or ``p0``/``p1``, ``start``/``end``), optional
-    ``kind``/``shape`` ('circle', 'sphere', 'cylinder', 'capsule').
+    coordinates; z = 0 when 2), ``radius`` (> 0), optional ``height`` (a vertical cylinder
+    of that height), capsule end points ``a``/``b`` (or ``p0``/``p1``, ``start``/``end``),
+    ``kind``/``type``/``shape`` ('circle' = 'cylinder', 'sphere', 'capsule', or the integer
+    codes 0, 1, 2), ``influence`` [m] and ``name``. Without a kind, a 2-coordinate centre
+    is a circle (infinite cylinder along z) and a 3-coordinate centre a sphere.
 
     Raises:
-        InputTypeError: ``obj`` has no radius.
-        InputError: bad coordinates or a non-positive radius.
+        InputTypeError: ``obj`` has no radius or no centre.
+        InputError: bad coordinates, a non-positive radius or an unknown kind.
     """
     if isinstance(obj, Obstacle):
         return obj
@@ -315,25 +346,34 @@ def as_obstacle(obj: object, name: str = "obstacle") -> Obstacle:
             f"got {type(obj).__name__} {obj!r}"[:200]
         )
     r = check_positive(radius, f"{name}.radius")
-    kind = _field(obj, ("kind", "shape"))
-    kind = str(kind).lower() if isinstance(kind, str) else None
+    kind = _kind_of(obj, name)
+    infl = _field(obj, ("influence",))
+    influence = 0.0 if infl is None else check_positive(infl, f"{name}.influence",
+                                                         allow_zero=True)
+    label = str(_field(obj, ("name",)) or "")
     for na, nb in _ENDPOINT_NAMES:
         pa, pb = _field(obj, (na,)), _field(obj, (nb,))
         if pa is not None and pb is not None and not isinstance(pa, (int, float, str)):
             a = _point3(pa, f"{name}.{na}")
             b = _point3(pb, f"{name}.{nb}")
-            return Obstacle("capsule", (a + b) / 2, r, None, a, b)
+            if np.allclose(a, b, rtol=0.0, atol=1e-12):
+                return Obstacle("sphere", a, r, influence=influence, name=label)
+            return Obstacle("capsule", (a + b) / 2, r, None, a, b, influence, label)
+    if kind == "capsule":
+        raise InputTypeError(f"{name} is a capsule but has no end points 'a' and 'b'")
     centre = _field(obj, ("center", "centre", "position", "c"))
     if centre is None:
         raise InputTypeError(f"{name} has a radius but no 'center': {obj!r}"[:200])
-    c = _point3(centre, f"{name}.center")
+    c_raw = as_float_array(centre, f"{name}.center")
+    c = _point3(c_raw, f"{name}.center")
     height = _field(obj, ("height", "h"))
     if height is not None:
         h = float(height)
-        return Obstacle("cylinder", c, r, h if np.isfinite(h) else None)
-    if kind == "cylinder":
-        return Obstacle("cylinder", c, r, None)
-    return Obstacle("sphere", c, r)
+        return Obstacle("cylinder", c, r, h if np.isfinite(h) else None, influence=influence,
+                        name=label)
+    if kind is None:
+        kind = "cylinder" if c_raw.shape == (2,) else "sphere"
+    return Obstacle(kind, c, r, influence=influence, name=label)
 
 
 def plot_obstacles(
@@ -343,7 +383,7 @@ def plot_obstacles(
     color: Any = "tab:gray",
     alpha: float = 0.35,
     edgecolor: Any = "0.25",
-    influence: float | None = None,
+    influence: bool | float = False,
 ) -> Any:
     """Draw obstacles: circles/capsule outlines on 2D axes, surfaces on 3D axes.
 
@@ -353,8 +393,9 @@ def plot_obstacles(
         color: face colour.
         alpha: face opacity.
         edgecolor: outline colour (2D).
-        influence: if given, also draw a dashed circle of radius ``radius + influence``
-            (the distance of influence, Figure 10) in 2D [m].
+        influence: in 2D, also draw a dashed circle of radius ``radius + influence`` (the
+            distance of influence, Figure 10): True uses each obstacle's own
+            ``influence``, a number [m] is used for all, False draws none.
 
     Returns:
         The axes. Every obstacle artist has ``gid='serialkin-obstacle'``.
@@ -372,12 +413,15 @@ def plot_obstacles(
             else:
                 ax.add_patch(Circle(tuple(o.center[:2]), o.radius, fc=color, ec=edgecolor,
                                     alpha=alpha, gid=OBSTACLE_GID))
-                if influence is not None:
-                    ax.add_patch(Circle(tuple(o.center[:2]), o.radius + float(influence),
+                extra = o.influence if influence is True else float(influence or 0.0)
+                if extra > 0.0:
+                    ax.add_patch(Circle(tuple(o.center[:2]), o.radius + extra,
                                         fill=False, ec=edgecolor, ls="--", lw=0.8,
                                         gid=OBSTACLE_GID + "-influence"))
             continue
-        X, Y, Z = _surface(o)
+        box = getattr(ax, "_serialkin_box", None)
+        tall = float(box[1][2] - box[0][2]) if box is not None else 0.0
+        X, Y, Z = _surface(o, default_height=max(4.0 * o.radius, tall))
         ax.plot_surface(X, Y, Z, color=color, alpha=alpha, linewidth=0, gid=OBSTACLE_GID)
         pts = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
         _set_equal_3d(ax, pts, 0.0)
@@ -398,8 +442,12 @@ def _stadium(a: np.ndarray, b: np.ndarray, r: float, k: int = 24) -> np.ndarray:
     return np.vstack([arc_b, arc_a])
 
 
-def _surface(o: Obstacle, k: int = 20) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Mesh grids (X, Y, Z) of a sphere, vertical cylinder or capsule."""
+def _surface(o: Obstacle, k: int = 20, default_height: float = 1.0,
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mesh grids (X, Y, Z) of a sphere, vertical cylinder or capsule.
+
+    An infinite cylinder (``height`` None) is drawn ``default_height`` tall.
+    """
     u = np.linspace(0, 2 * np.pi, k + 1)
     if o.kind == "sphere":
         v = np.linspace(0, np.pi, k // 2 + 1)
@@ -408,7 +456,7 @@ def _surface(o: Obstacle, k: int = 20) -> tuple[np.ndarray, np.ndarray, np.ndarr
         Z = o.center[2] + o.radius * np.outer(np.ones_like(u), np.cos(v))
         return X, Y, Z
     if o.kind == "cylinder":
-        h = o.height if o.height is not None else 4.0 * o.radius
+        h = o.height if o.height is not None else default_height
         z = o.center[2] + np.array([-h / 2, h / 2])
         X = o.center[0] + o.radius * np.outer(np.cos(u), np.ones(2))
         Y = o.center[1] + o.radius * np.outer(np.sin(u), np.ones(2))

@@ -221,7 +221,7 @@ for (const o of DATA.obstacles) {
     mesh = new THREE.Mesh(new THREE.SphereGeometry(o.radius, 32, 20), obstacleMat);
     mesh.position.set(...o.center);
   } else if (o.kind === "cylinder") {
-    const h = o.height === null ? 4 * o.radius : o.height;
+    const h = o.height === null ? Math.max(4 * o.radius, 0.3 * S) : o.height; // null: infinite
     mesh = new THREE.Mesh(new THREE.CylinderGeometry(o.radius, o.radius, h, 40), obstacleMat);
     mesh.position.set(...o.center);
     mesh.rotation.x = Math.PI / 2; // cylinder axis along world z
