@@ -25,7 +25,7 @@ TO_MATRIX = {"rpy": rpy_to_matrix, "zyz": zyz_to_matrix, "exp": so3_exp}
 def puma560() -> Robot:
     """Puma 560, standard DH (Corke, Robotics Toolbox 'Puma560'; a, d in m)."""
     a = [0.0, 0.4318, 0.0203, 0.0, 0.0, 0.0]
-    d = [0.0, 0.0, 0.15005, 0.4318, 0.0, 0.0]
+    d = [0.67183, 0.0, 0.15005, 0.4318, 0.0, 0.0]
     alpha = [np.pi / 2, 0.0, -np.pi / 2, np.pi / 2, -np.pi / 2, 0.0]
     rows = [{"a": a[i], "alpha": alpha[i], "d": d[i], "theta": 0.0} for i in range(6)]
     return Robot.from_dh(rows, name="puma560_test")
@@ -159,3 +159,19 @@ def test_bad_input_messages() -> None:
         rate_matrix(np.zeros(4), "rpy")
     with pytest.raises(InputError, match="tol must be a finite number > 0"):
         jacobian_analytic(PUMA, np.ones(6), "rpy", tol=-1.0)
+
+
+@pytest.mark.peer
+@pytest.mark.parametrize(("rep", "peer_rep"), [("rpy", "rpy/zyx"), ("zyz", "eul"), ("exp", "exp")])
+def test_agrees_with_robotics_toolbox(rep: str, peer_rep: str) -> None:
+    """J_A equals Robotics Toolbox's jacob0_analytical for the same Puma 560 DH table."""
+    rtb = pytest.importorskip("roboticstoolbox")
+    peer = rtb.models.DH.Puma560()
+    rng = np.random.default_rng(8)
+    for _ in range(5):
+        q = rng.uniform(-2.5, 2.5, 6)
+        if not away_from_singularity(PUMA, q, rep):
+            continue
+        assert np.allclose(peer.fkine(q).A, PUMA.fk(q), atol=1e-12)
+        ref = peer.jacob0_analytical(q, representation=peer_rep)
+        assert np.allclose(jacobian_analytic(PUMA, q, rep), ref, atol=1e-10)
