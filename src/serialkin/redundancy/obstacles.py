@@ -1,0 +1,507 @@
+"""Obstacles, link-obstacle distances and obstacle Jacobians (eqs 45, 51-56, corrected).
+
+The links of the robot are modelled as segments (capsules of radius ``link_radius``):
+link i (i = 1..n) runs from the origin of link frame i−1 to the origin of link frame i
+and moves with link frame i; when the tool transform has a translation, one more
+segment runs from the origin of frame n to the tool point. For a standard-DH arm these
+are the physical links (the joint axis z_{i−1} passes through frame i−1's origin, so it is
+a point of link i). For a prismatic joint the segment's first end is an approximation.
+
+Obstacles (all with an ``influence`` distance [m], beyond which the obstacle task of
+:mod:`serialkin.redundancy.multitask` ignores them):
+
+* :class:`Circle` — a circle in the world xy plane, i.e. an infinite cylinder along z
+  (``Cylinder`` is the same class); the distance is measured in the xy plane.
+* :class:`Sphere` — a ball in 3-D.
+* :class:`Capsule` — a segment with a radius in 3-D (a cylinder with round ends).
+
+Closest point (eqs 51-52, corrected by the ERRATA): the projection ``p_i = e_iᵀ(s_0 − s_i)``
+of the obstacle centre on link i is clamped to ``[0, ℓ_i]`` so that the closest point
+``s_ci = s_i + p_i e_i`` lies on the link *segment*, not on its infinite line. Eq 53 gives
+``d_ci = ‖s_ci − s_0‖``, eq 54 (corrected: ``s_ci``, not ``s_ai``) the unit vector
+``u_i = (s_ci − s_0)/d_ci`` from obstacle to link, and eqs 55-56 the obstacle-Jacobian row
+``J_ci = −u_iᵀ J_sci`` with ``J_sci = ∂s_ci/∂q`` (the point Jacobian of s_ci held fixed on
+its link, from the compiled kernel family). ``J_ci q̇`` is the rate at which link i
+approaches the obstacle; ``−J_ci`` is the gradient of its clearance.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+
+from serialkin._checks import as_vector, check_positive
+from serialkin.errors import InputError, InputTypeError
+from serialkin.kinematics import _kernels as K
+
+__all__ = [
+    "Capsule",
+    "Circle",
+    "ClosestPair",
+    "Cylinder",
+    "Obstacle",
+    "Sphere",
+    "check_obstacles",
+    "clearances",
+    "closest_pairs",
+    "obstacle_from_dict",
+    "obstacle_jacobian",
+    "robot_segments",
+]
+
+KIND_CIRCLE = 0
+KIND_SPHERE = 1
+KIND_CAPSULE = 2
+
+
+def _check_influence(influence: object) -> float:
+    return check_positive(influence, "influence", allow_zero=True)
+
+
+@dataclass(frozen=True)
+class Circle:
+    """A circle in the world xy plane (an infinite cylinder along z).
+
+    Attributes:
+        center: (2,) centre (x, y) [m].
+        radius: radius [m] (> 0).
+        influence: distance from the surface within which the obstacle task acts [m].
+        name: label.
+    """
+
+    center: np.ndarray
+    radius: float
+    influence: float = 0.02
+    name: str = ""
+    kind: int = field(default=KIND_CIRCLE, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "center", as_vector(self.center, "center", 2).copy())
+        object.__setattr__(self, "radius", check_positive(self.radius, "radius"))
+        object.__setattr__(self, "influence", _check_influence(self.influence))
+
+    def encode(self) -> np.ndarray:
+        """Row (kind, a(3), b(3), radius) for the compiled distance kernel."""
+        c = self.center
+        return np.array([KIND_CIRCLE, c[0], c[1], 0.0, c[0], c[1], 0.0, self.radius])
+
+    def to_dict(self) -> dict:
+        """Plain-data description (scenario files)."""
+        return {"type": "circle", "center": self.center.tolist(), "radius": self.radius,
+                "influence": self.influence, "name": self.name}
+
+
+Cylinder = Circle
+
+
+@dataclass(frozen=True)
+class Sphere:
+    """A ball in 3-D: centre (3,) [m], radius [m], influence [m], name."""
+
+    center: np.ndarray
+    radius: float
+    influence: float = 0.02
+    name: str = ""
+    kind: int = field(default=KIND_SPHERE, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "center", as_vector(self.center, "center", 3).copy())
+        object.__setattr__(self, "radius", check_positive(self.radius, "radius"))
+        object.__setattr__(self, "influence", _check_influence(self.influence))
+
+    def encode(self) -> np.ndarray:
+        """Row (kind, a(3), b(3), radius) for the compiled distance kernel."""
+        c = self.center
+        return np.array([KIND_SPHERE, *c, *c, self.radius])
+
+    def to_dict(self) -> dict:
+        """Plain-data description (scenario files)."""
+        return {"type": "sphere", "center": self.center.tolist(), "radius": self.radius,
+                "influence": self.influence, "name": self.name}
+
+
+@dataclass(frozen=True)
+class Capsule:
+    """A capsule in 3-D: the points within ``radius`` of the segment [a, b] (3,) [m]."""
+
+    a: np.ndarray
+    b: np.ndarray
+    radius: float
+    influence: float = 0.02
+    name: str = ""
+    kind: int = field(default=KIND_CAPSULE, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "a", as_vector(self.a, "a", 3).copy())
+        object.__setattr__(self, "b", as_vector(self.b, "b", 3).copy())
+        object.__setattr__(self, "radius", check_positive(self.radius, "radius"))
+        object.__setattr__(self, "influence", _check_influence(self.influence))
+
+    def encode(self) -> np.ndarray:
+        """Row (kind, a(3), b(3), radius) for the compiled distance kernel."""
+        return np.array([KIND_CAPSULE, *self.a, *self.b, self.radius])
+
+    def to_dict(self) -> dict:
+        """Plain-data description (scenario files)."""
+        return {"type": "capsule", "a": self.a.tolist(), "b": self.b.tolist(),
+                "radius": self.radius, "influence": self.influence, "name": self.name}
+
+
+Obstacle = Circle | Sphere | Capsule
+
+
+def obstacle_from_dict(d: dict, where: str = "obstacle") -> Obstacle:
+    """Build an obstacle from a mapping ``{type: circle|cylinder|sphere|capsule, ...}``.
+
+    Raises:
+        InputError: unknown type or missing/invalid field; the message starts with ``where``.
+    """
+    if not isinstance(d, dict):
+        raise InputTypeError(f"{where} must be a mapping, got {type(d).__name__}")
+    kinds = {"circle": Circle, "cylinder": Circle, "sphere": Sphere, "capsule": Capsule}
+    t = d.get("type")
+    if t not in kinds:
+        raise InputError(f"{where}.type must be one of {', '.join(kinds)}, got {t!r}")
+    cls = kinds[t]
+    fields = {"circle": ("center", "radius"), "cylinder": ("center", "radius"),
+              "sphere": ("center", "radius"), "capsule": ("a", "b", "radius")}[t]
+    extra = set(d) - set(fields) - {"type", "influence", "name"}
+    if extra:
+        raise InputError(f"{where}: unknown field(s) {sorted(extra)} for a {t}")
+    kwargs = {}
+    for f in fields:
+        if f not in d:
+            raise InputError(f"{where}.{f} is missing (a {t} needs {', '.join(fields)})")
+        kwargs[f] = d[f]
+    if "influence" in d:
+        kwargs["influence"] = d["influence"]
+    kwargs["name"] = str(d.get("name", ""))
+    try:
+        return cls(**kwargs)
+    except (InputError, InputTypeError) as exc:
+        raise type(exc)(f"{where}: {exc}") from exc
+
+
+def encode_obstacles(obstacles: Sequence[Obstacle]) -> np.ndarray:
+    """Obstacles as a (k, 8) float array for :func:`segment_obstacle_kernel`."""
+    for i, o in enumerate(obstacles):
+        if not isinstance(o, (Circle, Sphere, Capsule)):
+            raise InputTypeError(
+                f"obstacles[{i}] must be a Circle, Sphere or Capsule, got {type(o).__name__}")
+    if not obstacles:
+        return np.zeros((0, 8))
+    return np.ascontiguousarray(np.stack([o.encode() for o in obstacles]))
+
+
+# --------------------------------------------------------------------- compiled geometry
+@njit(cache=True)
+def _closest_segment_segment(p0, p1, a, b):
+    """Parameters (s, t) in [0, 1] of the closest points of segments p0p1 and ab (Ericson)."""
+    d1x = p1[0] - p0[0]
+    d1y = p1[1] - p0[1]
+    d1z = p1[2] - p0[2]
+    d2x = b[0] - a[0]
+    d2y = b[1] - a[1]
+    d2z = b[2] - a[2]
+    rx = p0[0] - a[0]
+    ry = p0[1] - a[1]
+    rz = p0[2] - a[2]
+    aa = d1x * d1x + d1y * d1y + d1z * d1z
+    ee = d2x * d2x + d2y * d2y + d2z * d2z
+    ff = d2x * rx + d2y * ry + d2z * rz
+    eps = 1e-18
+    if aa <= eps and ee <= eps:
+        return 0.0, 0.0
+    if aa <= eps:
+        return 0.0, min(max(ff / ee, 0.0), 1.0)
+    cc = d1x * rx + d1y * ry + d1z * rz
+    if ee <= eps:
+        return min(max(-cc / aa, 0.0), 1.0), 0.0
+    bb = d1x * d2x + d1y * d2y + d1z * d2z
+    den = aa * ee - bb * bb
+    s = min(max((bb * ff - cc * ee) / den, 0.0), 1.0) if den > eps else 0.0
+    t = (bb * s + ff) / ee
+    if t < 0.0:
+        t = 0.0
+        s = min(max(-cc / aa, 0.0), 1.0)
+    elif t > 1.0:
+        t = 1.0
+        s = min(max((bb - cc) / aa, 0.0), 1.0)
+    return s, t
+
+
+@njit(cache=True)
+def segment_obstacle_kernel(P0, P1, obs, link_radius, T, SC, B, D, C):
+    """Closest points between every segment and every obstacle (eqs 51-53, corrected).
+
+    Args:
+        P0: (s, 3) first ends of the segments [m].
+        P1: (s, 3) second ends [m].
+        obs: (k, 8) encoded obstacles (kind, a(3), b(3), radius).
+        link_radius: link capsule radius [m].
+        T: out (s, k) segment parameter of the closest point in [0, 1] (clamped: eq 51
+            corrected).
+        SC: out (s, k, 3) closest point on the segment s_c (eq 52).
+        B: out (s, k, 3) closest point of the obstacle's core (centre, axis or segment).
+        D: out (s, k) core distance ``‖s_c − b‖`` (eq 53).
+        C: out (s, k) clearance ``D − radius − link_radius`` (negative when penetrating).
+    """
+    pa = np.empty(3)
+    pb = np.empty(3)
+    q0 = np.empty(3)
+    q1 = np.empty(3)
+    for i in range(P0.shape[0]):
+        for j in range(obs.shape[0]):
+            kind = int(obs[j, 0])
+            if kind == KIND_CIRCLE:
+                # work in the xy plane: the obstacle is a vertical line through (cx, cy)
+                dx = P1[i, 0] - P0[i, 0]
+                dy = P1[i, 1] - P0[i, 1]
+                l2 = dx * dx + dy * dy
+                t = 0.0
+                if l2 > 1e-24:
+                    t = ((obs[j, 1] - P0[i, 0]) * dx + (obs[j, 2] - P0[i, 1]) * dy) / l2
+                    t = min(max(t, 0.0), 1.0)
+                for r in range(3):
+                    SC[i, j, r] = P0[i, r] + t * (P1[i, r] - P0[i, r])
+                B[i, j, 0] = obs[j, 1]
+                B[i, j, 1] = obs[j, 2]
+                B[i, j, 2] = SC[i, j, 2]
+            else:
+                for r in range(3):
+                    q0[r] = P0[i, r]
+                    q1[r] = P1[i, r]
+                    pa[r] = obs[j, 1 + r]
+                    pb[r] = obs[j, 4 + r]
+                s, u = _closest_segment_segment(q0, q1, pa, pb)
+                t = s
+                for r in range(3):
+                    SC[i, j, r] = q0[r] + s * (q1[r] - q0[r])
+                    B[i, j, r] = pa[r] + u * (pb[r] - pa[r])
+            T[i, j] = t
+            dd = 0.0
+            for r in range(3):
+                e = SC[i, j, r] - B[i, j, r]
+                dd += e * e
+            D[i, j] = math.sqrt(dd)
+            C[i, j] = D[i, j] - obs[j, 7] - link_radius
+
+
+# --------------------------------------------------------------------- python layer
+def robot_segments(robot, q: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The link segments of the robot at q.
+
+    Returns:
+        (P0, P1, link, frames): segment ends (s, 3) [m]; ``link`` (s,) the link frame each
+        segment moves with (1..n); ``frames`` (n+1, 4, 4) the link frames (``fk_all``).
+    """
+    qv = robot.check_q(q)
+    if qv.ndim != 1:
+        raise InputError(f"q must have shape ({robot.n},), got {qv.shape}")
+    g = _Geometry(robot, (), 0.0)
+    g.update(np.ascontiguousarray(qv))
+    return g.P0.copy(), g.P1.copy(), g.link.copy(), g.frames.copy()
+
+
+@dataclass(frozen=True)
+class ClosestPair:
+    """The closest points of one link segment and one obstacle.
+
+    Attributes:
+        segment: segment index (0-based; segment i moves with link frame ``link``).
+        obstacle: obstacle index.
+        link: link frame index (1..n) the segment moves with.
+        t: parameter of the closest point on the segment, in [0, 1].
+        point: s_c (3,), the closest point on the link [m] (eq 52).
+        obstacle_point: closest point of the obstacle's core (3,) [m].
+        distance: d_c, distance from the core (eq 53) [m].
+        clearance: d_c − obstacle radius − link radius [m] (negative when penetrating).
+        u: unit vector from obstacle to link (eq 54, corrected) (3,).
+        gradient: ∂clearance/∂q = uᵀ J_sc (n,), or None when not requested.
+    """
+
+    segment: int
+    obstacle: int
+    link: int
+    t: float
+    point: np.ndarray
+    obstacle_point: np.ndarray
+    distance: float
+    clearance: float
+    u: np.ndarray
+    gradient: np.ndarray | None
+
+    @property
+    def jacobian_row(self) -> np.ndarray | None:
+        """Eq 55: ``J_ci = −uᵀ J_sci`` (n,), the approach rate per unit joint velocity."""
+        return None if self.gradient is None else -self.gradient
+
+
+class _Geometry:
+    """Pre-allocated buffers for link-obstacle distances of one robot and obstacle set."""
+
+    def __init__(self, robot, obstacles: Sequence[Obstacle], link_radius: float) -> None:
+        self.robot = robot
+        self.obstacles = tuple(obstacles)
+        self.enc = encode_obstacles(self.obstacles)
+        self.link_radius = float(link_radius)
+        n = robot.n
+        self.frames = np.empty((n + 1, 4, 4))
+        self.has_tool = np.linalg.norm(robot.tool[:3, 3]) > 1e-12
+        s = n + (1 if self.has_tool else 0)
+        k = len(self.obstacles)
+        self.link = np.arange(1, n + 1, dtype=np.int64)
+        if self.has_tool:
+            self.link = np.append(self.link, n)
+        self.P0 = np.empty((s, 3))
+        self.P1 = np.empty((s, 3))
+        self.T = np.empty((s, k))
+        self.SC = np.empty((s, k, 3))
+        self.B = np.empty((s, k, 3))
+        self.D = np.empty((s, k))
+        self.C = np.empty((s, k))
+        self.Jbuf = np.empty((6, n))
+        self.pbuf = np.empty(3)
+        self.Tee = np.empty((4, 4))
+
+    def update(self, q: np.ndarray) -> None:
+        r = self.robot
+        K.fk_all_into(q, r._F, r._L, r._meta, self.frames)
+        n = r.n
+        self.P0[:n] = self.frames[:n, :3, 3]
+        self.P1[:n] = self.frames[1:, :3, 3]
+        if self.has_tool:
+            K.fk_into(q, r._F, r._meta, self.Tee)
+            self.P0[n] = self.frames[n, :3, 3]
+            self.P1[n] = self.Tee[:3, 3]
+        if self.enc.shape[0]:
+            segment_obstacle_kernel(self.P0, self.P1, self.enc, self.link_radius,
+                                    self.T, self.SC, self.B, self.D, self.C)
+
+    def gradient(self, q: np.ndarray, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
+        """(u (3,), ∂clearance/∂q (n,)) of segment i and obstacle j (after update)."""
+        k = int(self.link[i])
+        W = self.frames[k]
+        sc = self.SC[i, j]
+        local = W[:3, :3].T @ (sc - W[:3, 3])
+        r = self.robot
+        K.point_jacobian_into(q, r._F, r._L, r._meta, k, np.ascontiguousarray(local),
+                              self.Jbuf, self.pbuf)
+        d = self.D[i, j]
+        diff = sc - self.B[i, j]
+        if d > 1e-12:
+            u = diff / d
+        else:  # on the core: any direction; pick the segment's normal in xy
+            seg = self.P1[i] - self.P0[i]
+            u = np.array([-seg[1], seg[0], 0.0])
+            nu = np.linalg.norm(u)
+            u = u / nu if nu > 1e-12 else np.array([1.0, 0.0, 0.0])
+        return u, u @ self.Jbuf[:3]
+
+
+def clearances(robot, q: object, obstacles: Sequence[Obstacle], *,
+               link_radius: float = 0.0) -> np.ndarray:
+    """Signed clearance of every link segment to every obstacle, shape (s, k) [m].
+
+    ``s`` is the number of segments (n, plus one for a tool offset), ``k`` the number of
+    obstacles. Use ``.min(axis=0)`` for the clearance of each obstacle.
+    """
+    qv = robot.check_q(q)
+    if qv.ndim != 1:
+        raise InputError(f"q must have shape ({robot.n},), got {qv.shape}")
+    check_positive(link_radius, "link_radius", allow_zero=True)
+    g = _Geometry(robot, obstacles, link_radius)
+    g.update(np.ascontiguousarray(qv))
+    return g.C.copy()
+
+
+def closest_pairs(robot, q: object, obstacles: Sequence[Obstacle], *,
+                  link_radius: float = 0.0, with_jacobian: bool = False) -> list[ClosestPair]:
+    """Closest points of every link segment and every obstacle (eqs 51-56, corrected).
+
+    Args:
+        robot: the robot.
+        q: joint values, shape (n,).
+        obstacles: obstacles.
+        link_radius: link capsule radius [m].
+        with_jacobian: also compute ``∂clearance/∂q`` (eq 55 with the opposite sign).
+
+    Returns:
+        list of :class:`ClosestPair`, segment-major.
+    """
+    qv = np.ascontiguousarray(robot.check_q(q))
+    if qv.ndim != 1:
+        raise InputError(f"q must have shape ({robot.n},), got {qv.shape}")
+    check_positive(link_radius, "link_radius", allow_zero=True)
+    g = _Geometry(robot, obstacles, link_radius)
+    g.update(qv)
+    out = []
+    for i in range(g.C.shape[0]):
+        for j in range(g.C.shape[1]):
+            u, grad = g.gradient(qv, i, j) if with_jacobian else (None, None)
+            if u is None:
+                d = g.D[i, j]
+                u = (g.SC[i, j] - g.B[i, j]) / d if d > 1e-12 else np.zeros(3)
+            out.append(ClosestPair(i, j, int(g.link[i]), float(g.T[i, j]), g.SC[i, j].copy(),
+                                   g.B[i, j].copy(), float(g.D[i, j]), float(g.C[i, j]),
+                                   u, None if grad is None else grad.copy()))
+    return out
+
+
+def obstacle_jacobian(robot, q: object, obstacles: Sequence[Obstacle], *,
+                      link_radius: float = 0.0, within_influence: bool = True
+                      ) -> tuple[np.ndarray, np.ndarray, list[tuple[int, int]]]:
+    """Obstacle-avoidance Jacobian J_c (eqs 55-56): one row per (link, obstacle) pair.
+
+    Args:
+        robot: the robot.
+        q: joint values, shape (n,).
+        obstacles: obstacles.
+        link_radius: link capsule radius [m].
+        within_influence: keep only pairs closer than the obstacle's influence distance
+            (the chapter's "links that could collide"); else every pair.
+
+    Returns:
+        (J_c (r, n), clearance (r,), pairs [(segment, obstacle)]), rows ``−u_iᵀ J_sci``.
+    """
+    pairs = closest_pairs(robot, q, obstacles, link_radius=link_radius, with_jacobian=True)
+    obs = tuple(obstacles)
+    keep = [p for p in pairs if not within_influence or p.clearance < obs[p.obstacle].influence]
+    if not keep:
+        return np.zeros((0, robot.n)), np.zeros(0), []
+    return (np.array([p.jacobian_row for p in keep]), np.array([p.clearance for p in keep]),
+            [(p.segment, p.obstacle) for p in keep])
+
+
+def check_obstacles(robot, obstacles: Sequence[Obstacle], *, link_radius: float = 0.0) -> None:
+    """Raise when an obstacle overlaps the robot's base (the first joint's origin).
+
+    Raises:
+        InputError: naming the obstacle and its distance to the base.
+        InputTypeError: an entry that is not an obstacle.
+    """
+    encode_obstacles(tuple(obstacles))
+    base = np.array(robot.base[:3, 3], dtype=float)
+    frames0 = robot.fk_all(np.zeros(robot.n))
+    base = frames0[0, :3, 3] if frames0.shape[0] else base
+    P = np.ascontiguousarray(base[None, :])
+    enc = encode_obstacles(tuple(obstacles))
+    if not enc.shape[0]:
+        return
+    k = enc.shape[0]
+    T = np.empty((1, k))
+    SC = np.empty((1, k, 3))
+    B = np.empty((1, k, 3))
+    D = np.empty((1, k))
+    C = np.empty((1, k))
+    segment_obstacle_kernel(P, P, enc, float(link_radius), T, SC, B, D, C)
+    for j, o in enumerate(obstacles):
+        if C[0, j] <= 0.0:
+            label = f" {o.name!r}" if o.name else ""
+            raise InputError(
+                f"obstacles[{j}]{label} overlaps the robot base at {base.round(4).tolist()}: "
+                f"clearance {C[0, j]:.4g} m (radius {o.radius} m); move it or shrink it")

@@ -1,0 +1,307 @@
+"""Path tracking: follow a task-space path with a redundant (or any) arm.
+
+:func:`track` walks the path point by point ("CYCLE WHILE 1" of the chapter's algorithms)
+and, at each point, iterates a solver from the previous configuration until the task
+error is below ``tol`` or the iteration budget is spent ("CYCLE WHILE 2"). Solvers:
+
+* ``'dls'`` (default) — damped least squares, eq 46 as corrected by the ERRATA:
+  ``Δq = Jᵀ(J Jᵀ + λ²I)⁻¹ Δx; q ← q + Δq`` (the chapter's 6-link algorithm, steps 5-8,
+  corrected). The whole path runs in one compiled loop over the kernel family.
+* ``'multitask'`` or a :class:`~serialkin.redundancy.multitask.MultiTaskResolver` — the
+  weighted multi-task resolution of eq 48 (obstacles, joint limits, singularities).
+* any other name — an IK method of :func:`serialkin.ik.solve` (``robot.ik``), warm
+  started from the previous configuration.
+
+A point whose final error exceeds ``tolerance`` is reported (:class:`PathFailure`: index,
+error, target); tracking continues from the best configuration found or stops there, as
+chosen with ``on_unreachable``; everything computed so far is kept in the trajectory.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from serialkin._checks import check_choice, check_int, check_positive
+from serialkin.errors import InputError, InputTypeError
+from serialkin.kinematics import _kernels as K
+from serialkin.redundancy.multitask import MultiTaskResolver
+from serialkin.redundancy.objectives import task_rows
+from serialkin.redundancy.obstacles import _Geometry, check_obstacles, encode_obstacles
+from serialkin.spatial._kernels import pose_error_into
+from serialkin.tracking.path import Path
+from serialkin.tracking.trajectory import PathFailure, Trajectory
+
+__all__ = ["ON_UNREACHABLE", "dls_track", "limit_margins", "track"]
+
+ON_UNREACHABLE = ("continue", "stop")
+
+
+@njit(cache=True)
+def dls_track(q0, targets, rows, F, meta, lam, tol, max_iter, max_step, accept, stop_on_fail,
+              kick, Q, ITER, ERR, TIME_NS):
+    """Compiled DLS path tracking (eq 46 corrected, the 6-link algorithm).
+
+    Args:
+        q0: (n,) start configuration.
+        targets: (p, 4, 4) target poses.
+        rows: (m,) task rows of the pose error / Jacobian ([0, 1] for planar points).
+        F: chain fixed transforms ``robot.chain.F``.
+        meta: chain joint data ``robot.chain.meta``.
+        lam: damping λ [m].
+        tol: convergence tolerance on ‖e‖ [m].
+        max_iter: iteration budget per point.
+        max_step: cap on ‖Δq‖ per iteration [rad].
+        accept: acceptance tolerance [m] (a point is reached when ‖e‖ ≤ accept).
+        stop_on_fail: stop after the first point not reached.
+        kick: joint offset [rad] added to every joint when the step vanishes while the
+            error does not (an exact singularity), to leave it.
+        Q: out (p, n) joint values per point.
+        ITER: out (p,) iterations per point.
+        ERR: out (p,) final error norm per point [m].
+        TIME_NS: out (p,), zeroed (per-point times are filled by the caller).
+
+    Returns:
+        number of points computed.
+    """
+    n = q0.shape[0]
+    m = rows.shape[0]
+    p = targets.shape[0]
+    q = q0.copy()
+    J = np.empty((6, n))
+    T = np.empty((4, 4))
+    e6 = np.empty(6)
+    e = np.empty(m)
+    Jt = np.empty((m, n))
+    A = np.empty((m, m))
+    for k in range(p):
+        it = 0
+        while True:
+            K.jacobian_into(q, F, meta, J, T)
+            pose_error_into(T, targets[k], e6)
+            err2 = 0.0
+            for r in range(m):
+                e[r] = e6[rows[r]]
+                err2 += e[r] * e[r]
+                for c in range(n):
+                    Jt[r, c] = J[rows[r], c]
+            err = np.sqrt(err2)
+            if err < tol or it >= max_iter:
+                break
+            for r in range(m):
+                for c in range(m):
+                    s = 0.0
+                    for j in range(n):
+                        s += Jt[r, j] * Jt[c, j]
+                    A[r, c] = s
+                A[r, r] += lam * lam
+            y = np.linalg.solve(A, e)
+            dq = Jt.T @ y
+            nrm = np.sqrt(np.sum(dq * dq))
+            if nrm > max_step:
+                dq *= max_step / nrm
+            for j in range(n):
+                q[j] += dq[j]
+            it += 1
+            if nrm < 1e-12 * (1.0 + err):
+                # exactly singular with the error in the lost direction (e.g. the stretched
+                # q0 = 0 of the 6-link example and a target behind the arm): the DLS step
+                # vanishes; bend every joint by a small fixed angle to leave the singularity
+                for j in range(n):
+                    q[j] += kick
+        for j in range(n):
+            Q[k, j] = q[j]
+        ITER[k] = it
+        ERR[k] = err
+        TIME_NS[k] = 0
+        if stop_on_fail and err > accept:
+            return k + 1
+    return p
+
+
+def limit_margins(q: np.ndarray, qlim: np.ndarray) -> np.ndarray:
+    """Distance of each joint to its nearer limit, (..., n) [rad or m]; negative when outside."""
+    with np.errstate(invalid="ignore"):
+        m = np.minimum(q - qlim[:, 0], qlim[:, 1] - q)
+    return np.where(np.isnan(m), np.inf, m)
+
+
+def _ik_target(path: Path, k: int) -> np.ndarray:
+    if path.task in ("planar", "position", "planar_pose"):
+        return np.array(path.points[k])
+    return np.array(path.targets[k])
+
+
+def track(
+    robot,
+    path: Path,
+    solver: str | MultiTaskResolver = "dls",
+    *,
+    q0: object = None,
+    obstacles: tuple = (),
+    link_radius: float = 0.0,
+    tolerance: float = 5e-3,
+    on_unreachable: str = "continue",
+    damping: float = 0.02,
+    tol: float = 1e-6,
+    max_iter: int = 500,
+    max_step: float = 0.5,
+    ik_options: Mapping[str, Any] | None = None,
+) -> Trajectory:
+    """Track a path and record the trajectory.
+
+    Args:
+        robot: the robot.
+        path: a :class:`~serialkin.tracking.path.Path`.
+        solver: 'dls' (eq 46 corrected, compiled), 'multitask' (eq 48 with default
+            weights and the given obstacles), a ``MultiTaskResolver``, or an IK method
+            name of :func:`serialkin.ik.solve`.
+        q0: start configuration (n,); default zeros (the chapter's q0 = 0).
+        obstacles: obstacles for clearance reporting (and for ``'multitask'``); a
+            resolver's own obstacles are used when this is empty.
+        link_radius: link capsule radius for clearances [m].
+        tolerance: acceptance tolerance: a point is reached when its error ≤ this [m].
+        on_unreachable: 'continue' (report and go on from the best configuration) or
+            'stop' (report and stop; the trajectory keeps what was computed).
+        damping: λ of DLS [m].
+        tol: convergence tolerance of the iterations [m] (below ``tolerance``).
+        max_iter: iteration budget per point (DLS and IK; a resolver keeps its own).
+        max_step: cap on the joint step per DLS iteration [rad].
+        ik_options: extra keyword arguments for ``robot.ik`` (IK methods only).
+
+    Returns:
+        :class:`~serialkin.tracking.trajectory.Trajectory`.
+
+    Raises:
+        InputError: bad q0, negative tolerances, unknown ``on_unreachable``, obstacles
+            overlapping the base.
+        InputTypeError: path is not a Path.
+    """
+    if not isinstance(path, Path):
+        raise InputTypeError(f"path must be a serialkin.tracking.Path, got {type(path).__name__}")
+    check_choice(on_unreachable, "on_unreachable", ON_UNREACHABLE)
+    accept = check_positive(tolerance, "tolerance")
+    conv = check_positive(tol, "tol")
+    lam = check_positive(damping, "damping")
+    budget = check_int(max_iter, "max_iter", minimum=1)
+    cap = check_positive(max_step, "max_step")
+    check_positive(link_radius, "link_radius", allow_zero=True)
+    q_start = (np.zeros(robot.n) if q0 is None
+               else np.array(robot.check_q(q0, "q0"), dtype=float))
+    if q_start.shape != (robot.n,):
+        raise InputError(f"q0 must have shape ({robot.n},), got {q_start.shape}")
+    rows = task_rows(path.task if path.task != "pose" else "pose")
+    if isinstance(solver, MultiTaskResolver) and not obstacles:
+        obstacles = solver.obstacles
+    obstacles = tuple(obstacles)
+    encode_obstacles(obstacles)
+    check_obstacles(robot, obstacles, link_radius=link_radius)
+    stop = on_unreachable == "stop"
+    p = len(path)
+    n = robot.n
+    Q = np.zeros((p, n))
+    ITER = np.zeros(p, dtype=np.int64)
+    ERR = np.zeros(p)
+    TIMES = np.zeros(p)
+    targets = np.ascontiguousarray(path.targets)
+
+    if isinstance(solver, str) and solver == "dls":
+        label = f"DLS (eq 46), λ = {lam:g} m"
+        t0 = time.perf_counter()
+        count = dls_track(q_start, targets, rows, robot._F, robot._meta, lam, conv, budget, cap,
+                          accept, stop, 1e-3, Q, ITER, ERR, np.zeros(p, dtype=np.int64))
+        elapsed = time.perf_counter() - t0
+        # per-point time: shared in proportion to the iterations used
+        its = ITER[:count].astype(float) + 1.0
+        TIMES[:count] = elapsed * its / its.sum()
+    else:
+        if isinstance(solver, str) and solver == "multitask":
+            solver = MultiTaskResolver(task=path.task, obstacles=obstacles,
+                                       link_radius=link_radius, max_iter=budget, tol=conv)
+        if isinstance(solver, MultiTaskResolver):
+            if list(task_rows(solver.task)) != list(rows):
+                raise InputError(f"the resolver's task {solver.task!r} does not match the "
+                                 f"path's task {path.task!r}")
+            label = "multi-task resolution (eq 48)"
+            state = solver.prepare(robot)
+            step = lambda k, q: state.solve(targets[k], q)  # noqa: E731
+        elif isinstance(solver, str):
+            from serialkin import ik as ik_module
+
+            if not hasattr(ik_module, "solve"):
+                raise InputError(f"IK method {solver!r} needs serialkin.ik.solve, which is not "
+                                 "available; use solver='dls' or 'multitask'")
+            label = f"IK method {solver!r}"
+            opts = dict(ik_options or {})
+            opts.setdefault("max_iter", budget)
+            opts.setdefault("tol", conv)
+            step = _ik_step(robot, path, solver, opts)
+        else:
+            raise InputTypeError("solver must be 'dls', 'multitask', an IK method name or a "
+                                 f"MultiTaskResolver, got {type(solver).__name__}")
+        q = q_start.copy()
+        count = 0
+        for k in range(p):
+            t0 = time.perf_counter()
+            res = step(k, q)
+            TIMES[k] = time.perf_counter() - t0
+            q = np.array(res.q, dtype=float)
+            Q[k] = q
+            ITER[k] = res.iterations
+            ERR[k] = res.error
+            count = k + 1
+            if stop and res.error > accept:
+                break
+    return _assemble(robot, path, Q[:count], ITER[:count], ERR[:count], TIMES[:count],
+                     obstacles, link_radius, accept, label,
+                     stop and count > 0 and ERR[count - 1] > accept)
+
+
+class _IKStats:
+    def __init__(self, q: np.ndarray, iterations: int, error: float) -> None:
+        self.q, self.iterations, self.error = q, iterations, error
+
+
+def _ik_step(robot, path: Path, method: str, opts: dict):
+    rows = task_rows(path.task)
+    J = np.empty((6, robot.n))
+    T = np.empty((4, 4))
+    e6 = np.empty(6)
+
+    def step(k: int, q: np.ndarray) -> _IKStats:
+        res = robot.ik(_ik_target(path, k), method=method, q0=q, **opts)
+        qn = np.ascontiguousarray(res.q, dtype=float)
+        K.jacobian_into(qn, robot._F, robot._meta, J, T)
+        pose_error_into(T, path.targets[k], e6)
+        return _IKStats(qn, int(getattr(res, "iterations", 0)),
+                        float(np.linalg.norm(e6[rows])))
+
+    return step
+
+
+def _assemble(robot, path: Path, Q, ITER, ERR, TIMES, obstacles, link_radius, accept, label,
+              stopped) -> Trajectory:
+    count = Q.shape[0]
+    poses = robot.fk(Q) if count else np.zeros((0, 4, 4))
+    if obstacles and count:
+        g = _Geometry(robot, obstacles, link_radius)
+        clear = np.empty((count, len(obstacles)))
+        for k in range(count):
+            g.update(np.ascontiguousarray(Q[k]))
+            clear[k] = g.C.min(axis=0)
+    else:
+        clear = np.zeros((count, len(obstacles)))
+    margin = limit_margins(Q, np.asarray(robot.qlim, dtype=float))
+    reached = ERR <= accept
+    failures = [PathFailure(int(k), float(ERR[k]), tuple(float(v) for v in path.points[k]))
+                for k in np.flatnonzero(~reached)]
+    return Trajectory(
+        q=Q, poses=poses, targets=np.array(path.targets[:count]), errors=ERR,
+        iterations=ITER, reached=reached, clearance=clear, limit_margin=margin, times=TIMES,
+        task=path.task, tolerance=accept, joint_names=tuple(robot.joint_names),
+        obstacle_names=tuple(o.name or f"obstacle{i + 1}" for i, o in enumerate(obstacles)),
+        failures=failures, stopped=bool(stopped), path_length=len(path), solver=label)
