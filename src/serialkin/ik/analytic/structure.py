@@ -1,0 +1,305 @@
+"""Recognise which closed-form inverse kinematics a robot admits, from its joint axes.
+
+The test never looks at the robot's name or at its DH table: it walks the compiled
+chain (:mod:`serialkin.model.chain`) at q = 0 and reads every joint as a line in the
+world frame, unit direction ``w_i`` through a point ``r_i`` (product-of-exponentials
+form, ``T(q) = exp(ξ_1 q_1)···exp(ξ_n q_n)·M``). Standard DH, modified DH, general
+joints and URDF therefore give the same answer for the same mechanism, and base and
+tool transforms are part of the lines and of ``M`` (solving on ``M`` is the same as
+solving for the flange on ``base⁻¹·T·tool⁻¹``).
+
+Recognised classes (:data:`CLASSES`):
+
+``planar_2r``, ``planar_3r``
+    two / three revolute joints on parallel axes (the chapter's arms, eqs 21-27).
+``scara``, ``scara_rrp``
+    three / two revolute joints and one prismatic joint, all parallel (chapter Table 1).
+``puma``
+    6R with a spherical wrist (axes 4, 5, 6 meet in one point) and parallel axes 2, 3
+    (axis 1 not parallel to them): Pieper's case, up to 8 solutions.
+``pieper_intersecting``
+    6R with a spherical wrist whose first two axes intersect: up to 8 solutions.
+``stanford``
+    R R P with intersecting axes 1, 2 followed by a spherical wrist: up to 8.
+``ur``
+    6R with three consecutive parallel axes 2, 3, 4 (axis 1 not parallel to them) and
+    intersecting axes 5, 6 (Universal Robots class): up to 8 solutions.
+
+The geometric tests use :data:`ANGLE_TOL` [rad] and :data:`LENGTH_TOL` (relative to the
+robot's size): a closed form is exact only for the exact structure, so a robot whose
+axes are merely close to parallel (e.g. a URDF with angles rounded to 4 digits) is
+reported as not recognised, with the measured deviation in the message.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from serialkin.errors import NoClosedFormError
+from serialkin.model.robot import Robot
+
+#: Two axes are parallel when |w_i × w_j| is below this [rad].
+ANGLE_TOL = 1e-9
+#: Two lines meet / a point is on a line within this distance, times the robot's size [m].
+LENGTH_TOL = 1e-9
+
+#: Recognised class names and what they mean.
+CLASSES: dict[str, str] = {
+    "planar_2r": "planar arm, two revolute joints on parallel axes",
+    "planar_3r": "planar arm, three revolute joints on parallel axes",
+    "scara": "SCARA: three revolute and one prismatic joint, all axes parallel",
+    "scara_rrp": "two revolute and one prismatic joint, all axes parallel",
+    "puma": "6R, spherical wrist, parallel axes 2 and 3 (Pieper; Puma 560 class)",
+    "pieper_intersecting": "6R, spherical wrist, intersecting axes 1 and 2 (Pieper)",
+    "stanford": "RRP arm with intersecting axes 1 and 2 and a spherical wrist (Stanford arm)",
+    "ur": "6R, three parallel axes 2, 3, 4 and intersecting axes 5, 6 (UR class)",
+}
+
+NUMERICAL_HINT = (
+    "use a numerical method instead, e.g. robot.ik(target, method='lm') "
+    "(or serialkin.ik.solve(robot, target, method=...))"
+)
+
+
+@dataclass(frozen=True, eq=False)
+class Structure:
+    """A robot's joint lines at q = 0 and its recognised closed-form class.
+
+    Attributes:
+        kind: class name, a key of :data:`CLASSES`.
+        W: (n, 3) unit joint directions in the world frame at q = 0.
+        P: (n, 3) a point on each joint line (the joint frame's origin) [m].
+        M: (4, 4) tool pose at q = 0 (base and tool transforms included).
+        revolute: (n,) booleans.
+        aux: (k, 3) class-specific points and vectors (see each solver).
+        order: (k,) class-specific joint indices.
+        planar_z: the joints' axes are parallel to the world z axis, so planar targets
+            (x, y) and (x, y, φ) are meaningful.
+        scale: characteristic length of the robot [m] (for tolerances).
+    """
+
+    kind: str
+    W: np.ndarray
+    P: np.ndarray
+    M: np.ndarray
+    revolute: np.ndarray
+    aux: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    order: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    planar_z: bool = False
+    scale: float = 1.0
+
+
+def joint_lines(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Joint lines at q = 0 in the world frame, from the compiled chain.
+
+    Joint i's frame just before its motion is ``F[0]·M_1(o_1)·F[1] ··· F[i-1]`` (o =
+    joint offsets, see :mod:`serialkin.kinematics._kernels`); its line has direction
+    ``R·axis_i`` through that frame's origin.
+
+    Returns:
+        W (n, 3) unit directions, P (n, 3) points [m], M (4, 4) the pose ``T(0)``.
+    """
+    F, meta = robot.chain.F, robot.chain.meta
+    n = robot.n
+    W = np.empty((n, 3))
+    P = np.empty((n, 3))
+    T = F[0].copy()
+    for i in range(n):
+        a = meta[i, :3]
+        W[i] = T[:3, :3] @ a
+        P[i] = T[:3, 3]
+        x = meta[i, 4]
+        A = np.eye(4)
+        if meta[i, 3] == 1:
+            A[:3, 3] = x * a
+        else:
+            K = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+            A[:3, :3] = np.eye(3) + math.sin(x) * K + (1.0 - math.cos(x)) * (K @ K)
+        T = T @ A @ F[i + 1]
+    W /= np.linalg.norm(W, axis=1, keepdims=True)
+    return W, P, T
+
+
+def _sin_angle(w1: np.ndarray, w2: np.ndarray) -> float:
+    return float(np.linalg.norm(np.cross(w1, w2)))
+
+
+def _line_distance(p1, w1, p2, w2) -> float:
+    """Shortest distance between two lines [m]."""
+    x = np.cross(w1, w2)
+    nx = np.linalg.norm(x)
+    d = p2 - p1
+    if nx < ANGLE_TOL:
+        return float(np.linalg.norm(np.cross(d, w1)))
+    return float(abs(d @ x) / nx)
+
+
+def _closest_point(p1, w1, p2, w2) -> np.ndarray:
+    """Midpoint of the common perpendicular of two non-parallel lines."""
+    d = p2 - p1
+    c = w1 @ w2
+    den = 1.0 - c * c
+    t1 = (d @ w1 - c * (d @ w2)) / den
+    t2 = (c * (d @ w1) - d @ w2) / den
+    return 0.5 * ((p1 + t1 * w1) + (p2 + t2 * w2))
+
+
+def _point_line_distance(x, p, w) -> float:
+    return float(np.linalg.norm(np.cross(x - p, w)))
+
+
+def _unit_perp(w: np.ndarray) -> np.ndarray:
+    """A unit vector perpendicular to w (deterministic)."""
+    k = int(np.argmin(np.abs(w)))
+    e = np.zeros(3)
+    e[k] = 1.0
+    v = e - (e @ w) * w
+    return v / np.linalg.norm(v)
+
+
+def _fail(robot: Robot, why: str) -> NoClosedFormError:
+    types = "".join(robot.joint_types)
+    return NoClosedFormError(
+        f"no closed-form inverse kinematics for robot {robot.name!r} ({robot.n} joints, "
+        f"{types}): {why}. Closed forms are known here for: "
+        + "; ".join(CLASSES.values())
+        + f". For this robot, {NUMERICAL_HINT}."
+    )
+
+
+def analyse(robot: Robot) -> Structure:
+    """Recognise the robot's closed-form class from its joint lines.
+
+    Args:
+        robot: the robot.
+
+    Returns:
+        the :class:`Structure` with the class-specific data the solvers need.
+
+    Raises:
+        NoClosedFormError: the structure is none of :data:`CLASSES`; the message says
+            which test failed and points to the numerical methods.
+    """
+    W, P, M = joint_lines(robot)
+    n = robot.n
+    rev = np.array([t == "R" for t in robot.joint_types])
+    scale = max(1.0, float(np.max(np.linalg.norm(np.vstack([P, M[:3, 3]]) - P[0], axis=1))))
+    ltol = LENGTH_TOL * scale
+
+    def para(i: int, j: int) -> bool:
+        return _sin_angle(W[i], W[j]) < ANGLE_TOL
+
+    # ---------------------------------------------------------------- parallel family
+    if n <= 4 and all(para(0, j) for j in range(1, n)):
+        return _parallel_family(robot, W, P, M, rev, scale, ltol)
+    if n == 6:
+        return _six_dof(robot, W, P, M, rev, scale, ltol)
+    if n > 6:
+        raise _fail(robot, f"it has {n} joints, more than the 6 a pose needs: it is redundant "
+                           "and has infinitely many solutions per target")
+    raise _fail(robot, f"its {n} joints are not all parallel and it is not a 6-joint arm")
+
+
+def _parallel_family(robot, W, P, M, rev, scale, ltol) -> Structure:
+    n = robot.n
+    ir = [i for i in range(n) if rev[i]]
+    ip = [i for i in range(n) if not rev[i]]
+    nr, np_ = len(ir), len(ip)
+    if np_ > 1:
+        raise _fail(robot, f"{np_} prismatic joints along one direction are redundant")
+    if nr not in (2, 3):
+        raise _fail(robot, f"all its axes are parallel but it has {nr} revolute joint(s); "
+                           "closed forms need two or three (more are redundant)")
+    w = W[ir[0]]
+    if _point_line_distance(P[ir[1]], P[ir[0]], w) < ltol:
+        raise _fail(robot, f"the axes of joints {ir[0] + 1} and {ir[1] + 1} coincide")
+    last = P[ir[2]] if nr == 3 else M[:3, 3]
+    if _point_line_distance(last, P[ir[1]], w) < ltol:
+        what = f"the axis of joint {ir[2] + 1}" if nr == 3 else "the tool point"
+        raise _fail(robot, f"{what} lies on the axis of joint {ir[1] + 1}")
+    kind = {(2, 0): "planar_2r", (3, 0): "planar_3r", (3, 1): "scara", (2, 1): "scara_rrp"}[
+        (nr, np_)]
+    e1 = _unit_perp(w)
+    aux = np.array([w, e1])
+    order = np.array(ir + [ip[0] if ip else -1], dtype=np.int64)
+    planar_z = np_ == 0 and abs(abs(w[2]) - 1.0) < ANGLE_TOL
+    return Structure(kind, W, P, M, rev, aux, order, planar_z, scale)
+
+
+def _six_dof(robot, W, P, M, rev, scale, ltol) -> Structure:
+    types = "".join(robot.joint_types)
+    reasons = []
+    # ------------------------------------------------ spherical wrist (axes 4, 5, 6)
+    wrist = None
+    if types[3:] != "RRR":
+        reasons.append("joints 4-6 are not all revolute, so there is no spherical wrist")
+    elif _sin_angle(W[3], W[4]) < ANGLE_TOL or _sin_angle(W[4], W[5]) < ANGLE_TOL:
+        reasons.append("wrist axes 4/5 or 5/6 are parallel, so they do not form a spherical wrist")
+    else:
+        d45 = _line_distance(P[3], W[3], P[4], W[4])
+        c = _closest_point(P[3], W[3], P[4], W[4])
+        d6 = _point_line_distance(c, P[5], W[5])
+        if d45 < ltol and d6 < ltol:
+            wrist = c
+        else:
+            reasons.append(f"axes 4, 5, 6 do not meet in one point (axes 4-5 {d45:.3g} m "
+                           f"apart, axis 6 {d6:.3g} m from their meeting point)")
+    if wrist is not None:
+        v = _unit_perp(W[5])
+        if types[:3] == "RRR" and _sin_angle(W[1], W[2]) < ANGLE_TOL:
+            if _sin_angle(W[0], W[1]) < ANGLE_TOL:
+                reasons.append("axes 1, 2, 3 are all parallel: the wrist centre cannot leave a "
+                               "plane")
+            elif _point_line_distance(P[2], P[1], W[1]) < ltol:
+                reasons.append("axes 2 and 3 coincide")
+            elif _point_line_distance(wrist, P[2], W[2]) < ltol:
+                reasons.append("the wrist centre lies on axis 3")
+            else:
+                aux = np.array([wrist, W[1], _unit_perp(W[1]), v])
+                return Structure("puma", W, P, M, rev, aux, np.zeros(0, np.int64), False, scale)
+        d12 = _line_distance(P[0], W[0], P[1], W[1])
+        if _sin_angle(W[0], W[1]) >= ANGLE_TOL and d12 < ltol:
+            o = _closest_point(P[0], W[0], P[1], W[1])
+            if types[:3] == "RRR":
+                if _point_line_distance(o, P[2], W[2]) < ltol:
+                    reasons.append("axis 3 passes through the intersection of axes 1 and 2")
+                elif _point_line_distance(wrist, P[2], W[2]) < ltol:
+                    reasons.append("the wrist centre lies on axis 3")
+                else:
+                    aux = np.array([wrist, o, v])
+                    return Structure("pieper_intersecting", W, P, M, rev, aux,
+                                     np.zeros(0, np.int64), False, scale)
+            elif types[:3] == "RRP":
+                aux = np.array([wrist, o, v])
+                return Structure("stanford", W, P, M, rev, aux, np.zeros(0, np.int64), False,
+                                 scale)
+            else:
+                reasons.append(f"the arm joints are {types[:3]}; closed forms need RRR or RRP")
+        else:
+            reasons.append("the wrist is spherical but neither are axes 2 and 3 parallel nor do "
+                           f"axes 1 and 2 intersect (they are {d12:.3g} m apart)")
+    # ------------------------------------------------ three parallel axes (2, 3, 4)
+    if types == "RRRRRR":
+        if _sin_angle(W[1], W[2]) < ANGLE_TOL and _sin_angle(W[1], W[3]) < ANGLE_TOL:
+            w = W[1]
+            d56 = _line_distance(P[4], W[4], P[5], W[5])
+            if _sin_angle(W[0], w) < ANGLE_TOL:
+                reasons.append("axis 1 is parallel to the parallel axes 2, 3, 4")
+            elif _sin_angle(W[4], w) < ANGLE_TOL:
+                reasons.append("axis 5 is parallel to the parallel axes 2, 3, 4")
+            elif _sin_angle(W[4], W[5]) < ANGLE_TOL or d56 >= ltol:
+                reasons.append(f"axes 2, 3, 4 are parallel but axes 5 and 6 do not intersect "
+                               f"({d56:.3g} m apart)")
+            elif _point_line_distance(P[2], P[1], w) < ltol or \
+                    _point_line_distance(P[3], P[2], w) < ltol:
+                reasons.append("two of the parallel axes 2, 3, 4 coincide")
+            else:
+                p56 = _closest_point(P[4], W[4], P[5], W[5])
+                aux = np.array([p56, w, _unit_perp(w)])
+                return Structure("ur", W, P, M, rev, aux, np.zeros(0, np.int64), False, scale)
+        else:
+            reasons.append("axes 2, 3, 4 are not parallel")
+    raise _fail(robot, "; ".join(reasons))

@@ -1,0 +1,416 @@
+"""Compiled geometric subproblems shared by the closed-form solvers (numba, ``cache=True``).
+
+The closed-form solvers work on the product-of-exponentials form of the chain at its
+zero configuration (see :mod:`serialkin.ik.analytic.structure`): joint *i* is a line
+with unit direction ``w_i`` through a point ``r_i`` (world frame, q = 0), and
+
+``T(q) = exp(ξ_1 q_1) ··· exp(ξ_n q_n) · M``,  ``M = T(0)``.
+
+So every DH variant (standard, modified) and every general joint description reduce to
+the same few geometric subproblems (Paden–Kahan; R. M. Murray, Z. Li, S. S. Sastry,
+*A Mathematical Introduction to Robotic Manipulation*, CRC 1994, section 3.3):
+
+* :func:`sp1_dir` — the rotation about ``w`` that carries one vector onto another;
+* :func:`sp2_dir` — two rotations about intersecting axes carrying ``u`` onto ``v``;
+* :func:`sp3` — the rotation that puts a point at a given distance from another;
+* :func:`sp4` — the rotation that gives a rotated vector a given projection, ``a·R b = c``;
+* :func:`planar2r` — the two-link planar arm of the chapter (eqs 23-27, corrected per
+  the ERRATA), on any pair of parallel axes.
+
+Every function writes its (at most two) solutions into ``out`` and returns their
+count; the count is 0 when the sub-target is out of reach. Arguments slightly outside
+the domain of arccos (within :data:`CLAMP`) are clamped, so targets on the workspace
+boundary keep their (double) solution. Angles in radians, lengths in metres; all
+vectors are (3,) float64 arrays. Kernels trust their input.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from serialkin.kinematics._kernels import fk_into
+
+#: arccos arguments within this distance of ±1 are clamped (workspace boundary).
+CLAMP = 1e-9
+#: Two solutions closer than this in every joint (after wrapping) are one solution.
+DUPLICATE_TOL = 1e-9
+#: Solutions within this distance outside a joint limit are clipped onto it.
+LIMIT_TOL = 1e-10
+TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True)
+def dot3(a, b):
+    """Dot product of two 3-vectors."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True)
+def cross3(a, b):
+    """Cross product of two 3-vectors, a new (3,) array."""
+    out = np.empty(3)
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+    return out
+
+
+@njit(cache=True)
+def mm(A, B):
+    """Matrix product of small matrices (loops, no BLAS), a new array."""
+    n, k = A.shape
+    m = B.shape[1]
+    C = np.zeros((n, m))
+    for i in range(n):
+        for j in range(m):
+            acc = 0.0
+            for t in range(k):
+                acc += A[i, t] * B[t, j]
+            C[i, j] = acc
+    return C
+
+
+@njit(cache=True)
+def mtm(A, B):
+    """``Aᵀ·B`` for small matrices, a new array."""
+    k, n = A.shape
+    m = B.shape[1]
+    C = np.zeros((n, m))
+    for i in range(n):
+        for j in range(m):
+            acc = 0.0
+            for t in range(k):
+                acc += A[t, i] * B[t, j]
+            C[i, j] = acc
+    return C
+
+
+@njit(cache=True)
+def mv(A, v):
+    """``A[:3, :3]·v`` for a (3, 3) or (4, 4) matrix and a 3-vector."""
+    out = np.empty(3)
+    for i in range(3):
+        out[i] = A[i, 0] * v[0] + A[i, 1] * v[1] + A[i, 2] * v[2]
+    return out
+
+
+@njit(cache=True)
+def mtv(A, v):
+    """``A[:3, :3]ᵀ·v`` for a (3, 3) or (4, 4) matrix and a 3-vector."""
+    out = np.empty(3)
+    for i in range(3):
+        out[i] = A[0, i] * v[0] + A[1, i] * v[1] + A[2, i] * v[2]
+    return out
+
+
+@njit(cache=True)
+def target_rotation(T, M):
+    """``R_T·R_Mᵀ`` (3, 3): the rotation the joints must produce, from poses T and M (4, 4)."""
+    R = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            R[i, j] = T[i, 0] * M[j, 0] + T[i, 1] * M[j, 1] + T[i, 2] * M[j, 2]
+    return R
+
+
+@njit(cache=True)
+def rotation(w, theta):
+    """Rotation matrix (3, 3) by ``theta`` [rad] about the unit axis ``w`` (Rodrigues)."""
+    c = math.cos(theta)
+    s = math.sin(theta)
+    v = 1.0 - c
+    x = w[0]
+    y = w[1]
+    z = w[2]
+    R = np.empty((3, 3))
+    R[0, 0] = c + x * x * v
+    R[0, 1] = x * y * v - z * s
+    R[0, 2] = x * z * v + y * s
+    R[1, 0] = y * x * v + z * s
+    R[1, 1] = c + y * y * v
+    R[1, 2] = y * z * v - x * s
+    R[2, 0] = z * x * v - y * s
+    R[2, 1] = z * y * v + x * s
+    R[2, 2] = c + z * z * v
+    return R
+
+
+@njit(cache=True)
+def screw(w, r, theta, prismatic):
+    """``exp(ξ θ)`` (4, 4): rotation by θ about the line (w, r), or translation θ·w."""
+    E = np.eye(4)
+    if prismatic:
+        for i in range(3):
+            E[i, 3] = theta * w[i]
+        return E
+    R = rotation(w, theta)
+    E[:3, :3] = R
+    for i in range(3):
+        E[i, 3] = r[i] - (R[i, 0] * r[0] + R[i, 1] * r[1] + R[i, 2] * r[2])
+    return E
+
+
+@njit(cache=True)
+def inv_rigid(T):
+    """Inverse of a rigid transform (4, 4)."""
+    out = np.eye(4)
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = T[j, i]
+    for i in range(3):
+        out[i, 3] = -(out[i, 0] * T[0, 3] + out[i, 1] * T[1, 3] + out[i, 2] * T[2, 3])
+    return out
+
+
+@njit(cache=True)
+def transform_point(T, p):
+    """``T·p`` for a rigid transform T (4, 4) and a point p (3,)."""
+    out = np.empty(3)
+    for i in range(3):
+        out[i] = T[i, 0] * p[0] + T[i, 1] * p[1] + T[i, 2] * p[2] + T[i, 3]
+    return out
+
+
+@njit(cache=True)
+def _acos_clamped(x):
+    """arccos(x) for |x| <= 1 + CLAMP (clamped), else NaN (out of reach)."""
+    if x > 1.0:
+        return 0.0 if x <= 1.0 + CLAMP else math.nan
+    if x < -1.0:
+        return math.pi if x >= -1.0 - CLAMP else math.nan
+    return math.acos(x)
+
+
+@njit(cache=True)
+def sp1_dir(w, u, v):
+    """Subproblem 1 on directions: θ such that ``Rot(w, θ)·u`` points like ``v`` in the plane ⟂ w.
+
+    Returns ``atan2(w·(u' × v'), u'·v')`` with ``u'``, ``v'`` the projections on that
+    plane; 0 when either projection vanishes (the angle is then arbitrary).
+    """
+    wu = dot3(w, u)
+    wv = dot3(w, v)
+    up = u - wu * w
+    vp = v - wv * w
+    return math.atan2(dot3(w, cross3(up, vp)), dot3(up, vp))
+
+
+@njit(cache=True)
+def sp2_dir(w1, w2, u, v, out):
+    """Subproblem 2: θ1, θ2 with ``Rot(w1, θ1)·Rot(w2, θ2)·u = v`` (axes meet; w1 ∦ w2).
+
+    ``u`` and ``v`` are vectors from the common point (or directions). The intermediate
+    vector is ``z = α w1 + β w2 ± γ (w1 × w2)`` with ``w2·z = w2·u``, ``w1·z = w1·v`` and
+    ``|z| = |u|``. Writes rows (θ1, θ2) into ``out`` (2, 2); returns 0, 1 or 2.
+    """
+    c12 = dot3(w1, w2)
+    den = c12 * c12 - 1.0
+    a2u = dot3(w2, u)
+    a1v = dot3(w1, v)
+    alpha = (c12 * a2u - a1v) / den
+    beta = (c12 * a1v - a2u) / den
+    x = cross3(w1, w2)
+    nx2 = dot3(x, x)
+    uu = dot3(u, u)
+    g2 = (uu - alpha * alpha - beta * beta - 2.0 * alpha * beta * c12) / nx2
+    if g2 < 0.0:
+        if g2 < -CLAMP * max(uu, 1e-300) / nx2:
+            return 0
+        g2 = 0.0
+    g = math.sqrt(g2)
+    count = 1 if g == 0.0 else 2
+    for k in range(count):
+        sg = g if k == 0 else -g
+        z = alpha * w1 + beta * w2 + sg * x
+        out[k, 1] = sp1_dir(w2, u, z)
+        out[k, 0] = sp1_dir(w1, z, v)
+    return count
+
+
+@njit(cache=True)
+def sp3(w, r, p, q, delta, out):
+    """Subproblem 3: θ with ``|Rot(w, θ; r)·p − q| = δ`` (rotation about the line (w, r)).
+
+    Projected on the plane ⟂ w: ``|u'|² + |v'|² − 2|u'||v'| cos(θ − θ0) = δ'²`` with
+    ``u = p − r``, ``v = q − r``, ``δ'² = δ² − (w·(p − q))²``. Writes θ into ``out``
+    (2,), returns 0, 1 or 2 (0 also when p or q lies on the axis).
+    """
+    u = p - r
+    v = q - r
+    up = u - dot3(w, u) * w
+    vp = v - dot3(w, v) * w
+    nu = math.sqrt(dot3(up, up))
+    nv = math.sqrt(dot3(vp, vp))
+    if nu < 1e-12 or nv < 1e-12:
+        return 0
+    h = dot3(w, p - q)
+    d2 = delta * delta - h * h
+    theta0 = math.atan2(dot3(w, cross3(up, vp)), dot3(up, vp))
+    c = _acos_clamped((nu * nu + nv * nv - d2) / (2.0 * nu * nv))
+    if math.isnan(c):
+        return 0
+    out[0] = theta0 - c
+    if c == 0.0:
+        return 1
+    out[1] = theta0 + c
+    return 2
+
+
+@njit(cache=True)
+def sp4(w, b, a, c, out):
+    """θ with ``a·Rot(w, θ)·b = c``: ``A cos θ + B sin θ = c − (a·w)(w·b)``.
+
+    ``A = a·b'``, ``B = a·(w × b')``, ``b'`` the part of b ⟂ w, so θ = atan2(B, A) ±
+    arccos(D / sqrt(A² + B²)). When A = B = 0 any θ solves a consistent equation:
+    θ = 0 is returned as the representative. Writes into ``out`` (2,), returns 0, 1 or 2.
+    """
+    bp = b - dot3(w, b) * w
+    A = dot3(a, bp)
+    B = dot3(a, cross3(w, bp))
+    D = c - dot3(a, w) * dot3(w, b)
+    Rn = math.hypot(A, B)
+    scale = math.sqrt(dot3(a, a) * dot3(b, b))
+    if Rn <= 1e-12 * max(scale, 1e-300):
+        if abs(D) <= 1e-9 * max(scale, 1.0):
+            out[0] = 0.0
+            return 1
+        return 0
+    phi = math.atan2(B, A)
+    x = _acos_clamped(D / Rn)
+    if math.isnan(x):
+        return 0
+    out[0] = phi + x
+    if x == 0.0:
+        return 1
+    out[1] = phi - x
+    return 2
+
+
+@njit(cache=True)
+def planar2r(w, e1, c1, c2, p, t, out):
+    """Two revolute joints on parallel axes (w; through c1, c2) carrying point p to t.
+
+    The chapter's closed form (eqs 23-27, corrected per the ERRATA) in the plane ⟂ w
+    with basis (e1, e2 = w × e1), origin c1, link lengths L1 = |c2 − c1|' and
+    L2 = |p − c2|' (' = projected):
+
+    * r = sqrt(x² + y²), α = atan2(y, x)  (eqs 23-24, corrected)
+    * θ2 = ±arccos((x² + y² − L1² − L2²) / (2 L1 L2))  (eq 25)
+    * β = arccos((L1² − L2² + r²) / (2 L1 r))  (eq 26, corrected), evaluated in the
+      equivalent form β = atan2(L2 sin|θ2|, L1 + L2 cos θ2), which stays accurate near
+      the workspace boundary;
+    * θ1 = α − β with θ2 = +arccos(..), θ1 = α + β with θ2 = −arccos(..)  (eq 27).
+
+    The link angles are then measured from the zero configuration. Writes rows
+    (θ1, θ2) [rad, about +w] into ``out`` (2, 2); returns 0, 1 or 2. When the target is
+    on the first axis with L1 = L2, θ1 is arbitrary and θ1 = α = 0 is returned.
+    """
+    e2 = cross3(w, e1)
+    l1 = c2 - c1
+    l2 = p - c2
+    d = t - c1
+    L1 = math.hypot(dot3(e1, l1), dot3(e2, l1))
+    L2 = math.hypot(dot3(e1, l2), dot3(e2, l2))
+    phi10 = math.atan2(dot3(e2, l1), dot3(e1, l1))
+    phi20 = math.atan2(dot3(e2, l2), dot3(e1, l2)) - phi10
+    x = dot3(e1, d)
+    y = dot3(e2, d)
+    r2 = x * x + y * y
+    th2 = _acos_clamped((r2 - L1 * L1 - L2 * L2) / (2.0 * L1 * L2))
+    if math.isnan(th2):
+        return 0
+    alpha = math.atan2(y, x)
+    beta = math.atan2(L2 * math.sin(th2), L1 + L2 * math.cos(th2))
+    out[0, 0] = alpha - beta - phi10
+    out[0, 1] = th2 - phi20
+    if th2 == 0.0:
+        return 1
+    out[1, 0] = alpha + beta - phi10
+    out[1, 1] = -th2 - phi20
+    return 2
+
+
+@njit(cache=True)
+def _lex_less(a, b):
+    for j in range(a.shape[0]):
+        if a[j] < b[j]:
+            return True
+        if a[j] > b[j]:
+            return False
+    return False
+
+
+@njit(cache=True)
+def finalize(cand, k, revolute, qlim, mid, F, meta, T, check_rot, tol_p, tol_r, out):
+    """Wrap, limit-check, verify, de-duplicate and sort candidate solutions.
+
+    For each of the first ``k`` rows of ``cand`` (K, n): revolute angles are moved by a
+    multiple of 2π to the value nearest the middle of their limits ``mid`` (n,); a row
+    with any joint outside ``qlim`` (n, 2) (beyond :data:`LIMIT_TOL`) is dropped; the
+    rest must reproduce ``T`` (4, 4) through forward kinematics (eq 11, the shared
+    kernel): position within ``tol_p`` [m] and, when ``check_rot``, every rotation entry
+    within ``tol_r``. Duplicates (within :data:`DUPLICATE_TOL`) are dropped and the
+    accepted rows are sorted lexicographically into ``out`` (K, n). Returns their count.
+    """
+    n = cand.shape[1]
+    m = 0
+    q = np.empty(n)
+    Tq = np.empty((4, 4))
+    for i in range(k):
+        ok = True
+        for j in range(n):
+            v = cand[i, j]
+            if not math.isfinite(v):
+                ok = False
+                break
+            if revolute[j]:
+                v = v - TWO_PI * math.floor((v - mid[j]) / TWO_PI + 0.5)
+            lo = qlim[j, 0]
+            hi = qlim[j, 1]
+            if v < lo:
+                if v < lo - LIMIT_TOL:
+                    ok = False
+                    break
+                v = lo
+            elif v > hi:
+                if v > hi + LIMIT_TOL:
+                    ok = False
+                    break
+                v = hi
+            q[j] = v
+        if not ok:
+            continue
+        fk_into(q, F, meta, Tq)
+        ep = 0.0
+        for r in range(3):
+            ep += (Tq[r, 3] - T[r, 3]) ** 2
+        if math.sqrt(ep) > tol_p:
+            continue
+        if check_rot:
+            er = 0.0
+            for r in range(3):
+                for c in range(3):
+                    er = max(er, abs(Tq[r, c] - T[r, c]))
+            if er > tol_r:
+                continue
+        dup = False
+        for s in range(m):
+            dmax = 0.0
+            for j in range(n):
+                dmax = max(dmax, abs(out[s, j] - q[j]))
+            if dmax < DUPLICATE_TOL:
+                dup = True
+                break
+        if dup:
+            continue
+        # insertion into the sorted prefix out[:m]
+        pos = m
+        while pos > 0 and _lex_less(q, out[pos - 1]):
+            out[pos] = out[pos - 1]
+            pos -= 1
+        out[pos] = q
+        m += 1
+    return m
