@@ -151,3 +151,33 @@ def pose_error_batch(T, T_target, E):
     """Pose errors ``E`` (N, 6) between ``T`` (N, 4, 4) and ``T_target`` (N, 4, 4)."""
     for k in range(T.shape[0]):
         pose_error_into(T[k], T_target[k], E[k])
+
+
+@njit(cache=True)
+def transforms_valid(T, tol):
+    """True when every ``T[k]`` of ``T`` (N, 4, 4) is a finite rigid transform.
+
+    Same criteria as :func:`serialkin._checks.check_transform` (last row [0, 0, 0, 1],
+    max |RᵀR − I| ≤ tol, |det R − 1| ≤ tol), without allocation; the Python wrapper
+    calls ``check_transform`` only when this fails, to build the error message.
+    """
+    for k in range(T.shape[0]):
+        A = T[k]
+        for i in range(4):
+            for j in range(4):
+                if not math.isfinite(A[i, j]):
+                    return False
+        if (abs(A[3, 0]) > tol or abs(A[3, 1]) > tol or abs(A[3, 2]) > tol
+                or abs(A[3, 3] - 1.0) > tol):
+            return False
+        for i in range(3):
+            for j in range(3):
+                s = A[0, i] * A[0, j] + A[1, i] * A[1, j] + A[2, i] * A[2, j]
+                if abs(s - (1.0 if i == j else 0.0)) > tol:
+                    return False
+        det = (A[0, 0] * (A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1])
+               - A[0, 1] * (A[1, 0] * A[2, 2] - A[1, 2] * A[2, 0])
+               + A[0, 2] * (A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]))
+        if abs(det - 1.0) > tol:
+            return False
+    return True

@@ -15,21 +15,40 @@ from __future__ import annotations
 
 import numpy as np
 
-from serialkin._checks import check_transform
+from serialkin._checks import ROTATION_TOL, check_transform
 from serialkin.errors import InputError
 from serialkin.spatial import _kernels as K
+
+
+def _validated(x: object, name: str, check: bool) -> np.ndarray:
+    """``x`` as a float64 array of shape (..., 4, 4), checked when ``check``."""
+    if (
+        type(x) is np.ndarray
+        and x.dtype == np.float64
+        and x.ndim >= 2
+        and x.shape[-2:] == (4, 4)
+    ):
+        if not check or K.transforms_valid(
+            np.ascontiguousarray(x).reshape(-1, 4, 4), ROTATION_TOL
+        ):
+            return x
+        return check_transform(x, name)
+    if check:
+        return check_transform(x, name)
+    return np.asarray(x, dtype=np.float64)
 
 
 def _pair(
     T: object, T_target: object, check: bool
 ) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
-    """Validate two (batches of) transforms and broadcast them to (N, 4, 4) C arrays."""
-    if check:
-        a = check_transform(T, "T")
-        b = check_transform(T_target, "T_target")
-    else:
-        a = np.asarray(T, dtype=np.float64)
-        b = np.asarray(T_target, dtype=np.float64)
+    """Validate two (batches of) transforms and broadcast them to (N, 4, 4) C arrays.
+
+    Float64 arrays of shape (..., 4, 4) are validated by a compiled kernel; only when it
+    reports a problem (or for other input types) does ``check_transform`` run, to coerce
+    the input or to raise its detailed message.
+    """
+    a = _validated(T, "T", check)
+    b = _validated(T_target, "T_target", check)
     try:
         batch = np.broadcast_shapes(a.shape[:-2], b.shape[:-2])
     except ValueError as exc:
