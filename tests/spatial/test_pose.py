@@ -134,3 +134,29 @@ def test_pose_error_bad_input_messages() -> None:
         pose_error(nan, np.eye(4))
     with pytest.raises(InputError, match="do not broadcast"):
         pose_error(random_poses(2, 0), random_poses(3, 0))
+
+
+@SETTINGS
+@given(seeds, st.integers(0, 15), st.sampled_from([0.0, 1e-8, 1e-5, 1e-3]))
+def test_compiled_validity_check_agrees_with_check_transform(seed: int, entry: int,
+                                                             delta: float) -> None:
+    """transforms_valid accepts exactly what check_transform accepts (perturbed entries)."""
+    from serialkin._checks import ROTATION_TOL, check_transform
+
+    T = random_poses(3, seed)
+    T[1].flat[entry] += delta
+    try:
+        check_transform(T)
+        ok = True
+    except InputError:
+        ok = False
+    assert K.transforms_valid(T, ROTATION_TOL) == ok
+    assert ok == (delta < ROTATION_TOL or entry in (3, 7, 11))
+
+
+def test_pose_error_accepts_lists_and_unchecked_arrays() -> None:
+    """Nested lists are coerced; check=False skips validation but computes the same error."""
+    A = random_poses(1, 9)[0]
+    e_list = pose_error(A.tolist(), np.eye(4).tolist())
+    assert np.allclose(e_list, pose_error(A, np.eye(4)))
+    assert np.array_equal(pose_error(A, np.eye(4), check=False), pose_error(A, np.eye(4)))
