@@ -12,6 +12,7 @@ poses are 4x4 homogeneous transforms of the end-effector (tool) in the world fra
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -220,9 +221,12 @@ class Robot:
     def _nonfinite(self, q: np.ndarray, name: str = "q") -> InputError:
         return InputError(f"{name} must be finite, got {q}")
 
-    @property
+    @functools.cached_property
     def is_planar(self) -> bool:
-        """True when the tool moves in the world xy plane only (rows vz, wx, wy of J vanish)."""
+        """True when the tool moves in the world xy plane only (rows vz, wx, wy of J vanish).
+
+        Computed once per robot (robots are immutable); every IK call reads it.
+        """
         J = self.jacobian(self.random_q(3, seed=0))
         return bool(np.allclose(J[:, [2, 3, 4]], 0.0, atol=1e-9))
 
