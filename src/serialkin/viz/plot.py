@@ -170,6 +170,7 @@ def plot_robot(
     planar: bool | None = None,
     linewidth: float = 2.5,
     frame_scale: float | None = None,
+    markersize: float = 6.0,
 ) -> Axes:
     """Draw the robot in configuration ``q``.
 
@@ -190,6 +191,7 @@ def plot_robot(
             ``ax`` when given, else :attr:`Robot.is_planar`.
         linewidth: link line width [points].
         frame_scale: triad axis length [m] (default 8 % of :func:`robot_scale`).
+        markersize: joint marker size [points] (0 hides joint, base and tool markers).
 
     Returns:
         The axes drawn into. The link line has ``gid='serialkin-links'``, the joint
@@ -214,10 +216,14 @@ def plot_robot(
 
     ax.plot(*pts[:, :dims].T, "-", color=color, alpha=alpha, lw=linewidth, label=label,
             gid=LINKS_GID, solid_capstyle="round")
-    ax.plot(*joints[:, :dims].T, "o", color=color, alpha=alpha, ms=6, mfc="white",
-            mew=1.8, gid=JOINTS_GID)
-    ax.plot(*pts[:1, :dims].T, "s", color="0.2", alpha=alpha, ms=8, gid="serialkin-base")
-    ax.plot(*pts[-1:, :dims].T, "o", color=color, alpha=alpha, ms=4, gid="serialkin-tool")
+    ms = float(markersize)
+    if ms > 0:
+        ax.plot(*joints[:, :dims].T, "o", color=color, alpha=alpha, ms=ms, mfc="white",
+                mew=0.3 * ms, gid=JOINTS_GID)
+        ax.plot(*pts[:1, :dims].T, "s", color="0.2", alpha=alpha, ms=1.33 * ms,
+                gid="serialkin-base")
+        ax.plot(*pts[-1:, :dims].T, "o", color=color, alpha=alpha, ms=0.67 * ms,
+                gid="serialkin-tool")
     if frames:
         Ts = list(robot.fk_all(qv)) + [robot.fk(qv)]
         for i, T in enumerate(Ts):
