@@ -51,6 +51,18 @@ def chapter(out: str, quiet: bool, sections: tuple[str, ...]) -> None:
     click.echo(f"wrote {path}")
 
 
+def _register() -> None:
+    """Add the subcommands of this package to :data:`cli`."""
+    from serialkin.cli.commands import fk_cmd, ik_cmd, jacobian_cmd, models_cmd
+    from serialkin.cli.workspace_cmd import workspace_cmd
+
+    for command in (models_cmd, fk_cmd, jacobian_cmd, ik_cmd, workspace_cmd):
+        cli.add_command(command)
+
+
+_register()
+
+
 def main() -> None:
     """Console entry point."""
     cli(prog_name="serialkin")

@@ -38,7 +38,7 @@ import numpy as np
 from serialkin.errors import RobotDefinitionError
 from serialkin.model.dh import CONVENTIONS, DHLink
 from serialkin.model.joint import normalize_joint_type
-from serialkin.spatial.transforms import make_transform, rotx, roty, rotz
+from serialkin.spatial import make_transform, rpy_to_matrix
 
 #: Accepted angle units and their factor to radians.
 ANGLE_UNITS: dict[str, float] = {"rad": 1.0, "deg": math.pi / 180.0}
@@ -78,12 +78,6 @@ def _vector(value: object, field: str, where: _Where, size: int, unit: str) -> n
     return np.array([_number(v, f"{field}[{i}]", where, unit) for i, v in enumerate(value)])
 
 
-def rpy_to_rotation(rpy: object) -> np.ndarray:
-    """Rotation from roll-pitch-yaw [rad] about fixed x, y, z: ``Rz(y) · Ry(p) · Rx(r)``, (3, 3)."""
-    r, p, y = (float(v) for v in np.asarray(rpy, dtype=float).reshape(3))
-    return rotz(y) @ roty(p) @ rotx(r)
-
-
 def _transform(value: object, field: str, where: _Where, ang: float, lin: float,
                angle_unit: str, length_unit: str) -> np.ndarray:
     """Parse ``{xyz, rpy}`` (either optional) or a 4x4 nested list into a rigid transform."""
@@ -96,7 +90,7 @@ def _transform(value: object, field: str, where: _Where, ang: float, lin: float,
                if "xyz" in value else np.zeros(3))
         rpy = (_vector(value["rpy"], f"{field}.rpy", where, 3, angle_unit) * ang
                if "rpy" in value else np.zeros(3))
-        return make_transform(rpy_to_rotation(rpy), xyz)
+        return make_transform(rpy_to_matrix(rpy), xyz)
     if isinstance(value, (list, tuple)) and len(value) == 4:
         rows = [_vector(r, f"{field}[{i}]", where, 4, "matrix row") for i, r in enumerate(value)]
         T = np.array(rows)

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from serialkin._checks import as_generator, check_int
+from serialkin.spatial import so3_log, wrap_angle
 
 #: Configurations per chunk (bounds memory: a chunk's Jacobians take chunk·6·n·8 bytes).
 CHUNK = 50_000
@@ -90,31 +91,6 @@ def sample_configurations(robot: object, samples: int, seed: None | int | np.ran
     return robot.random_q(N, seed=as_generator(seed))  # type: ignore[attr-defined]
 
 
-def rotation_log(R: np.ndarray) -> np.ndarray:
-    """Rotation vectors ``θ·u`` (..., 3) of rotations R (..., 3, 3): the SO(3) logarithm.
-
-    ``θ = arccos((tr R − 1)/2)``; ``u`` from the skew part, and from ``(R + I)/2 = u uᵀ``
-    when θ is near π (where the skew part vanishes).
-    """
-    tr = np.trace(R, axis1=-2, axis2=-1)
-    theta = np.arccos(np.clip((tr - 1.0) / 2.0, -1.0, 1.0))
-    v = 0.5 * np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
-                        R[..., 1, 0] - R[..., 0, 1]], axis=-1)  # sin θ · u
-    s = np.sin(theta)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        scale = np.where(theta < 1e-8, 1.0, theta / np.where(s == 0, 1.0, s))
-    out = v * scale[..., None]
-    near_pi = theta > np.pi - 1e-3
-    if np.any(near_pi):
-        B = 0.5 * (R[near_pi] + np.eye(3))
-        k = np.argmax(np.diagonal(B, axis1=-2, axis2=-1), axis=-1)
-        col = np.take_along_axis(B, k[:, None, None].repeat(3, axis=1), axis=2)[..., 0]
-        u = col / np.linalg.norm(col, axis=-1, keepdims=True)
-        sign = np.where(np.sum(u * v[near_pi], axis=-1) < 0, -1.0, 1.0)
-        out[near_pi] = u * (sign * theta[near_pi])[:, None]
-    return out
-
-
 def orientation_distance(R: np.ndarray, R_target: np.ndarray) -> np.ndarray:
     """Angle [rad] of the rotation between R (..., 3, 3) and R_target (3, 3): ``‖log(R_t Rᵀ)‖``."""
     tr = np.einsum("ij,...ij->...", R_target, R)  # tr(R_t Rᵀ) = sum R_t ∘ R
@@ -124,11 +100,6 @@ def orientation_distance(R: np.ndarray, R_target: np.ndarray) -> np.ndarray:
 def planar_angle(R: np.ndarray) -> np.ndarray:
     """Orientation angle φ = atan2(R_10, R_00) [rad] of planar tool frames (..., 3, 3)."""
     return np.arctan2(R[..., 1, 0], R[..., 0, 0])
-
-
-def wrap_angle(a: np.ndarray) -> np.ndarray:
-    """Wrap angles to (−π, π]."""
-    return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
 
 
 def project_orientation(robot: object, Q: np.ndarray, R_target: np.ndarray, *,
@@ -174,7 +145,7 @@ def project_orientation(robot: object, Q: np.ndarray, R_target: np.ndarray, *,
                 err = wrap_angle(phi_t - planar_angle(T[:, :3, :3]))[:, None]
                 ang = np.abs(err[:, 0])
             else:
-                err = rotation_log(R_target @ np.swapaxes(T[:, :3, :3], -1, -2))
+                err = so3_log(R_target @ np.swapaxes(T[:, :3, :3], -1, -2), check=False)
                 ang = np.linalg.norm(err, axis=1)
             todo = ang > max_angle + 0.5 * tol
             if not np.any(todo):

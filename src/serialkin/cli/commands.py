@@ -1,0 +1,532 @@
+"""The ``models``, ``fk``, ``jacobian`` and ``ik`` subcommands.
+
+Conventions of the command line: lengths in metres; angles in radians unless
+``--degrees`` is given (then joint angles, rpy and φ are read and shown in degrees);
+JSON output (``--json`` or ``--out *.json``) is always in SI units (m, rad) and strict
+JSON (no NaN/inf). Exit codes: 0 success, 1 an IK target not reached, 2 bad input.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from typing import Any
+
+import click
+import numpy as np
+
+from serialkin.cli.io import (
+    EXIT_NOT_REACHED,
+    CLIError,
+    command_help,
+    dumps_json,
+    format_matrix,
+    format_table,
+    parse_numbers,
+    read_csv_rows,
+    write_output,
+)
+from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot, robot_argument
+from serialkin.errors import SerialkinError
+
+
+def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """Turn library input errors and OS errors into one clear ``Error:`` line (exit 2)."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(*args, **kwargs)
+        except SerialkinError as exc:
+            raise CLIError(str(exc)) from exc
+        except PermissionError as exc:
+            raise CLIError(f"permission denied: {exc.filename or exc}") from exc
+
+    return wrapper
+
+
+json_option = click.option("--json", "as_json", is_flag=True,
+                           help="Print the results as JSON (SI units) instead of a table.")
+quiet_option = click.option("--quiet", "-q", is_flag=True,
+                            help="Print nothing but errors (and JSON with --json); no "
+                                 "progress bar.")
+degrees_option = click.option("--degrees", "-d", is_flag=True,
+                              help="Joint angles, rpy and φ in degrees (input and table).")
+out_option = click.option("--out", "-o", "out", type=click.Path(dir_okay=False),
+                          help="Also write the results to this file (.json or .csv), "
+                               "atomically.")
+
+
+def _angle_factor(robot: Any, degrees: bool) -> np.ndarray:
+    """Per-joint factor from the user's unit to SI: π/180 for revolute joints with --degrees."""
+    f = np.ones(robot.n)
+    if degrees:
+        f[np.array(robot.joint_types) == "R"] = np.pi / 180.0
+    return f
+
+
+def read_q(robot: Any, q_texts: tuple[str, ...], q_file: str | None, degrees: bool) -> np.ndarray:
+    """Configurations (N, n) [SI] from ``--q`` options and/or a CSV file (zeros if neither)."""
+    rows = [parse_numbers(t, "--q", robot.n) for t in q_texts]
+    Q = np.array(rows).reshape(-1, robot.n)
+    if q_file:
+        Q = np.vstack([Q, read_csv_rows(q_file, "q", robot.n)])
+    if Q.shape[0] == 0:
+        Q = np.zeros((1, robot.n))
+    return Q * _angle_factor(robot, degrees)
+
+
+def _robot_info(robot: Any) -> dict[str, Any]:
+    return {"name": robot.name, "n": robot.n, "joint_types": "".join(robot.joint_types),
+            "joint_names": list(robot.joint_names), "convention": robot.convention,
+            "source": robot.source}
+
+
+def _emit(text: str, quiet: bool) -> None:
+    if not quiet:
+        click.echo(text)
+
+
+# ---------------------------------------------------------------------------- models
+_MODELS_CMD_HELP = command_help(
+    "List the built-in robot models: DOF, joint types, convention and source.",
+    ['serialkin models', 'serialkin models --json'],
+)
+
+
+@click.command("models", help=_MODELS_CMD_HELP)
+@json_option
+def models_cmd(as_json: bool) -> None:
+    """List the built-in robot models: DOF, joint types, convention and source."""
+    from serialkin import models
+
+    entries = []
+    for info in models.catalog():
+        robot = info.build() if info.dof is not None else None
+        entries.append({
+            "name": info.name,
+            "dof": robot.n if robot else None,
+            "joint_types": "".join(robot.joint_types) if robot else "R…",
+            "convention": info.convention,
+            "summary": info.summary,
+            "source": robot.source if robot else "planar<N>: N unit links (or --param "
+                                                 "lengths=[...])",
+        })
+    if as_json:
+        click.echo(dumps_json({"models": entries}), nl=False)
+        return
+    rows = [(e["name"], e["dof"] if e["dof"] is not None else "any", e["joint_types"],
+             e["convention"], e["summary"]) for e in entries]
+    click.echo(format_table(rows, ["name", "DOF", "joints", "DH", "description"]))
+    click.echo("\nSources:")
+    for e in entries:
+        click.echo(f"  {e['name']}: {e['source']}")
+    click.echo("\nAlso: planar<N> (e.g. planar6), a robot file (.yaml/.json) or a URDF.")
+
+
+# ---------------------------------------------------------------------------- fk
+def _fk_record(robot: Any, q: np.ndarray, frames: bool) -> dict[str, Any]:
+    from serialkin.spatial import matrix_to_rpy
+
+    T = robot.fk(q)
+    rec: dict[str, Any] = {"q": q, "T": T, "position": T[:3, 3],
+                           "rpy": matrix_to_rpy(T[:3, :3], check=False)}
+    if frames:
+        rec["frames"] = robot.fk_all(q)
+    return rec
+
+
+_FK_CMD_HELP = command_help(
+    "Forward kinematics: the tool pose T = base·A1(q1)···An(qn)·tool (eqs 10-11).\n\n"
+    "ROBOT is " + ROBOT_HELP + ".",
+    ['serialkin fk puma560 --q "0, 0.5, -0.3, 0, 0.2, 0"',
+     'serialkin fk two_link --q "30,45" --degrees --json',
+     "serialkin fk examples/robots/two_link.yaml --q-file q.csv --out poses.csv"],
+)
+
+
+@click.command("fk", help=_FK_CMD_HELP)
+@robot_argument
+@click.option("--q", "q_texts", multiple=True, metavar="Q1,Q2,...",
+              help="Joint values (repeatable for several configurations). Default: zeros.")
+@click.option("--q-file", type=click.Path(dir_okay=False),
+              help="CSV file with one configuration per row (n columns; '-' = stdin).")
+@click.option("--frames", is_flag=True, help="Also give every link frame 0..n (eq 11).")
+@degrees_option
+@param_option
+@json_option
+@out_option
+@quiet_option
+@handle_errors
+def fk_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frames: bool,
+           degrees: bool, params: tuple[str, ...], as_json: bool, out: str | None,
+           quiet: bool) -> None:
+    """Forward kinematics: the tool pose T = base·A1(q1)···An(qn)·tool (eqs 10-11)."""
+    r = resolve_robot(robot, params)
+    Q = read_q(r, q_texts, q_file, degrees)
+    recs = [_fk_record(r, q, frames) for q in Q]
+    data = {"robot": _robot_info(r), "units": {"length": "m", "angle": "rad"},
+            "results": recs}
+    if out:
+        header = ([f"q{i + 1}" for i in range(r.n)] + ["x", "y", "z", "roll", "pitch", "yaw"]
+                  + [f"T{i}{j}" for i in range(3) for j in range(4)])
+        rows = np.array([np.concatenate([rec["q"], rec["position"], rec["rpy"],
+                                         rec["T"][:3].ravel()]) for rec in recs])
+        path = write_output(out, data, (header, rows))
+        if not as_json:
+            _emit(f"wrote {path}", quiet)
+    if as_json:
+        click.echo(dumps_json(data), nl=False)
+        return
+    if quiet:
+        return
+    f = _angle_factor(r, degrees)
+    unit = "deg" if degrees else "rad"
+    if len(recs) == 1:
+        rec = recs[0]
+        click.echo(f"{r.name} ({r.n} joints {''.join(r.joint_types)}), "
+                   f"q = {np.array2string(rec['q'] / f, precision=6, separator=', ')}")
+        click.echo("T (world from tool):")
+        click.echo(format_matrix(rec["T"]))
+        click.echo(f"position [m]: {np.array2string(rec['position'], precision=6)}")
+        rpy = np.degrees(rec["rpy"]) if degrees else rec["rpy"]
+        click.echo(f"rpy [{unit}]: {np.array2string(rpy, precision=6)}")
+        if frames:
+            for k, Fk in enumerate(rec["frames"]):
+                click.echo(f"frame {k}:")
+                click.echo(format_matrix(Fk))
+        return
+    rows = []
+    for k, rec in enumerate(recs):
+        rpy = np.degrees(rec["rpy"]) if degrees else rec["rpy"]
+        rows.append([k + 1, *rec["position"], *rpy])
+    click.echo(format_table(rows, ["#", "x [m]", "y [m]", "z [m]", f"roll [{unit}]",
+                                   f"pitch [{unit}]", f"yaw [{unit}]"]))
+
+
+
+
+# ---------------------------------------------------------------------------- jacobian
+_JACOBIAN_CMD_HELP = command_help(
+    "Geometric Jacobian J(q) (eqs 33-36), rows [vx, vy, vz, wx, wy, wz].\n\n"
+    "Also prints the manipulability sqrt(det(J_t J_tᵀ)) (eq 43) of the task rows "
+    "(--task), the condition number and the rank. ROBOT is " + ROBOT_HELP + ".",
+    ['serialkin jacobian two_link --q "0.3,0.9"',
+     'serialkin jacobian ur5 --q "0,-1.2,1.4,0,0.5,0" --frame ee --json',
+     'serialkin jacobian puma560 --link 3 --point "0,0,0.1"'],
+)
+
+
+@click.command("jacobian", help=_JACOBIAN_CMD_HELP)
+@robot_argument
+@click.option("--q", "q_texts", multiple=True, metavar="Q1,Q2,...",
+              help="Joint values (repeatable). Default: zeros.")
+@click.option("--q-file", type=click.Path(dir_okay=False),
+              help="CSV file with one configuration per row (n columns).")
+@click.option("--frame", type=click.Choice(["base", "ee"]), default="base", show_default=True,
+              help="Express J in the world/base frame or in the tool frame.")
+@click.option("--link", type=int, default=None,
+              help="Jacobian of a point on link frame k (0..n) instead of the tool.")
+@click.option("--point", default=None, metavar="X,Y,Z",
+              help="The point on --link, in that link frame [m] (default its origin).")
+@click.option("--planar", is_flag=True,
+              help="Planar task Jacobian: rows vx, vy, wz (eqs 30-32, 38).")
+@click.option("--task", type=click.Choice(["auto", "full", "position", "orientation", "planar",
+                                           "planar_pose"]), default="auto", show_default=True,
+              help="Task rows for manipulability and condition number (auto: planar/"
+                   "planar_pose for planar robots, full with >= 6 joints, else position).")
+@degrees_option
+@param_option
+@json_option
+@out_option
+@quiet_option
+@handle_errors
+def jacobian_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frame: str,
+                 link: int | None, point: str | None, planar: bool, task: str, degrees: bool,
+                 params: tuple[str, ...], as_json: bool, out: str | None, quiet: bool) -> None:
+    """Geometric Jacobian J(q) (eqs 33-36), rows [vx, vy, vz, wx, wy, wz]."""
+    r = resolve_robot(robot, params)
+    Q = read_q(r, q_texts, q_file, degrees)
+    pt = parse_numbers(point, "--point", 3) if point is not None else None
+    if pt is not None and link is None:
+        raise CLIError("--point needs --link (the link frame the point is fixed on)")
+    from serialkin.model.robot import TASK_ROWS
+    from serialkin.workspace.sampling import manipulability_task
+
+    rows_sel = [0, 1, 5] if planar else list(range(6))
+    names = ["vx", "vy", "vz", "wx", "wy", "wz"]
+    task_name = manipulability_task(r, bool(r.is_planar)) if task == "auto" else task
+    task_rows = list(TASK_ROWS[task_name])
+    recs = []
+    for q in Q:
+        J6 = r.jacobian(q, frame=frame, link=link, point=pt)
+        J = J6[rows_sel]
+        Jt = J6[task_rows]
+        s = np.linalg.svd(Jt, compute_uv=False)
+        w = float(np.sqrt(max(np.linalg.det(Jt @ Jt.T), 0.0)))
+        cond = float(s[0] / s[-1]) if s[-1] > 1e-15 * max(s[0], 1e-300) else float("inf")
+        rank = int(np.sum(s > 1e-10 * max(s[0], 1e-300)))
+        recs.append({"q": q, "J": J, "manipulability": w, "condition_number": cond,
+                     "rank": rank, "singular_values": s})
+    data = {"robot": _robot_info(r), "frame": frame, "link": link, "point": pt,
+            "rows": [names[i] for i in rows_sel], "task": task_name,
+            "task_rows": [names[i] for i in task_rows], "results": recs}
+    if out:
+        header = [f"q{i + 1}" for i in range(r.n)] + [
+            f"J_{names[i]}_{j + 1}" for i in rows_sel for j in range(r.n)
+        ] + ["manipulability", "condition_number"]
+        table = np.array([np.concatenate([rec["q"], rec["J"].ravel(),
+                                          [rec["manipulability"], rec["condition_number"]]])
+                          for rec in recs])
+        path = write_output(out, data, (header, table))
+        if not as_json:
+            _emit(f"wrote {path}", quiet)
+    if as_json:
+        click.echo(dumps_json(data), nl=False)
+        return
+    if quiet:
+        return
+    f = _angle_factor(r, degrees)
+    for k, rec in enumerate(recs):
+        click.echo(f"{r.name}: q = {np.array2string(rec['q'] / f, precision=6, separator=', ')}"
+                   f"  (J in the {frame} frame"
+                   + (f", point on link {link}" if link is not None else "") + ")")
+        click.echo(format_table([[names[i], *rec["J"][k2]] for k2, i in enumerate(rows_sel)],
+                                ["row"] + [f"q{j + 1}" for j in range(r.n)]))
+        click.echo(f"{task_name} task ({', '.join(names[i] for i in task_rows)}): "
+                   f"manipulability {rec['manipulability']:.6g}, condition number "
+                   f"{rec['condition_number']:.6g}, rank {rec['rank']}")
+        if k + 1 < len(recs):
+            click.echo("")
+
+
+
+
+# ---------------------------------------------------------------------------- ik
+def _target_rows(robot: Any, values: np.ndarray, degrees: bool, planar: bool) -> list[Any]:
+    """Turn rows of numbers into IK targets (see ``serialkin ik --help``)."""
+    from serialkin.spatial import make_transform, rpy_to_matrix
+
+    out: list[Any] = []
+    for row in values:
+        k = row.shape[0]
+        if k == 16:
+            out.append(row.reshape(4, 4))
+        elif k == 6:
+            rpy = np.radians(row[3:]) if degrees else row[3:]
+            out.append(make_transform(rpy_to_matrix(rpy), row[:3]))
+        elif k == 3 and planar:
+            out.append(np.array([row[0], row[1], np.radians(row[2]) if degrees else row[2]]))
+        elif k in (2, 3):
+            out.append(row.copy())
+        else:  # pragma: no cover - counts are validated by the readers
+            raise CLIError(f"a target needs 2, 3, 6 or 16 numbers, got {k}")
+    return out
+
+
+def _target_sizes(planar: bool) -> tuple[int, ...]:
+    return (2, 3, 6, 16) if planar else (3, 6, 16)
+
+
+def _ik_options(options: tuple[str, ...]) -> dict[str, Any]:
+    from serialkin.cli.robots import parse_params
+
+    try:
+        return parse_params(options)
+    except CLIError as exc:
+        raise CLIError(str(exc).replace("--param", "--option")) from exc
+
+
+def _methods_table() -> str:
+    from serialkin.ik import METHODS, available_methods
+
+    rows = [(m, METHODS[m].family, METHODS[m].summary) for m in available_methods()]
+    text = format_table(rows, ["method", "family", "description"])
+    opts = [f"  {m}: " + ", ".join(f"{k}={v}" for k, v in METHODS[m].options.items())
+            for m in available_methods() if METHODS[m].options]
+    return text + ("\n\nOptions (--option key=value):\n" + "\n".join(opts) if opts else "")
+
+
+_IK_CMD_HELP = command_help(
+    "Inverse kinematics: joint values that put the tool on a target (sections 4, 5.3).\n\n"
+    "ROBOT is " + ROBOT_HELP + ". Exit code 1 when a target is not reached (the output "
+    "still lists every result, with success false and the reason); 2 on bad input.",
+    ['serialkin ik puma560 --target "0.5,0.2,0.3,0,90,0" --degrees',
+     'serialkin ik two_link --target "1.2,0.4" --all',
+     "serialkin ik ur5 --target-file targets.csv --method dls --option damping=0.05 --json",
+     "serialkin ik --list-methods"],
+)
+
+
+@click.command("ik", help=_IK_CMD_HELP)
+@click.argument("robot", metavar="ROBOT", required=False)
+@click.option("--target", "-t", "targets", multiple=True, metavar="NUMBERS",
+              help="Target (repeatable): x,y,z (position); x,y,z,roll,pitch,yaw (pose); 16 "
+                   "numbers (4x4 row-major); planar robots: x,y or x,y,phi.")
+@click.option("--target-file", type=click.Path(dir_okay=False),
+              help="CSV file with one target per row (same forms as --target).")
+@click.option("--method", "-m", default="lm", show_default=True,
+              help="IK method (see --list-methods).")
+@click.option("--q0", default=None, metavar="Q1,Q2,...", help="Initial guess (n values).")
+@click.option("--mask", default=None, metavar="W1,...,W6",
+              help="Weights of [vx,vy,vz,wx,wy,wz] (0 drops a coordinate).")
+@click.option("--tol", type=float, default=None, help="Tolerance on position [m] and "
+              "orientation [rad] errors (default 1e-9).")
+@click.option("--max-iter", type=int, default=None, help="Iterations per attempt.")
+@click.option("--restarts", type=int, default=None,
+              help="Restarts from random configurations.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of random starts.")
+@click.option("--no-limits", is_flag=True, help="Do not enforce the joint limits.")
+@click.option("--option", "options", multiple=True, metavar="KEY=VALUE",
+              help="Method-specific option, repeatable (e.g. --option damping=0.05).")
+@click.option("--all", "all_solutions", is_flag=True,
+              help="Every closed-form solution (section 4.1) instead of one numerical solve.")
+@click.option("--list-methods", is_flag=True, help="List the IK methods and their options.")
+@degrees_option
+@param_option
+@json_option
+@out_option
+@quiet_option
+@handle_errors
+def ik_cmd(robot: str | None, targets: tuple[str, ...], target_file: str | None, method: str,
+           q0: str | None, mask: str | None, tol: float | None, max_iter: int | None,
+           restarts: int | None, seed: int, no_limits: bool, options: tuple[str, ...],
+           all_solutions: bool, list_methods: bool, degrees: bool, params: tuple[str, ...],
+           as_json: bool, out: str | None, quiet: bool) -> None:
+    """Inverse kinematics: joint values that put the tool on a target (sections 4, 5.3)."""
+    if list_methods:
+        click.echo(_methods_table())
+        return
+    if robot is None:
+        raise CLIError("missing ROBOT: " + ROBOT_HELP)
+    r = resolve_robot(robot, params)
+    planar = bool(r.is_planar)
+    sizes = _target_sizes(planar)
+    rows = [parse_numbers(t, "--target", sizes) for t in targets]
+    if target_file:
+        rows += list(read_csv_rows(target_file, "targets", sizes))
+    if not rows:
+        raise CLIError("no target: give --target (repeatable) or --target-file")
+    tgts = _target_rows(r, rows_to_array(rows), degrees, planar) if len({len(x) for x in rows}) \
+        == 1 else [t for x in rows for t in _target_rows(r, x[None, :], degrees, planar)]
+    f = _angle_factor(r, degrees)
+    q0v = parse_numbers(q0, "--q0", r.n) * f if q0 is not None else None
+    maskv = parse_numbers(mask, "--mask", 6) if mask is not None else None
+    opts = _ik_options(options)
+    info = _robot_info(r)
+
+    if all_solutions:
+        _ik_all(r, tgts, info, as_json, out, quiet, f, degrees)
+        return
+
+    results = _solve_all(r, tgts, method, q0v, maskv, tol, max_iter, restarts, seed,
+                         not no_limits, opts, quiet)
+    recs = []
+    for k, (tg, res) in enumerate(zip(tgts, results)):
+        recs.append({"index": k + 1, "target": tg, "success": bool(res.success), "q": res.q,
+                     "position_error": float(res.position_error),
+                     "orientation_error": float(res.orientation_error),
+                     "iterations": int(res.iterations), "restarts": int(res.restarts),
+                     "reason": str(res.reason), "T": r.fk(res.q)})
+    ok = all(rec["success"] for rec in recs)
+    data = {"robot": info, "method": method, "success": ok,
+            "solved": sum(rec["success"] for rec in recs), "count": len(recs),
+            "units": {"length": "m", "angle": "rad"}, "results": recs}
+    if out:
+        header = ["success"] + [f"q{i + 1}" for i in range(r.n)] + [
+            "position_error", "orientation_error", "iterations", "restarts"]
+        table = np.array([[float(rec["success"]), *rec["q"], rec["position_error"],
+                           rec["orientation_error"], rec["iterations"], rec["restarts"]]
+                          for rec in recs])
+        path = write_output(out, data, (header, table))
+        if not as_json:
+            _emit(f"wrote {path}", quiet)
+    if as_json:
+        click.echo(dumps_json(data), nl=False)
+    elif not quiet:
+        unit = "deg" if degrees else "rad"
+        trows = [[rec["index"], "yes" if rec["success"] else "NO",
+                  np.array2string(rec["q"] / f, precision=5, separator=", "),
+                  rec["position_error"], rec["orientation_error"], rec["iterations"],
+                  rec["restarts"]] for rec in recs]
+        click.echo(f"{r.name}, method {method}:")
+        click.echo(format_table(trows, ["#", "ok", f"q [{unit}/m]", "pos err [m]",
+                                        "ori err [rad]", "iters", "restarts"], digits=3))
+    for rec in recs:
+        if not rec["success"]:
+            click.echo(f"target {rec['index']} not reached: {rec['reason']} (position error "
+                       f"{rec['position_error']:.3g} m, orientation error "
+                       f"{rec['orientation_error']:.3g} rad)", err=True)
+    if not ok:
+        raise SystemExit(EXIT_NOT_REACHED)
+
+
+
+
+def rows_to_array(rows: list[np.ndarray]) -> np.ndarray:
+    """Stack equal-length rows into an (N, k) array."""
+    return np.array(rows, dtype=float)
+
+
+def _solve_all(r: Any, tgts: list[Any], method: str, q0: np.ndarray | None,
+               mask: np.ndarray | None, tol: float | None, max_iter: int | None,
+               restarts: int | None, seed: int, respect_limits: bool, opts: dict[str, Any],
+               quiet: bool) -> list[Any]:
+    """Solve every target, in batches when they have one shape (compiled batch kernel).
+
+    A progress bar is shown on a terminal for long runs (more than one batch).
+    """
+    from tqdm import tqdm
+
+    kw = dict(method=method, mask=mask, tol=tol, max_iter=max_iter, restarts=restarts,
+              seed=seed, respect_limits=respect_limits, **opts)
+    shapes = {np.shape(t) for t in tgts}
+    if len(tgts) == 1:
+        return [r.ik(tgts[0], q0=q0, **kw)]
+    if len(shapes) != 1:
+        return [r.ik(t, q0=q0, **kw) for t in tgts]
+    stack = np.array(tgts)
+    out: list[Any] = []
+    chunk = 256
+    bar = tqdm(total=len(tgts), desc="ik", unit="target",
+               disable=True if quiet or len(tgts) <= chunk else None, leave=False)
+    try:
+        for s in range(0, len(tgts), chunk):
+            res = r.ik(stack[s:s + chunk], q0=q0, **kw)
+            out.extend(res[k] for k in range(len(res)))
+            bar.update(min(chunk, len(tgts) - s))
+    finally:
+        bar.close()
+    return out
+
+
+def _ik_all(r: Any, tgts: list[Any], info: dict[str, Any], as_json: bool, out: str | None,
+            quiet: bool, f: np.ndarray, degrees: bool) -> None:
+    recs = []
+    for k, tg in enumerate(tgts):
+        sols = np.asarray(r.ik_all(tg), dtype=float).reshape(-1, r.n)
+        recs.append({"index": k + 1, "target": tg, "success": bool(len(sols)),
+                     "solutions": sols, "count": int(len(sols))})
+    ok = all(rec["success"] for rec in recs)
+    data = {"robot": info, "method": "closed form (all solutions)", "success": ok,
+            "units": {"length": "m", "angle": "rad"}, "results": recs}
+    if out:
+        header = ["target"] + [f"q{i + 1}" for i in range(r.n)]
+        table = np.array([[rec["index"], *q] for rec in recs for q in rec["solutions"]])
+        path = write_output(out, data, (header, table.reshape(-1, r.n + 1)))
+        if not as_json:
+            _emit(f"wrote {path}", quiet)
+    if as_json:
+        click.echo(dumps_json(data), nl=False)
+    elif not quiet:
+        unit = "deg" if degrees else "rad"
+        for rec in recs:
+            click.echo(f"target {rec['index']}: {rec['count']} solution(s) [{unit}/m]")
+            for q in rec["solutions"]:
+                click.echo("  " + np.array2string(q / f, precision=6, separator=", "))
+    for rec in recs:
+        if not rec["success"]:
+            click.echo(f"target {rec['index']} not reached: no closed-form solution inside "
+                       "the joint limits", err=True)
+    if not ok:
+        raise SystemExit(EXIT_NOT_REACHED)
