@@ -206,3 +206,13 @@ def test_unknown_kind_rejected():
     """An unknown obstacle kind names the field and the valid kinds."""
     with pytest.raises(InputError, match="kind must be one of"):
         as_obstacle(dict(center=[0, 0, 0], radius=1.0, kind="cube"))
+
+
+def test_package_exports_resolve():
+    """Every name in serialkin.viz.__all__ resolves to a callable of its submodule."""
+    import serialkin.viz as viz
+
+    for name in viz.__all__:
+        assert callable(getattr(viz, name)), name
+    with pytest.raises(AttributeError):
+        viz.no_such_function  # noqa: B018

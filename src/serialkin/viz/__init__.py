@@ -22,11 +22,18 @@ _EXPORTS = {
     "plot_path": "plot",
     "robot_points": "plot",
     "joint_positions": "plot",
+    "as_obstacle": "plot",
     "plot_joint_trajectories": "trajectory",
     "plot_tracking_error": "trajectory",
     "plot_clearance": "trajectory",
+    "plot_motion": "trajectory",
+    "clearance_along": "trajectory",
+    "tracking_figure": "trajectory",
     "animate_trajectory": "animate",
+    "save_animation": "animate",
+    "ffmpeg_available": "animate",
     "viewer_html": "viewer",
+    "viewer_data": "viewer",
     "write_viewer": "viewer",
 }
 

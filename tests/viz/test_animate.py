@@ -1,0 +1,83 @@
+"""Tests for serialkin.viz.animate: GIF/MP4 bytes, frame count, atomic files."""
+
+import io
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from serialkin.errors import InputError, NotSupportedError
+from serialkin.viz.animate import (
+    animate_trajectory,
+    ffmpeg_available,
+    frame_indices,
+    save_animation,
+)
+
+
+def _frames(data: bytes) -> int:
+    return Image.open(io.BytesIO(data)).n_frames
+
+
+def test_gif_bytes_and_frame_count(planar3):
+    """A planar GIF starts with GIF89a and has one frame per configuration."""
+    Q = np.linspace([0.0, 0.0, 0.0], [1.0, -0.8, 0.6], 7)
+    data = animate_trajectory(planar3, Q, path_points=planar3.fk(Q)[:, :2, 3],
+                              obstacles=[dict(center=[0.3, 0.6], radius=0.1)], frames=True,
+                              dpi=40)
+    assert data[:6] == b"GIF89a"
+    assert _frames(data) == 7
+
+
+def test_gif_3d_with_max_frames(spatial4):
+    """A spatial robot animates in 3D; max_frames caps the frame count (first and last kept)."""
+    Q = spatial4.random_q(12, seed=9)
+    data = animate_trajectory(spatial4, Q, max_frames=5, dpi=40, title="spatial")
+    assert data[:6] == b"GIF89a" and _frames(data) == 5
+    idx = frame_indices(12, 5)
+    assert idx[0] == 0 and idx[-1] == 11 and len(idx) == 5
+    np.testing.assert_array_equal(frame_indices(4, 10), np.arange(4))
+
+
+def test_frames_show_the_motion(planar3):
+    """Consecutive frames differ (the arm moves): the first and last images are not equal."""
+    Q = np.linspace([0.0, 0.0, 0.0], [2.0, 0.0, 0.0], 3)
+    im = Image.open(io.BytesIO(animate_trajectory(planar3, Q, dpi=40)))
+    first = np.asarray(im.convert("RGB")).copy()
+    im.seek(2)
+    last = np.asarray(im.convert("RGB"))
+    assert (first != last).any(axis=-1).mean() > 0.005
+
+
+def test_save_animation_atomic(tmp_path, planar3):
+    """save_animation writes the file by its suffix and leaves no temporary file behind."""
+    Q = np.linspace([0.0, 0.0, 0.0], [0.5, 0.5, 0.5], 3)
+    out = save_animation(planar3, Q, tmp_path / "sub" / "arm.gif", dpi=30)
+    assert out.read_bytes()[:6] == b"GIF89a"
+    assert [p.name for p in out.parent.iterdir()] == ["arm.gif"]
+    with pytest.raises(InputError, match=r"\.gif or \.mp4"):
+        save_animation(planar3, Q, tmp_path / "arm.avi")
+
+
+def test_bad_arguments(planar3):
+    """Unknown formats, empty or wrong-width trajectories and fps <= 0 are rejected."""
+    Q = np.zeros((2, 3))
+    with pytest.raises(InputError, match="fmt"):
+        animate_trajectory(planar3, Q, fmt="avi")
+    with pytest.raises(InputError, match="fps"):
+        animate_trajectory(planar3, Q, fps=0)
+    with pytest.raises(InputError, match="q"):
+        animate_trajectory(planar3, np.zeros((2, 4)))
+    with pytest.raises(InputError, match="q must have shape"):
+        animate_trajectory(planar3, np.zeros(3))
+
+
+def test_mp4_when_ffmpeg_present(tmp_path, planar3):
+    """With ffmpeg an MP4 (ISO base media, 'ftyp' box) is written; without, a clear error."""
+    Q = np.linspace([0.0, 0.0, 0.0], [0.5, 0.5, 0.5], 4)
+    if not ffmpeg_available():
+        with pytest.raises(NotSupportedError, match="ffmpeg"):
+            animate_trajectory(planar3, Q, fmt="mp4")
+        pytest.skip("ffmpeg not on PATH: MP4 output not exercised (the error was checked)")
+    out = save_animation(planar3, Q, tmp_path / "arm.mp4", dpi=40)
+    assert out.read_bytes()[4:8] == b"ftyp"
