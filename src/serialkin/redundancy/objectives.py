@@ -213,8 +213,10 @@ def joint_limit_distance(robot: Robot, qlim: object = None) -> Objective:
     finite = np.isfinite(lim).all(axis=1)
     if np.any(lim[finite, 0] >= lim[finite, 1]):
         raise InputError("qlim: every lower limit must be below its upper limit")
-    mid = np.where(finite, 0.5 * (lim[:, 0] + lim[:, 1]), 0.0)
-    span = np.where(finite, lim[:, 1] - lim[:, 0], 1.0)
+    lo = np.where(finite, lim[:, 0], 0.0)
+    hi = np.where(finite, lim[:, 1], 1.0)
+    mid = np.where(finite, 0.5 * (lo + hi), 0.0)
+    span = hi - lo
     mask = finite.astype(float)
 
     def value(q: np.ndarray) -> float:

@@ -5,7 +5,7 @@ link i (i = 1..n) runs from the origin of link frame i−1 to the origin of link
 and moves with link frame i; when the tool transform has a translation, one more
 segment runs from the origin of frame n to the tool point. For a standard-DH arm these
 are the physical links (the joint axis z_{i−1} passes through frame i−1's origin, so it is
-a point of link i). For a prismatic joint the segment's first end is an approximation.
+a point of link i); a prismatic joint makes its segment stretch.
 
 Obstacles (all with an ``influence`` distance [m], beyond which the obstacle task of
 :mod:`serialkin.redundancy.multitask` ignores them):
@@ -20,8 +20,10 @@ of the obstacle centre on link i is clamped to ``[0, ℓ_i]`` so that the closes
 ``s_ci = s_i + p_i e_i`` lies on the link *segment*, not on its infinite line. Eq 53 gives
 ``d_ci = ‖s_ci − s_0‖``, eq 54 (corrected: ``s_ci``, not ``s_ai``) the unit vector
 ``u_i = (s_ci − s_0)/d_ci`` from obstacle to link, and eqs 55-56 the obstacle-Jacobian row
-``J_ci = −u_iᵀ J_sci`` with ``J_sci = ∂s_ci/∂q`` (the point Jacobian of s_ci held fixed on
-its link, from the compiled kernel family). ``J_ci q̇`` is the rate at which link i
+``J_ci = −u_iᵀ J_sci`` with ``J_sci = ∂s_ci/∂q = (1 − t) J_{o_{i−1}} + t J_{o_i}``, the
+blend of the point Jacobians of the segment's ends at the closest parameter t (from the
+compiled kernel family; for a revolute joint this is the Jacobian of s_ci held fixed on
+link i). ``J_ci q̇`` is the rate at which link i
 approaches the obstacle; ``−J_ci`` is the gradient of its clearance.
 """
 
@@ -383,14 +385,28 @@ class _Geometry:
                                     self.T, self.SC, self.B, self.D, self.C)
 
     def gradient(self, q: np.ndarray, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
-        """(u (3,), ∂clearance/∂q (n,)) of segment i and obstacle j (after update)."""
-        k = int(self.link[i])
-        W = self.frames[k]
-        sc = self.SC[i, j]
-        local = W[:3, :3].T @ (sc - W[:3, 3])
+        """(u (3,), ∂clearance/∂q (n,)) of segment i and obstacle j (after update).
+
+        ``J_sc = ∂s_c/∂q`` (eq 56) for ``s_c = (1 − t) P0 + t P1`` at fixed t is
+        ``(1 − t) J_P0 + t J_P1``, with the point Jacobians of the segment's ends (the
+        origins of link frames k−1 and k, or frame n's origin and the tool point). Holding
+        t fixed is exact for the distance's gradient (t is optimal, envelope theorem).
+        """
         r = self.robot
-        K.point_jacobian_into(q, r._F, r._L, r._meta, k, np.ascontiguousarray(local),
-                              self.Jbuf, self.pbuf)
+        k = int(self.link[i])
+        t = float(self.T[i, j])
+        sc = self.SC[i, j]
+        zero = np.zeros(3)
+        if i >= r.n:  # tool segment: both ends on link n
+            W = self.frames[k]
+            local = np.ascontiguousarray(W[:3, :3].T @ (sc - W[:3, 3]))
+            K.point_jacobian_into(q, r._F, r._L, r._meta, k, local, self.Jbuf, self.pbuf)
+            Js = self.Jbuf[:3].copy()
+        else:
+            K.point_jacobian_into(q, r._F, r._L, r._meta, k - 1, zero, self.Jbuf, self.pbuf)
+            Js = (1.0 - t) * self.Jbuf[:3]
+            K.point_jacobian_into(q, r._F, r._L, r._meta, k, zero, self.Jbuf, self.pbuf)
+            Js += t * self.Jbuf[:3]
         d = self.D[i, j]
         diff = sc - self.B[i, j]
         if d > 1e-12:
@@ -400,7 +416,7 @@ class _Geometry:
             u = np.array([-seg[1], seg[0], 0.0])
             nu = np.linalg.norm(u)
             u = u / nu if nu > 1e-12 else np.array([1.0, 0.0, 0.0])
-        return u, u @ self.Jbuf[:3]
+        return u, u @ Js
 
 
 def clearances(robot, q: object, obstacles: Sequence[Obstacle], *,

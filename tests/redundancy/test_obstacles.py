@@ -1,0 +1,144 @@
+"""Obstacles, closest points and obstacle Jacobians (eqs 51-56, corrected)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from serialkin.errors import InputError, InputTypeError
+from serialkin.redundancy import (
+    Capsule,
+    Circle,
+    Sphere,
+    check_obstacles,
+    clearances,
+    closest_pairs,
+    obstacle_jacobian,
+)
+from serialkin.redundancy.obstacles import obstacle_from_dict, robot_segments
+
+from ._robots import six_link, spatial_rp
+
+SEEDS = st.integers(0, 2**31 - 1)
+
+
+def _brute_clearance(P0, P1, obstacle, samples=4001):
+    """Clearance by dense sampling of the segment (independent reference)."""
+    t = np.linspace(0, 1, samples)[:, None]
+    pts = P0 + t * (P1 - P0)
+    if isinstance(obstacle, Circle):
+        d = np.linalg.norm(pts[:, :2] - obstacle.center, axis=1)
+    elif isinstance(obstacle, Sphere):
+        d = np.linalg.norm(pts - obstacle.center, axis=1)
+    else:
+        s = np.linspace(0, 1, samples)[:, None]
+        core = obstacle.a + s * (obstacle.b - obstacle.a)
+        d = np.min(np.linalg.norm(pts[::8, None, :] - core[None, ::8, :], axis=2), axis=1)
+    return d.min() - obstacle.radius
+
+
+def test_closest_point_is_clamped_to_the_segment():
+    """ERRATA (51)-(52): an obstacle beyond a link's end is closest to the end, not the line."""
+    robot = six_link()
+    q = np.zeros(6)  # links along +x: link 1 from (0,0) to (0.1,0)
+    obs = [Circle([-0.3, 0.05], 0.02)]  # behind the base, off the line
+    pairs = closest_pairs(robot, q, obs)
+    p = pairs[0]
+    assert p.t == 0.0
+    np.testing.assert_allclose(p.point[:2], [0.0, 0.0], atol=1e-15)
+    assert p.clearance == pytest.approx(np.hypot(0.3, 0.05) - 0.02)
+    # the unclamped projection would give a point at x = -0.3, distance 0.05
+    np.testing.assert_allclose(p.u[:2], np.array([0.3, -0.05]) / np.hypot(0.3, 0.05))
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=SEEDS)
+def test_clearances_match_dense_sampling(seed):
+    """Clearances of circles, spheres and capsules equal a brute-force sampled minimum."""
+    rng = np.random.default_rng(seed)
+    robot = spatial_rp()
+    q = robot.random_q(seed=rng)
+    obs = [Circle(rng.uniform(-0.4, 0.4, 2), 0.03),
+           Sphere(rng.uniform(-0.4, 0.4, 3), 0.04),
+           Capsule(rng.uniform(-0.4, 0.4, 3), rng.uniform(-0.4, 0.4, 3), 0.02)]
+    C = clearances(robot, q, obs)
+    P0, P1, _, _ = robot_segments(robot, q)
+    assert C.shape == (P0.shape[0], 3)
+    for i in range(P0.shape[0]):
+        for j, o in enumerate(obs):
+            ref = _brute_clearance(P0[i], P1[i], o)
+            tol = 2e-3 if isinstance(o, Capsule) else 1e-6
+            assert C[i, j] <= ref + 1e-9
+            assert C[i, j] == pytest.approx(ref, abs=tol)
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=SEEDS)
+def test_obstacle_jacobian_rows_match_finite_differences(seed):
+    """Eq 55: J_ci q̇ is the approach rate, i.e. J_ci = −∂c_i/∂q (finite differences)."""
+    rng = np.random.default_rng(seed)
+    robot = spatial_rp()
+    q = robot.random_q(seed=rng)
+    obs = [Sphere(rng.uniform(-0.4, 0.4, 3), 0.03),
+           Capsule(rng.uniform(-0.4, 0.4, 3), rng.uniform(-0.4, 0.4, 3), 0.02),
+           Circle(rng.uniform(-0.4, 0.4, 2), 0.03)]
+    pairs = closest_pairs(robot, q, obs, with_jacobian=True)
+    h = 1e-7
+    for p in pairs:
+        if p.distance < 1e-6:
+            continue
+        fd = np.empty(robot.n)
+        for k in range(robot.n):
+            d = np.zeros(robot.n)
+            d[k] = h
+            cp = clearances(robot, q + d, obs)[p.segment, p.obstacle]
+            cm = clearances(robot, q - d, obs)[p.segment, p.obstacle]
+            fd[k] = (cp - cm) / (2 * h)
+        np.testing.assert_allclose(p.jacobian_row, -fd, atol=1e-5)
+
+
+def test_obstacle_jacobian_keeps_only_pairs_within_influence():
+    """Only link/obstacle pairs closer than the influence distance give rows."""
+    robot = six_link()
+    q = np.zeros(6)
+    near = Circle([0.15, 0.05], 0.03, influence=0.05)   # 20 mm from links 1-2
+    far = Circle([0.15, 0.5], 0.03, influence=0.05)
+    Jc, c, pairs = obstacle_jacobian(robot, q, [near, far])
+    assert Jc.shape[1] == 6 and Jc.shape[0] == len(pairs) == len(c) > 0
+    assert all(j == 0 for _, j in pairs)
+    assert np.all(c < 0.05)
+    Jc2, _, _ = obstacle_jacobian(robot, q, [far])
+    assert Jc2.shape == (0, 6)
+
+
+def test_obstacle_overlapping_base_is_rejected():
+    """An obstacle that covers the robot's base raises InputError naming it."""
+    robot = six_link()
+    with pytest.raises(InputError, match="overlaps the robot base"):
+        check_obstacles(robot, [Circle([0.01, 0.0], 0.05, name="pillar")])
+    check_obstacles(robot, [Circle([0.2, 0.0], 0.05)])
+
+
+def test_obstacle_construction_errors():
+    """Bad radii, centres and dictionaries raise clear errors."""
+    with pytest.raises(InputError, match="radius"):
+        Circle([0, 0], -1.0)
+    with pytest.raises(InputError, match="center"):
+        Sphere([0, 0], 1.0)
+    with pytest.raises(InputError, match="finite"):
+        Circle([np.nan, 0], 1.0)
+    with pytest.raises(InputError, match="influence"):
+        Circle([0, 0], 1.0, influence=-0.1)
+    with pytest.raises(InputError, match="obstacle.type"):
+        obstacle_from_dict({"type": "cube"})
+    with pytest.raises(InputError, match="obstacle.radius is missing"):
+        obstacle_from_dict({"type": "circle", "center": [0, 0]})
+    with pytest.raises(InputError, match="unknown field"):
+        obstacle_from_dict({"type": "circle", "center": [0, 0], "radius": 1, "colour": "r"})
+    with pytest.raises(InputTypeError):
+        clearances(six_link(), np.zeros(6), ["not an obstacle"])
+    o = obstacle_from_dict({"type": "capsule", "a": [0, 0, 0], "b": [1, 0, 0], "radius": 0.1})
+    back = obstacle_from_dict(o.to_dict())
+    assert isinstance(back, Capsule) and np.allclose(back.b, o.b) and back.radius == o.radius
