@@ -1,4 +1,4 @@
-"""The chapter's simulations reproduced: 6-link circle (Figs 8-9), 20-link free/constrained (11-12)."""
+"""The chapter's simulations reproduced: 6-link circle (Figs 8-9), 20-link arm (Figs 11-12)."""
 
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ def constrained():
 
 
 def test_six_link_scenario_is_the_chapter_example(six):
-    """The shipped (a) scenario: L = 0.1 m, circle (−2.5L, 0) radius L, φ = 0..2π step 0.2, q0 = 0."""
+    """Shipped (a): L = 0.1 m, circle (−2.5L, 0) radius L, φ = 0..2π step 0.2, q0 = 0."""
     s, _ = six
     assert s.robot.n == 6
     np.testing.assert_allclose([d.a for d in s.robot.dh], 0.1)
