@@ -54,9 +54,11 @@ def chapter(out: str, quiet: bool, sections: tuple[str, ...]) -> None:
 def _register() -> None:
     """Add the subcommands of this package to :data:`cli`."""
     from serialkin.cli.commands import fk_cmd, ik_cmd, jacobian_cmd, models_cmd
+    from serialkin.cli.track_cmd import track_cmd
+    from serialkin.cli.view_cmd import view_cmd
     from serialkin.cli.workspace_cmd import workspace_cmd
 
-    for command in (models_cmd, fk_cmd, jacobian_cmd, ik_cmd, workspace_cmd):
+    for command in (models_cmd, fk_cmd, jacobian_cmd, ik_cmd, track_cmd, workspace_cmd, view_cmd):
         cli.add_command(command)
 
 

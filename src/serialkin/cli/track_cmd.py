@@ -1,0 +1,159 @@
+"""The ``track`` subcommand: run a path-tracking scenario (section 5.3) and write its outputs."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from serialkin.cli.commands import handle_errors, json_option, quiet_option
+from serialkin.cli.io import (
+    EXIT_NOT_REACHED,
+    CLIError,
+    command_help,
+    dumps_json,
+    ensure_dir,
+    write_bytes_atomic,
+    write_text_atomic,
+)
+
+_TRACK_HELP = command_help(
+    "Track the path of a scenario file and write the trajectory, figures and animation.\n\n"
+    "SCENARIO is a scenario file (.yaml/.json: robot, path, obstacles, limits, solver; see "
+    "serialkin.tracking.scenario) or the name of a shipped scenario (--list). Writes "
+    "<name>.csv and/or <name>.npz (the trajectory), <name>.png (motion, joint variables, "
+    "tracking error, clearance), <name>.gif (and .mp4 with --mp4 when ffmpeg is present) "
+    "and, with --viewer, <name>.html (the interactive viewer). Exit code 1 when a path "
+    "point is not reached within the tolerance; 2 on bad input.",
+    ["serialkin track six_link_circle --out out/track",
+     "serialkin track twenty_link_obstacles --format npz --viewer",
+     "serialkin track my_scenario.yaml --no-animation --json",
+     "serialkin track --list"],
+)
+
+
+@click.command("track", help=_TRACK_HELP)
+@click.argument("scenario", required=False)
+@click.option("--out", "-o", "out", type=click.Path(file_okay=False), default="out/track",
+              show_default=True, help="Output folder.")
+@click.option("--format", "fmt", type=click.Choice(["csv", "npz", "both"]), default="both",
+              show_default=True, help="Trajectory file format.")
+@click.option("--no-figures", is_flag=True, help="Do not draw the summary figure.")
+@click.option("--no-animation", is_flag=True, help="Do not render the GIF animation.")
+@click.option("--mp4", is_flag=True, help="Also render an MP4 (needs ffmpeg).")
+@click.option("--fps", type=float, default=15.0, show_default=True, help="Animation frame rate.")
+@click.option("--max-frames", type=int, default=150, show_default=True,
+              help="At most this many animation frames (evenly spread).")
+@click.option("--viewer", is_flag=True, help="Also write the interactive viewer page.")
+@click.option("--list", "list_only", is_flag=True, help="List the shipped scenarios.")
+@json_option
+@quiet_option
+@handle_errors
+def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_animation: bool,
+              mp4: bool, fps: float, max_frames: int, viewer: bool, list_only: bool,
+              as_json: bool, quiet: bool) -> None:
+    """Track a scenario's path and write trajectory, figures and animation."""
+    from serialkin.tracking import list_scenarios, load_scenario
+
+    if list_only:
+        names = list_scenarios()
+        if as_json:
+            click.echo(dumps_json({"scenarios": names}), nl=False)
+        else:
+            for n in names:
+                click.echo(n)
+        return
+    if scenario is None:
+        raise CLIError("missing SCENARIO: a scenario file or a shipped name (see --list)")
+    sc = load_scenario(scenario)
+    folder = ensure_dir(out)
+    stem = Path(scenario).stem if Path(scenario).suffix else scenario
+    show = not quiet and not as_json and sys.stderr.isatty()
+    if show:
+        click.echo(f"tracking {sc.name}: {len(sc.path)} path points, robot {sc.robot.name} "
+                   f"({sc.robot.n} joints) ...", err=True)
+    traj = sc.run()
+    files: dict[str, str] = {}
+    for ext in (("csv", "npz") if fmt == "both" else (fmt,)):
+        p = folder / f"{stem}.{ext}"
+        try:
+            traj.save(p)
+        except OSError as exc:
+            raise CLIError(f"cannot write {p} ({exc.strerror or exc})") from exc
+        files[ext] = str(p)
+    if not no_figures or not no_animation:
+        import matplotlib
+
+        matplotlib.use("Agg")
+    if not no_figures:
+        import io
+
+        import matplotlib.pyplot as plt
+
+        from serialkin.viz.trajectory import tracking_figure
+
+        fig = tracking_figure(traj, sc.robot, obstacles=sc.obstacles, title=sc.name)
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=100, bbox_inches="tight")
+        plt.close(fig)
+        files["figure"] = str(write_bytes_atomic(folder / f"{stem}.png", buf.getvalue()))
+    if not no_animation:
+        from serialkin.viz.animate import animate_trajectory, ffmpeg_available
+
+        formats = ["gif"] + (["mp4"] if mp4 else [])
+        if mp4 and not ffmpeg_available():
+            click.echo("note: --mp4 skipped, ffmpeg is not installed", err=True)
+            formats = ["gif"]
+        for f in formats:
+            data = animate_trajectory(sc.robot, traj, fmt=f, fps=fps, obstacles=sc.obstacles,
+                                      max_frames=max_frames, title=sc.name,
+                                      progress=(not quiet and not as_json
+                                                and sys.stderr.isatty()))
+            files[f] = str(write_bytes_atomic(folder / f"{stem}.{f}", data))
+    if viewer:
+        from serialkin.viz.viewer import write_viewer
+
+        p = folder / f"{stem}.html"
+        try:
+            write_viewer(sc.robot, p, trajectory=traj.q, path_points=traj.targets[:, :3, 3],
+                         obstacles=sc.obstacles, title=sc.name)
+        except OSError as exc:
+            raise CLIError(f"cannot write {p} ({exc.strerror or exc})") from exc
+        files["viewer"] = str(p)
+    summary = _summary(sc, traj, files)
+    write_text_atomic(folder / f"{stem}.json", dumps_json(summary))
+    files["summary"] = str(folder / f"{stem}.json")
+    if as_json:
+        click.echo(dumps_json(summary), nl=False)
+    elif not quiet:
+        click.echo(traj.summary())
+        for v in files.values():
+            click.echo(f"  wrote {v}")
+    for f in traj.failures:
+        click.echo(str(f), err=True)
+    if not traj.complete:
+        raise SystemExit(EXIT_NOT_REACHED)
+
+
+def _summary(sc: Any, traj: Any, files: dict[str, str]) -> dict[str, Any]:
+    return {
+        "scenario": sc.name,
+        "robot": {"name": sc.robot.name, "n": sc.robot.n,
+                  "joint_types": "".join(sc.robot.joint_types)},
+        "success": bool(traj.complete),
+        "path_points": int(traj.path_length),
+        "computed": len(traj),
+        "reached": int(np.sum(traj.reached)),
+        "tolerance": traj.tolerance,
+        "max_error": traj.max_error,
+        "min_clearance": traj.min_clearance,
+        "min_limit_margin": traj.min_limit_margin,
+        "solver": traj.solver,
+        "stopped": traj.stopped,
+        "failures": [{"index": f.index, "error": f.error, "target": list(f.target)}
+                     for f in traj.failures],
+        "files": dict(files),
+    }
