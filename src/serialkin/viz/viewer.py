@@ -117,7 +117,7 @@ def _view(points: np.ndarray, planar: bool, scale: float) -> dict[str, Any]:
     lo, hi = points.min(axis=0), points.max(axis=0)
     target = (lo + hi) / 2
     radius = max(float(np.linalg.norm(hi - lo)) / 2, 0.25 * scale)
-    distance = radius / np.sin(np.radians(20.0)) * 1.05  # 40° vertical field of view
+    distance = radius / np.sin(np.radians(20.0)) * 1.3  # 40° vertical field, some margin
     if planar:
         return {"target": target.tolist(), "radius": distance, "azimuth": -np.pi / 2,
                 "elevation": np.radians(70.0)}
