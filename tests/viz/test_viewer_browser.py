@@ -43,9 +43,8 @@ def _find(*names):
     return None
 
 
-@pytest.fixture(scope="module")
-def driver():
-    """A headless Chromium session, or a skip that names what is missing."""
+def _start(extra_flags=()):
+    """Start headless Chromium; return (driver, profile dir) or skip saying what is missing."""
     webdriver = pytest.importorskip(
         "selenium.webdriver", reason="selenium is not installed (pip install -e '.[dev]')"
     )
@@ -62,7 +61,7 @@ def driver():
     profile = tempfile.mkdtemp(prefix="serialkin-chromium-")
     options = webdriver.ChromeOptions()
     options.binary_location = chromium
-    for flag in CHROMIUM_FLAGS:
+    for flag in [*CHROMIUM_FLAGS, *extra_flags]:
         options.add_argument(flag)
     options.add_argument(f"--user-data-dir={profile}")
     options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
@@ -71,6 +70,13 @@ def driver():
     except Exception as exc:  # noqa: BLE001 - any start-up failure means: cannot test here
         shutil.rmtree(profile, ignore_errors=True)
         pytest.skip(f"headless Chromium could not start: {str(exc).splitlines()[0]}")
+    return drv, profile
+
+
+@pytest.fixture(scope="module")
+def driver():
+    """A headless Chromium session, or a skip that names what is missing."""
+    drv, profile = _start()
     yield drv
     drv.quit()
     shutil.rmtree(profile, ignore_errors=True)
@@ -209,3 +215,37 @@ def test_trajectory_frames_and_play(driver, tmp_path, planar3):
     assert k > 0
     np.testing.assert_allclose(_end_effector(driver), planar3.fk(Q[k]), atol=1e-9)
     assert _severe(driver) == []
+
+
+def test_keyboard_and_limit_highlight(driver, tmp_path, spatial4):
+    """Arrow keys move a slider by 1/200 of its range; leaving the limits turns it red."""
+    from selenium.webdriver.common.keys import Keys
+
+    _load(driver, tmp_path, spatial4, q=[0.0, 0.0, 0.1, 0.0])
+    slider = driver.find_element("id", "sk-joint-0")
+    slider.send_keys(Keys.ARROW_RIGHT)
+    q = np.array(driver.execute_script("return window.serialkin.getJoints()"))
+    assert q[0] == pytest.approx(2 * np.pi / 200, abs=1e-12)
+    np.testing.assert_allclose(_end_effector(driver), spatial4.fk(q), atol=1e-9)
+    unit = driver.find_element("id", "sk-unit-2")
+    assert "sk-outside" not in unit.get_attribute("class")
+    driver.execute_script("window.serialkin.setJoint(2, 0.5)")  # limits (0, 0.3) m
+    assert "sk-outside" in unit.get_attribute("class")
+    assert _severe(driver) == []
+
+
+def test_without_webgl_page_still_computes(tmp_path, planar3):
+    """With WebGL disabled the page says so, logs no error, and still computes FK."""
+    drv, profile = _start(["--disable-webgl", "--disable-3d-apis"])
+    try:
+        _load(drv, tmp_path, planar3)
+        state = drv.execute_script("return window.serialkin.state")
+        assert state["webgl"] is False
+        message = drv.find_element("id", "sk-message")
+        assert message.is_displayed() and "WebGL" in message.text
+        drv.execute_script("window.serialkin.setJoint(1, 0.4)")
+        np.testing.assert_allclose(_end_effector(drv), planar3.fk([0.0, 0.4, 0.0]), atol=1e-9)
+        assert _severe(drv) == []
+    finally:
+        drv.quit()
+        shutil.rmtree(profile, ignore_errors=True)

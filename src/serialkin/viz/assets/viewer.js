@@ -91,15 +91,29 @@ function showMessage(text) {
 // ------------------------------------------------------------------ three.js scene
 const S = DATA.scale;
 const view = $("sk-view");
+function webglAvailable() {
+  try {
+    const c = document.createElement("canvas");
+    return !!(window.WebGL2RenderingContext && c.getContext("webgl2"));
+  } catch (err) {
+    return false;
+  }
+}
 let renderer = null;
-try {
-  renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-  state.webgl = true;
-} catch (err) {
-  state.error = String(err);
+if (webglAvailable()) {
+  try {
+    renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    state.webgl = true;
+  } catch (err) {
+    state.error = String(err);
+  }
+} else {
+  state.error = "WebGL 2 is not available";
+}
+if (!renderer) {
   showMessage(
     "WebGL is not available in this browser, so the robot cannot be drawn. " +
-      "The sliders and the end-effector readout still work.",
+      "The sliders, the end-effector readout and window.serialkin still work.",
   );
 }
 const scene = new THREE.Scene();
@@ -131,6 +145,7 @@ const jointMatR = new THREE.MeshStandardMaterial({ color: 0xf0a030, metalness: 0
 const jointMatP = new THREE.MeshStandardMaterial({ color: 0x9b59b6, metalness: 0.1, roughness: 0.4 });
 const baseMat = new THREE.MeshStandardMaterial({ color: 0x444a52, roughness: 0.6 });
 const eeMat = new THREE.MeshStandardMaterial({ color: 0xd03030, roughness: 0.4 });
+const outsideMat = new THREE.MeshStandardMaterial({ color: 0xe02020, emissive: 0x600000 });
 const rLink = DATA.sizes.link_radius, rJoint = DATA.sizes.joint_radius;
 const Y = new THREE.Vector3(0, 1, 0);
 
@@ -235,6 +250,12 @@ for (const o of DATA.obstacles) {
 }
 
 // ------------------------------------------------------------------ update and render
+function outsideLimits(i) {
+  // True when q_i is outside its joint limits (null limits: unlimited).
+  const [lo, hi] = DATA.qlim[i];
+  return (lo !== null && state.q[i] < lo - 1e-12) || (hi !== null && state.q[i] > hi + 1e-12);
+}
+
 let current = kinematics(state.q);
 
 function updateRobot() {
@@ -252,6 +273,8 @@ function updateRobot() {
     ).normalize();
     jointMeshes[i].position.set(J[3], J[7], J[11]);
     jointMeshes[i].quaternion.setFromUnitVectors(Y, axis);
+    const out = outsideLimits(i);
+    jointMeshes[i].material = out ? outsideMat : m[3] === 1 ? jointMatP : jointMatR;
   }
   setMatrix(base, current.frames[0]);
   setMatrix(ee, current.tool);
@@ -369,6 +392,18 @@ function buildJointControls() {
     box.value = state.q[i];
     box.setAttribute("aria-label", `${DATA.joint_names[i]} value`);
     slider.addEventListener("input", () => setJoint(i, slider.valueAsNumber, "slider"));
+    // step="any" keeps slider values exact; keys move by 1/200 (PageUp/Down 1/20) of the range
+    slider.addEventListener("keydown", (ev) => {
+      const span = lim[1] - lim[0];
+      const steps = { ArrowRight: 1, ArrowUp: 1, ArrowLeft: -1, ArrowDown: -1, PageUp: 10, PageDown: -10 };
+      let v = null;
+      if (ev.key in steps) v = state.q[i] + (steps[ev.key] * span) / 200;
+      else if (ev.key === "Home") v = lim[0];
+      else if (ev.key === "End") v = lim[1];
+      if (v === null) return;
+      ev.preventDefault();
+      setJoint(i, Math.min(lim[1], Math.max(lim[0], v)), "api");
+    });
     box.addEventListener("change", () => {
       const v = parseFloat(box.value);
       if (Number.isFinite(v)) setJoint(i, v, "box");
@@ -390,6 +425,8 @@ function syncControl(i, source) {
   if (source !== "slider") sliders[i].value = state.q[i];
   if (source !== "box") boxes[i].value = +state.q[i].toPrecision(10);
   const u = $(`sk-unit-${i}`);
+  u.classList.toggle("sk-outside", outsideLimits(i));
+  u.title = outsideLimits(i) ? "outside the joint limits" : "";
   u.textContent =
     DATA.joint_types[i] === "R"
       ? `${fmt(state.q[i], 4)} rad = ${fmt((state.q[i] * 180) / Math.PI, 2)}°`
