@@ -45,9 +45,10 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import as_float_array, check_positive, check_transform
+from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
 from serialkin.errors import InputError, NoClosedFormError
 from serialkin.ik.analytic.structure import CLASSES, NUMERICAL_HINT, Structure, analyse
+from serialkin.ik.analytic.subproblems import rigid_ok
 from serialkin.model.robot import Robot
 
 __all__ = ["CLASSES", "classify", "ik_all", "structure"]
@@ -123,6 +124,8 @@ def classify(robot: Robot) -> str:
 
 
 def _prepared(robot: Robot) -> _Prepared:
+    if not isinstance(robot, Robot):
+        raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
     p = _PREPARED.get(robot)
     if p is None:
         p = _Prepared(robot, structure(robot))
@@ -133,6 +136,9 @@ def _prepared(robot: Robot) -> _Prepared:
 def _parse_target(p: _Prepared, robot: Robot, target: object) -> tuple[np.ndarray, bool]:
     """Turn the target into a (4, 4) world pose and whether its rotation counts."""
     if type(target) is np.ndarray and target.shape == (4, 4) and target.dtype == np.float64:
+        T = np.ascontiguousarray(target)
+        if rigid_ok(T, ROTATION_TOL):  # fast path; check_transform gives the message
+            return T, True
         a = target
     else:
         a = as_float_array(target, "target")

@@ -35,6 +35,8 @@ from serialkin.kinematics._kernels import fk_into
 
 #: arccos arguments within this distance of ±1 are clamped (workspace boundary).
 CLAMP = 1e-9
+#: arccos arguments within this distance of ±1 give exactly 0 / π (one merged branch).
+SNAP = 1e-14
 #: Two solutions closer than this in every joint (after wrapping) are one solution.
 DUPLICATE_TOL = 1e-9
 #: Solutions within this distance outside a joint limit are clipped onto it.
@@ -176,10 +178,15 @@ def transform_point(T, p):
 
 @njit(cache=True)
 def _acos_clamped(x):
-    """arccos(x) for |x| <= 1 + CLAMP (clamped), else NaN (out of reach)."""
-    if x > 1.0:
+    """arccos(x) for |x| <= 1 + CLAMP (clamped), else NaN (out of reach).
+
+    Within :data:`SNAP` of ±1 the result snaps to 0 / π, so the two branches of a
+    boundary configuration (stretched elbow) merge into one solution instead of two
+    copies ~1e-8 rad apart; the pose error this causes is second order (< 1e-14 m).
+    """
+    if x >= 1.0 - SNAP:
         return 0.0 if x <= 1.0 + CLAMP else math.nan
-    if x < -1.0:
+    if x <= -1.0 + SNAP:
         return math.pi if x >= -1.0 - CLAMP else math.nan
     return math.acos(x)
 
@@ -331,6 +338,30 @@ def planar2r(w, e1, c1, c2, p, t, out):
     out[1, 0] = alpha + beta - phi10
     out[1, 1] = -th2 - phi20
     return 2
+
+
+@njit(cache=True)
+def rigid_ok(T, tol):
+    """True when T (4, 4) is a rigid transform within ``tol`` (as ``check_transform`` tests).
+
+    Finite entries, last row [0, 0, 0, 1], max |RᵀR − I| <= tol and |det R − 1| <= tol.
+    """
+    for i in range(4):
+        for j in range(4):
+            if not math.isfinite(T[i, j]):
+                return False
+    if abs(T[3, 0]) > tol or abs(T[3, 1]) > tol or abs(T[3, 2]) > tol \
+            or abs(T[3, 3] - 1.0) > tol:
+        return False
+    for i in range(3):
+        for j in range(3):
+            g = T[0, i] * T[0, j] + T[1, i] * T[1, j] + T[2, i] * T[2, j]
+            if abs(g - (1.0 if i == j else 0.0)) > tol:
+                return False
+    det = (T[0, 0] * (T[1, 1] * T[2, 2] - T[1, 2] * T[2, 1])
+           - T[0, 1] * (T[1, 0] * T[2, 2] - T[1, 2] * T[2, 0])
+           + T[0, 2] * (T[1, 0] * T[2, 1] - T[1, 1] * T[2, 0]))
+    return abs(det - 1.0) <= tol
 
 
 @njit(cache=True)

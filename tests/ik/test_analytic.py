@@ -1,0 +1,440 @@
+"""Closed-form inverse kinematics, all solutions (chapter section 4.1, serialkin.ik.analytic).
+
+Round trips FK(q) -> ik_all -> {q_k}: the set contains q (up to 2π) and every q_k
+reproduces the target; on the built-in models, on the same mechanisms in modified DH, as
+general joints (URDF) and on users' own robots of each class (scaled lengths, offsets,
+base and tool transforms, generated with a seed).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import serialkin as sk
+from serialkin import Robot, models
+from serialkin.errors import InputError, NoClosedFormError
+from serialkin.ik.analytic import CLASSES, classify, ik_all
+from serialkin.model.dh import DHLink, standard_to_modified
+from serialkin.spatial import make_transform, rotx, roty, rotz
+
+H = math.pi / 2
+
+
+# ----------------------------------------------------------------------------- helpers
+def _random_transform(rng: np.random.Generator, size: float = 0.3) -> np.ndarray:
+    R = rotz(rng.uniform(-np.pi, np.pi)) @ roty(rng.uniform(-np.pi, np.pi)) \
+        @ rotx(rng.uniform(-np.pi, np.pi))
+    return make_transform(R, rng.uniform(-size, size, 3))
+
+
+def _joint_distance(robot: Robot, S: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Max joint difference of each row of S to q, revolute joints modulo 2π."""
+    d = S - q
+    rev = np.array([t == "R" for t in robot.joint_types])
+    d[:, rev] = (d[:, rev] + np.pi) % (2 * np.pi) - np.pi
+    return np.abs(d).max(axis=1)
+
+
+def _check_round_trips(robot: Robot, count: int, seed: int, *, expect_all: bool = True,
+                       tol: float = 1e-9) -> list[int]:
+    """FK(q) -> ik_all contains q and every solution reproduces the pose; returns the counts."""
+    rng = np.random.default_rng(seed)
+    counts = []
+    for _ in range(count):
+        q = robot.random_q(seed=rng)
+        T = robot.fk(q)
+        S = ik_all(robot, T)
+        assert S.ndim == 2 and S.shape[1] == robot.n
+        counts.append(len(S))
+        if expect_all:
+            assert len(S) and _joint_distance(robot, S, q).min() < 1e-6, (q, S)
+        if len(S):
+            err = np.abs(robot.fk(S) - T).max(axis=(1, 2))
+            assert err.max() < tol, err
+            assert np.all(robot.within_limits(S))
+    return counts
+
+
+def _scara_rows(l1=0.35, l2=0.30, d1=0.4, d2=0.1, theta=(0.0, 0.0, 0.0, 0.0)):
+    return [
+        DHLink(a=l1, alpha=0.0, d=d1, theta=theta[0], qlim=(-2.6, 2.6)),
+        DHLink(a=l2, alpha=0.0, d=0.0, theta=theta[1], qlim=(-2.5, 2.5)),
+        DHLink(a=0.0, alpha=math.pi, d=d2, theta=theta[2], type="P", qlim=(-0.3, 0.0)),
+        DHLink(a=0.0, alpha=0.0, d=0.0, theta=theta[3], qlim=(-2 * np.pi, 2 * np.pi)),
+    ]
+
+
+def _pieper_rows():
+    """A 6R arm with intersecting axes 1, 2 and a spherical wrist (not a Puma: 2 ∦ 3)."""
+    lim = (-np.pi, np.pi)
+    return [
+        DHLink(a=0.0, alpha=-H, d=0.4, qlim=lim),
+        DHLink(a=0.0, alpha=H, d=0.1, qlim=lim),
+        DHLink(a=0.3, alpha=H, d=0.2, qlim=lim),
+        DHLink(a=0.0, alpha=-H, d=0.35, qlim=lim),
+        DHLink(a=0.0, alpha=H, d=0.0, qlim=lim),
+        DHLink(a=0.0, alpha=0.0, d=0.1, qlim=lim),
+    ]
+
+
+def _variant(robot: Robot, rng: np.random.Generator, keep_zero: tuple[str, ...] = ()) -> Robot:
+    """A user's own robot of the same class: scaled a/d, joint offsets, base and tool."""
+    rows = []
+    for i, r in enumerate(robot.dh):
+        a = 0.0 if f"a{i + 1}" in keep_zero else r.a * rng.uniform(0.5, 2.0) \
+            + rng.uniform(-0.1, 0.1)
+        d = 0.0 if f"d{i + 1}" in keep_zero else r.d * rng.uniform(0.5, 2.0) \
+            + rng.uniform(-0.1, 0.1)
+        theta = r.theta + (rng.uniform(-np.pi, np.pi) if r.type == "R" else 0.0)
+        rows.append(DHLink(a=a, alpha=r.alpha, d=d, theta=theta, type=r.type, qlim=r.qlim,
+                           name=r.name))
+    return Robot.from_dh(rows, robot.convention, base=_random_transform(rng),
+                         tool=_random_transform(rng, 0.1), name="users_own")
+
+
+ROBOTS = {
+    "two_link": (models.two_link, "planar_2r"),
+    "three_link": (models.three_link, "planar_3r"),
+    "scara": (models.scara, "scara"),
+    "puma560": (models.puma560, "puma"),
+    "stanford": (models.stanford, "stanford"),
+    "ur5": (models.ur5, "ur"),
+    "pieper": (lambda: Robot.from_dh(_pieper_rows(), name="pieper"), "pieper_intersecting"),
+}
+
+
+# ----------------------------------------------------------------------------- round trips
+@pytest.mark.parametrize("name", list(ROBOTS))
+def test_round_trip_builtin(name):
+    """For random q inside the limits, ik_all(FK(q)) contains q and every row reproduces FK(q)."""
+    build, kind = ROBOTS[name]
+    robot = build()
+    assert classify(robot) == kind
+    counts = _check_round_trips(robot, 150, seed=1)
+    assert max(counts) >= (1 if kind == "planar_2r" else 2)  # 2R + pose: one orientation
+
+
+@pytest.mark.parametrize("name", ["scara", "puma560", "stanford", "ur5", "pieper"])
+def test_round_trip_modified_dh(name):
+    """The same mechanism written in modified (Craig) DH is recognised and solved identically."""
+    build, kind = ROBOTS[name]
+    std = build()
+    rows, base, tool = standard_to_modified(std.dh, std.base, std.tool)
+    mod = Robot.from_dh(rows, "modified", base=base, tool=tool, name="modified")
+    assert classify(mod) == kind
+    _check_round_trips(mod, 60, seed=2)
+    T = std.fk(std.random_q(seed=3))
+    np.testing.assert_allclose(ik_all(mod, T), ik_all(std, T), atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["puma560", "ur5", "stanford"])
+def test_round_trip_general_joints_from_urdf(name):
+    """Recognition works on general joints (URDF round trip), not only on DH tables."""
+    build, kind = ROBOTS[name]
+    std = build()
+    urdf = Robot.from_urdf(std.to_urdf())
+    assert urdf.dh is None or urdf.convention is not None
+    general = Robot.from_joints(urdf.joints, base=urdf.base, tool=urdf.tool, name="g")
+    assert classify(general) == kind
+    T = std.fk(std.random_q(seed=4))
+    np.testing.assert_allclose(ik_all(general, T), ik_all(std, T), atol=1e-8)
+
+
+VARIANT_ZEROS = {
+    # DH entries that must stay 0 for the class; every other a, d is scaled and shifted
+    "two_link": (),
+    "three_link": (),
+    "scara": (),
+    "puma560": ("a4", "a5", "d5"),          # spherical wrist
+    "ur5": ("a5",),                         # axes 5 and 6 intersect
+    "stanford": ("a1", "a4", "a5", "d5"),   # axes 1, 2 intersect; spherical wrist
+    "pieper": ("a1", "a4", "a5", "d5"),
+}
+
+
+@pytest.mark.parametrize("name", list(VARIANT_ZEROS))
+@pytest.mark.parametrize("seed", [11, 12, 13])
+def test_round_trip_users_own_robot(name, seed):
+    """A user's robot of the same class (other lengths, offsets, base, tool) is fully solved."""
+    build, kind = ROBOTS[name]
+    rng = np.random.default_rng(seed)
+    robot = _variant(build(), rng, VARIANT_ZEROS[name])
+    assert classify(robot) == kind
+    _check_round_trips(robot, 40, seed=seed)
+
+
+@settings(max_examples=25, deadline=None)
+@given(l1=st.floats(0.1, 2.0), l2=st.floats(0.1, 2.0), d1=st.floats(-1.0, 1.0),
+       d2=st.floats(-0.5, 0.5), seed=st.integers(0, 2**31 - 1))
+def test_scara_any_dimensions(l1, l2, d1, d2, seed):
+    """Any SCARA of Table 1's structure is recognised and its round trips close."""
+    robot = Robot.from_dh(_scara_rows(l1, l2, d1, d2), base=_random_transform(
+        np.random.default_rng(seed)), name="my_scara")
+    assert classify(robot) == "scara"
+    _check_round_trips(robot, 5, seed=seed)
+
+
+@settings(max_examples=25, deadline=None)
+@given(a2=st.floats(0.1, 1.0), a3=st.floats(-0.2, 0.2), d3=st.floats(-0.3, 0.3),
+       d4=st.floats(0.1, 1.0), a1=st.floats(-0.3, 0.3), seed=st.integers(0, 2**31 - 1))
+def test_puma_class_any_dimensions(a2, a3, d3, d4, a1, seed):
+    """Puma-class arms with any shoulder/elbow offsets (a1 ≠ 0: KUKA-like) close round trips."""
+    rows = [DHLink(a=a1, alpha=H, d=0.5), DHLink(a=a2, alpha=0.0, d=0.0),
+            DHLink(a=a3, alpha=-H, d=d3), DHLink(a=0.0, alpha=H, d=d4),
+            DHLink(a=0.0, alpha=-H, d=0.0), DHLink(a=0.0, alpha=0.0, d=0.08)]
+    robot = Robot.from_dh(rows, tool=_random_transform(np.random.default_rng(seed), 0.1))
+    assert classify(robot) == "puma"
+    counts = _check_round_trips(robot, 5, seed=seed)
+    assert max(counts) <= 8
+
+
+def test_eight_solutions_without_limits():
+    """Unlimited Puma 560 and Pieper arm: 8 solutions per pose; UR5: 8 for most, never more."""
+    for robot in (models.puma560(), Robot.from_dh(_pieper_rows())):
+        free = robot.with_limits(np.tile([-np.inf, np.inf], (6, 1)))
+        assert _check_round_trips(free, 20, seed=5) == [8] * 20
+    free = models.ur5().with_limits(np.tile([-np.inf, np.inf], (6, 1)))
+    counts = _check_round_trips(free, 40, seed=5)
+    assert max(counts) == 8 and counts.count(8) >= 20, counts
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560", "pieper"])
+def test_solution_set_is_complete(name):
+    """Least squares from 30 random starts finds no solution missing from ik_all's set."""
+    optimize = pytest.importorskip("scipy.optimize")
+    robot = ROBOTS[name][0]().with_limits(np.tile([-np.inf, np.inf], (6, 1)))
+    rng = np.random.default_rng(14)
+
+    def residual(q, T):
+        F = robot.fk(q)
+        return np.concatenate([F[:3, 3] - T[:3, 3], (F[:3, :3] - T[:3, :3]).ravel()])
+
+    for _ in range(3):
+        T = robot.fk(robot.random_q(seed=rng))
+        S = ik_all(robot, T)
+        for _ in range(30):
+            sol = optimize.least_squares(residual, rng.uniform(-np.pi, np.pi, 6), args=(T,),
+                                         xtol=1e-15, ftol=1e-15, gtol=1e-15)
+            if np.abs(sol.fun).max() < 1e-9:
+                assert _joint_distance(robot, S, sol.x).min() < 1e-5
+
+
+def test_stanford_negative_stroke_gives_eight():
+    """Without stroke limits the Stanford arm has 8 solutions (4 with the slide reversed)."""
+    free = models.stanford().with_limits(np.tile([-np.inf, np.inf], (6, 1)))
+    counts = _check_round_trips(free, 20, seed=6)
+    assert counts.count(8) >= 15, counts
+
+
+# ----------------------------------------------------------------------------- chapter
+def test_two_link_matches_chapter_equations():
+    """Planar 2-link: both elbow solutions equal eqs 23-27 as corrected by the ERRATA."""
+    l1, l2 = 0.7, 0.45
+    robot = models.two_link(l1, l2)
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        x, y = robot.fk(robot.random_q(seed=rng))[:2, 3]
+        r = math.hypot(x, y)                                         # eq 23, corrected
+        alpha = math.atan2(y, x)                                     # eq 24
+        th2 = math.acos((x * x + y * y - l1 * l1 - l2 * l2) / (2 * l1 * l2))  # eq 25
+        beta = math.acos((l1 * l1 - l2 * l2 + r * r) / (2 * l1 * r))          # eq 26, corrected
+        expected = np.array([[alpha - beta, th2], [alpha + beta, -th2]])      # eq 27 pairing
+        expected = (expected + np.pi) % (2 * np.pi) - np.pi
+        S = ik_all(robot, [x, y])
+        assert S.shape == (2, 2)
+        np.testing.assert_allclose(S[np.lexsort(S.T[::-1])],
+                                   expected[np.lexsort(expected.T[::-1])], atol=1e-7)
+
+
+def test_planar_targets():
+    """(x, y) on the 2-link arm and (x, y, φ) on the 3-link arm: positions and heading match."""
+    two, three = models.two_link(), models.three_link(1.0, 0.8, 0.3)
+    S = ik_all(two, (1.2, 0.5))
+    assert len(S) == 2
+    np.testing.assert_allclose(two.fk(S)[:, :2, 3], [[1.2, 0.5]] * 2, atol=1e-12)
+    S = ik_all(three, (1.0, 0.6, 0.4))
+    assert len(S) == 2
+    T = three.fk(S)
+    np.testing.assert_allclose(T[:, :2, 3], [[1.0, 0.6]] * 2, atol=1e-12)
+    np.testing.assert_allclose(np.arctan2(T[:, 1, 0], T[:, 0, 0]), [0.4, 0.4], atol=1e-12)
+    np.testing.assert_allclose(S.sum(axis=1), [0.4, 0.4], atol=1e-12)
+
+
+def test_two_link_pose_target_filters_orientation():
+    """A 4x4 pose on a 2-link arm keeps only the elbow solution with the right orientation."""
+    robot = models.two_link()
+    q = np.array([0.3, 1.1])
+    S = ik_all(robot, robot.fk(q))
+    np.testing.assert_allclose(S, [q], atol=1e-9)
+
+
+def test_scara_chapter_table():
+    """The chapter's SCARA (Table 1): both elbow solutions, stroke and q4 recovered."""
+    robot = models.scara()
+    q = np.array([0.4, -0.9, -0.12, 1.3])
+    S = ik_all(robot, robot.fk(q))
+    assert len(S) == 2
+    assert _joint_distance(robot, S, q).min() < 1e-9
+    np.testing.assert_allclose(S[:, 2], [-0.12, -0.12], atol=1e-12)
+
+
+# ----------------------------------------------------------------------------- edge cases
+@pytest.mark.parametrize("name", ["two_link", "scara", "puma560", "stanford", "ur5"])
+def test_unreachable_target_gives_empty_array(name):
+    """A target beyond the reach gives an empty (0, n) array, not an exception."""
+    robot = ROBOTS[name][0]()
+    T = robot.fk(robot.random_q(seed=8))
+    T[:3, 3] += 50.0
+    S = ik_all(robot, T)
+    assert S.shape == (0, robot.n)
+
+
+def test_reachable_only_outside_limits_gives_empty_array():
+    """A pose reachable only with joints outside their limits gives no solution."""
+    robot = models.two_link().with_limits([[-np.pi, np.pi], [0.5, 1.0]])
+    T = models.two_link().fk([0.2, 2.0])
+    assert ik_all(robot, T).shape == (0, 2)
+    assert ik_all(robot, T[:2, 3]).shape == (0, 2)
+
+
+def test_rotation_the_robot_cannot_make_gives_empty_array():
+    """A SCARA pose whose tool axis is tilted is unreachable: empty, no exception."""
+    robot = models.scara()
+    T = robot.fk(np.array([0.4, -0.9, -0.12, 1.3])) @ make_transform(rotx(0.2))
+    assert ik_all(robot, T).shape == (0, 4)
+
+
+def _puma_stretched_q3() -> float:
+    """q3 that aligns the Puma 560's forearm (axis 3 → wrist centre) with link 2."""
+    robot = models.puma560()
+    frames = robot.fk_all(np.zeros(6))
+    v = np.linalg.inv(frames[2]) @ frames[4][:, 3]  # wrist centre in frame 2 at q3 = 0
+    return -math.atan2(v[1], v[0])
+
+
+@pytest.mark.parametrize("robot, q", [
+    (models.ur5(), [0.3, -1.0, 0.7, 0.2, 0.0, 0.4]),              # wrist singular
+    (models.ur5(), [0.3, -1.0, 0.0, 0.2, 0.9, 0.4]),              # elbow stretched
+    (models.puma560(), [0.3, 0.5, -0.7, 0.2, 0.0, 0.4]),          # wrist singular
+    (models.puma560(), [0.3, 0.5, _puma_stretched_q3(), 0.2, 0.9, 0.4]),  # elbow stretched
+])
+def test_singular_configurations(robot, q):
+    """At singular configurations: finite solutions, q among them, all reproducing the target."""
+    q = np.array(q)
+    T = robot.fk(q)
+    S = ik_all(robot, T)
+    assert len(S) >= 1 and np.isfinite(S).all()
+    assert np.abs(robot.fk(S) - T).max() < 1e-9
+    if q[4] != 0.0:  # wrist not singular: q itself is found (else only q4 + q6 is fixed)
+        assert _joint_distance(robot, S, q).min() < 1e-6
+
+
+def test_two_link_stretched_has_one_solution():
+    """At the workspace boundary (arm stretched) both elbow branches merge into one solution."""
+    robot = models.two_link()
+    S = ik_all(robot, (2.0, 0.0))
+    np.testing.assert_allclose(S, [[0.0, 0.0]], atol=1e-12)
+
+
+def test_all_turns_lists_every_equivalent():
+    """all_turns adds every 2π-equivalent angle inside the limits (UR5: ±2π, so 2⁶ per solution)."""
+    robot = models.ur5()
+    T = robot.fk(robot.random_q(seed=9))
+    base = ik_all(robot, T)
+    full = ik_all(robot, T, all_turns=True)
+    assert len(full) == 64 * len(base)
+    assert np.all(robot.within_limits(full))
+    assert np.all(_joint_distance(robot, base, full[0]).min() < 1e-9)
+    assert np.abs(robot.fk(full) - T).max() < 1e-9
+
+
+def test_deterministic_and_sorted():
+    """Same input, same output; rows sorted lexicographically and unique."""
+    robot = models.puma560().with_limits(np.tile([-np.pi, np.pi], (6, 1)))
+    T = robot.fk(robot.random_q(seed=10))
+    S1, S2 = ik_all(robot, T), robot.ik_all(T)
+    np.testing.assert_array_equal(S1, S2)
+    assert np.array_equal(S1, S1[np.lexsort(S1.T[::-1])])
+    assert len(np.unique(np.round(S1, 9), axis=0)) == len(S1)
+
+
+def test_wrapping_into_limits():
+    """Angles are returned inside the limits even when those are offset by 2π (e.g. [2π, 4π])."""
+    robot = models.three_link().with_limits([[2 * np.pi, 4 * np.pi], [-np.pi, np.pi],
+                                             [-3 * np.pi, -np.pi]])
+    q = np.array([2 * np.pi + 0.5, 0.7, -2 * np.pi - 0.3])
+    S = ik_all(robot, robot.fk(q))
+    assert np.all(robot.within_limits(S))
+    assert np.abs(S - q).max(axis=1).min() < 1e-9
+
+
+# ----------------------------------------------------------------------------- recognition
+def test_recognition_ignores_the_name():
+    """A Puma table named 'ur5' is a puma, a UR5 named 'my_arm' is a UR."""
+    assert classify(Robot.from_dh(models.puma560().dh, name="ur5")) == "puma"
+    assert classify(Robot.from_dh(models.ur5().dh, name="my_arm")) == "ur"
+    assert set(CLASSES) >= {"planar_2r", "planar_3r", "scara", "puma", "stanford", "ur"}
+
+
+@pytest.mark.parametrize("robot, words", [
+    (models.panda(), ["redundant", "robot.ik(target, method='lm')"]),
+    (models.iiwa7(), ["redundant"]),
+    (models.planar(4), ["redundant", "4 revolute"]),
+    (Robot.from_dh([DHLink(a=0.3, alpha=0.4, d=0.1 * i) for i in range(6)], name="odd"),
+     ["do not meet in one point", "axes 2, 3, 4 are not parallel", "robot.ik"]),
+])
+def test_unsupported_robot_raises_with_reason(robot, words):
+    """Robots without a closed form raise NoClosedFormError saying why and pointing to robot.ik."""
+    with pytest.raises(NoClosedFormError) as info:
+        robot.ik_all(np.eye(4))
+    for w in words:
+        assert w in str(info.value)
+    with pytest.raises(NoClosedFormError):
+        classify(robot)
+
+
+def test_near_structure_is_not_recognised():
+    """Axes parallel only to 1e-5 rad are not taken for a UR (the closed form would be wrong)."""
+    rows = list(models.ur5().dh)
+    rows[2] = DHLink(a=rows[2].a, alpha=1e-5, d=rows[2].d, qlim=rows[2].qlim)
+    with pytest.raises(NoClosedFormError, match="axes 2, 3, 4 are not parallel"):
+        classify(Robot.from_dh(rows))
+
+
+# ----------------------------------------------------------------------------- bad input
+def test_infinite_solution_targets_raise():
+    """Targets with infinitely many solutions (position on 6R, (x, y) on 3R) raise NoClosedForm."""
+    with pytest.raises(NoClosedFormError, match="orientation is free"):
+        ik_all(models.ur5(), [0.3, 0.1, 0.4])
+    with pytest.raises(NoClosedFormError, match="orientation is free"):
+        ik_all(models.three_link(), [1.0, 0.5])
+
+
+@pytest.mark.parametrize("target, match", [
+    (np.diag([1.0, 1.0, 2.0, 1.0]), "target"),
+    (np.full((4, 4), np.nan), "target"),
+    (np.zeros((3, 4, 4)), "one target"),
+    (np.zeros(5), "must be a 4x4 pose"),
+    ("pose", "target"),
+])
+def test_bad_target(target, match):
+    """Non-rigid, NaN, batched, misshaped or non-numeric targets raise errors naming 'target'."""
+    with pytest.raises((InputError, sk.errors.InputTypeError), match=match):
+        ik_all(models.ur5(), target)
+
+
+def test_bad_options():
+    """A non-positive tol or an unknown option raises InputError naming it."""
+    robot = models.ur5()
+    T = robot.fk(np.zeros(6))
+    with pytest.raises(InputError, match="tol"):
+        ik_all(robot, T, tol=-1.0)
+    with pytest.raises(InputError, match="unknown option"):
+        ik_all(robot, T, q0=np.zeros(6))
+    with pytest.raises(InputError, match="Robot"):
+        ik_all("ur5", T)
