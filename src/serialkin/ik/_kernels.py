@@ -22,10 +22,13 @@ Method codes and steps:
 * ``PINV`` — ``Δq = Jw⁺ r`` (eq 40, Moore-Penrose pseudoinverse by SVD, singular values
   below ``rcond·σ_max`` dropped), then scaled so that ``max |Δq_i| ≤ max_step``.
 * ``DLS`` — ``Δq = Jwᵀ (Jw Jwᵀ + λ² I)⁻¹ r`` (eq 46 as corrected in the errata), fixed λ.
-* ``LM`` — Levenberg-Marquardt with adaptive damping μ and a gain-ratio test
-  (Madsen, Nielsen & Tingleff 2004, §3.2): ``(JwᵀJw + μI) Δq = Jwᵀ r``; a step is
-  accepted when the cost decreases (ρ > 0), then ``μ ← μ·max(1/3, 1 − (2ρ − 1)³)``,
-  otherwise ``μ ← μ·ν, ν ← 2ν``.
+* ``LM`` — Levenberg-Marquardt with error-adaptive damping,
+  ``(JwᵀJw + μI) Δq = Jwᵀ r`` with ``μ = λE`` (Chan & Lawrence's rule with a small λ,
+  so the step is strongly damped far from the target and becomes the Gauss-Newton
+  step — quadratic convergence — at it), every step taken (non-monotone: it escapes
+  shallow local minima that a monotone trust-region LM falls into), and a
+  **limit-aware step**: a joint at a limit whose step points outward is frozen (its
+  column removed) and the step recomputed for the others before projection.
 * ``LM_WAMPLER`` / ``LM_CHAN`` / ``LM_SUGIHARA`` — ``(JwᵀJw + W_N) Δq = Jwᵀ r`` with
   ``W_N = λ I`` (Wampler 1986), ``W_N = λ E I`` (Chan & Lawrence 1988) and
   ``W_N = E I + λ I`` (Sugihara 2011); every step is taken.
@@ -69,12 +72,26 @@ SDLS = 7
 NEWTON = 8
 GAUSS_NEWTON = 9
 
-#: Indices into the ``params`` array.
-P_DAMPING = 0  # λ (DLS, Wampler, Chan, Sugihara) or initial τ (LM)
-P_WINDOW = 1  # stagnation window [iterations]
-P_MAX_STEP = 2  # max |Δq_i| (PINV) or γ_max (SDLS) [rad / m]
-P_RCOND = 3  # relative cut-off for singular values (PINV, NEWTON, GAUSS_NEWTON)
-N_PARAMS = 4
+#: Layout of the configuration vector ``cfg`` (float64, length N_CFG).
+C_WEIGHTS = 0  # 6 task weights w, indices 0..5
+C_METHOD = 6  # method code
+C_TOL = 7  # tolerance on position [m] and orientation [rad] errors
+C_MAX_ITER = 8  # iterations per attempt
+C_RESTARTS = 9  # restarts allowed
+C_RESPECT = 10  # 1: project onto the joint limits after every step
+C_USE_Q0 = 11  # 1: the first attempt starts from q0
+P_DAMPING = 12  # λ (DLS, LM, Wampler, Chan, Sugihara)
+P_WINDOW = 13  # stagnation window [iterations]
+P_MAX_STEP = 14  # max |Δq_i| (PINV) or γ_max (SDLS) [rad / m]
+P_RCOND = 15  # relative cut-off for singular values (PINV, NEWTON, GAUSS_NEWTON)
+N_CFG = 16
+
+#: Rows of the per-robot ``box`` array (5, n).
+B_LO = 0  # lower joint limits (-inf allowed)
+B_HI = 1  # upper joint limits (+inf allowed)
+B_SLO = 2  # finite sampling box for random starts, lower
+B_SHI = 3  # finite sampling box, upper
+B_REVOLUTE = 4  # 1.0 for revolute joints, 0.0 for prismatic
 
 #: Layout of the ``info`` output (float64, length N_INFO).
 I_SUCCESS = 0
@@ -107,6 +124,39 @@ def random_q_into(state, slo, shi, q):
         q[i] = slo[i] + (shi[i] - slo[i]) * u
 
 
+# ---------------------------------------------------------------- fast input checks
+@njit(cache=True)
+def is_rigid(T, tol):
+    """True when the (4, 4) ``T`` is a rigid transform to ``tol`` (fast target check).
+
+    Finite entries, last row [0, 0, 0, 1], orthonormal rotation block with det +1.
+    """
+    for i in range(4):
+        for j in range(4):
+            if not math.isfinite(T[i, j]):
+                return False
+    if abs(T[3, 0]) > tol or abs(T[3, 1]) > tol or abs(T[3, 2]) > tol or abs(T[3, 3] - 1.0) > tol:
+        return False
+    for i in range(3):
+        for j in range(3):
+            s = T[0, i] * T[0, j] + T[1, i] * T[1, j] + T[2, i] * T[2, j]
+            if abs(s - (1.0 if i == j else 0.0)) > tol:
+                return False
+    det = (T[0, 0] * (T[1, 1] * T[2, 2] - T[1, 2] * T[2, 1])
+           - T[0, 1] * (T[1, 0] * T[2, 2] - T[1, 2] * T[2, 0])
+           + T[0, 2] * (T[1, 0] * T[2, 1] - T[1, 1] * T[2, 0]))
+    return abs(det - 1.0) <= tol
+
+
+@njit(cache=True)
+def inside_limits(q, lo, hi, tol):
+    """True when every q_i (finite) lies in [lo_i − tol, hi_i + tol]."""
+    for i in range(q.shape[0]):
+        if not math.isfinite(q[i]) or q[i] < lo[i] - tol or q[i] > hi[i] + tol:
+            return False
+    return True
+
+
 # ---------------------------------------------------------------- joint limits
 @njit(cache=True)
 def project_into(q, lo, hi, revolute):
@@ -115,7 +165,7 @@ def project_into(q, lo, hi, revolute):
         x = q[i]
         if x >= lo[i] and x <= hi[i]:
             continue
-        if revolute[i] and math.isfinite(lo[i]):
+        if revolute[i] != 0 and math.isfinite(lo[i]):
             y = lo[i] + (x - lo[i]) % TWO_PI  # same angle, in [lo, lo + 2π)
             if y <= hi[i]:
                 q[i] = y
@@ -137,7 +187,7 @@ def normalize_into(q, lo, hi, revolute):
     its range is shifted by a multiple of 2π when that brings it inside.
     """
     for i in range(q.shape[0]):
-        if not revolute[i]:
+        if revolute[i] == 0:
             continue
         if not math.isfinite(lo[i]) or not math.isfinite(hi[i]):
             q[i] = (q[i] + math.pi) % TWO_PI - math.pi
@@ -310,7 +360,7 @@ def _limit_step(dq, max_step):
 # ---------------------------------------------------------------- one attempt
 @njit(cache=True)
 def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol, max_iter,
-             q, J, T, e, Jw, r, A, g, dq, qn, Jn, Tn, en, M6, y6):
+             q, J, T, e, Jw, r, A, g, dq, qn, Jn, Tn, en, M6, y6, free):
     """Iterate ``method`` from q (n,) in place; return (iterations, converged, cost).
 
     On return q, J, T, e describe the final (last accepted) configuration.
@@ -322,8 +372,6 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol,
     cost = _cost(e, w)
     ref_cost = cost
     ref_it = 0
-    mu = -1.0
-    nu = 2.0
     for it in range(max_iter):
         pe, oe = _errors(e, w)
         if pe <= tol and oe <= tol:
@@ -337,51 +385,42 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol,
             return it, False, cost
         _weigh(J, e, sw, Jw, r)
         if method == LM:
-            _normal(Jw, r, A, g)
-            if mu < 0.0:
+            # error-damped LM, μ = λE, with an active set for the joint limits: a joint
+            # that sits at a limit and whose step points outward is frozen (its column
+            # removed) and the step recomputed, at most n times.
+            for j in range(n):
+                free[j] = 1.0
+            lam = params[P_DAMPING]
+            for _pass in range(n + 1):
+                for i in range(6):
+                    for j in range(n):
+                        Jw[i, j] = sw[i] * J[i, j] * free[j]
+                _normal(Jw, r, A, g)
                 d = 0.0
                 for i in range(n):
                     d = max(d, A[i, i])
-                mu = params[P_DAMPING] * max(d, 1e-12)
-            for i in range(n):
-                A[i, i] += mu
-            if not _chol_solve(A, g, dq, n):
-                mu *= nu
-                nu *= 2.0
-                continue
-            # predicted decrease of the (projected) step: gᵀh − ½ hᵀ JwᵀJw h = ½ hᵀ(μh + g)
-            for i in range(n):
-                qn[i] = q[i] + dq[i]
-            if respect:
-                project_into(qn, lo, hi, revolute)
-            jacobian_into(qn, F, meta, Jn, Tn)
-            pose_error_into(Tn, Tt, en)
-            cost_n = _cost(en, w)
-            lin = 0.0
-            for i in range(6):
-                s = 0.0
-                for j in range(n):
-                    s += Jw[i, j] * (qn[j] - q[j])
-                lin += (r[i] - s) * (r[i] - s)
-            pred = cost - 0.5 * lin
-            rho = (cost - cost_n) / pred if pred > 0.0 else -1.0
-            if rho > 0.0 and math.isfinite(cost_n):
-                q[:] = qn
-                J[:, :] = Jn
-                T[:, :] = Tn
-                e[:] = en
-                cost = cost_n
-                t = 2.0 * rho - 1.0
-                mu *= max(1.0 / 3.0, 1.0 - t * t * t)
-                nu = 2.0
-            else:
-                mu *= nu
-                nu *= 2.0
-                if mu > 1e20:
-                    return it + 1, False, cost
-            continue
-        # ---- methods that always take their step
-        if method == TRANSPOSE:
+                mu = lam * cost + 1e-12 * (1.0 + d)
+                for i in range(n):
+                    A[i, i] += mu + (1.0 - free[i])
+                if not _chol_solve(A, g, dq, n):
+                    return it, False, cost
+                if not respect:
+                    break
+                changed = False
+                for i in range(n):
+                    x = q[i] + dq[i]
+                    if free[i] == 0.0 or (x >= lo[i] and x <= hi[i]):
+                        continue
+                    if revolute[i] != 0 and math.isfinite(lo[i]) \
+                            and lo[i] + (x - lo[i]) % TWO_PI <= hi[i]:
+                        continue  # a 2π shift brings it inside: not blocked
+                    if (x < lo[i] and q[i] <= lo[i] + 1e-12) \
+                            or (x > hi[i] and q[i] >= hi[i] - 1e-12):
+                        free[i] = 0.0
+                        changed = True
+                if not changed:
+                    break
+        elif method == TRANSPOSE:
             for j in range(n):
                 s = 0.0
                 for i in range(6):
@@ -459,33 +498,34 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol,
 
 
 @njit(cache=True)
-def solve_one(F, meta, Tt, w, lo, hi, slo, shi, revolute, respect, q0, use_q0, method, params,
-              tol, max_iter, restarts, seed, q_out, info):
+def solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     """Solve one target with restarts; write the best q into ``q_out`` (n,) and ``info``.
 
     Args:
         F: (n+1, 4, 4) chain fixed transforms (see :mod:`serialkin.kinematics._kernels`).
         meta: (n, 5) chain joint data.
         Tt: (4, 4) target pose.
-        w: (6,) task weights.
-        lo: (n,) lower joint limits (-inf allowed).
-        hi: (n,) upper joint limits (+inf allowed).
-        slo: (n,) lower bounds of the (finite) sampling box for restarts.
-        shi: (n,) upper bounds of the sampling box.
-        revolute: (n,) bool, True for revolute joints.
-        respect: project onto the limits after every step.
-        q0: (n,) first start configuration, read when ``use_q0``.
-        use_q0: start the first attempt from q0 (else from the random stream).
-        method: method code (``TRANSPOSE`` ... ``GAUSS_NEWTON``).
-        params: (N_PARAMS,) method parameters (``P_*``).
-        tol: tolerance on both the position [m] and orientation [rad] errors.
-        max_iter: iterations per attempt.
-        restarts: extra attempts allowed.
+        box: (5, n) joint limits, sampling box and joint types (rows ``B_*``).
+        q0: (n,) first start configuration, read when ``cfg[C_USE_Q0]`` is 1.
+        cfg: (N_CFG,) weights, method code, tolerance, budget and method parameters
+            (indices ``C_*`` and ``P_*``).
         seed: uint64 seed of this target's random stream.
         q_out: (n,) output, the best configuration found.
         info: (N_INFO,) output, see ``I_*``.
     """
     n = meta.shape[0]
+    w = cfg[C_WEIGHTS:C_WEIGHTS + 6]
+    lo = box[B_LO]
+    hi = box[B_HI]
+    slo = box[B_SLO]
+    shi = box[B_SHI]
+    revolute = box[B_REVOLUTE]
+    method = int(cfg[C_METHOD])
+    tol = cfg[C_TOL]
+    max_iter = int(cfg[C_MAX_ITER])
+    restarts = int(cfg[C_RESTARTS])
+    respect = cfg[C_RESPECT] > 0.5
+    use_q0 = cfg[C_USE_Q0] > 0.5
     J = np.empty((6, n))
     T = np.empty((4, 4))
     e = np.empty(6)
@@ -500,6 +540,7 @@ def solve_one(F, meta, Tt, w, lo, hi, slo, shi, revolute, respect, q0, use_q0, m
     en = np.empty(6)
     M6 = np.empty((6, 6))
     y6 = np.empty(6)
+    free = np.empty(n)
     q = np.empty(n)
     be = np.empty(6)
     sw = np.empty(6)
@@ -530,9 +571,9 @@ def solve_one(F, meta, Tt, w, lo, hi, slo, shi, revolute, respect, q0, use_q0, m
             random_q_into(state, slo, shi, q)
         if respect:
             project_into(q, lo, hi, revolute)
-        its, ok, cost = _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params,
+        its, ok, cost = _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, cfg,
                                  tol, max_iter, q, J, T, e, Jw, r, A, g, dq, qn, Jn, Tn, en,
-                                 M6, y6)
+                                 M6, y6, free)
         total += its
         finite = math.isfinite(cost)
         for i in range(n):
@@ -556,14 +597,13 @@ def solve_one(F, meta, Tt, w, lo, hi, slo, shi, revolute, respect, q0, use_q0, m
 
 
 @njit(cache=True, parallel=True)
-def solve_batch(F, meta, Tt, w, lo, hi, slo, shi, revolute, respect, Q0, use_q0, method, params,
-                tol, max_iter, restarts, seed, Q_out, info):
+def solve_batch(F, meta, Tt, box, Q0, cfg, seed, Q_out, info):
     """:func:`solve_one` for N targets ``Tt`` (N, 4, 4) across the cores.
 
-    ``Q0`` (N, n) start configurations (read when ``use_q0``), ``Q_out`` (N, n) and
-    ``info`` (N, N_INFO) outputs. Every target uses the same random stream ``seed``, so a
-    batch solve returns exactly what the single solves with that seed return.
+    ``Q0`` (N, n) start configurations (read when ``cfg[C_USE_Q0]`` is 1), ``Q_out``
+    (N, n) and ``info`` (N, N_INFO) outputs. Every target uses the same random stream
+    ``seed``, so a batch solve returns exactly what the single solves with that seed
+    return.
     """
     for k in prange(Tt.shape[0]):
-        solve_one(F, meta, Tt[k], w, lo, hi, slo, shi, revolute, respect, Q0[k], use_q0, method,
-                  params, tol, max_iter, restarts, seed, Q_out[k], info[k])
+        solve_one(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k])

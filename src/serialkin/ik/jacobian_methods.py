@@ -12,7 +12,7 @@ name               step
 ``transpose``      Jacobian transpose, ``Δq = α Jᵀe``, Buss/Wolovich step length
 ``pinv``           Moore-Penrose pseudoinverse, ``Δq = J⁺e`` (eq 40), step capped
 ``dls``            damped least squares, ``Δq = Jᵀ(JJᵀ + λ²I)⁻¹e`` (eq 46, corrected)
-``lm``             Levenberg-Marquardt, adaptive damping with gain-ratio test (default)
+``lm``             Levenberg-Marquardt, damping λE adapted to the error, limit-aware (default)
 ``lm_wampler``     ``(JᵀJ + λI)Δq = Jᵀe`` (Wampler 1986)
 ``lm_chan``        ``(JᵀJ + λE·I)Δq = Jᵀe`` (Chan & Lawrence 1988)
 ``lm_sugihara``    ``(JᵀJ + (E + λ)I)Δq = Jᵀe`` (Sugihara 2011)
@@ -56,9 +56,11 @@ register_method(MethodSpec(
 ))
 register_method(MethodSpec(
     name="lm", family="jacobian",
-    summary="Levenberg-Marquardt with adaptive damping and gain-ratio test (default, robust)",
-    limits=_PROJECTION, max_iter=100, restarts=100,
-    options={"damping": 1e-3, "stall_window": 12}, kernel_code=K.LM,
+    summary="Levenberg-Marquardt, damping λE adapted to the error, limit-aware (default)",
+    limits="limit-aware step: joints at a limit whose step points outward are frozen and "
+    "the step recomputed for the others; then " + _PROJECTION,
+    max_iter=100, restarts=100,
+    options={"damping": 0.03, "stall_window": 10}, kernel_code=K.LM,
 ))
 register_method(MethodSpec(
     name="lm_wampler", family="jacobian",

@@ -1,9 +1,11 @@
 """The IK method registry: method name → :class:`MethodSpec`.
 
 A method is registered once, at import of the module that implements it, with
-:func:`register_method`. Modules of :mod:`serialkin.ik` whose name ends in ``_methods``
-(e.g. ``jacobian_methods.py``) are imported automatically the first time the registry is
-read, so adding a file that follows that convention is all a new family needs.
+:func:`register_method`. Every public module of :mod:`serialkin.ik` (a ``.py`` file whose
+name does not start with ``_``, other than the skeleton's own modules) is imported the
+first time the registry is read, so adding a file that registers its methods is all a new
+family needs. The closed-form solvers (:mod:`serialkin.ik.analytic`) are served as the
+method ``'analytic'`` when that package provides ``ik_all``.
 
 Two kinds of methods share the same skeleton (:mod:`serialkin.ik.solver`):
 
@@ -89,8 +91,12 @@ def register_method(spec: MethodSpec) -> MethodSpec:
     return spec
 
 
+#: Modules of the skeleton itself (they register nothing).
+_SKELETON = frozenset({"registry", "solver", "target", "result", "compare"})
+
+
 def _discover() -> None:
-    """Import every ``serialkin.ik.*_methods`` module once (they register themselves)."""
+    """Import every public ``serialkin.ik`` module once (they register themselves)."""
     global _DISCOVERED
     if _DISCOVERED:
         return
@@ -98,8 +104,12 @@ def _discover() -> None:
     import serialkin.ik as pkg
 
     for info in pkgutil.iter_modules(pkg.__path__):
-        if info.name.endswith("_methods"):
+        if not info.ispkg and not info.name.startswith("_") and info.name not in _SKELETON:
             importlib.import_module(f"serialkin.ik.{info.name}")
+    if "analytic" not in _REGISTRY:
+        from serialkin.ik.solver import register_analytic
+
+        register_analytic()
 
 
 class _MethodTable(Mapping[str, MethodSpec]):
@@ -136,6 +146,10 @@ def get_method(name: object) -> MethodSpec:
     Raises:
         InputError: unknown name; the message lists the available methods.
     """
+    if _DISCOVERED and isinstance(name, str):
+        spec = _REGISTRY.get(name)
+        if spec is not None:
+            return spec
     _discover()
     check_choice(name, "method", sorted(_REGISTRY))
     return _REGISTRY[name]  # type: ignore[index]

@@ -38,7 +38,7 @@ from serialkin.errors import InputError, InputTypeError
 from serialkin.ik import _kernels as K
 from serialkin.ik.registry import MethodSpec, get_method
 from serialkin.ik.result import IKResult
-from serialkin.ik.target import Target, check_q0, check_tol, parse_target
+from serialkin.ik.target import Target, check_q0, check_tol, parse_target, robot_arrays
 from serialkin.kinematics import _kernels as FK
 from serialkin.model.robot import Robot
 from serialkin.spatial import _kernels as SK
@@ -47,6 +47,9 @@ from serialkin.spatial import _kernels as SK
 DEFAULT_TOL = 1e-9
 
 _MASK64 = (1 << 64) - 1
+
+#: Hot-path cache of kernel parameter vectors for default options.
+_PARAMS: dict[str, tuple[MethodSpec, np.ndarray]] = {}
 
 
 @dataclass(frozen=True, eq=False)
@@ -147,8 +150,10 @@ def _stream_seed(seed: object) -> int:
     )
 
 
-def _options(spec: MethodSpec, options: Mapping[str, Any]) -> dict[str, Any]:
+def _options(spec: MethodSpec, options: Mapping[str, Any]) -> Mapping[str, Any]:
     """Method options merged over the method's defaults; unknown names raise."""
+    if not options:
+        return spec.options
     unknown = sorted(set(options) - set(spec.options))
     if unknown:
         accepted = ", ".join(sorted(spec.options)) or "none"
@@ -160,13 +165,8 @@ def _options(spec: MethodSpec, options: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _limits(robot: Robot, respect_limits: bool) -> tuple[np.ndarray, ...]:
-    lo = np.ascontiguousarray(robot.qlim[:, 0], dtype=np.float64)
-    hi = np.ascontiguousarray(robot.qlim[:, 1], dtype=np.float64)
-    samp = robot.sampling_limits()
-    slo = np.ascontiguousarray(samp[:, 0])
-    shi = np.ascontiguousarray(samp[:, 1])
-    revolute = np.array([t == "R" for t in robot.joint_types])
-    return lo, hi, slo, shi, revolute
+    a = robot_arrays(robot)
+    return a.lo, a.hi, a.slo, a.shi, a.revolute
 
 
 def failure_reason(pos_err: float, ori_err: float, tol: float, attempts: int,
@@ -232,14 +232,22 @@ def run_attempts(spec: MethodSpec, problem: IKProblem, q0: np.ndarray | None, ma
 
 
 def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
-    """Kernel parameter vector from a compiled method's options."""
+    """The method-parameter tail ``cfg[P_DAMPING:]`` of the kernel configuration."""
     from serialkin._checks import check_positive
 
-    p = np.zeros(K.N_PARAMS)
-    p[K.P_DAMPING] = check_positive(opts.get("damping", 1e-3), "damping", allow_zero=True)
-    p[K.P_WINDOW] = check_int(opts.get("stall_window", 20), "stall_window", minimum=1)
-    p[K.P_MAX_STEP] = check_positive(opts.get("max_step", 0.5), "max_step")
-    p[K.P_RCOND] = check_positive(opts.get("rcond", 1e-10), "rcond")
+    if opts is spec.options or opts == spec.options:
+        cached = _PARAMS.get(spec.name)
+        if cached is not None and cached[0] is spec:
+            return cached[1]
+    base = K.P_DAMPING
+    p = np.zeros(K.N_CFG - base)
+    p[K.P_DAMPING - base] = check_positive(opts.get("damping", 1e-3), "damping", allow_zero=True)
+    p[K.P_WINDOW - base] = check_int(opts.get("stall_window", 20), "stall_window", minimum=1)
+    p[K.P_MAX_STEP - base] = check_positive(opts.get("max_step", 0.5), "max_step")
+    p[K.P_RCOND - base] = check_positive(opts.get("rcond", 1e-10), "rcond")
+    if opts == spec.options:
+        p.setflags(write=False)
+        _PARAMS[spec.name] = (spec, p)
     return p
 
 
@@ -313,25 +321,33 @@ def solve(
 def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | None,
                     tol: float, max_iter: int, restarts: int, seed: int, respect: bool,
                     opts: Mapping[str, Any]) -> IKResult:
-    lo, hi, slo, shi, revolute = _limits(robot, respect)
-    params = _method_params(spec, opts)
+    box = robot_arrays(robot).box
+    cfg = np.empty(K.N_CFG)
+    cfg[K.C_WEIGHTS:K.C_WEIGHTS + 6] = tgt.weights
+    cfg[K.C_METHOD] = spec.kernel_code
+    cfg[K.C_TOL] = tol
+    cfg[K.C_MAX_ITER] = max_iter
+    cfg[K.C_RESTARTS] = restarts
+    cfg[K.C_RESPECT] = 1.0 if respect else 0.0
+    cfg[K.C_USE_Q0] = 0.0 if q0 is None else 1.0
+    cfg[K.P_DAMPING:] = _method_params(spec, opts)
     F, meta = robot.chain.F, robot.chain.meta
     n = robot.n
     seed64 = np.uint64(seed)
+    # the kernels are compiled for writable target / q0 arrays: copy read-only ones
+    Tt = tgt.T if tgt.T.flags.writeable else tgt.T.copy()
     if not tgt.batch:
         q = np.empty(n)
         info = np.empty(K.N_INFO)
-        K.solve_one(F, meta, tgt.T, tgt.weights, lo, hi, slo, shi, revolute, respect,
-                    q0 if q0 is not None else np.zeros(n), q0 is not None, spec.kernel_code,
-                    params, tol, max_iter, restarts, seed64, q, info)
+        q0k = q0 if q0 is not None and q0.flags.writeable else (
+            np.zeros(n) if q0 is None else q0.copy())
+        K.solve_one(F, meta, Tt, box, q0k, cfg, seed64, q, info)
         return _result_single(robot, tgt, spec, q, info, tol)
-    N = tgt.T.shape[0]
+    N = Tt.shape[0]
     Q = np.empty((N, n))
     info = np.empty((N, K.N_INFO))
-    Q0 = q0 if q0 is not None else np.zeros((N, n))
-    K.solve_batch(F, meta, tgt.T, tgt.weights, lo, hi, slo, shi, revolute, respect, Q0,
-                  q0 is not None, spec.kernel_code, params, tol, max_iter, restarts, seed64, Q,
-                  info)
+    Q0 = np.zeros((N, n)) if q0 is None else np.array(q0, dtype=np.float64, order="C")
+    K.solve_batch(F, meta, Tt, box, Q0, cfg, seed64, Q, info)
     return _result_batch(robot, tgt, spec, Q, info, tol, respect)
 
 
@@ -399,3 +415,61 @@ def _solve_python(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | 
         restarts=np.array([r[6] for r in rows], dtype=np.int64),
         method=spec.name,
     )
+
+
+def _analytic_solve(robot: Robot, problem: IKProblem, q0: np.ndarray | None,
+                    options: Mapping[str, Any]) -> tuple[np.ndarray, bool, int, str]:
+    """The 'analytic' method: every closed-form solution, then the one nearest q0.
+
+    Nearest is measured joint by joint, revolute differences wrapped to [-π, π]; without
+    q0 the reference is the middle of the joint ranges.
+    """
+    from serialkin.ik.analytic import ik_all
+
+    T = problem.T_target
+    if problem.kind == "pose":
+        target: object = T
+    elif problem.kind == "position":
+        target = T[:3, 3].copy()
+    elif problem.kind == "planar":
+        target = T[:2, 3].copy()
+    else:
+        target = np.array([T[0, 3], T[1, 3], np.arctan2(T[1, 0], T[0, 0])])
+    sols = np.asarray(ik_all(robot, target, **options), dtype=np.float64).reshape(-1, robot.n)
+    if sols.shape[0] == 0:
+        mid = robot.sampling_limits().mean(axis=1)
+        return (q0 if q0 is not None else mid), False, 0, (
+            "no closed-form solution inside the joint limits: the target is out of reach or "
+            "reachable only outside the limits"
+        )
+    ref = q0 if q0 is not None else robot.sampling_limits().mean(axis=1)
+    d = sols - ref
+    rev = problem.revolute
+    d[:, rev] = (d[:, rev] + np.pi) % (2 * np.pi) - np.pi
+    best = sols[int(np.argmin(np.sum(d * d, axis=1)))]
+    ok = problem.converged(best) and (not problem.respect_limits
+                                      or bool(robot.within_limits(best, 1e-12)))
+    reason = "" if ok else "the closed-form solution does not reproduce the target within tol"
+    return best, ok, 1, reason
+
+
+def register_analytic() -> None:
+    """Register the method 'analytic' when :mod:`serialkin.ik.analytic` provides ``ik_all``."""
+    import importlib
+
+    from serialkin.ik.registry import register_method
+
+    try:
+        mod = importlib.import_module("serialkin.ik.analytic")
+    except ModuleNotFoundError as exc:
+        if exc.name not in ("serialkin.ik.analytic",):
+            raise
+        return
+    if not hasattr(mod, "ik_all"):
+        return
+    register_method(MethodSpec(
+        name="analytic", family="analytic",
+        summary="closed-form solutions (section 4.1), the one nearest q0",
+        limits="only solutions inside the limits are returned by ik_all",
+        max_iter=1, restarts=0, options={}, solve=_analytic_solve,
+    ))

@@ -20,12 +20,14 @@ Accepted targets:
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
 
-from serialkin._checks import as_float_array, check_positive, check_transform
+from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
 from serialkin.errors import InputError
+from serialkin.ik._kernels import inside_limits, is_rigid
 from serialkin.model.robot import Robot
 
 #: Names of the six task coordinates, in the order of the pose error and Jacobian rows.
@@ -38,6 +40,53 @@ KIND_WEIGHTS = {
     "planar": (1.0, 1.0, 0.0, 0.0, 0.0, 0.0),
     "planar_pose": (1.0, 1.0, 0.0, 0.0, 0.0, 1.0),
 }
+
+
+def _frozen(values: tuple[float, ...]) -> np.ndarray:
+    a = np.array(values, dtype=np.float64)
+    a.setflags(write=False)
+    return a
+
+
+_DEFAULT_WEIGHTS = {kind: _frozen(w) for kind, w in KIND_WEIGHTS.items()}
+
+
+@dataclass(frozen=True, eq=False)
+class RobotArrays:
+    """Contiguous per-robot arrays the solvers use (cached; robots are immutable).
+
+    Attributes:
+        lo, hi: (n,) joint limits (±inf where unlimited).
+        slo, shi: (n,) finite sampling box for random starts (:meth:`Robot.sampling_limits`).
+        revolute: (n,) bool.
+        box: (5, n) rows lo, hi, slo, shi, revolute (1.0 / 0.0), the kernels' layout.
+    """
+
+    lo: np.ndarray
+    hi: np.ndarray
+    slo: np.ndarray
+    shi: np.ndarray
+    revolute: np.ndarray
+    box: np.ndarray
+
+
+_ARRAYS: weakref.WeakKeyDictionary[Robot, RobotArrays] = weakref.WeakKeyDictionary()
+
+
+def robot_arrays(robot: Robot) -> RobotArrays:
+    """The cached :class:`RobotArrays` of ``robot``."""
+    a = _ARRAYS.get(robot)
+    if a is None:
+        samp = robot.sampling_limits()
+        revolute = np.array([t == "R" for t in robot.joint_types])
+        box = np.ascontiguousarray(
+            np.stack([robot.qlim[:, 0], robot.qlim[:, 1], samp[:, 0], samp[:, 1],
+                      revolute.astype(np.float64)]), dtype=np.float64)
+        a = RobotArrays(lo=box[0], hi=box[1], slo=box[2], shi=box[3], revolute=revolute, box=box)
+        for x in (a.revolute, a.box):
+            x.setflags(write=False)
+        _ARRAYS[robot] = a
+    return a
 
 
 @dataclass(frozen=True, eq=False)
@@ -113,7 +162,7 @@ def parse_mask(mask: object, kind: str) -> np.ndarray:
             coordinate selected that the target does not define (e.g. an orientation
             coordinate for a position target).
     """
-    default = np.array(KIND_WEIGHTS[kind])
+    default = _DEFAULT_WEIGHTS[kind]
     if mask is None:
         return default
     w = as_float_array(mask, "mask")
@@ -147,9 +196,9 @@ def parse_target(robot: Robot, target: object, mask: object = None) -> Target:
             rotation block, last row not [0, 0, 0, 1]), a shape that is none of the
             accepted ones, a planar target on a non-planar robot, or a bad mask.
     """
-    if isinstance(target, np.ndarray) and target.shape == (4, 4) and target.dtype == np.float64:
-        T = check_transform(target, "target")
-        return Target(np.ascontiguousarray(T), parse_mask(mask, "pose"), "pose")
+    if (isinstance(target, np.ndarray) and target.shape == (4, 4)
+            and target.dtype == np.float64 and is_rigid(target, ROTATION_TOL)):
+        return Target(np.ascontiguousarray(target), parse_mask(mask, "pose"), "pose")
     a = as_float_array(target, "target")
     if a.ndim >= 2 and a.shape[-2:] == (4, 4):
         if a.ndim > 3:
@@ -202,6 +251,11 @@ def check_q0(robot: Robot, q0: object, n_targets: int | None, respect_limits: bo
     Raises:
         InputError: wrong size, NaN/inf, or (with ``respect_limits``) outside the limits.
     """
+    if n_targets is None and isinstance(q0, np.ndarray) and q0.dtype == np.float64 \
+            and q0.shape == (robot.n,) and q0.flags.c_contiguous:
+        arr = robot_arrays(robot)
+        if inside_limits(q0, arr.lo, arr.hi, 1e-12 if respect_limits else np.inf):
+            return q0
     q = robot.check_q(q0, "q0")
     if n_targets is None:
         if q.ndim != 1:
