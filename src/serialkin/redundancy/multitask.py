@@ -45,6 +45,7 @@ from serialkin.redundancy.obstacles import (
     Circle,
     Sphere,
     _Geometry,
+    accumulate_obstacle_task,
     check_obstacles,
 )
 from serialkin.spatial._kernels import pose_error_into
@@ -253,7 +254,7 @@ class _State:
         self.use_limits = res.joint_limit_weight > 0 and bool(np.isfinite(self.lim).any())
         self.geom = _Geometry(robot, res.obstacles, res.link_radius) if res.obstacles else None
         self.infl = np.array([o.influence for o in res.obstacles])
-        self.eye = np.eye(n)
+        self.di = np.arange(n)
 
     def qdot(self, q: np.ndarray, xdot: np.ndarray) -> np.ndarray:
         """Eq 48 at q, with J and T already evaluated into the buffers."""
@@ -266,31 +267,21 @@ class _State:
             w = float(np.sqrt(max(np.linalg.det(Jt @ Jt.T), 0.0)))
             if w < r.manipulability_threshold:
                 lam2 += (r.singularity_damping * (1.0 - w / r.manipulability_threshold)) ** 2
-        A[np.diag_indices_from(A)] += lam2
+        A[self.di, self.di] += lam2
         if self.use_limits:
             wl = joint_limit_weights(q, self.lim, buffer=r.limit_buffer,
                                      max_weight=r.joint_limit_weight)
-            A[np.diag_indices_from(A)] += wl
+            A[self.di, self.di] += wl
             if r.repulsive_gain > 0:
                 rhs += wl * r.repulsive_gain * joint_limit_repulsion(q, self.lim,
                                                                      buffer=r.limit_buffer)
         if self.geom is not None:
             g = self.geom
             g.update(q)
-            active = np.argwhere(g.C < self.infl[None, :])
-            for i, j in active:
-                c = g.C[i, j]
-                infl = self.infl[j]
-                s = 1.0 if infl <= 0 else (infl - c) / infl
-                wc = r.obstacle_weight * float(smoothstep(s))
-                if wc <= 0.0:
-                    continue
-                _, grad = g.gradient(q, int(i), int(j))
-                row = -grad  # eq 55: J_ci = -u^T J_sci
-                A += wc * np.outer(row, row)
-                if r.repulsive_gain > 0:
-                    xc = -r.repulsive_gain * (infl - c)
-                    rhs += wc * xc * row
+            rb = self.robot
+            accumulate_obstacle_task(q, rb._F, rb._L, rb._meta, g.frames, g.P0, g.P1, g.link,
+                                     g.T, g.SC, g.B, g.D, g.C, self.infl, r.obstacle_weight,
+                                     r.repulsive_gain, A, rhs, g.Jbuf, g.pbuf)
         return np.linalg.solve(A, rhs)
 
     def error(self, q: np.ndarray, target: np.ndarray) -> np.ndarray:

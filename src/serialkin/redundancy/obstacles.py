@@ -387,36 +387,103 @@ class _Geometry:
     def gradient(self, q: np.ndarray, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
         """(u (3,), ∂clearance/∂q (n,)) of segment i and obstacle j (after update).
 
-        ``J_sc = ∂s_c/∂q`` (eq 56) for ``s_c = (1 − t) P0 + t P1`` at fixed t is
-        ``(1 − t) J_P0 + t J_P1``, with the point Jacobians of the segment's ends (the
-        origins of link frames k−1 and k, or frame n's origin and the tool point). Holding
-        t fixed is exact for the distance's gradient (t is optimal, envelope theorem).
+        See :func:`pair_gradient_into`.
         """
         r = self.robot
-        k = int(self.link[i])
-        t = float(self.T[i, j])
-        sc = self.SC[i, j]
-        zero = np.zeros(3)
-        if i >= r.n:  # tool segment: both ends on link n
-            W = self.frames[k]
-            local = np.ascontiguousarray(W[:3, :3].T @ (sc - W[:3, 3]))
-            K.point_jacobian_into(q, r._F, r._L, r._meta, k, local, self.Jbuf, self.pbuf)
-            Js = self.Jbuf[:3].copy()
+        u = np.empty(3)
+        g = np.empty(r.n)
+        pair_gradient_into(q, r._F, r._L, r._meta, self.frames, self.P0, self.P1, self.link,
+                           self.T, self.SC, self.B, self.D, i, j, self.Jbuf, self.pbuf, u, g)
+        return u, g
+
+
+@njit(cache=True)
+def pair_gradient_into(q, F, L, meta, frames, P0, P1, link, T, SC, B, D, i, j, Jbuf, pbuf,
+                       u, g):
+    """Unit vector u (eq 54, corrected) and clearance gradient ``g = uᵀ J_sc`` of one pair.
+
+    ``J_sc = ∂s_c/∂q`` (eq 56) for ``s_c = (1 − t) P0 + t P1`` at fixed t is
+    ``(1 − t) J_P0 + t J_P1``, with the point Jacobians of the segment's ends (the origins
+    of link frames k−1 and k, or frame n's origin and the tool point for the tool
+    segment). Holding t fixed is exact for the distance's gradient (t is optimal: envelope
+    theorem). Writes ``u`` (3,) and ``g`` (n,); eq 55's row is ``−g``.
+    """
+    n = q.shape[0]
+    k = link[i]
+    t = T[i, j]
+    d = D[i, j]
+    if d > 1e-12:
+        for r in range(3):
+            u[r] = (SC[i, j, r] - B[i, j, r]) / d
+    else:  # on the core: any direction; the segment's normal in xy
+        sx = -(P1[i, 1] - P0[i, 1])
+        sy = P1[i, 0] - P0[i, 0]
+        nu = math.sqrt(sx * sx + sy * sy)
+        if nu > 1e-12:
+            u[0] = sx / nu
+            u[1] = sy / nu
         else:
-            K.point_jacobian_into(q, r._F, r._L, r._meta, k - 1, zero, self.Jbuf, self.pbuf)
-            Js = (1.0 - t) * self.Jbuf[:3]
-            K.point_jacobian_into(q, r._F, r._L, r._meta, k, zero, self.Jbuf, self.pbuf)
-            Js += t * self.Jbuf[:3]
-        d = self.D[i, j]
-        diff = sc - self.B[i, j]
-        if d > 1e-12:
-            u = diff / d
-        else:  # on the core: any direction; pick the segment's normal in xy
-            seg = self.P1[i] - self.P0[i]
-            u = np.array([-seg[1], seg[0], 0.0])
-            nu = np.linalg.norm(u)
-            u = u / nu if nu > 1e-12 else np.array([1.0, 0.0, 0.0])
-        return u, u @ Js
+            u[0] = 1.0
+            u[1] = 0.0
+        u[2] = 0.0
+    for c in range(n):
+        g[c] = 0.0
+    local = np.zeros(3)
+    if i >= n:  # tool segment: both ends on link n, s_c fixed in frame k
+        W = frames[k]
+        for a in range(3):
+            s = 0.0
+            for r in range(3):
+                s += W[r, a] * (SC[i, j, r] - W[r, 3])
+            local[a] = s
+        K.point_jacobian_into(q, F, L, meta, k, local, Jbuf, pbuf)
+        for c in range(n):
+            g[c] = u[0] * Jbuf[0, c] + u[1] * Jbuf[1, c] + u[2] * Jbuf[2, c]
+        return
+    K.point_jacobian_into(q, F, L, meta, k - 1, local, Jbuf, pbuf)
+    for c in range(n):
+        g[c] = (1.0 - t) * (u[0] * Jbuf[0, c] + u[1] * Jbuf[1, c] + u[2] * Jbuf[2, c])
+    K.point_jacobian_into(q, F, L, meta, k, local, Jbuf, pbuf)
+    for c in range(n):
+        g[c] += t * (u[0] * Jbuf[0, c] + u[1] * Jbuf[1, c] + u[2] * Jbuf[2, c])
+
+
+@njit(cache=True)
+def accumulate_obstacle_task(q, F, L, meta, frames, P0, P1, link, T, SC, B, D, C, influence,
+                             max_weight, repulsive_gain, A, rhs, Jbuf, pbuf):
+    """Add the obstacle task of eq 48 to the normal equations ``A q̇ = rhs`` in place.
+
+    For every pair (segment i, obstacle j) with clearance ``c < d_infl,j``: row
+    ``J_ci = −g`` (eq 55), weight ``w = max_weight · smoothstep((d_infl − c)/d_infl)``
+    (1 at contact and beyond); ``A += w J_ciᵀJ_ci`` and, with a repulsive gain k,
+    ``rhs += w J_ciᵀ x_c`` with ``x_c = −k (d_infl − c)``. Returns the number of active pairs.
+    """
+    n = q.shape[0]
+    u = np.empty(3)
+    g = np.empty(n)
+    count = 0
+    for i in range(C.shape[0]):
+        for j in range(C.shape[1]):
+            c = C[i, j]
+            dinf = influence[j]
+            if c >= dinf:
+                continue
+            s = 1.0 if dinf <= 0.0 else (dinf - c) / dinf
+            s = min(max(s, 0.0), 1.0)
+            w = max_weight * s * s * (3.0 - 2.0 * s)
+            if w <= 0.0:
+                continue
+            count += 1
+            pair_gradient_into(q, F, L, meta, frames, P0, P1, link, T, SC, B, D, i, j, Jbuf,
+                               pbuf, u, g)
+            for a in range(n):
+                for b in range(n):
+                    A[a, b] += w * g[a] * g[b]
+            if repulsive_gain > 0.0:
+                xc = -repulsive_gain * (dinf - c)
+                for a in range(n):
+                    rhs[a] -= w * g[a] * xc
+    return count
 
 
 def clearances(robot, q: object, obstacles: Sequence[Obstacle], *,

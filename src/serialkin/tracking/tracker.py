@@ -286,7 +286,9 @@ def _ik_step(robot, path: Path, method: str, opts: dict):
 def _assemble(robot, path: Path, Q, ITER, ERR, TIMES, obstacles, link_radius, accept, label,
               stopped) -> Trajectory:
     count = Q.shape[0]
-    poses = robot.fk(Q) if count else np.zeros((0, 4, 4))
+    poses = np.empty((count, 4, 4))
+    for k in range(count):  # serial: the parallel batch kernel costs ms of thread start-up
+        K.fk_into(np.ascontiguousarray(Q[k]), robot._F, robot._meta, poses[k])
     if obstacles and count:
         g = _Geometry(robot, obstacles, link_radius)
         clear = np.empty((count, len(obstacles)))
