@@ -128,3 +128,11 @@ def test_tracking_figure_duck_typed_without_robot():
                            tolerance=0.005, clearance=np.empty((3, 0)))
     fig = tracking_figure(traj)
     assert len(fig.axes) == 2
+
+
+def test_tracking_error_log_scale_when_far_below_tolerance():
+    """Errors far below the tolerance switch to a log axis by default; log=False keeps linear."""
+    e = np.array([1e-7, 2e-7, 5e-8])
+    assert plot_tracking_error(e, tolerance=5e-3).get_yscale() == "log"
+    assert plot_tracking_error(e, tolerance=5e-3, log=False).get_yscale() == "linear"
+    assert plot_tracking_error(np.array([1e-3, 4e-3]), tolerance=5e-3).get_yscale() == "linear"

@@ -174,7 +174,7 @@ def plot_tracking_error(
     actual: object = None,
     tolerance: float | None = None,
     unit: str = "mm",
-    log: bool = False,
+    log: bool | None = None,
     label: str | None = None,
     title: str | None = "Tracking error",
 ) -> Axes:
@@ -192,7 +192,8 @@ def plot_tracking_error(
         tolerance: acceptance tolerance [m], drawn as a dashed line; points above it are
             marked with red crosses. Default the trajectory's tolerance, if any.
         unit: 'mm', 'cm' or 'm' for the y axis.
-        log: logarithmic y axis.
+        log: logarithmic y axis; None chooses it when every error is below 1/20 of the
+            tolerance (a linear axis would show a flat line at zero).
         label: legend label of the error line.
         title: axes title.
 
@@ -230,6 +231,9 @@ def plot_tracking_error(
         if bad.any():
             ax.plot(x[bad], e[bad] * k, "x", color="C3", ms=6, label="not reached",
                     gid="serialkin-unreached")
+    if log is None:
+        log = bool(tolerance is not None and e.size and e.max() < float(tolerance) / 20
+                   and e.max() > 0)
     if log:
         ax.set_yscale("log")
     else:
@@ -321,9 +325,9 @@ def plot_clearance(
     for j in range(m):
         ax.plot(x, C[:, j] * k, color=colours[j], lw=1.4, label=labels[j],
                 gid=f"serialkin-clearance-{j}")
-    ax.axhline(0.0, color="C3", lw=1.2, label="contact", gid="serialkin-contact")
+    ax.axhline(0.0, color="k", lw=1.2, label="contact", gid="serialkin-contact")
     lo = min(float(C.min()) * k, 0.0)
-    ax.axhspan(lo - abs(lo) * 0.1 - 1e-12, 0.0, color="C3", alpha=0.08)
+    ax.axhspan(lo - abs(lo) * 0.1 - 1e-12, 0.0, color="k", alpha=0.06)
     if influence is not None:
         dists = np.broadcast_to(np.asarray(influence, dtype=float), (m,))
         for j, d in enumerate(np.unique(dists)):
