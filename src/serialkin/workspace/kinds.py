@@ -339,8 +339,10 @@ def dexterous_workspace(robot: Any, orientations: int | Sequence[object] | None 
     ``singularity_margin · max w`` over all samples. With ``singularity_margin = 0`` this
     is the total-orientation workspace of the sampled orientations.
 
-    Sampling caveat: a cell missed for one orientation drops out of the intersection, so
-    the estimate's lower side is the more likely; its error bound adds each orientation's
+    Sampling caveats: (1) the result is the dexterous set for the *sampled* orientations,
+    a superset of the set for every orientation; use enough orientations (its excess
+    shrinks like the spacing² of the orientations). (2) A cell missed for one
+    orientation drops out of the intersection; the error bound adds each orientation's
     Chao1 estimate of missed cells.
 
     Args:
