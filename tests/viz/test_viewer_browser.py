@@ -249,3 +249,32 @@ def test_without_webgl_page_still_computes(tmp_path, planar3):
     finally:
         drv.quit()
         shutil.rmtree(profile, ignore_errors=True)
+
+
+@pytest.mark.slow
+def test_random_dh_robots_both_conventions(driver, tmp_path):
+    """Random DH robots (both conventions, R/P, base, tool): page FK equals robot.fk."""
+    rng = np.random.default_rng(11)
+    for k in range(6):
+        n = int(rng.integers(2, 8))
+        rows = []
+        for _ in range(n):
+            kind = "P" if rng.random() < 0.25 else "R"
+            rows.append(dict(a=float(rng.uniform(-0.5, 0.5)),
+                             alpha=float(rng.uniform(-np.pi, np.pi)),
+                             d=float(rng.uniform(-0.3, 0.3)),
+                             theta=float(rng.uniform(-np.pi, np.pi)), type=kind,
+                             qlim=(-0.4, 0.4) if kind == "P" else (-np.inf, np.inf)))
+        base, tool = np.eye(4), np.eye(4)
+        base[:3, 3] = rng.uniform(-0.2, 0.2, 3)
+        tool[:3, 3] = rng.uniform(-0.1, 0.1, 3)
+        convention = ("standard", "modified")[k % 2]
+        robot = Robot.from_dh(rows, convention, base=base, tool=tool, name=f"random{k}")
+        _load(driver, tmp_path, robot)
+        for q in robot.random_q(3, seed=k):
+            driver.execute_script("window.serialkin.setJoints(arguments[0])", q.tolist())
+            np.testing.assert_allclose(_end_effector(driver), robot.fk(q), atol=1e-9)
+            page_fk = np.array(driver.execute_script("return window.serialkin.fk(arguments[0])",
+                                                     q.tolist()))
+            np.testing.assert_allclose(page_fk, robot.fk(q), atol=1e-12)
+    assert _severe(driver) == []
