@@ -158,6 +158,8 @@ def animate_trajectory(
         _fix_limits(ax, robot, P, path_points, obs)
         if title:
             ax.set_title(title)
+        if two_d:
+            fig.tight_layout()
         label = (ax.text(0.02, 0.97, "", transform=ax.transAxes, va="top", fontsize=9)
                  if two_d else ax.text2D(0.02, 0.97, "", transform=ax.transAxes, va="top",
                                          fontsize=9))
