@@ -8,17 +8,20 @@ Adding a method family: write a module ``serialkin/ik/<family>_methods.py`` that
 :func:`~serialkin.ik.registry.register_method` at import; it is discovered automatically.
 """
 
+from serialkin.ik.compare import CompareTable, compare
 from serialkin.ik.registry import METHODS, MethodSpec, available_methods, register_method
 from serialkin.ik.result import IKResult
 from serialkin.ik.solver import DEFAULT_TOL, IKProblem, solve
 
 __all__ = [
+    "CompareTable",
     "DEFAULT_TOL",
     "IKProblem",
     "IKResult",
     "METHODS",
     "MethodSpec",
     "available_methods",
+    "compare",
     "register_method",
     "solve",
 ]
