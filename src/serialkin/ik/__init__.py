@@ -2,10 +2,12 @@
 
 Use ``robot.ik(target, method="lm", ...)`` or :func:`solve`; every method returns an
 :class:`IKResult`. :data:`METHODS` maps each method name to its
-:class:`~serialkin.ik.registry.MethodSpec`; :func:`available_methods` lists the names.
+:class:`~serialkin.ik.registry.MethodSpec`; :func:`available_methods` lists the names;
+:func:`compare` runs several methods on the same targets and tabulates the results.
 
-Adding a method family: write a module ``serialkin/ik/<family>_methods.py`` that calls
-:func:`~serialkin.ik.registry.register_method` at import; it is discovered automatically.
+Adding a method family: write a module ``serialkin/ik/<family>.py`` that calls
+:func:`~serialkin.ik.registry.register_method` at import; every public module of this
+package is imported (and so registered) the first time the registry is read.
 """
 
 from serialkin.ik.compare import CompareTable, compare
