@@ -81,3 +81,11 @@ def test_mp4_when_ffmpeg_present(tmp_path, planar3):
         pytest.skip("ffmpeg not on PATH: MP4 output not exercised (the error was checked)")
     out = save_animation(planar3, Q, tmp_path / "arm.mp4", dpi=40)
     assert out.read_bytes()[4:8] == b"ftyp"
+
+
+def test_progress_bar_counts_frames(planar3, capsys):
+    """progress=True reports every rendered frame on stderr (tqdm)."""
+    Q = np.linspace([0.0, 0.0, 0.0], [0.5, 0.5, 0.5], 4)
+    data = animate_trajectory(planar3, Q, dpi=30, progress=True)
+    assert _frames(data) == 4
+    assert "4/4" in capsys.readouterr().err
