@@ -31,10 +31,12 @@ influence zone) and ``x_L,i = k · (distance into the buffer, signed towards mid
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+from numba import njit
 
 from serialkin._checks import as_float_array, check_int, check_positive
 from serialkin.errors import InputError
@@ -47,14 +49,17 @@ from serialkin.redundancy.obstacles import (
     _Geometry,
     accumulate_obstacle_task,
     check_obstacles,
+    update_geometry_into,
 )
 from serialkin.spatial._kernels import pose_error_into
 
 __all__ = [
     "MultiTaskResolver",
     "SolveStats",
+    "eq48_into",
     "joint_limit_repulsion",
     "joint_limit_weights",
+    "multitask_solve_into",
     "smoothstep",
 ]
 
@@ -65,6 +70,29 @@ def smoothstep(s: np.ndarray | float) -> np.ndarray:
     return x * x * (3.0 - 2.0 * x)
 
 
+@njit(cache=True)
+def _limit_weight_and_push(q, lo, hi, buffer, max_weight):
+    """Eq 49 weight of one joint and its signed depth into the buffer (towards mid-range).
+
+    Returns (0, 0) for a joint with an infinite limit.
+    """
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return 0.0, 0.0
+    width = buffer * (hi - lo)
+    s = max((lo + width - q) / width, (q - (hi - width)) / width)
+    s = 1.0 if q <= lo or q >= hi else min(max(s, 0.0), 1.0)  # exactly the max at the limit
+    w = max_weight * s * s * (3.0 - 2.0 * s)
+    push = max(lo + width - q, 0.0) - max(q - (hi - width), 0.0)
+    return w, push
+
+
+def _check_buffer(buffer: float) -> float:
+    b = float(buffer)
+    if not 0.0 < b <= 0.5:
+        raise InputError(f"buffer must be in (0, 0.5], got {buffer!r}")
+    return b
+
+
 def joint_limit_weights(q: object, qlim: object, *, buffer: float = 0.1,
                         max_weight: float = 1.0) -> np.ndarray:
     """The joint-limit weight function of eq 49 (designed per the ERRATA), shape (n,).
@@ -73,7 +101,8 @@ def joint_limit_weights(q: object, qlim: object, *, buffer: float = 0.1,
 
     * ``W_Li = 0`` for ``q_m + b ≤ q ≤ q_M − b`` (well inside the range),
     * ``W_Li = max_weight · smoothstep((q_m + b − q)/b)`` in the lower buffer (and
-      symmetrically in the upper one): continuous, growing towards the limit,
+      symmetrically in the upper one), ``smoothstep(s) = 3s² − 2s³``: continuous (C¹),
+      growing towards the limit,
     * ``W_Li = max_weight`` at and beyond the limit.
 
     Joints with an infinite limit get 0.
@@ -84,20 +113,12 @@ def joint_limit_weights(q: object, qlim: object, *, buffer: float = 0.1,
         buffer: buffer width as a fraction of the range, in (0, 0.5].
         max_weight: weight at and beyond the limit (≥ 0).
     """
-    qv = np.asarray(q, dtype=float)
-    lim = np.asarray(qlim, dtype=float)
-    b = float(buffer)
-    if not 0.0 < b <= 0.5:
-        raise InputError(f"buffer must be in (0, 0.5], got {buffer!r}")
+    qv = np.asarray(q, dtype=float).reshape(-1)
+    lim = np.asarray(qlim, dtype=float).reshape(-1, 2)
+    b = _check_buffer(buffer)
     wmax = check_positive(max_weight, "max_weight", allow_zero=True)
-    finite = np.isfinite(lim).all(axis=-1)
-    lo = np.where(finite, lim[..., 0], 0.0)
-    hi = np.where(finite, lim[..., 1], 1.0)
-    width = b * (hi - lo)
-    s_lo = (lo + width - qv) / width
-    s_hi = (qv - (hi - width)) / width
-    w = wmax * smoothstep(np.maximum(s_lo, s_hi))
-    return np.where(finite, w, 0.0)
+    return np.array([_limit_weight_and_push(qv[i], lim[i, 0], lim[i, 1], b, wmax)[0]
+                     for i in range(qv.shape[0])])
 
 
 def joint_limit_repulsion(q: object, qlim: object, *, buffer: float = 0.1) -> np.ndarray:
@@ -106,15 +127,144 @@ def joint_limit_repulsion(q: object, qlim: object, *, buffer: float = 0.1) -> np
     ``+(q_m + b − q)`` in the lower buffer (or beyond), ``−(q − (q_M − b))`` in the upper one,
     0 elsewhere; the optional repulsive target ``x_L`` is this times a gain.
     """
-    qv = np.asarray(q, dtype=float)
-    lim = np.asarray(qlim, dtype=float)
-    finite = np.isfinite(lim).all(axis=-1)
-    lo = np.where(finite, lim[..., 0], -np.inf)
-    hi = np.where(finite, lim[..., 1], np.inf)
-    width = np.where(finite, buffer * (hi - lo), 0.0)
-    up = np.maximum(lo + width - qv, 0.0)
-    down = np.maximum(qv - (hi - width), 0.0)
-    return np.where(finite, up - down, 0.0)
+    qv = np.asarray(q, dtype=float).reshape(-1)
+    lim = np.asarray(qlim, dtype=float).reshape(-1, 2)
+    b = _check_buffer(buffer)
+    return np.array([_limit_weight_and_push(qv[i], lim[i, 0], lim[i, 1], b, 1.0)[1]
+                     for i in range(qv.shape[0])])
+
+
+# settings vector of the compiled kernels
+_W, _DAMP, _SING, _W0, _WL, _BUF, _WC, _KREP, _GAIN, _MAXX, _MAXQ, _TOL, _ITER = range(13)
+_LINKR, _USE_LIM, _USE_OBS, _HAS_TOOL = 13, 14, 15, 16
+
+
+@njit(cache=True)
+def eq48_into(q, xdot, J, rows, F, L, meta, cfg, qlim, enc, influence, link, frames, P0, P1, Tee,
+              T, SC, B, D, C, Jbuf, pbuf, A, rhs, qdot):
+    """Eq 48 (corrected): ``q̇ = (JᵀWJ + J_cᵀW_cJ_c + J_LᵀW_LJ_L + W_s)⁻¹(JᵀWẋ + …)``.
+
+    Args:
+        q: (n,) joint values.
+        xdot: (m,) primary task velocity.
+        J: (6, n) geometric Jacobian at q (only ``rows`` are used).
+        rows: (m,) task rows.
+        F: chain fixed transforms.
+        L: chain link-frame offsets.
+        meta: chain joint data.
+        cfg: settings vector (see :class:`MultiTaskResolver`).
+        qlim: (n, 2) joint limits of the joint-limit task.
+        enc: (k, 8) encoded obstacles.
+        influence: (k,) influence distances [m].
+        link: (s,) link frame of each segment.
+        frames: (n+1, 4, 4) buffer.
+        P0: (s, 3) buffer.
+        P1: (s, 3) buffer.
+        Tee: (4, 4) buffer.
+        T: (s, k) buffer.
+        SC: (s, k, 3) buffer.
+        B: (s, k, 3) buffer.
+        D: (s, k) buffer.
+        C: (s, k) buffer (clearances at q on return).
+        Jbuf: (6, n) buffer.
+        pbuf: (3,) buffer.
+        A: (n, n) buffer.
+        rhs: (n,) buffer.
+        qdot: (n,) output.
+    """
+    n = q.shape[0]
+    m = rows.shape[0]
+    w = cfg[_W]
+    for a in range(n):
+        s = 0.0
+        for r in range(m):
+            s += J[rows[r], a] * xdot[r]
+        rhs[a] = w * s
+        for b in range(n):
+            s = 0.0
+            for r in range(m):
+                s += J[rows[r], a] * J[rows[r], b]
+            A[a, b] = w * s
+    lam2 = cfg[_DAMP] * cfg[_DAMP]
+    if cfg[_SING] > 0.0 and cfg[_W0] > 0.0:
+        M = np.empty((m, m))
+        for r in range(m):
+            for c in range(m):
+                s = 0.0
+                for a in range(n):
+                    s += J[rows[r], a] * J[rows[c], a]
+                M[r, c] = s
+        wm = math.sqrt(max(np.linalg.det(M), 0.0))
+        if wm < cfg[_W0]:
+            ls = cfg[_SING] * (1.0 - wm / cfg[_W0])
+            lam2 += ls * ls
+    for a in range(n):
+        A[a, a] += lam2
+    if cfg[_USE_LIM] > 0.0:
+        for a in range(n):
+            wl, push = _limit_weight_and_push(q[a], qlim[a, 0], qlim[a, 1], cfg[_BUF], cfg[_WL])
+            A[a, a] += wl
+            if cfg[_KREP] > 0.0:
+                rhs[a] += wl * cfg[_KREP] * push
+    if cfg[_USE_OBS] > 0.0:
+        update_geometry_into(q, F, L, meta, cfg[_HAS_TOOL] > 0.0, enc, cfg[_LINKR], frames, P0,
+                             P1, Tee, T, SC, B, D, C)
+        accumulate_obstacle_task(q, F, L, meta, frames, P0, P1, link, T, SC, B, D, C, influence,
+                                 cfg[_WC], cfg[_KREP], A, rhs, Jbuf, pbuf)
+    x = np.linalg.solve(A, rhs)
+    for a in range(n):
+        qdot[a] = x[a]
+
+
+@njit(cache=True)
+def multitask_solve_into(q, target, rows, F, L, meta, cfg, qlim, enc, influence, link, frames,
+                         P0, P1, Tee, T, SC, B, D, C, Jbuf, pbuf, A, rhs, qdot, J, Tpose, e6):
+    """Iterate eq 48 towards ``target`` (4, 4) from ``q`` (updated in place).
+
+    Each iteration: ẋ = gain·(x_d − x) with ‖ẋ‖ capped, q̇ from :func:`eq48_into` with
+    ‖q̇‖ capped, q ← q + q̇ (dt = 1). Stops when ‖x_d − x‖ < tol, after max_iter
+    iterations or when the step vanishes (a compromise between the tasks). Buffers as in
+    :func:`eq48_into`; ``J`` (6, n), ``Tpose`` (4, 4), ``e6`` (6,).
+
+    Returns:
+        (iterations, final error norm).
+    """
+    n = q.shape[0]
+    m = rows.shape[0]
+    xdot = np.empty(m)
+    it = 0
+    max_iter = int(cfg[_ITER])
+    while True:
+        K.jacobian_into(q, F, meta, J, Tpose)
+        pose_error_into(Tpose, target, e6)
+        err2 = 0.0
+        for r in range(m):
+            err2 += e6[rows[r]] * e6[rows[r]]
+        err = math.sqrt(err2)
+        if err < cfg[_TOL] or it >= max_iter:
+            return it, err
+        scale = cfg[_GAIN]
+        if scale * err > cfg[_MAXX]:
+            scale = cfg[_MAXX] / err
+        for r in range(m):
+            xdot[r] = scale * e6[rows[r]]
+        eq48_into(q, xdot, J, rows, F, L, meta, cfg, qlim, enc, influence, link, frames, P0, P1,
+                  Tee, T, SC, B, D, C, Jbuf, pbuf, A, rhs, qdot)
+        nq = 0.0
+        for a in range(n):
+            nq += qdot[a] * qdot[a]
+        nq = math.sqrt(nq)
+        f = 1.0 if nq <= cfg[_MAXQ] else cfg[_MAXQ] / nq
+        for a in range(n):
+            q[a] += f * qdot[a]
+        it += 1
+        if nq < 1e-12:
+            K.jacobian_into(q, F, meta, J, Tpose)
+            pose_error_into(Tpose, target, e6)
+            err2 = 0.0
+            for r in range(m):
+                err2 += e6[rows[r]] * e6[rows[r]]
+            return it, math.sqrt(err2)
 
 
 @dataclass(frozen=True)
@@ -223,7 +373,6 @@ class MultiTaskResolver:
         xd = as_float_array(xdot, "xdot", ndim=1)
         if xd.shape[0] != st.rows.size:
             raise InputError(f"xdot must have {st.rows.size} values, got {xd.shape[0]}")
-        K.jacobian_into(qv, robot._F, robot._meta, st.J, st.T)
         return st.qdot(qv, xd)
 
     def solve(self, robot, target: np.ndarray, q0: object, *, state: _State | None = None
@@ -240,75 +389,50 @@ class MultiTaskResolver:
 
 
 class _State:
-    """Per-robot buffers of a :class:`MultiTaskResolver`."""
+    """Per-robot buffers of a :class:`MultiTaskResolver` for the compiled kernels."""
 
     def __init__(self, res: MultiTaskResolver, robot) -> None:
         self.res = res
         self.robot = robot
         self.rows = task_rows(res.task)
         n = robot.n
+        self.lim = np.ascontiguousarray(res._limits(robot), dtype=float)
+        use_limits = res.joint_limit_weight > 0 and bool(np.isfinite(self.lim).any())
+        self.geom = _Geometry(robot, res.obstacles, res.link_radius)
+        self.infl = np.array([o.influence for o in res.obstacles], dtype=float)
+        cfg = np.zeros(17)
+        cfg[[_W, _DAMP, _SING, _W0, _WL, _BUF, _WC, _KREP, _GAIN, _MAXX, _MAXQ, _TOL, _ITER,
+             _LINKR]] = [res.weight, res.damping, res.singularity_damping,
+                         res.manipulability_threshold, res.joint_limit_weight,
+                         float(res.limit_buffer), res.obstacle_weight, res.repulsive_gain,
+                         res.gain, res.max_task_step, res.max_step, res.tol, res.max_iter,
+                         res.link_radius]
+        cfg[_USE_LIM] = float(use_limits)
+        cfg[_USE_OBS] = float(len(res.obstacles) > 0)
+        cfg[_HAS_TOOL] = float(self.geom.has_tool)
+        self.cfg = cfg
+        self.A = np.empty((n, n))
+        self.rhs = np.empty(n)
+        self.qdot_buf = np.empty(n)
         self.J = np.empty((6, n))
         self.T = np.empty((4, 4))
         self.e6 = np.empty(6)
-        self.lim = res._limits(robot)
-        self.use_limits = res.joint_limit_weight > 0 and bool(np.isfinite(self.lim).any())
-        self.geom = _Geometry(robot, res.obstacles, res.link_radius) if res.obstacles else None
-        self.infl = np.array([o.influence for o in res.obstacles])
-        self.di = np.arange(n)
+
+    def _args(self):
+        g = self.geom
+        rb = self.robot
+        return (rb._F, rb._L, rb._meta, self.cfg, self.lim, g.enc, self.infl, g.link,
+                g.frames, g.P0, g.P1, g.Tee, g.T, g.SC, g.B, g.D, g.C, g.Jbuf, g.pbuf, self.A,
+                self.rhs, self.qdot_buf)
 
     def qdot(self, q: np.ndarray, xdot: np.ndarray) -> np.ndarray:
-        """Eq 48 at q, with J and T already evaluated into the buffers."""
-        r = self.res
-        Jt = self.J[self.rows]
-        A = r.weight * (Jt.T @ Jt)
-        rhs = r.weight * (Jt.T @ xdot)
-        lam2 = r.damping ** 2
-        if r.singularity_damping > 0 and r.manipulability_threshold > 0:
-            w = float(np.sqrt(max(np.linalg.det(Jt @ Jt.T), 0.0)))
-            if w < r.manipulability_threshold:
-                lam2 += (r.singularity_damping * (1.0 - w / r.manipulability_threshold)) ** 2
-        A[self.di, self.di] += lam2
-        if self.use_limits:
-            wl = joint_limit_weights(q, self.lim, buffer=r.limit_buffer,
-                                     max_weight=r.joint_limit_weight)
-            A[self.di, self.di] += wl
-            if r.repulsive_gain > 0:
-                rhs += wl * r.repulsive_gain * joint_limit_repulsion(q, self.lim,
-                                                                     buffer=r.limit_buffer)
-        if self.geom is not None:
-            g = self.geom
-            g.update(q)
-            rb = self.robot
-            accumulate_obstacle_task(q, rb._F, rb._L, rb._meta, g.frames, g.P0, g.P1, g.link,
-                                     g.T, g.SC, g.B, g.D, g.C, self.infl, r.obstacle_weight,
-                                     r.repulsive_gain, A, rhs, g.Jbuf, g.pbuf)
-        return np.linalg.solve(A, rhs)
-
-    def error(self, q: np.ndarray, target: np.ndarray) -> np.ndarray:
-        robot = self.robot
-        K.jacobian_into(q, robot._F, robot._meta, self.J, self.T)
-        pose_error_into(self.T, target, self.e6)
-        return self.e6[self.rows]
+        """Eq 48 at q (n,) for the task velocity ẋ (m,)."""
+        rb = self.robot
+        K.jacobian_into(q, rb._F, rb._meta, self.J, self.T)
+        eq48_into(q, np.ascontiguousarray(xdot, dtype=float), self.J, self.rows, *self._args())
+        return self.qdot_buf.copy()
 
     def solve(self, target: np.ndarray, q: np.ndarray) -> SolveStats:
-        r = self.res
-        it = 0
-        e = self.error(q, target)
-        err = float(np.linalg.norm(e))
-        while err >= r.tol and it < r.max_iter:
-            xdot = r.gain * e
-            nx = np.linalg.norm(xdot)
-            if nx > r.max_task_step:
-                xdot *= r.max_task_step / nx
-            dq = self.qdot(q, xdot)
-            nq = np.linalg.norm(dq)
-            if nq > r.max_step:
-                dq *= r.max_step / nq
-            q += dq
-            it += 1
-            e = self.error(q, target)
-            err = float(np.linalg.norm(e))
-            if nq < 1e-12:
-                break
-        return SolveStats(q, it, err, err < r.tol)
-
+        it, err = multitask_solve_into(q, target, self.rows, *self._args(), self.J, self.T,
+                                       self.e6)
+        return SolveStats(q, int(it), float(err), bool(err < self.res.tol))

@@ -353,7 +353,7 @@ class _Geometry:
         self.link_radius = float(link_radius)
         n = robot.n
         self.frames = np.empty((n + 1, 4, 4))
-        self.has_tool = np.linalg.norm(robot.tool[:3, 3]) > 1e-12
+        self.has_tool = bool(np.linalg.norm(robot.tool[:3, 3]) > 1e-12)
         s = n + (1 if self.has_tool else 0)
         k = len(self.obstacles)
         self.link = np.arange(1, n + 1, dtype=np.int64)
@@ -372,17 +372,9 @@ class _Geometry:
 
     def update(self, q: np.ndarray) -> None:
         r = self.robot
-        K.fk_all_into(q, r._F, r._L, r._meta, self.frames)
-        n = r.n
-        self.P0[:n] = self.frames[:n, :3, 3]
-        self.P1[:n] = self.frames[1:, :3, 3]
-        if self.has_tool:
-            K.fk_into(q, r._F, r._meta, self.Tee)
-            self.P0[n] = self.frames[n, :3, 3]
-            self.P1[n] = self.Tee[:3, 3]
-        if self.enc.shape[0]:
-            segment_obstacle_kernel(self.P0, self.P1, self.enc, self.link_radius,
-                                    self.T, self.SC, self.B, self.D, self.C)
+        update_geometry_into(q, r._F, r._L, r._meta, self.has_tool, self.enc, self.link_radius,
+                             self.frames, self.P0, self.P1, self.Tee, self.T, self.SC, self.B,
+                             self.D, self.C)
 
     def gradient(self, q: np.ndarray, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
         """(u (3,), ∂clearance/∂q (n,)) of segment i and obstacle j (after update).
@@ -395,6 +387,31 @@ class _Geometry:
         pair_gradient_into(q, r._F, r._L, r._meta, self.frames, self.P0, self.P1, self.link,
                            self.T, self.SC, self.B, self.D, i, j, self.Jbuf, self.pbuf, u, g)
         return u, g
+
+
+@njit(cache=True)
+def update_geometry_into(q, F, L, meta, has_tool, enc, link_radius, frames, P0, P1, Tee, T, SC,
+                         B, D, C):
+    """Link frames, link segments and every segment-obstacle closest pair at q.
+
+    Segment i < n runs from the origin of link frame i to that of frame i+1 (0-based);
+    with ``has_tool`` one more runs from frame n's origin to the tool point. Writes
+    ``frames`` (n+1, 4, 4), ``P0``/``P1`` (s, 3), ``Tee`` (4, 4) and the outputs of
+    :func:`segment_obstacle_kernel`.
+    """
+    n = q.shape[0]
+    K.fk_all_into(q, F, L, meta, frames)
+    for i in range(n):
+        for r in range(3):
+            P0[i, r] = frames[i, r, 3]
+            P1[i, r] = frames[i + 1, r, 3]
+    if has_tool:
+        K.fk_into(q, F, meta, Tee)
+        for r in range(3):
+            P0[n, r] = frames[n, r, 3]
+            P1[n, r] = Tee[r, 3]
+    if enc.shape[0] > 0:
+        segment_obstacle_kernel(P0, P1, enc, link_radius, T, SC, B, D, C)
 
 
 @njit(cache=True)
