@@ -74,6 +74,8 @@ def read_csv_rows(path: str | os.PathLike[str], name: str,
                   columns: int | Sequence[int]) -> np.ndarray:
     """Read a numeric CSV file into an (N, k) array.
 
+    The first non-comment line is a header when none of its cells is a number.
+
     Args:
         path: the file; ``-`` reads standard input.
         name: what the rows are (for messages), e.g. 'q'.
@@ -102,8 +104,8 @@ def read_csv_rows(path: str | os.PathLike[str], name: str,
         try:
             vals = [float(c) for c in cells]
         except ValueError:
-            if first_data and any(c and c[0].isalpha() for c in cells):
-                first_data = False  # a header line
+            if first_data and not any(_is_number(c) for c in cells):
+                first_data = False  # a header line: no cell is a number
                 continue
             bad = next(c for c in cells if not _is_number(c))
             raise CLIError(f"{label}, line {lineno}: {bad!r} is not a number") from None

@@ -75,8 +75,9 @@ def plot_workspace(ws: Workspace, ax: Any = None, *, color_by_manipulability: bo
             ax.imshow(np.where(g.occupied.T, 1.0, np.nan), origin="lower", extent=ext,
                       cmap="Greys", vmin=0, vmax=4, interpolation="nearest", zorder=0)
         if len(P):
-            sc = ax.scatter(P[:, 0], P[:, 1], s=0.6, c=w if w is not None else "C0",
-                            cmap="viridis", alpha=0.6, linewidths=0, zorder=1, rasterized=True)
+            colour = {"c": w, "cmap": "viridis"} if w is not None else {"color": "C0"}
+            sc = ax.scatter(P[:, 0], P[:, 1], s=0.6, alpha=0.6, linewidths=0, zorder=1,
+                            rasterized=True, **colour)
             if w is not None:
                 plt.colorbar(sc, ax=ax, label="manipulability", shrink=0.8)
         if show_boundary and len(P):
@@ -88,8 +89,9 @@ def plot_workspace(ws: Workspace, ax: Any = None, *, color_by_manipulability: bo
         ax.set_ylabel("y [m]")
     else:
         if len(P):
-            sc = ax.scatter(P[:, 0], P[:, 1], P[:, 2], s=0.5, c=w if w is not None else "C0",
-                            cmap="viridis", alpha=0.35, linewidths=0, rasterized=True)
+            colour = {"c": w, "cmap": "viridis"} if w is not None else {"color": "C0"}
+            sc = ax.scatter(P[:, 0], P[:, 1], P[:, 2], s=0.5, alpha=0.35, linewidths=0,
+                            rasterized=True, **colour)
             if w is not None:
                 plt.colorbar(sc, ax=ax, label="manipulability", shrink=0.6, pad=0.1)
             lo, hi = P.min(axis=0), P.max(axis=0)
