@@ -26,12 +26,13 @@ $(STAMP_TEST): pyproject.toml | $(PY)
 run: $(STAMP_RUN)
 	$(VENV)/bin/serialkin chapter --out out/chapter
 
-# Headless Chromium for the viewer tests (Debian packages). Failure is not fatal:
-# the browser tests then skip and say why.
+# Headless Chromium for the viewer tests and ffmpeg for MP4 animations (Debian packages).
+# Failure is not fatal: those tests then skip and say why.
 browser-deps:
-	@command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1 || \
-	  ( (apt-get update -qq && apt-get install -y -qq chromium chromium-driver >/dev/null) \
-	    || echo "browser-deps: could not install chromium; browser tests will be skipped" )
+	@command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1 \
+	  && command -v ffmpeg >/dev/null 2>&1 || \
+	  ( (apt-get update -qq && apt-get install -y -qq chromium chromium-driver ffmpeg >/dev/null) \
+	    || echo "browser-deps: could not install chromium/ffmpeg; those tests will be skipped" )
 
 test: $(STAMP_TEST) browser-deps
 	$(PY) -m pytest -n 2 --dist loadfile
