@@ -42,7 +42,7 @@ TASKS = ("position", "planar", "planar_pose")
 
 
 # ---------------------------------------------------------------------------- numbers
-def exact(value: float, *, angle: bool = False, tol: float = 1e-10) -> sp.Expr:
+def exact(value: float, *, angle: bool = False, tol: float = 1e-12) -> sp.Expr:
     """Turn a float into an exact sympy number when it is simple, else a Float.
 
     Args:
