@@ -120,3 +120,25 @@ def test_track_with_ik_method(arm):
     path = Path.circle([-0.25, 0.0], 0.1, step=0.4)
     tr = track(arm, path, "lm", q0=np.full(6, 0.3))
     assert tr.max_error <= 0.005
+
+
+@pytest.mark.parametrize("task", ["pose", "position"])
+def test_spatial_arm_tracks_pose_and_position_paths(task):
+    """DLS and the multi-task resolver track 6-D pose / 3-D position paths of a spatial arm."""
+    from ..redundancy._robots import spatial_rp
+
+    robot = spatial_rp()
+    qa = robot.random_q(seed=11)
+    qs = qa + np.linspace(0, 1, 15)[:, None] * np.linspace(0.2, -0.2, robot.n)
+    qs[:, 2] = np.clip(qs[:, 2], 0.05, 0.35)
+    T = robot.fk(qs)
+    path = Path.from_poses(T) if task == "pose" else Path.from_points(T[:, :3, 3])
+    for solver in ("dls", MultiTaskResolver(task=task, tol=1e-7, joint_limit_weight=0.0,
+                                            max_task_step=0.05)):
+        tr = track(robot, path, solver, q0=qa, damping=0.01, tol=1e-8)
+        assert tr.complete, tr.summary()
+        assert tr.max_error < 1e-6
+        if task == "pose":
+            R_err = np.einsum("kij,kij->k", tr.poses[:, :3, :3], T[:, :3, :3])
+            assert np.all(R_err > 3 - 1e-9)  # trace(RᵀR_d) = 3: same orientation
+        np.testing.assert_allclose(tr.positions, T[:, :3, 3], atol=2e-6)

@@ -194,7 +194,7 @@ def track(
                else np.array(robot.check_q(q0, "q0"), dtype=float))
     if q_start.shape != (robot.n,):
         raise InputError(f"q0 must have shape ({robot.n},), got {q_start.shape}")
-    rows = task_rows(path.task if path.task != "pose" else "pose")
+    rows = task_rows(path.task)
     if isinstance(solver, MultiTaskResolver) and not obstacles:
         obstacles = solver.obstacles
     obstacles = tuple(obstacles)
