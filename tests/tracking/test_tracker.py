@@ -142,3 +142,21 @@ def test_spatial_arm_tracks_pose_and_position_paths(task):
             R_err = np.einsum("kij,kij->k", tr.poses[:, :3, :3], T[:, :3, :3])
             assert np.all(R_err > 3 - 1e-9)  # trace(RᵀR_d) = 3: same orientation
         np.testing.assert_allclose(tr.positions, T[:, :3, 3], atol=2e-6)
+
+
+@pytest.mark.parametrize("repulsive_gain", [0.0, 1.0])
+def test_joint_limit_task_keeps_joints_inside_limits(repulsive_gain):
+    """With limits ±80° the joint-limit task (faithful or repulsive) keeps q inside, path reached.
+
+    Without the task the joints of the same circle-tracking run leave the range.
+    """
+    path = Path.circle([-0.25, 0.0], 0.1, step=0.2)
+    robot = planar_arm(6, 0.1, joint_limits_deg=[-80, 80])
+    q0 = np.radians([-60.0, 20, 20, 20, 20, 20])
+    free = track(robot, path, MultiTaskResolver(joint_limit_weight=0.0, damping=0.01), q0=q0)
+    assert np.abs(free.q).max() > np.radians(80.0)
+    tr = track(robot, path, MultiTaskResolver(joint_limit_weight=100.0, damping=0.01,
+                                              repulsive_gain=repulsive_gain), q0=q0)
+    assert tr.complete and tr.max_error <= 0.005
+    assert np.abs(tr.q).max() < np.radians(80.0)
+    assert tr.min_limit_margin > 0
