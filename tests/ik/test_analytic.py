@@ -265,6 +265,26 @@ def test_planar_targets():
     np.testing.assert_allclose(S.sum(axis=1), [0.4, 0.4], atol=1e-12)
 
 
+def test_scara_position_and_heading_target():
+    """The chapter's SCARA takes (x, y, z, φ): both elbow solutions reach it with heading φ."""
+    robot = models.scara()
+    T0 = robot.fk(np.array([0.4, -0.9, -0.12, 1.3]))
+    phi = math.atan2(T0[1, 0], T0[0, 0])
+    S = ik_all(robot, [*T0[:3, 3], phi])
+    assert len(S) == 2
+    np.testing.assert_allclose(robot.fk(S), [T0, T0], atol=1e-12)
+
+
+def test_slightly_non_orthonormal_target_is_projected():
+    """A pose rounded to 7 decimals (rotation off SO(3) by ~1e-7) still gives every solution."""
+    robot = models.puma560()
+    q = np.array([0.3, 0.5, -0.7, 0.2, 0.6, 0.4])
+    T = np.round(robot.fk(q), 7)
+    S = ik_all(robot, T)
+    assert len(S) >= 2 and _joint_distance(robot, S, q).min() < 1e-6
+    assert np.abs(robot.fk(S) - T).max() < 1e-6
+
+
 def test_two_link_pose_target_filters_orientation():
     """A 4x4 pose on a 2-link arm keeps only the elbow solution with the right orientation."""
     robot = models.two_link()

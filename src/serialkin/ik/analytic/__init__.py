@@ -48,7 +48,7 @@ import numpy as np
 from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
 from serialkin.errors import InputError, NoClosedFormError
 from serialkin.ik.analytic.structure import CLASSES, NUMERICAL_HINT, Structure, analyse
-from serialkin.ik.analytic.subproblems import rigid_ok
+from serialkin.ik.analytic.subproblems import rigid_error
 from serialkin.model.robot import Robot
 
 __all__ = ["CLASSES", "classify", "ik_all", "structure"]
@@ -133,22 +133,39 @@ def _prepared(robot: Robot) -> _Prepared:
     return p
 
 
+def _as_pose(a: np.ndarray) -> np.ndarray:
+    """A (4, 4) float array as an exactly rigid target: checked, rotation projected on SO(3)."""
+    T = np.ascontiguousarray(a, dtype=float)
+    err = rigid_error(T)
+    if err > ROTATION_TOL:
+        check_transform(T, "target")  # raises with a message naming what is wrong
+    if err > 1e-13:  # nearest rotation (polar decomposition), exact last row
+        U, _, Vt = np.linalg.svd(T[:3, :3])
+        T = T.copy()
+        T[:3, :3] = U @ Vt
+        T[3] = (0.0, 0.0, 0.0, 1.0)
+    return T
+
+
+def _heading(p: _Prepared, phi: float) -> np.ndarray:
+    """Rotation with heading φ: ``Rz(φ − φ0)·R0`` (R0, φ0 of the zero configuration)."""
+    c, s = math.cos(phi - p.phi0), math.sin(phi - p.phi0)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ p.M[:3, :3]
+
+
 def _parse_target(p: _Prepared, robot: Robot, target: object) -> tuple[np.ndarray, bool]:
     """Turn the target into a (4, 4) world pose and whether its rotation counts."""
     if type(target) is np.ndarray and target.shape == (4, 4) and target.dtype == np.float64:
-        T = np.ascontiguousarray(target)
-        if rigid_ok(T, ROTATION_TOL):  # fast path; check_transform gives the message
-            return T, True
-        a = target
-    else:
-        a = as_float_array(target, "target")
+        return _as_pose(target), True
+    a = as_float_array(target, "target")
     kind = p.s.kind
     if a.shape == (4, 4):
-        return np.ascontiguousarray(check_transform(a, "target")), True
+        return _as_pose(a), True
     if a.ndim == 3 and a.shape[1:] == (4, 4):
         raise InputError(f"ik_all takes one target, got a batch of shape {a.shape}; call it "
                          "once per target (each may have a different number of solutions)")
-    if a.shape in ((2,), (3,)) and p.s.planar_z:
+    planar = kind in ("planar_2r", "planar_3r")
+    if a.shape in ((2,), (3,)) and planar and p.s.planar_z:
         T = p.M.copy()
         T[0, 3], T[1, 3] = a[0], a[1]
         if a.shape == (2,):
@@ -158,8 +175,12 @@ def _parse_target(p: _Prepared, robot: Robot, target: object) -> tuple[np.ndarra
                     "position target (x, y): the orientation is free. Give (x, y, phi) or a "
                     f"4x4 pose to ik_all, or {NUMERICAL_HINT}")
             return T, False
-        c, s = math.cos(a[2] - p.phi0), math.sin(a[2] - p.phi0)
-        T[:3, :3] = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ p.M[:3, :3]
+        T[:3, :3] = _heading(p, a[2])
+        return T, True
+    if a.shape == (4,) and kind == "scara" and p.s.planar_z:
+        T = np.eye(4)
+        T[:3, 3] = a[:3]
+        T[:3, :3] = _heading(p, a[3])
         return T, True
     if a.shape == (3,) and kind == "scara_rrp":
         T = p.M.copy()
@@ -169,8 +190,10 @@ def _parse_target(p: _Prepared, robot: Robot, target: object) -> tuple[np.ndarra
         raise NoClosedFormError(
             f"robot {robot.name!r} ({kind}) has infinitely many solutions for a position-only "
             f"target: the orientation is free. Give ik_all a 4x4 pose, or {NUMERICAL_HINT}")
-    if p.s.planar_z:
+    if planar and p.s.planar_z:
         want = "a 4x4 pose, (x, y) or (x, y, phi)"
+    elif kind == "scara" and p.s.planar_z:
+        want = "a 4x4 pose or (x, y, z, phi)"
     elif kind == "scara_rrp":
         want = "a 4x4 pose or a position (x, y, z)"
     elif kind in ("planar_2r", "planar_3r"):
@@ -210,7 +233,9 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         target: (4, 4) tool pose in the world frame (base and tool transforms included);
             on a planar arm whose axes are along the world z axis also ``(x, y)`` [m]
             (2R) or ``(x, y, φ)`` [m, m, rad], φ the heading ``atan2(R[1, 0], R[0, 0])`` of
-            the tool x axis; on an R R P arm also a position ``(x, y, z)`` [m].
+            the tool x axis; on such a SCARA ``(x, y, z, φ)``; on an R R P arm a position
+            ``(x, y, z)`` [m]. A pose's rotation may deviate from orthonormal by up to
+            1e-6 (``check_transform``); it is replaced by the nearest rotation first.
         tol: verification tolerance: each returned row reproduces the target within
             ``tol``·max(1, robot size) metres and ``tol`` in every rotation entry.
         all_turns: also list every 2π-equivalent of each revolute angle inside the limits

@@ -76,8 +76,8 @@ class Structure:
         revolute: (n,) booleans.
         aux: (k, 3) class-specific points and vectors (see each solver).
         order: (k,) class-specific joint indices.
-        planar_z: the joints' axes are parallel to the world z axis, so planar targets
-            (x, y) and (x, y, φ) are meaningful.
+        planar_z: every joint axis is parallel to the world z axis, so planar targets
+            (x, y), (x, y, φ) and SCARA targets (x, y, z, φ) are meaningful.
         scale: characteristic length of the robot [m] (for tolerances).
     """
 
@@ -225,7 +225,7 @@ def _parallel_family(robot, W, P, M, rev, scale, ltol) -> Structure:
     e1 = _unit_perp(w)
     aux = np.array([w, e1])
     order = np.array(ir + [ip[0] if ip else -1], dtype=np.int64)
-    planar_z = np_ == 0 and abs(abs(w[2]) - 1.0) < ANGLE_TOL
+    planar_z = abs(abs(w[2]) - 1.0) < ANGLE_TOL
     return Structure(kind, W, P, M, rev, aux, order, planar_z, scale)
 
 

@@ -341,27 +341,25 @@ def planar2r(w, e1, c1, c2, p, t, out):
 
 
 @njit(cache=True)
-def rigid_ok(T, tol):
-    """True when T (4, 4) is a rigid transform within ``tol`` (as ``check_transform`` tests).
+def rigid_error(T):
+    """How far T (4, 4) is from a rigid transform (the quantities ``check_transform`` tests).
 
-    Finite entries, last row [0, 0, 0, 1], max |RᵀR − I| <= tol and |det R − 1| <= tol.
+    The largest of |last row − [0, 0, 0, 1]|, |RᵀR − I| and |det R − 1|; inf when an
+    entry is not finite.
     """
     for i in range(4):
         for j in range(4):
             if not math.isfinite(T[i, j]):
-                return False
-    if abs(T[3, 0]) > tol or abs(T[3, 1]) > tol or abs(T[3, 2]) > tol \
-            or abs(T[3, 3] - 1.0) > tol:
-        return False
+                return math.inf
+    err = max(abs(T[3, 0]), abs(T[3, 1]), abs(T[3, 2]), abs(T[3, 3] - 1.0))
     for i in range(3):
         for j in range(3):
             g = T[0, i] * T[0, j] + T[1, i] * T[1, j] + T[2, i] * T[2, j]
-            if abs(g - (1.0 if i == j else 0.0)) > tol:
-                return False
+            err = max(err, abs(g - (1.0 if i == j else 0.0)))
     det = (T[0, 0] * (T[1, 1] * T[2, 2] - T[1, 2] * T[2, 1])
            - T[0, 1] * (T[1, 0] * T[2, 2] - T[1, 2] * T[2, 0])
            + T[0, 2] * (T[1, 0] * T[2, 1] - T[1, 1] * T[2, 0]))
-    return abs(det - 1.0) <= tol
+    return max(err, abs(det - 1.0))
 
 
 @njit(cache=True)
