@@ -303,7 +303,8 @@ class Robot:
             (6, n) or (..., 6, n).
         """
         if type(q) is np.ndarray and q.dtype is _F64 and q.shape == self._qshape \
-                and link is None and frame == "base" and q.flags.c_contiguous:
+                and link is None and point is None and frame == "base" \
+                and q.flags.c_contiguous:
             J = np.empty((6, self.n))
             T = np.empty((4, 4))
             jac = _ENTRY.get("jacobian_checked") or _entry(
