@@ -193,6 +193,34 @@ def test_puma_class_any_dimensions(a2, a3, d3, d4, a1, seed):
     assert max(counts) <= 8
 
 
+@settings(max_examples=25, deadline=None)
+@given(d1=st.floats(0.05, 0.5), a2=st.floats(-0.8, -0.1), a3=st.floats(-0.8, -0.1),
+       d4=st.floats(-0.3, 0.3), d5=st.floats(0.02, 0.3), d6=st.floats(0.0, 0.3),
+       a1=st.floats(-0.2, 0.2), seed=st.integers(0, 2**31 - 1))
+def test_ur_class_any_dimensions(d1, a2, a3, d4, d5, d6, a1, seed):
+    """UR-class arms of any dimensions (and a1 ≠ 0), base and tool close all round trips."""
+    rng = np.random.default_rng(seed)
+    rows = [DHLink(a=a1, alpha=H, d=d1), DHLink(a=a2, alpha=0.0, d=0.0),
+            DHLink(a=a3, alpha=0.0, d=0.0), DHLink(a=0.0, alpha=H, d=d4),
+            DHLink(a=0.0, alpha=-H, d=d5), DHLink(a=0.0, alpha=0.0, d=d6)]
+    robot = Robot.from_dh(rows, base=_random_transform(rng), tool=_random_transform(rng, 0.1))
+    assert classify(robot) == "ur"
+    counts = _check_round_trips(robot, 5, seed=seed)
+    assert max(counts) <= 8
+
+
+def test_wrist_singular_representative():
+    """At an aligned wrist (q5 = 0) only q4 + q6 is fixed: the representative has q4 = 0."""
+    robot = models.puma560()
+    q = np.array([0.3, 0.5, -0.7, 0.2, 0.0, 0.4])
+    S = ik_all(robot, robot.fk(q))
+    on_branch = S[np.abs(S[:, 4]) < 1e-9]
+    assert len(on_branch) >= 1
+    np.testing.assert_allclose(on_branch[:, 3], 0.0, atol=1e-12)
+    np.testing.assert_allclose(on_branch[:, 5], np.full(len(on_branch), q[3] + q[5]),
+                               atol=1e-9)
+
+
 def test_eight_solutions_without_limits():
     """Unlimited Puma 560 and Pieper arm: 8 solutions per pose; UR5: 8 for most, never more."""
     for robot in (models.puma560(), Robot.from_dh(_pieper_rows())):

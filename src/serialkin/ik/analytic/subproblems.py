@@ -196,12 +196,15 @@ def sp1_dir(w, u, v):
     """Subproblem 1 on directions: θ such that ``Rot(w, θ)·u`` points like ``v`` in the plane ⟂ w.
 
     Returns ``atan2(w·(u' × v'), u'·v')`` with ``u'``, ``v'`` the projections on that
-    plane; 0 when either projection vanishes (the angle is then arbitrary).
+    plane; 0 when either projection vanishes to rounding level (< 1e-12 of |u|, |v|):
+    the angle is then arbitrary (a singular configuration) and 0 is its representative.
     """
     wu = dot3(w, u)
     wv = dot3(w, v)
     up = u - wu * w
     vp = v - wv * w
+    if dot3(up, up) <= 1e-24 * dot3(u, u) or dot3(vp, vp) <= 1e-24 * dot3(v, v):
+        return 0.0
     return math.atan2(dot3(w, cross3(up, vp)), dot3(up, vp))
 
 
