@@ -115,11 +115,10 @@ def main() -> None:
     Q = np.zeros((p, 6))
     IT = np.zeros(p, dtype=np.int64)
     ER = np.zeros(p)
-    TN = np.zeros(p, dtype=np.int64)
 
     def kernel():
         dls_track(s.q0, targets, rows_, s.robot._F, s.robot._meta, lam, tol, max_iter, max_step,
-                  s.tolerance, False, 1e-3, Q, IT, ER, TN)
+                  s.tolerance, False, 1e-3, Q, IT, ER)
 
     t_kernel = median_time(kernel, 21)
     t_track = median_time(s.run)

@@ -43,7 +43,7 @@ ON_UNREACHABLE = ("continue", "stop")
 
 @njit(cache=True)
 def dls_track(q0, targets, rows, F, meta, lam, tol, max_iter, max_step, accept, stop_on_fail,
-              kick, Q, ITER, ERR, TIME_NS):
+              kick, Q, ITER, ERR):
     """Compiled DLS path tracking (eq 46 corrected, the 6-link algorithm).
 
     Args:
@@ -63,7 +63,6 @@ def dls_track(q0, targets, rows, F, meta, lam, tol, max_iter, max_step, accept, 
         Q: out (p, n) joint values per point.
         ITER: out (p,) iterations per point.
         ERR: out (p,) final error norm per point [m].
-        TIME_NS: out (p,), zeroed (per-point times are filled by the caller).
 
     Returns:
         number of points computed.
@@ -117,7 +116,6 @@ def dls_track(q0, targets, rows, F, meta, lam, tol, max_iter, max_step, accept, 
             Q[k, j] = q[j]
         ITER[k] = it
         ERR[k] = err
-        TIME_NS[k] = 0
         if stop_on_fail and err > accept:
             return k + 1
     return p
@@ -213,7 +211,7 @@ def track(
         label = f"DLS (eq 46), λ = {lam:g} m"
         t0 = time.perf_counter()
         count = dls_track(q_start, targets, rows, robot._F, robot._meta, lam, conv, budget, cap,
-                          accept, stop, 1e-3, Q, ITER, ERR, np.zeros(p, dtype=np.int64))
+                          accept, stop, 1e-3, Q, ITER, ERR)
         elapsed = time.perf_counter() - t0
         # per-point time: shared in proportion to the iterations used
         its = ITER[:count].astype(float) + 1.0
