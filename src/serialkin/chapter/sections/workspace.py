@@ -1,0 +1,249 @@
+"""Report section 1: degrees of freedom, joint space, workspace kinds and task space.
+
+Computed by :mod:`serialkin.workspace` (sampling on the batched FK kernels):
+
+* a table of the built-in robots: DOF n, the joint space Q (product of joint ranges),
+  the task space dimension m and the degree of redundancy n − m;
+* the 2-link arm: sampled area of the maximal workspace against the closed form
+  π((L1+L2)² − (L1−L2)²), with the sampling error bound, for several link lengths; the
+  workspace with its boundary and the manipulability map (eq 43);
+* the 3-link arm: every workspace kind of section 1 (maximal, constant-orientation,
+  inclusive-orientation, total-orientation, dexterous), with areas, the closed forms
+  where they are known, and one figure each plus an overlay;
+* a spatial robot (PUMA 560): the maximal workspace as a 3D point cloud with its volume,
+  planar slices, and the constant-orientation workspace with the tool pointing down.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from serialkin import models
+from serialkin.chapter.report import ReportContext, Section
+from serialkin.spatial import rpy_to_matrix
+from serialkin.workspace import (
+    constant_orientation_workspace,
+    dexterous_workspace,
+    inclusive_orientation_workspace,
+    reachable_workspace,
+    total_orientation_workspace,
+    workspace_slice,
+)
+
+SEED = 2024
+
+
+def _annulus(L1: float, L2: float) -> float:
+    """π((L1+L2)² − (L1−L2)²) = 4π L1 L2: the area of the 2-link workspace."""
+    return math.pi * ((L1 + L2) ** 2 - (L1 - L2) ** 2)
+
+
+def _three_link_reachable(L: tuple[float, float, float]) -> float:
+    """Maximal workspace of a planar 3R arm: the annulus r_min ≤ |p| ≤ L1+L2+L3."""
+    r_max = sum(L)
+    r_min = max(0.0, 2 * max(L) - r_max)
+    return math.pi * (r_max**2 - r_min**2)
+
+
+def _three_link_total(L: tuple[float, float, float]) -> float:
+    """Total-orientation workspace of a planar 3R arm (unlimited joints).
+
+    Every heading φ is reachable at p when the wrist p − L3 e_φ is in the 2-link annulus
+    [d, L1+L2], d = |L1−L2|, for every φ: |p| ∈ [d + L3, L1 + L2 − L3], plus the disc
+    |p| ≤ L3 − d when L3 > d.
+    """
+    L1, L2, L3 = L
+    d = abs(L1 - L2)
+    outer = max(L1 + L2 - L3, 0.0)
+    ring = math.pi * max(outer**2 - (d + L3) ** 2, 0.0) if outer > d + L3 else 0.0
+    return ring + math.pi * max(L3 - d, 0.0) ** 2
+
+
+def _limits_text(robot: object) -> str:
+    parts = []
+    for (lo, hi), t in zip(robot.qlim, robot.joint_types):  # type: ignore[attr-defined]
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            parts.append("ℝ" if t == "P" else "S¹")
+        elif t == "R":
+            parts.append(f"[{math.degrees(lo):.0f}°, {math.degrees(hi):.0f}°]")
+        else:
+            parts.append(f"[{lo:.3g}, {hi:.3g}] m")
+    return " × ".join(parts)
+
+
+def _dof_table(ctx: ReportContext) -> str:
+    rows = []
+    for info in models.catalog():
+        r = info.build() if info.dof is not None else info.build(6, 0.1)
+        planar = bool(r.is_planar)
+        # generic rank of J: the dimension of the task space the tool can move in
+        J = r.jacobian(r.random_q(8, seed=SEED))
+        m = int(max(np.linalg.matrix_rank(Jk, tol=1e-9) for Jk in J))
+        rows.append((r.name, r.n, "".join(r.joint_types), _limits_text(r),
+                     "planar (x, y, φ)" if planar else "spatial (x, y, z, 3 rotations)", m,
+                     r.n - m))
+    return ctx.table(rows, ["robot", "DOF n", "joints", "joint space Q",
+                            "task space", "m = rank J", "redundancy n − m"])
+
+
+def _fig_close(ctx: ReportContext, ax: object, name: str, caption: str) -> str:
+    return ctx.figure(ax.figure, name, caption)  # type: ignore[attr-defined]
+
+
+def build(ctx: ReportContext) -> Section:
+    """Compute section 1's workspace examples and return the report section."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from serialkin.workspace.plot import (
+        plot_manipulability_map,
+        plot_slice,
+        plot_workspace,
+        plot_workspace_kinds,
+    )
+
+    progress = False if ctx.quiet else None
+    parts: list[str] = []
+
+    # --- DOF, joint space, task space -------------------------------------------------
+    parts.append(
+        "<h3>Degrees of freedom, joint space and task space</h3>"
+        "<p>The number of DOF is the dimension of the joint space Q (one coordinate per "
+        "joint); the task space of a planar arm has m = 3 coordinates (x, y, φ), that of a "
+        "spatial arm m = 6; the table gives the generic rank of the Jacobian, the number "
+        "of task coordinates the tool can actually move in (2 for the 2-link arm, 4 for "
+        "the SCARA: x, y, z and the yaw). A robot with n &gt; m is kinematically redundant "
+        "(section 5.3). S¹ is an unlimited revolute joint.</p>" + _dof_table(ctx)
+    )
+
+    # --- 2-link arm: area against the closed form --------------------------------------
+    parts.append(
+        "<h3>Maximal workspace of the 2-link arm</h3>"
+        "<p>Joint space sampled uniformly (seeded), every sample's tool position computed "
+        "by the batched FK kernel and binned on an occupancy grid. The area estimate Â "
+        "counts interior cells fully and boundary cells by half; the error bound ε adds "
+        "half the boundary cells and the Chao1 estimate of cells no sample hit "
+        "(see <code>serialkin.workspace.grid</code>). The closed form is "
+        "π((L1+L2)² − (L1−L2)²) = 4π L1 L2.</p>"
+    )
+    rows = []
+    for L1, L2 in ((1.0, 1.0), (1.0, 0.6), (0.7, 0.4), (0.5, 0.9)):
+        ws = reachable_workspace(models.two_link(L1, L2), 300_000, seed=SEED,
+                                 progress=progress)
+        exact = _annulus(L1, L2)
+        e = ws.estimate
+        rows.append((L1, L2, exact, e.value, e.error, abs(e.value - exact),
+                     "yes" if abs(e.value - exact) <= e.error else "NO", e.cell))
+    parts.append(ctx.table(rows, ["L1 [m]", "L2 [m]", "π((L1+L2)²−(L1−L2)²) [m²]",
+                                  "sampled Â [m²]", "error bound ε [m²]", "|Â − exact|",
+                                  "within ε", "cell [m]"]))
+    two = models.two_link(1.0, 0.6)
+    ws2 = reachable_workspace(two, 300_000, seed=SEED, manipulability=True, progress=progress)
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.2))
+    plot_workspace(ws2, axes[0], robot=two, q=[0.6, 1.1])
+    plot_manipulability_map(ws2, axes[1])
+    fig.tight_layout()
+    parts.append(ctx.figure(fig, "workspace_two_link",
+                            "2-link arm (L1 = 1 m, L2 = 0.6 m): maximal workspace with its "
+                            "boundary (left) and the manipulability w = L1 L2 |sin q2| per cell "
+                            "(right, eq 43): zero on both boundary circles, the singular "
+                            "configurations q2 = 0, π."))
+
+    # --- 3-link arm: every kind ---------------------------------------------------------
+    L = (1.0, 0.8, 0.3)
+    three = models.three_link(*L)
+    phi = 0.0
+    kinds = [
+        ("maximal (reachable)", reachable_workspace(three, 300_000, seed=SEED,
+                                                    progress=progress),
+         _three_link_reachable(L)),
+        ("constant orientation φ = 0", constant_orientation_workspace(
+            three, phi, 150_000, seed=SEED, progress=progress), _annulus(L[0], L[1])),
+        ("inclusive orientation |φ| ≤ 30°", inclusive_orientation_workspace(
+            three, phi, math.radians(30), 150_000, seed=SEED, progress=progress), None),
+        ("total orientation (12 headings)", total_orientation_workspace(
+            three, 12, 60_000, seed=SEED, progress=progress), _three_link_total(L)),
+        ("dexterous (12 headings, w ≥ 5 % of max)", dexterous_workspace(
+            three, 12, 60_000, seed=SEED, singularity_margin=0.05, progress=progress), None),
+    ]
+    parts.append(
+        f"<h3>Workspace kinds of the 3-link arm (L = {L} m)</h3>"
+        "<p>Constant- and inclusive-orientation samples are moved onto the orientation "
+        "constraint by damped least-squares steps on the angular rows of the Jacobian; the "
+        "total-orientation and dexterous workspaces intersect the constant-orientation "
+        "occupancy grids of 12 evenly spaced headings, the dexterous one keeping only "
+        "samples whose manipulability (planar pose task) is at least 5 % of the largest. "
+        "Closed forms: maximal = annulus up to L1+L2+L3; constant orientation = the 2-link "
+        "annulus of L1, L2 about the wrist; total orientation = |p| ∈ [|L1−L2|+L3, "
+        "L1+L2−L3] plus the disc |p| ≤ L3 − |L1−L2| when positive.</p>"
+    )
+    rows = []
+    for label, ws, exact in kinds:
+        e = ws.estimate
+        ok = "" if exact is None else ("yes" if abs(e.value - exact) <= e.error else "NO")
+        rows.append((label, e.value, e.error, "—" if exact is None else exact, ok,
+                     ws.points.shape[0]))
+    parts.append(ctx.table(rows, ["kind", "area Â [m²]", "error ε [m²]", "closed form [m²]",
+                                  "within ε", "samples kept"]))
+    fig, axes = plt.subplots(2, 3, figsize=(15, 9.6))
+    for ax, (label, ws, _) in zip(axes.ravel(), kinds):
+        plot_workspace(ws, ax, color_by_manipulability=False, max_points=15_000,
+                       title=f"{label}\n{ws.estimate.value:.3f} ± {ws.estimate.error:.2g} m²")
+    plot_workspace_kinds([kinds[0][1], kinds[1][1], kinds[4][1]], axes.ravel()[5],
+                         labels=["maximal", "constant φ = 0", "dexterous"],
+                         title="overlay")
+    fig.tight_layout()
+    parts.append(ctx.figure(fig, "workspace_three_link_kinds",
+                            "3-link arm: the workspace kinds of section 1 with their "
+                            "boundaries and areas; bottom right, three of them overlaid."))
+
+    # --- spatial robot ------------------------------------------------------------------
+    puma = models.puma560()
+    ws3 = reachable_workspace(puma, 400_000, seed=SEED, progress=progress)
+    down = rpy_to_matrix([math.pi, 0.0, 0.0])  # tool z axis pointing down
+    wsc = constant_orientation_workspace(puma, down, 120_000, seed=SEED, progress=progress)
+    slices = [workspace_slice(ws3, "z", z) for z in (0.2, 0.67, 1.1)]
+    parts.append(
+        "<h3>A spatial robot: PUMA 560</h3>"
+        "<p>Spatial workspaces are 3D point clouds measured on a voxel grid; planar slices "
+        "(samples within half a voxel of the plane) show the cross-sections.</p>"
+        + ctx.table(
+            [("maximal", ws3.estimate.value, ws3.estimate.error, ws3.points.shape[0]),
+             ("constant orientation (tool down)", wsc.estimate.value, wsc.estimate.error,
+              wsc.points.shape[0])]
+            + [(f"slice z = {s.value:.2f} m (area, m²)", s.estimate.value, s.estimate.error,
+                s.points.shape[0]) for s in slices],
+            ["set", "volume [m³] / area [m²]", "error bound", "samples"])
+    )
+    fig = plt.figure(figsize=(15, 5.2))
+    ax = fig.add_subplot(1, 3, 1, projection="3d")
+    plot_workspace(ws3, ax, max_points=12_000)
+    ax = fig.add_subplot(1, 3, 2, projection="3d")
+    plot_workspace(wsc, ax, max_points=12_000)
+    plot_slice(slices[1], ax=fig.add_subplot(1, 3, 3), title=(
+        f"slice z = {slices[1].value:.2f} m: "
+        f"{slices[1].estimate.value:.3f} ± {slices[1].estimate.error:.2g} m²"))
+    fig.tight_layout()
+    parts.append(ctx.figure(fig, "workspace_puma560",
+                            "PUMA 560: maximal workspace (left), constant-orientation "
+                            "workspace with the tool pointing down (middle) and the maximal "
+                            "workspace's slice at shoulder height (right)."))
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8))
+    for ax, s in zip(axes, slices):
+        plot_slice(s, ax=ax)
+    fig.tight_layout()
+    parts.append(ctx.figure(fig, "workspace_puma560_slices",
+                            "PUMA 560 maximal workspace: horizontal slices with their "
+                            "boundaries and cross-section areas."))
+    plt.close("all")
+    return Section(
+        title="1. Degrees of freedom, joint space and workspace",
+        equations="section 1 definitions (DOF, joint space, maximal / inclusive / constant / "
+                  "total-orientation / dexterous workspace, task space); eq 43 "
+                  "(manipulability map); eqs 10-11 (batched FK)",
+        html="".join(parts),
+    )
