@@ -220,3 +220,13 @@ def test_result_repr_and_fields(ur5):
         res.success = False  # type: ignore[misc]
     with pytest.raises(TypeError):
         res[0]
+
+
+def test_polish_returns_closest_pose(two_link):
+    """For an unreachable target, 'lm' polishes its best attempt to the closest pose."""
+    res = two_link.ik(np.array([3.0, 1.0]), seed=0, restarts=3)
+    assert not res.success
+    # closest point of the reach circle (radius 2) to (3, 1): distance sqrt(10) − 2
+    assert res.position_error == pytest.approx(np.sqrt(10.0) - 2.0, abs=1e-6)
+    rough = two_link.ik(np.array([3.0, 1.0]), seed=0, restarts=3, polish=False)
+    assert rough.position_error >= res.position_error - 1e-12

@@ -48,7 +48,10 @@ iteration). Unlimited revolute joints are wrapped into [-π, π) at the end.
 Stagnation: an attempt ends when the cost has not halved within ``window``
 iterations (or becomes non-finite); the solver then restarts from a configuration drawn
 uniformly inside the (sampling) limits by a per-target splitmix64 stream. The returned
-q is that of the best attempt (lowest cost), so it is always finite.
+q is that of the best attempt (lowest cost), so it is always finite. With the polish
+flag (method ``lm``), when every attempt failed the best one is refined by a monotone
+Levenberg-Marquardt (:func:`_polish`) down to a local least-squares minimum, so an
+unreachable target returns the closest pose found.
 """
 
 from __future__ import annotations
@@ -84,7 +87,8 @@ P_DAMPING = 12  # λ (DLS, LM, Wampler, Chan, Sugihara)
 P_WINDOW = 13  # stagnation window [iterations]
 P_MAX_STEP = 14  # max |Δq_i| (PINV) or γ_max (SDLS) [rad / m]
 P_RCOND = 15  # relative cut-off for singular values (PINV, NEWTON, GAUSS_NEWTON)
-N_CFG = 16
+C_POLISH = 16  # 1: after failed attempts, polish the best one with a monotone LM
+N_CFG = 17
 
 #: Rows of the per-robot ``box`` array (5, n).
 B_LO = 0  # lower joint limits (-inf allowed)
@@ -498,6 +502,75 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol,
 
 
 @njit(cache=True)
+def _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
+            q, J, T, e, Jw, r, A, g, dq, qn, Jn, Tn, en):
+    """Monotone Levenberg-Marquardt from q (in place) to the nearest least-squares minimum.
+
+    Gain-ratio damping update of Madsen, Nielsen & Tingleff (2004, §3.2): a step is
+    accepted only when it lowers the cost (ρ > 0), then ``μ ← μ·max(1/3, 1 − (2ρ − 1)³)``,
+    else ``μ ← μ·ν, ν ← 2ν``. Used after every attempt failed, so the best attempt
+    reported for an unreachable target is a local minimum of the cost (the closest pose
+    the arm can take from there), not wherever a non-monotone iteration stopped.
+    Returns (iterations, converged, cost); q, J, T, e describe the final point.
+    """
+    n = q.shape[0]
+    jacobian_into(q, F, meta, J, T)
+    pose_error_into(T, Tt, e)
+    cost = _cost(e, w)
+    mu = -1.0
+    nu = 2.0
+    quiet = 0
+    for it in range(max_iter):
+        pe, oe = _errors(e, w)
+        if pe <= tol and oe <= tol:
+            return it, True, cost
+        _weigh(J, e, sw, Jw, r)
+        _normal(Jw, r, A, g)
+        d = 0.0
+        for i in range(n):
+            d = max(d, A[i, i])
+        if mu < 0.0:
+            mu = 1e-3 * max(d, 1e-12)
+        for i in range(n):
+            A[i, i] += mu
+        if not _chol_solve(A, g, dq, n):
+            return it, False, cost
+        for i in range(n):
+            qn[i] = q[i] + dq[i]
+        if respect:
+            project_into(qn, lo, hi, revolute)
+        jacobian_into(qn, F, meta, Jn, Tn)
+        pose_error_into(Tn, Tt, en)
+        cost_n = _cost(en, w)
+        lin = 0.0
+        for i in range(6):
+            s = 0.0
+            for j in range(n):
+                s += Jw[i, j] * (qn[j] - q[j])
+            lin += (r[i] - s) * (r[i] - s)
+        pred = cost - 0.5 * lin
+        rho = (cost - cost_n) / pred if pred > 0.0 else -1.0
+        if rho > 0.0 and math.isfinite(cost_n):
+            quiet = quiet + 1 if cost - cost_n <= 1e-12 * cost else 0
+            q[:] = qn
+            J[:, :] = Jn
+            T[:, :] = Tn
+            e[:] = en
+            cost = cost_n
+            t = 2.0 * rho - 1.0
+            mu *= max(1.0 / 3.0, 1.0 - t * t * t)
+            nu = 2.0
+        else:
+            quiet += 1
+            mu *= nu
+            nu *= 2.0
+        if quiet > 10 or mu > 1e16 * (1.0 + d):
+            return it + 1, False, cost
+    pe, oe = _errors(e, w)
+    return max_iter, (pe <= tol and oe <= tol), cost
+
+
+@njit(cache=True)
 def solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     """Solve one target with restarts; write the best q into ``q_out`` (n,) and ``info``.
 
@@ -586,6 +659,16 @@ def solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
         if ok:
             success = True
             break
+    if not success and cfg[C_POLISH] > 0.5:
+        q[:] = q_out
+        its, ok, cost = _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
+                                q, J, T, e, Jw, r, A, g, dq, qn, Jn, Tn, en)
+        total += its
+        if ok or cost < best_cost:
+            best_cost = cost
+            q_out[:] = q
+            be[:] = e
+            success = ok
     normalize_into(q_out, lo, hi, revolute)
     pe, oe = _errors(be, w)
     info[I_SUCCESS] = 1.0 if success else 0.0

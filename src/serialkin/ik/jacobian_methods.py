@@ -22,6 +22,13 @@ name               step
 =================  =====================================================================
 
 (``J`` and ``e`` are weighted by the task mask; ``E = ½ eᵀWe``.)
+
+Options (keyword arguments of ``robot.ik``; defaults in ``METHODS[name].options``):
+``damping`` (λ), ``stall_window`` (iterations within which the cost must halve before
+a restart), ``max_step`` (``pinv``: cap on max |Δq_i|; ``sdls``: γ_max), ``rcond``
+(relative singular-value cut-off) and, for ``lm``, ``polish``: when every attempt
+failed, refine the best one with a monotone Levenberg-Marquardt down to a local
+least-squares minimum, so that an unreachable target returns the closest pose found.
 """
 
 from __future__ import annotations
@@ -60,7 +67,7 @@ register_method(MethodSpec(
     limits="limit-aware step: joints at a limit whose step points outward are frozen and "
     "the step recomputed for the others; then " + _PROJECTION,
     max_iter=100, restarts=100,
-    options={"damping": 0.03, "stall_window": 10}, kernel_code=K.LM,
+    options={"damping": 0.03, "stall_window": 10, "polish": True}, kernel_code=K.LM,
 ))
 register_method(MethodSpec(
     name="lm_wampler", family="jacobian",

@@ -241,6 +241,10 @@ def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
             return cached[1]
     base = K.P_DAMPING
     p = np.zeros(K.N_CFG - base)
+    polish = opts.get("polish", False)
+    if not isinstance(polish, (bool, np.bool_)):
+        raise InputTypeError(f"polish must be True or False, got {polish!r}")
+    p[K.C_POLISH - base] = 1.0 if polish else 0.0
     p[K.P_DAMPING - base] = check_positive(opts.get("damping", 1e-3), "damping", allow_zero=True)
     p[K.P_WINDOW - base] = check_int(opts.get("stall_window", 20), "stall_window", minimum=1)
     p[K.P_MAX_STEP - base] = check_positive(opts.get("max_step", 0.5), "max_step")
