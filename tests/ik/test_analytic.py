@@ -259,6 +259,27 @@ def test_stanford_negative_stroke_gives_eight():
     assert counts.count(8) >= 15, counts
 
 
+def test_puma_agrees_with_robotics_toolbox_ikine_a():
+    """Every solution of Robotics Toolbox's Puma 560 ikine_a (8 configurations) is in our set."""
+    rtb = pytest.importorskip("roboticstoolbox")
+    puma = rtb.models.DH.Puma560()
+    rows = [DHLink(a=float(L.a), alpha=float(L.alpha), d=float(L.d), theta=float(L.offset))
+            for L in puma.links]
+    ours = Robot.from_dh(rows, base=np.asarray(puma.base.A), tool=np.asarray(puma.tool.A))
+    assert classify(ours) == "puma"
+    rng = np.random.default_rng(15)
+    for _ in range(8):
+        q = rng.uniform(-np.pi, np.pi, 6)
+        T = ours.fk(q)
+        np.testing.assert_allclose(np.asarray(puma.fkine(q).A), T, atol=1e-12)
+        S = ik_all(ours, T)
+        assert len(S) == 8
+        for config in ("lun", "lud", "lfn", "lfd", "run", "rud", "rfn", "rfd"):
+            sol = puma.ikine_a(T, config=config)
+            if sol.success:
+                assert _joint_distance(ours, S, np.asarray(sol.q, float)).min() < 1e-6
+
+
 # ----------------------------------------------------------------------------- chapter
 def test_two_link_matches_chapter_equations():
     """Planar 2-link: both elbow solutions equal eqs 23-27 as corrected by the ERRATA."""

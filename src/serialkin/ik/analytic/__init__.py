@@ -51,7 +51,7 @@ from serialkin.ik.analytic.structure import CLASSES, NUMERICAL_HINT, Structure, 
 from serialkin.ik.analytic.subproblems import rigid_error
 from serialkin.model.robot import Robot
 
-__all__ = ["CLASSES", "classify", "ik_all", "structure"]
+__all__ = ["CLASSES", "classify", "ik_all", "structure_of"]
 
 _STRUCTURES: weakref.WeakKeyDictionary[Robot, Structure | NoClosedFormError] = \
     weakref.WeakKeyDictionary()
@@ -93,7 +93,7 @@ class _Prepared:
 _PREPARED: weakref.WeakKeyDictionary[Robot, _Prepared] = weakref.WeakKeyDictionary()
 
 
-def structure(robot: Robot) -> Structure:
+def structure_of(robot: Robot) -> Structure:
     """The robot's recognised closed-form structure (cached per robot object).
 
     Raises:
@@ -120,7 +120,7 @@ def classify(robot: Robot) -> str:
         NoClosedFormError: no closed form is known for this structure (the message says
             why and points to ``robot.ik(target, method="lm")``).
     """
-    return structure(robot).kind
+    return structure_of(robot).kind
 
 
 def _prepared(robot: Robot) -> _Prepared:
@@ -128,7 +128,7 @@ def _prepared(robot: Robot) -> _Prepared:
         raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
     p = _PREPARED.get(robot)
     if p is None:
-        p = _Prepared(robot, structure(robot))
+        p = _Prepared(robot, structure_of(robot))
         _PREPARED[robot] = p
     return p
 
@@ -136,6 +136,8 @@ def _prepared(robot: Robot) -> _Prepared:
 def _as_pose(a: np.ndarray) -> np.ndarray:
     """A (4, 4) float array as an exactly rigid target: checked, rotation projected on SO(3)."""
     T = np.ascontiguousarray(a, dtype=float)
+    if not T.flags.writeable:  # one array type for the kernels (no extra compilation)
+        T = T.copy()
     err = rigid_error(T)
     if err > ROTATION_TOL:
         check_transform(T, "target")  # raises with a message naming what is wrong
