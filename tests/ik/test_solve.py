@@ -230,3 +230,28 @@ def test_polish_returns_closest_pose(two_link):
     assert res.position_error == pytest.approx(np.sqrt(10.0) - 2.0, abs=1e-6)
     rough = two_link.ik(np.array([3.0, 1.0]), seed=0, restarts=3, polish=False)
     assert rough.position_error >= res.position_error - 1e-12
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560", "stanford"])
+def test_analytic_method_nearest_to_q0(name):
+    """Method 'analytic' returns the closed-form solution nearest q0 (q0 itself for FK(q0))."""
+    pytest.importorskip("serialkin.ik.analytic")
+    robot = models.get(name)
+    for q in robot.random_q(5, seed=90):
+        T = robot.fk(q)
+        res = robot.ik(T, method="analytic", q0=q)
+        assert_reaches(robot, res, T)
+        assert np.allclose(res.q, q, atol=1e-6)
+        assert res.iterations == 1 and res.restarts == 0
+
+
+def test_analytic_method_errors(panda, two_link):
+    """'analytic' on a robot without closed form raises; an unreachable target fails cleanly."""
+    pytest.importorskip("serialkin.ik.analytic")
+    from serialkin.errors import NoClosedFormError
+
+    with pytest.raises(NoClosedFormError):
+        panda.ik(panda.fk(np.zeros(7)), method="analytic")
+    res = two_link.ik(np.array([3.0, 0.0]), method="analytic")
+    assert not res.success and "no closed-form solution" in res.reason
+    assert np.isfinite(res.q).all()

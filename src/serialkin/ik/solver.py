@@ -426,7 +426,8 @@ def _analytic_solve(robot: Robot, problem: IKProblem, q0: np.ndarray | None,
     """The 'analytic' method: every closed-form solution, then the one nearest q0.
 
     Nearest is measured joint by joint, revolute differences wrapped to [-π, π]; without
-    q0 the reference is the middle of the joint ranges.
+    q0 the reference is the middle of the joint ranges. A revolute joint is then shifted
+    by a multiple of 2π towards the reference when that stays inside its limits.
     """
     from serialkin.ik.analytic import ik_all
 
@@ -450,7 +451,14 @@ def _analytic_solve(robot: Robot, problem: IKProblem, q0: np.ndarray | None,
     d = sols - ref
     rev = problem.revolute
     d[:, rev] = (d[:, rev] + np.pi) % (2 * np.pi) - np.pi
-    best = sols[int(np.argmin(np.sum(d * d, axis=1)))]
+    best = sols[int(np.argmin(np.sum(d * d, axis=1)))].copy()
+    # among 2π-equivalent values of each revolute joint, take the one nearest the reference
+    # that stays inside the limits (wide ranges such as the UR5's ±2π allow several)
+    lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
+    for i in np.flatnonzero(rev):
+        shifted = best[i] + 2 * np.pi * np.round((ref[i] - best[i]) / (2 * np.pi))
+        if lo[i] <= shifted <= hi[i]:
+            best[i] = shifted
     ok = problem.converged(best) and (not problem.respect_limits
                                       or bool(robot.within_limits(best, 1e-12)))
     reason = "" if ok else "the closed-form solution does not reproduce the target within tol"
