@@ -207,9 +207,14 @@ class SymbolicKinematics:
         Returns:
             (m, n) sympy matrix, m = 3 ('position', 'planar_pose') or 2 ('planar').
         """
-        x = self.task(task)
-        J = x.jacobian(sp.Matrix(self.q))
-        return self._simp(J)
+        qv = sp.Matrix(self.q)
+        if task != "planar_pose":
+            return self._simp(self.task(task).jacobian(qv))
+        # dφ/dq of φ = atan2(R21, R11), written as (R11 dR21 − R21 dR11) / (R11² + R21²)
+        c, s = self.T[0, 0], self.T[1, 0]
+        dphi = ((c * sp.Matrix([s]).jacobian(qv) - s * sp.Matrix([c]).jacobian(qv))
+                / (c**2 + s**2))
+        return self._simp(sp.Matrix.vstack(self.position[:2, :].jacobian(qv), dphi))
 
     def geometric_jacobian(self) -> sp.Matrix:
         """Geometric Jacobian (eqs 33-37), rows (vx, vy, vz, wx, wy, wz), (6, n).
