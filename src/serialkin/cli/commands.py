@@ -76,6 +76,12 @@ def read_q(robot: Any, q_texts: tuple[str, ...], q_file: str | None, degrees: bo
     return Q * _angle_factor(robot, degrees)
 
 
+def fmt_vector(v: np.ndarray, decimals: int = 6) -> str:
+    """A vector as ``[a, b, c]`` with fixed decimals (no wrapping, no scientific notation)."""
+    return "[" + ", ".join(f"{0.0 if abs(x) < 0.5 * 10**-decimals else x:.{decimals}f}"
+                           for x in np.asarray(v, dtype=float)) + "]"
+
+
 def _robot_info(robot: Any) -> dict[str, Any]:
     return {"name": robot.name, "n": robot.n, "joint_types": "".join(robot.joint_types),
             "joint_names": list(robot.joint_names), "convention": robot.convention,
@@ -185,12 +191,12 @@ def fk_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frames: boo
     if len(recs) == 1:
         rec = recs[0]
         click.echo(f"{r.name} ({r.n} joints {''.join(r.joint_types)}), "
-                   f"q = {np.array2string(rec['q'] / f, precision=6, separator=', ')}")
+                   f"q = {fmt_vector(rec['q'] / f)}")
         click.echo("T (world from tool):")
         click.echo(format_matrix(rec["T"]))
-        click.echo(f"position [m]: {np.array2string(rec['position'], precision=6)}")
+        click.echo(f"position [m]: {fmt_vector(rec['position'])}")
         rpy = np.degrees(rec["rpy"]) if degrees else rec["rpy"]
-        click.echo(f"rpy [{unit}]: {np.array2string(rpy, precision=6)}")
+        click.echo(f"rpy [{unit}]: {fmt_vector(rpy)}")
         if frames:
             for k, Fk in enumerate(rec["frames"]):
                 click.echo(f"frame {k}:")
@@ -288,7 +294,7 @@ def jacobian_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frame
         return
     f = _angle_factor(r, degrees)
     for k, rec in enumerate(recs):
-        click.echo(f"{r.name}: q = {np.array2string(rec['q'] / f, precision=6, separator=', ')}"
+        click.echo(f"{r.name}: q = {fmt_vector(rec['q'] / f)}"
                    f"  (J in the {frame} frame"
                    + (f", point on link {link}" if link is not None else "") + ")")
         click.echo(format_table([[names[i], *rec["J"][k2]] for k2, i in enumerate(rows_sel)],
@@ -446,7 +452,7 @@ def ik_cmd(robot: str | None, targets: tuple[str, ...], target_file: str | None,
     elif not quiet:
         unit = "deg" if degrees else "rad"
         trows = [[rec["index"], "yes" if rec["success"] else "NO",
-                  np.array2string(rec["q"] / f, precision=5, separator=", "),
+                  fmt_vector(rec["q"] / f, 4),
                   rec["position_error"], rec["orientation_error"], rec["iterations"],
                   rec["restarts"]] for rec in recs]
         click.echo(f"{r.name}, method {method}:")
@@ -523,7 +529,7 @@ def _ik_all(r: Any, tgts: list[Any], info: dict[str, Any], as_json: bool, out: s
         for rec in recs:
             click.echo(f"target {rec['index']}: {rec['count']} solution(s) [{unit}/m]")
             for q in rec["solutions"]:
-                click.echo("  " + np.array2string(q / f, precision=6, separator=", "))
+                click.echo("  " + fmt_vector(q / f))
     for rec in recs:
         if not rec["success"]:
             click.echo(f"target {rec['index']} not reached: no closed-form solution inside "
