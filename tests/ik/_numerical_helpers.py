@@ -1,0 +1,42 @@
+"""Shared helpers for the CCD / FABRIK / BFGS / Powell / compare tests."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from serialkin.spatial.pose import pose_error
+
+
+def well_conditioned_q(robot, count, seed, task="full", max_cond=15.0, margin=0.05):
+    """``count`` configurations inside the shrunk limits with task condition number < max_cond.
+
+    Targets away from singularities and workspace boundaries, where every method's
+    documented tolerance applies.
+    """
+    rng = np.random.default_rng(seed)
+    lo, hi = robot.sampling_limits().T
+    span = hi - lo
+    out = []
+    for _ in range(1000 * count):
+        q = lo + margin * span + (1 - 2 * margin) * span * rng.random(robot.n)
+        if robot.condition_number(q, task) < max_cond:
+            out.append(q)
+            if len(out) == count:
+                return np.array(out)
+    raise RuntimeError(f"no configuration with condition number < {max_cond} for {task!r}")
+
+
+def selected_errors(robot, q, T_target, weights):
+    """(position error [m], orientation error [rad]) of FK(q) over the selected rows."""
+    e = pose_error(robot.fk(q), T_target)
+    sel = np.asarray(weights) > 0
+    return float(np.linalg.norm(e[:3][sel[:3]])), float(np.linalg.norm(e[3:][sel[3:]]))
+
+
+def assert_solution(robot, res, T_target, weights, tol):
+    """The returned q reproduces the target within tol and lies inside the limits."""
+    assert res.success, res.reason
+    pe, oe = selected_errors(robot, res.q, T_target, weights)
+    assert pe <= tol * 1.0000001, pe
+    assert oe <= tol * 1.0000001, oe
+    assert robot.within_limits(res.q, 1e-12)
