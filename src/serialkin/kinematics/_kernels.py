@@ -104,6 +104,13 @@ def fk_batch(Q, F, meta, out):
 
 
 @njit(cache=True)
+def fk_batch_serial(Q, F, meta, out):
+    """:func:`fk_batch` on one core: small batches, where starting threads costs more."""
+    for k in range(Q.shape[0]):
+        fk_into(Q[k], F, meta, out[k])
+
+
+@njit(cache=True)
 def fk_all_into(q, F, L, meta, out):
     """Every link frame 0..n (base to last link, without the tool) into ``out`` (n+1, 4, 4)."""
     n = meta.shape[0]
@@ -181,6 +188,13 @@ def jacobian_into(q, F, meta, J, T):
 def jacobian_batch(Q, F, meta, J, T):
     """Geometric Jacobians (N, 6, n) and poses (N, 4, 4) for a batch ``Q`` (N, n)."""
     for k in prange(Q.shape[0]):
+        jacobian_into(Q[k], F, meta, J[k], T[k])
+
+
+@njit(cache=True)
+def jacobian_batch_serial(Q, F, meta, J, T):
+    """:func:`jacobian_batch` on one core, for small batches."""
+    for k in range(Q.shape[0]):
         jacobian_into(Q[k], F, meta, J[k], T[k])
 
 

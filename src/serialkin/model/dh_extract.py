@@ -48,12 +48,11 @@ def common_normal(p1: np.ndarray, z1: np.ndarray, p2: np.ndarray, z2: np.ndarray
     cross = np.cross(z1, z2)
     s = np.linalg.norm(cross)
     if s > _EPS:
-        w = p1 - p2
-        b = z1 @ z2
-        d, e = z1 @ w, z2 @ w
-        denom = 1.0 - b * b
-        t1 = (b * e - d) / denom
-        t2 = (e - b * d) / denom
+        # feet from cross products: well conditioned even for nearly parallel axes
+        n = cross / s
+        dp = p2 - p1
+        t1 = np.cross(dp, z2) @ n / s
+        t2 = np.cross(dp, z1) @ n / s
         c1, c2 = p1 + t1 * z1, p2 + t2 * z2
         gap = c2 - c1
         if np.linalg.norm(gap) > _EPS:

@@ -35,6 +35,8 @@ if TYPE_CHECKING:
     from serialkin.ik.result import IKResult
 
 _F64 = np.dtype(np.float64)
+#: Batches smaller than this run on one core (thread start-up would cost more).
+PARALLEL_MIN_BATCH = 256
 _ENTRY: dict[str, Any] = {}
 
 
@@ -256,7 +258,8 @@ class Robot:
             return T
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
         out = np.empty((flat.shape[0], 4, 4))
-        K.fk_batch(flat, self._F, self._meta, out)
+        kernel = K.fk_batch if flat.shape[0] >= PARALLEL_MIN_BATCH else K.fk_batch_serial
+        kernel(flat, self._F, self._meta, out)
         return out.reshape(a.shape[:-1] + (4, 4))
 
     def fk_all(self, q: object) -> np.ndarray:
@@ -271,8 +274,9 @@ class Robot:
         a = self.check_q(q)
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
         out = np.empty((flat.shape[0], self.n + 1, 4, 4))
-        if flat.shape[0] == 1:
-            K.fk_all_into(flat[0], self._F, self._L, self._meta, out[0])
+        if flat.shape[0] < PARALLEL_MIN_BATCH:
+            for k in range(flat.shape[0]):
+                K.fk_all_into(flat[k], self._F, self._L, self._meta, out[k])
         else:
             K.fk_all_batch(flat, self._F, self._L, self._meta, out)
         return out.reshape(a.shape[:-1] + (self.n + 1, 4, 4))
@@ -321,7 +325,8 @@ class Robot:
         if link is None:
             if point is not None:
                 raise InputError("point is given without link; pass link=k (0..n) as well")
-            K.jacobian_batch(flat, self._F, self._meta, J, T)
+            kernel = K.jacobian_batch if N >= PARALLEL_MIN_BATCH else K.jacobian_batch_serial
+            kernel(flat, self._F, self._meta, J, T)
         else:
             k = check_int(link, "link")
             if k > self.n:
@@ -330,7 +335,11 @@ class Robot:
             if p.shape != (3,):
                 raise InputError(f"point must have 3 values, got shape {p.shape}")
             P = np.empty((N, 3))
-            K.point_jacobian_batch(flat, self._F, self._L, self._meta, k, p, J, P)
+            if N < PARALLEL_MIN_BATCH:
+                for i in range(N):
+                    K.point_jacobian_into(flat[i], self._F, self._L, self._meta, k, p, J[i], P[i])
+            else:
+                K.point_jacobian_batch(flat, self._F, self._L, self._meta, k, p, J, P)
             if frame == "ee":
                 T = self.fk_all(flat)[:, k]
         if frame == "ee":
