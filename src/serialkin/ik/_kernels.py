@@ -19,8 +19,9 @@ Method codes and steps:
 * ``TRANSPOSE`` — ``Δq = α Jwᵀ r`` with the step length of Buss (2004) / Wolovich & Elliott
   (1984), ``α = ⟨r, Jw Jwᵀ r⟩ / |Jw Jwᵀ r|²`` (the exact minimiser of the linearised
   residual along the gradient).
-* ``PINV`` — ``Δq = Jw⁺ r`` (eq 40, Moore-Penrose pseudoinverse by SVD, singular values
-  below ``rcond·σ_max`` dropped), then scaled so that ``max |Δq_i| ≤ max_step``.
+* ``PINV`` — ``Δq = Jw⁺ r`` (eq 40; Moore-Penrose pseudoinverse by a one-sided Jacobi
+  SVD, :func:`_jacobi_svd`, singular values below ``rcond·σ_max`` dropped), then scaled
+  so that ``max |Δq_i| ≤ max_step``.
 * ``DLS`` — ``Δq = Jwᵀ (Jw Jwᵀ + λ² I)⁻¹ r`` (eq 46 as corrected in the errata), fixed λ.
 * ``LM`` — Levenberg-Marquardt with error-adaptive damping,
   ``(JwᵀJw + μI) Δq = Jwᵀ r`` with ``μ = λE`` (Chan & Lawrence's rule with a small λ,
@@ -281,32 +282,102 @@ def _normal(Jw, r, A, g):
 
 
 @njit(cache=True)
+def _jacobi_svd(M, W, V, s):
+    """Singular value decomposition of a small matrix by one-sided Jacobi (Hestenes).
+
+    ``M`` (m, k) is copied into ``W`` (m, k), whose columns are orthogonalised by plane
+    rotations accumulated in ``V`` (k, k), so that ``M = W Vᵀ`` with orthogonal columns:
+    ``σ_j = |W[:, j]|`` into ``s`` (k,) (unsorted; k − rank of them are 0) and
+    ``u_j = W[:, j] / σ_j``. Accurate to working precision for every singular value and
+    allocation free — much cheaper than a LAPACK call for the 6×n matrices of IK.
+    """
+    m = M.shape[0]
+    k = M.shape[1]
+    for i in range(m):
+        for j in range(k):
+            W[i, j] = M[i, j]
+    for i in range(k):
+        for j in range(k):
+            V[i, j] = 1.0 if i == j else 0.0
+    frob = 0.0
+    for i in range(m):
+        for j in range(k):
+            frob += M[i, j] * M[i, j]
+    tiny = 1e-30 * frob  # columns below this squared norm count as zero (rank deficiency)
+    for _sweep in range(60):
+        rotated = False
+        for p in range(k - 1):
+            for q in range(p + 1, k):
+                alpha = 0.0
+                beta = 0.0
+                gamma = 0.0
+                for i in range(m):
+                    alpha += W[i, p] * W[i, p]
+                    beta += W[i, q] * W[i, q]
+                    gamma += W[i, p] * W[i, q]
+                if alpha <= tiny or beta <= tiny or abs(gamma) <= 1e-15 * math.sqrt(alpha * beta):
+                    continue
+                rotated = True
+                zeta = (beta - alpha) / (2.0 * gamma)
+                t = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                sn = c * t
+                for i in range(m):
+                    wp = W[i, p]
+                    wq = W[i, q]
+                    W[i, p] = c * wp - sn * wq
+                    W[i, q] = sn * wp + c * wq
+                for i in range(k):
+                    vp = V[i, p]
+                    vq = V[i, q]
+                    V[i, p] = c * vp - sn * vq
+                    V[i, q] = sn * vp + c * vq
+        if not rotated:
+            break
+    for j in range(k):
+        t = 0.0
+        for i in range(m):
+            t += W[i, j] * W[i, j]
+        s[j] = math.sqrt(t)
+
+
+@njit(cache=True)
 def _pinv_step(M, rhs, dq, rcond):
-    """Dq = M⁺ rhs by SVD (singular values below rcond·σ_max dropped); M is (m, n)."""
-    U, s, Vt = np.linalg.svd(M, full_matrices=False)
+    """Pseudoinverse step ``dq = M⁺ rhs`` for a small (m, n) M (σ below rcond·σ_max dropped)."""
+    m = M.shape[0]
     n = M.shape[1]
+    W = np.empty((m, n))
+    V = np.empty((n, n))
+    s = np.empty(n)
+    _jacobi_svd(M, W, V, s)
+    smax = 0.0
     for j in range(n):
+        smax = max(smax, s[j])
         dq[j] = 0.0
-    if s.shape[0] == 0 or not s[0] > 0.0:
+    if not smax > 0.0:
         return
-    cut = rcond * s[0]
-    for k in range(s.shape[0]):
+    cut = rcond * smax
+    for k in range(n):
         if s[k] <= cut:
             continue
         a = 0.0
-        for i in range(M.shape[0]):
-            a += U[i, k] * rhs[i]
-        a /= s[k]
+        for i in range(m):
+            a += W[i, k] * rhs[i]
+        a /= s[k] * s[k]  # u_kᵀ rhs / σ_k with u_k = W[:, k] / σ_k
         for j in range(n):
-            dq[j] += a * Vt[k, j]
+            dq[j] += a * V[j, k]
 
 
 @njit(cache=True)
 def _sdls_step(Jw, r, dq, gamma_max):
     """Selectively damped least squares step (Buss & Kim 2005), two 3-row blocks."""
-    U, s, Vt = np.linalg.svd(Jw, full_matrices=False)
     n = Jw.shape[1]
+    W = np.empty((6, n))
+    V = np.empty((n, n))
+    s = np.empty(n)
+    _jacobi_svd(Jw, W, V, s)
     rho = np.empty(n)
+    smax = 0.0
     for j in range(n):
         a = 0.0
         b = 0.0
@@ -315,29 +386,31 @@ def _sdls_step(Jw, r, dq, gamma_max):
             b += Jw[i + 3, j] * Jw[i + 3, j]
         rho[j] = math.sqrt(a) + math.sqrt(b)
         dq[j] = 0.0
-    if s.shape[0] == 0 or not s[0] > 0.0:
+        smax = max(smax, s[j])
+    if not smax > 0.0:
         return
     phi = np.empty(n)
-    for k in range(s.shape[0]):
-        if s[k] <= 1e-12 * s[0]:
+    for k in range(n):
+        if s[k] <= 1e-12 * smax:
             continue
         alpha = 0.0
         a = 0.0
         b = 0.0
         for i in range(3):
-            a += U[i, k] * U[i, k]
-            b += U[i + 3, k] * U[i + 3, k]
+            a += W[i, k] * W[i, k]
+            b += W[i + 3, k] * W[i + 3, k]
         for i in range(6):
-            alpha += U[i, k] * r[i]
-        N = math.sqrt(a) + math.sqrt(b)
+            alpha += W[i, k] * r[i]
+        alpha /= s[k]  # α = u_kᵀ r
+        N = (math.sqrt(a) + math.sqrt(b)) / s[k]  # |u_k| over the two blocks
         M = 0.0
         for j in range(n):
-            M += abs(Vt[k, j]) * rho[j]
+            M += abs(V[j, k]) * rho[j]
         M /= s[k]
         gamma = gamma_max * min(1.0, N / M) if M > 0.0 else gamma_max
         big = 0.0
         for j in range(n):
-            phi[j] = alpha / s[k] * Vt[k, j]
+            phi[j] = alpha / s[k] * V[j, k]
             big = max(big, abs(phi[j]))
         scale = gamma / big if big > gamma else 1.0
         for j in range(n):
