@@ -193,3 +193,26 @@ def test_fk_matches_robotics_toolbox(name):
     robot = models.get(name)
     for q in robot.random_q(10, seed=5):
         np.testing.assert_allclose(robot.fk(q), peer.fkine(q).A, atol=1e-12)
+
+
+@pytest.mark.peer
+def test_panda_and_ur5_match_manufacturer_urdfs_in_pinocchio():
+    """Panda fk equals panda_link8 (flange) and UR5 fk equals Rz(π)·tool0 of the URDFs."""
+    pin = pytest.importorskip("pinocchio")
+    from tests.erd import urdf
+
+    cases = [("panda", "panda_description/urdf/panda.urdf", "panda_link8", np.eye(4)),
+             ("ur5", "ur_description/urdf/ur5_robot.urdf", "tool0", np.diag([-1, -1, 1, 1.0]))]
+    for name, rel, frame, world_from_urdf in cases:
+        path = urdf(rel)
+        if path is None:
+            pytest.skip(f"example-robot-data does not ship {rel}")
+        model = pin.buildModelFromUrdf(str(path))
+        data = model.createData()
+        fid = model.getFrameId(frame)
+        robot = models.get(name)
+        for q in robot.random_q(10, seed=6):
+            qq = np.concatenate([q, np.zeros(model.nq - robot.n)])  # Panda: finger joints
+            pin.framesForwardKinematics(model, data, qq)
+            T = world_from_urdf @ data.oMf[fid].homogeneous
+            np.testing.assert_allclose(robot.fk(q), T, atol=1e-9)
