@@ -41,6 +41,9 @@ def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
             raise CLIError(str(exc)) from exc
         except PermissionError as exc:
             raise CLIError(f"permission denied: {exc.filename or exc}") from exc
+        except OSError as exc:
+            where = f"{exc.filename}: " if exc.filename else ""
+            raise CLIError(f"{where}{exc.strerror or exc}") from exc
 
     return wrapper
 
@@ -309,7 +312,8 @@ def jacobian_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frame
 
 
 # ---------------------------------------------------------------------------- ik
-def _target_rows(robot: Any, values: np.ndarray, degrees: bool, planar: bool) -> list[Any]:
+def _target_rows(robot: Any, values: list[np.ndarray], degrees: bool, planar: bool
+                 ) -> list[Any]:
     """Turn rows of numbers into IK targets (see ``serialkin ik --help``)."""
     from serialkin.spatial import make_transform, rpy_to_matrix
 
@@ -413,8 +417,7 @@ def ik_cmd(robot: str | None, targets: tuple[str, ...], target_file: str | None,
         rows += list(read_csv_rows(target_file, "targets", sizes))
     if not rows:
         raise CLIError("no target: give --target (repeatable) or --target-file")
-    tgts = _target_rows(r, rows_to_array(rows), degrees, planar) if len({len(x) for x in rows}) \
-        == 1 else [t for x in rows for t in _target_rows(r, x[None, :], degrees, planar)]
+    tgts = _target_rows(r, rows, degrees, planar)
     f = _angle_factor(r, degrees)
     q0v = parse_numbers(q0, "--q0", r.n) * f if q0 is not None else None
     maskv = parse_numbers(mask, "--mask", 6) if mask is not None else None
@@ -467,11 +470,6 @@ def ik_cmd(robot: str | None, targets: tuple[str, ...], target_file: str | None,
         raise SystemExit(EXIT_NOT_REACHED)
 
 
-
-
-def rows_to_array(rows: list[np.ndarray]) -> np.ndarray:
-    """Stack equal-length rows into an (N, k) array."""
-    return np.array(rows, dtype=float)
 
 
 def _solve_all(r: Any, tgts: list[Any], method: str, q0: np.ndarray | None,
