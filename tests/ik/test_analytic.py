@@ -82,6 +82,26 @@ def _pieper_rows():
     ]
 
 
+def _skew_rows():
+    """A 6R arm with a spherical wrist and skew axes 1-2 and 2-3 (Pieper's general case)."""
+    lim = (-np.pi, np.pi)
+    return [
+        DHLink(a=0.15, alpha=math.pi / 3, d=0.4, qlim=lim),
+        DHLink(a=0.5, alpha=math.pi / 4, d=0.1, qlim=lim),
+        DHLink(a=0.1, alpha=H, d=0.2, qlim=lim),
+        DHLink(a=0.0, alpha=-H, d=0.4, qlim=lim),
+        DHLink(a=0.0, alpha=H, d=0.0, qlim=lim),
+        DHLink(a=0.0, alpha=0.0, d=0.1, qlim=lim),
+    ]
+
+
+def _parallel12_rows():
+    """A 6R arm with a spherical wrist, parallel axes 1-2 and skew axes 2-3."""
+    rows = _skew_rows()
+    rows[0] = DHLink(a=0.3, alpha=0.0, d=0.4, qlim=(-np.pi, np.pi))
+    return rows
+
+
 def _variant(robot: Robot, rng: np.random.Generator, keep_zero: tuple[str, ...] = ()) -> Robot:
     """A user's own robot of the same class: scaled a/d, joint offsets, base and tool."""
     rows = []
@@ -105,6 +125,8 @@ ROBOTS = {
     "stanford": (models.stanford, "stanford"),
     "ur5": (models.ur5, "ur"),
     "pieper": (lambda: Robot.from_dh(_pieper_rows(), name="pieper"), "pieper_intersecting"),
+    "skew": (lambda: Robot.from_dh(_skew_rows(), name="skew"), "pieper_general"),
+    "par12": (lambda: Robot.from_dh(_parallel12_rows(), name="par12"), "pieper_general"),
 }
 
 
@@ -119,7 +141,7 @@ def test_round_trip_builtin(name):
     assert max(counts) >= (1 if kind == "planar_2r" else 2)  # 2R + pose: one orientation
 
 
-@pytest.mark.parametrize("name", ["scara", "puma560", "stanford", "ur5", "pieper"])
+@pytest.mark.parametrize("name", ["scara", "puma560", "stanford", "ur5", "pieper", "skew"])
 def test_round_trip_modified_dh(name):
     """The same mechanism written in modified (Craig) DH is recognised and solved identically."""
     build, kind = ROBOTS[name]
@@ -154,6 +176,8 @@ VARIANT_ZEROS = {
     "ur5": ("a5",),                         # axes 5 and 6 intersect
     "stanford": ("a1", "a4", "a5", "d5"),   # axes 1, 2 intersect; spherical wrist
     "pieper": ("a1", "a4", "a5", "d5"),
+    "skew": ("a4", "a5", "d5"),
+    "par12": ("a4", "a5", "d5"),
 }
 
 
@@ -221,6 +245,32 @@ def test_wrist_singular_representative():
                                atol=1e-9)
 
 
+def _zero_or_away(low: float, high: float) -> st.SearchStrategy[float]:
+    """Exactly 0 (a special structure) or well away from it (a well-conditioned one)."""
+    return st.one_of(st.just(0.0), st.floats(low, high), st.floats(-high, -low))
+
+
+@settings(max_examples=30, deadline=None)
+@given(a=st.lists(_zero_or_away(0.05, 0.5), min_size=3, max_size=3),
+       alpha=st.lists(_zero_or_away(0.2, 2.9), min_size=3, max_size=3),
+       d=st.lists(_zero_or_away(0.05, 0.5), min_size=4, max_size=4),
+       seed=st.integers(0, 2**31 - 1))
+def test_any_arm_with_spherical_wrist(a, alpha, d, seed):
+    """Any well-conditioned R R R arm followed by a spherical wrist is solved (Pieper)."""
+    rows = [DHLink(a=a[i], alpha=alpha[i], d=d[i]) for i in range(3)]
+    rows += [DHLink(a=0.0, alpha=-H, d=d[3]), DHLink(a=0.0, alpha=H, d=0.0),
+             DHLink(a=0.0, alpha=0.0, d=0.1)]
+    robot = Robot.from_dh(rows, base=_random_transform(np.random.default_rng(seed)))
+    try:
+        kind = classify(robot)
+    except NoClosedFormError as exc:  # degenerate draws: the message says which test failed
+        assert "parallel" in str(exc) or "axis 3" in str(exc) or "coincide" in str(exc)
+        return
+    assert kind in ("puma", "pieper_intersecting", "pieper_general")
+    counts = _check_round_trips(robot, 5, seed=seed, tol=1e-8)
+    assert max(counts) <= 8
+
+
 def test_eight_solutions_without_limits():
     """Unlimited Puma 560 and Pieper arm: 8 solutions per pose; UR5: 8 for most, never more."""
     for robot in (models.puma560(), Robot.from_dh(_pieper_rows())):
@@ -231,7 +281,7 @@ def test_eight_solutions_without_limits():
     assert max(counts) == 8 and counts.count(8) >= 20, counts
 
 
-@pytest.mark.parametrize("name", ["ur5", "puma560", "pieper"])
+@pytest.mark.parametrize("name", ["ur5", "puma560", "pieper", "skew", "par12"])
 def test_solution_set_is_complete(name):
     """Least squares from 30 random starts finds no solution missing from ik_all's set."""
     optimize = pytest.importorskip("scipy.optimize")

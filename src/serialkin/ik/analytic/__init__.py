@@ -13,6 +13,7 @@ class                       structure                                           
 ``scara_rrp``               R R P, all axes parallel                              2
 ``puma``                    6R, spherical wrist, axes 2 ∥ 3 (Pieper)              8
 ``pieper_intersecting``     6R, spherical wrist, axes 1 and 2 intersect           8
+``pieper_general``          6R, spherical wrist, any other arm (Pieper's quartic)  8
 ``stanford``                R R P + spherical wrist, axes 1 and 2 intersect       8
 ``ur``                      6R, axes 2 ∥ 3 ∥ 4, axes 5 and 6 intersect            8
 ==========================  ====================================================  =====
@@ -188,7 +189,8 @@ def _parse_target(p: _Prepared, robot: Robot, target: object) -> tuple[np.ndarra
         T = p.M.copy()
         T[:3, 3] = a
         return T, False
-    if a.shape == (3,) and kind in ("puma", "pieper_intersecting", "stanford", "ur", "scara"):
+    if a.shape == (3,) and kind in ("puma", "pieper_intersecting", "pieper_general", "stanford",
+                                    "ur", "scara"):
         raise NoClosedFormError(
             f"robot {robot.name!r} ({kind}) has infinitely many solutions for a position-only "
             f"target: the orientation is free. Give ik_all a 4x4 pose, or {NUMERICAL_HINT}")
@@ -275,11 +277,12 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         out = np.empty((2, p.n))
         k = solve_scara(T, p.W, p.P, p.M, p.order, p.aux[0], p.aux[1], p.revolute, p.qlim,
                         p.mid, p.F, p.meta, check_rot, tol_p, tol, out)
-    elif kind in ("puma", "pieper_intersecting"):
+    elif kind in ("puma", "pieper_intersecting", "pieper_general"):
         from serialkin.ik.analytic.spherical_wrist import solve_spherical_wrist
 
         out = np.empty((8, 6))
-        k = solve_spherical_wrist(T, p.W, p.P, p.M, p.aux, 0 if kind == "puma" else 1,
+        arm = ("puma", "pieper_intersecting", "pieper_general").index(kind)
+        k = solve_spherical_wrist(T, p.W, p.P, p.M, p.aux, arm,
                                   p.revolute, p.qlim, p.mid, p.F, p.meta, tol_p, tol, out)
     elif kind == "stanford":
         from serialkin.ik.analytic.stanford import solve_stanford

@@ -15,6 +15,9 @@ problem splits (D. L. Pieper, PhD thesis, Stanford 1968):
    * ``pieper_intersecting`` — axes 1 and 2 meet at ``o``: rotations about them keep
      the distance to ``o``, so ``|exp(ξ3 q3)·c − o| = |p_w − o|`` gives q3 (subproblem 3),
      then q1, q2 by subproblem 2.
+   * ``pieper_general`` — any other R R R arm (axes 1 and 2 skew): the invariants of
+     joint 1 give a quartic in q3 (Pieper), solved as a degree-2 trigonometric
+     polynomial (:func:`general_candidates`), then q2 and q1 in closed form.
 2. **Orientation.** ``R4·R5·R6 = (R1 R2 R3)ᵀ·R_T·R_Mᵀ =: X``; ``R4 R5 w6 = X w6`` gives
    q4, q5 (subproblem 2, two solutions: wrist flip) and q6 follows by subproblem 1.
 
@@ -25,10 +28,13 @@ representative with q4 = 0 is returned.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
 from serialkin.ik.analytic.subproblems import (
+    CLAMP,
     dot3,
     finalize,
     mm,
@@ -151,6 +157,141 @@ def intersecting_candidates(T, W, P, M, aux, out):
 
 
 @njit(cache=True)
+def _general_residual(theta, c, w3, r3, r2, w2, a1, ca, sa, rho2, h):
+    """E(θ3) = g1² + g2² − (|u|² − (w2·u)²) of the general arm (see general_candidates)."""
+    u = mv(rotation(w3, theta), c - r3) + r3 - r2
+    uu = dot3(u, u)
+    wu = dot3(w2, u)
+    g1 = (rho2 - uu - a1 * a1) / (2.0 * a1)
+    g2 = (h - ca * wu) / sa
+    return g1 * g1 + g2 * g2 - (uu - wu * wu)
+
+
+@njit(cache=True)
+def general_candidates(T, W, P, M, aux, out):
+    """Candidates for a ``pieper_general`` arm; aux = (c, r1, r2, n, m, v). Returns the count.
+
+    Axes 1 and 2 do not meet: r1, r2 are the feet of their common perpendicular, a1 = |r2 − r1|,
+    n = (r2 − r1)/a1, m = w2 × n, and w1 = cα·w2 + sα·m. With u = exp(ξ3 θ3)·c − r2 and
+    x = exp(ξ2 θ2)·(r2 + u) the point that joint 1 must turn onto p_w, the invariants of
+    joint 1 (distance to r1 and height along w1) give (Pieper; Craig, *Introduction to
+    Robotics*, section 4.6)
+
+    * n·R2 u = g1 = (|p_w − r1|² − |u|² − a1²)/(2 a1),
+    * m·R2 u = g2 = (w1·(p_w − r1) − cα w2·u)/sα,
+
+    and since R2 turns the (n, m) components of u rigidly, g1² + g2² = |u|² − (w2·u)²:
+    a trigonometric polynomial E(θ3) of degree 2 (a quartic). Its Fourier coefficients
+    come exactly from 5 samples; the roots of ``z²·E`` (z = e^{iθ3}) on the unit circle,
+    polished by Newton's method, give up to 4 values of θ3; then
+    θ2 = atan2(g2, g1) − atan2(m·u, n·u) and θ1 by subproblem 1.
+
+    When axes 1 and 2 are parallel (sα = 0) the second invariant reads w2·u = cα·w1·(p_w − r1)
+    instead: θ3 by :func:`~serialkin.ik.analytic.subproblems.sp4` (two values) and
+    g2 = ±sqrt(|u|² − (w2·u)² − g1²) (two values of θ2 each).
+    """
+    c = aux[0].copy()
+    r1 = aux[1].copy()
+    r2 = aux[2].copy()
+    n = aux[3].copy()
+    m = aux[4].copy()
+    v = aux[5].copy()
+    w1 = W[0].copy()
+    w2 = W[1].copy()
+    w3 = W[2].copy()
+    r3 = P[2].copy()
+    pw, Rg = _wrist_centre(T, M, c)
+    a1 = dot3(r2 - r1, n)
+    ca = dot3(w1, w2)
+    sa = dot3(w1, m)
+    rho2 = dot3(pw - r1, pw - r1)
+    h = dot3(w1, pw - r1)
+    thetas = np.empty(4)
+    if abs(sa) < 1e-9:  # axes 1 ∥ 2: w2·u(θ3) = cα·h fixes θ3 (two values), g2 = ±sqrt(..)
+        nt = sp4(w3, c - r3, w2, ca * h - dot3(w2, r3 - r2), thetas)
+    else:
+        nt = _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas)
+    k = 0
+    for i in range(nt):
+        th = thetas[i]
+        u = mv(rotation(w3, th), c - r3) + r3 - r2
+        uu = dot3(u, u)
+        wu = dot3(w2, u)
+        g1 = (rho2 - uu - a1 * a1) / (2.0 * a1)
+        if abs(sa) < 1e-9:
+            g2sq = uu - wu * wu - g1 * g1
+            if g2sq < -CLAMP * max(uu, 1e-300):
+                continue
+            g2 = math.sqrt(max(g2sq, 0.0))
+            ng = 1 if g2 == 0.0 else 2
+        else:
+            g2 = (h - ca * wu) / sa
+            ng = 1
+        for j in range(ng):
+            gj = g2 if j == 0 else -g2
+            th2 = math.atan2(gj, g1) - math.atan2(dot3(m, u), dot3(n, u))
+            x = mv(rotation(w2, th2), u) + r2
+            th1 = sp1_dir(w1, x - r1, pw - r1)
+            R123 = mm(mm(rotation(w1, th1), rotation(w2, th2)), rotation(w3, th))
+            if k + 2 > out.shape[0]:
+                return k
+            k = wrist_into(Rg, R123, W, v, th1, th2, th, out, k)
+    return k
+
+
+@njit(cache=True)
+def _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas):
+    """Real roots θ3 of E(θ3) (degree-2 trigonometric polynomial) into ``thetas``; the count.
+
+    The Fourier coefficients c0, c1, c2 of E come exactly from 5 equally spaced samples;
+    the roots of ``z²·E(z)`` (z = e^{iθ}) near the unit circle are polished by Newton's
+    method on E and kept when E vanishes there.
+    """
+    coef = np.zeros(3, dtype=np.complex128)
+    scale = 0.0
+    for j in range(5):
+        th = 2.0 * np.pi * j / 5.0
+        e = _general_residual(th, c, w3, r3, r2, w2, a1, ca, sa, rho2, h)
+        scale = max(scale, abs(e))
+        for k in range(3):
+            coef[k] += e * np.exp(-1j * k * th) / 5.0
+    poly = np.empty(5, dtype=np.complex128)  # z²·E(z) = c2 z⁴ + c1 z³ + c0 z² + c̄1 z + c̄2
+    poly[0] = coef[2]
+    poly[1] = coef[1]
+    poly[2] = coef[0]
+    poly[3] = np.conj(coef[1])
+    poly[4] = np.conj(coef[2])
+    big = max(abs(poly[0]), abs(poly[1]), abs(poly[2]))
+    if big <= 1e-12 * max(scale, 1e-300):
+        return 0  # E(θ3) ≡ 0: a continuum of solutions (excluded by the structure test)
+    if abs(poly[0]) > 1e-13 * big:
+        roots = np.roots(poly)
+    else:
+        roots = np.roots(poly[1:4]) if abs(poly[1]) > 1e-13 * big else np.roots(poly[2:3])
+    count = 0
+    for z in roots:
+        if abs(abs(z) - 1.0) > 1e-3 or count == thetas.shape[0]:
+            continue
+        th = math.atan2(z.imag, z.real)
+        for _ in range(8):  # Newton on E(θ) = c0 + 2 Re(c1 e^{iθ} + c2 e^{2iθ})
+            e1 = np.exp(1j * th)
+            e2 = e1 * e1
+            f = coef[0].real + 2.0 * (coef[1] * e1 + coef[2] * e2).real
+            df = 2.0 * (1j * coef[1] * e1 + 2j * coef[2] * e2).real
+            if df == 0.0:
+                break
+            step = f / df
+            th -= step
+            if abs(step) < 1e-15:
+                break
+        if abs(_general_residual(th, c, w3, r3, r2, w2, a1, ca, sa, rho2, h)) \
+                <= 1e-8 * max(scale, 1e-300):
+            thetas[count] = th
+            count += 1
+    return count
+
+
+@njit(cache=True)
 def solve_spherical_wrist(T, W, P, M, aux, arm, revolute, qlim, mid, F, meta, tol_p, tol_r,
                           out):
     """Every solution of a spherical-wrist 6R arm inside the limits, sorted, into ``out``.
@@ -161,7 +302,7 @@ def solve_spherical_wrist(T, W, P, M, aux, arm, revolute, qlim, mid, F, meta, to
         P: (6, 3) a point of each joint line at q = 0 [m].
         M: (4, 4) tool pose at q = 0.
         aux: class data (see the candidate functions).
-        arm: 0 for ``puma``, 1 for ``pieper_intersecting``.
+        arm: 0 for ``puma``, 1 for ``pieper_intersecting``, 2 for ``pieper_general``.
         revolute: (6,) booleans, True for revolute joints.
         qlim: (6, 2) joint limits.
         mid: (6,) wrapping centres of the revolute joints.
@@ -177,6 +318,8 @@ def solve_spherical_wrist(T, W, P, M, aux, arm, revolute, qlim, mid, F, meta, to
     cand = np.zeros((MAX_SOLUTIONS, 6))
     if arm == 0:
         k = puma_candidates(T, W, P, M, aux, cand)
-    else:
+    elif arm == 1:
         k = intersecting_candidates(T, W, P, M, aux, cand)
+    else:
+        k = general_candidates(T, W, P, M, aux, cand)
     return finalize(cand, k, revolute, qlim, mid, F, meta, T, True, tol_p, tol_r, out)

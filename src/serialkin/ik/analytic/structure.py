@@ -19,6 +19,9 @@ Recognised classes (:data:`CLASSES`):
     (axis 1 not parallel to them): Pieper's case, up to 8 solutions.
 ``pieper_intersecting``
     6R with a spherical wrist whose first two axes intersect: up to 8 solutions.
+``pieper_general``
+    any other 6R with a spherical wrist (axes 1 and 2 skew: Pieper's quartic; or
+    parallel with axes 2, 3 not): up to 8.
 ``stanford``
     R R P with intersecting axes 1, 2 followed by a spherical wrist: up to 8.
 ``ur``
@@ -54,6 +57,7 @@ CLASSES: dict[str, str] = {
     "scara_rrp": "two revolute and one prismatic joint, all axes parallel",
     "puma": "6R, spherical wrist, parallel axes 2 and 3 (Pieper; Puma 560 class)",
     "pieper_intersecting": "6R, spherical wrist, intersecting axes 1 and 2 (Pieper)",
+    "pieper_general": "any other 6R with a spherical wrist (Pieper's quartic)",
     "stanford": "RRP arm with intersecting axes 1 and 2 and a spherical wrist (Stanford arm)",
     "ur": "6R, three parallel axes 2, 3, 4 and intersecting axes 5, 6 (UR class)",
 }
@@ -147,6 +151,14 @@ def _closest_point(p1, w1, p2, w2) -> np.ndarray:
     return 0.5 * ((p1 + t1 * w1) + (p2 + t2 * w2))
 
 
+def _closest_point_on_first(p1, w1, p2, w2) -> np.ndarray:
+    """The point of line 1 closest to line 2 (lines not parallel)."""
+    d = p2 - p1
+    c = w1 @ w2
+    t1 = (d @ w1 - c * (d @ w2)) / (1.0 - c * c)
+    return p1 + t1 * w1
+
+
 def _point_line_distance(x, p, w) -> float:
     return float(np.linalg.norm(np.cross(x - p, w)))
 
@@ -229,6 +241,63 @@ def _parallel_family(robot, W, P, M, rev, scale, ltol) -> Structure:
     return Structure(kind, W, P, M, rev, aux, order, planar_z, scale)
 
 
+def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons) -> Structure | None:
+    """The arm class in front of a spherical wrist, or None (a reason is appended)."""
+    v = _unit_perp(W[5])
+    none = np.zeros(0, np.int64)
+    if types[:3] not in ("RRR", "RRP"):
+        reasons.append(f"the arm joints are {types[:3]}; closed forms need RRR or RRP")
+        return None
+    p12 = _sin_angle(W[0], W[1]) < ANGLE_TOL
+    if types[:3] == "RRR":
+        if _sin_angle(W[0], W[2]) < ANGLE_TOL and _point_line_distance(P[2], P[0], W[0]) < ltol:
+            reasons.append("axes 1 and 3 coincide")
+            return None
+        if _point_line_distance(wrist, P[2], W[2]) < ltol:
+            reasons.append("the wrist centre lies on axis 3")
+            return None
+        if _sin_angle(W[1], W[2]) < ANGLE_TOL:  # Puma class, or degenerate
+            if p12:
+                reasons.append("axes 1, 2, 3 are all parallel: the wrist centre cannot leave "
+                               "a plane")
+            elif _point_line_distance(P[2], P[1], W[1]) < ltol:
+                reasons.append("axes 2 and 3 coincide")
+            else:
+                aux = np.array([wrist, W[1], _unit_perp(W[1]), v])
+                return Structure("puma", W, P, M, rev, aux, none, False, scale)
+            return None
+    d12 = _line_distance(P[0], W[0], P[1], W[1])
+    if p12 and d12 < ltol:
+        reasons.append("axes 1 and 2 coincide")
+        return None
+    if p12 and types[:3] == "RRP":
+        reasons.append("the arm is R R P with parallel axes 1 and 2")
+        return None
+    if d12 < ltol:
+        o = _closest_point(P[0], W[0], P[1], W[1])
+        if types[:3] == "RRP":
+            return Structure("stanford", W, P, M, rev, np.array([wrist, o, v]), none, False,
+                             scale)
+        if _point_line_distance(o, P[2], W[2]) < ltol:
+            reasons.append("axis 3 passes through the intersection of axes 1 and 2")
+            return None
+        return Structure("pieper_intersecting", W, P, M, rev, np.array([wrist, o, v]), none,
+                         False, scale)
+    if types[:3] == "RRP":
+        reasons.append(f"the arm is R R P but axes 1 and 2 do not intersect ({d12:.3g} m "
+                       "apart)")
+        return None
+    if p12:  # parallel axes 1, 2: any common perpendicular
+        r1 = P[0]
+        r2 = P[1] + ((P[0] - P[1]) @ W[1]) * W[1]
+    else:
+        r1 = _closest_point_on_first(P[0], W[0], P[1], W[1])
+        r2 = _closest_point_on_first(P[1], W[1], P[0], W[0])
+    nvec = (r2 - r1) / np.linalg.norm(r2 - r1)
+    aux = np.array([wrist, r1, r2, nvec, np.cross(W[1], nvec), v])
+    return Structure("pieper_general", W, P, M, rev, aux, none, False, scale)
+
+
 def _six_dof(robot, W, P, M, rev, scale, ltol) -> Structure:
     types = "".join(robot.joint_types)
     reasons = []
@@ -248,39 +317,9 @@ def _six_dof(robot, W, P, M, rev, scale, ltol) -> Structure:
             reasons.append(f"axes 4, 5, 6 do not meet in one point (axes 4-5 {d45:.3g} m "
                            f"apart, axis 6 {d6:.3g} m from their meeting point)")
     if wrist is not None:
-        v = _unit_perp(W[5])
-        if types[:3] == "RRR" and _sin_angle(W[1], W[2]) < ANGLE_TOL:
-            if _sin_angle(W[0], W[1]) < ANGLE_TOL:
-                reasons.append("axes 1, 2, 3 are all parallel: the wrist centre cannot leave a "
-                               "plane")
-            elif _point_line_distance(P[2], P[1], W[1]) < ltol:
-                reasons.append("axes 2 and 3 coincide")
-            elif _point_line_distance(wrist, P[2], W[2]) < ltol:
-                reasons.append("the wrist centre lies on axis 3")
-            else:
-                aux = np.array([wrist, W[1], _unit_perp(W[1]), v])
-                return Structure("puma", W, P, M, rev, aux, np.zeros(0, np.int64), False, scale)
-        d12 = _line_distance(P[0], W[0], P[1], W[1])
-        if _sin_angle(W[0], W[1]) >= ANGLE_TOL and d12 < ltol:
-            o = _closest_point(P[0], W[0], P[1], W[1])
-            if types[:3] == "RRR":
-                if _point_line_distance(o, P[2], W[2]) < ltol:
-                    reasons.append("axis 3 passes through the intersection of axes 1 and 2")
-                elif _point_line_distance(wrist, P[2], W[2]) < ltol:
-                    reasons.append("the wrist centre lies on axis 3")
-                else:
-                    aux = np.array([wrist, o, v])
-                    return Structure("pieper_intersecting", W, P, M, rev, aux,
-                                     np.zeros(0, np.int64), False, scale)
-            elif types[:3] == "RRP":
-                aux = np.array([wrist, o, v])
-                return Structure("stanford", W, P, M, rev, aux, np.zeros(0, np.int64), False,
-                                 scale)
-            else:
-                reasons.append(f"the arm joints are {types[:3]}; closed forms need RRR or RRP")
-        else:
-            reasons.append("the wrist is spherical but neither are axes 2 and 3 parallel nor do "
-                           f"axes 1 and 2 intersect (they are {d12:.3g} m apart)")
+        found = _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons)
+        if found is not None:
+            return found
     # ------------------------------------------------ three parallel axes (2, 3, 4)
     if types == "RRRRRR":
         if _sin_angle(W[1], W[2]) < ANGLE_TOL and _sin_angle(W[1], W[3]) < ANGLE_TOL:
