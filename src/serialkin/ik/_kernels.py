@@ -2,8 +2,9 @@
 
 One general kernel, :func:`solve_one`, runs every Jacobian-based method (chapter section
 5.3) selected by a method code, including restarts, the iteration budget, stagnation
-detection and joint-limit projection; :func:`solve_batch` runs it over N targets across
-the cores (``prange``). It is built on the only FK/Jacobian implementation
+detection and joint-limit projection; :func:`solve_chunk` runs it over a range of N
+targets with the GIL released, so that the batch driver solves across all cores (one
+thread per core). It is built on the only FK/Jacobian implementation
 (``serialkin.kinematics._kernels.jacobian_into`` and ``fk_into``) and the only
 pose-error implementation
 (:func:`serialkin.spatial._kernels.pose_error_into`).
@@ -60,7 +61,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from serialkin.kinematics._kernels import fk_into, jacobian_into
 from serialkin.spatial._kernels import pose_error_into
@@ -752,14 +753,16 @@ def solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     info[I_COST] = best_cost
 
 
-@njit(cache=True, parallel=True)
-def solve_batch(F, meta, Tt, box, Q0, cfg, seed, Q_out, info):
-    """:func:`solve_one` for N targets ``Tt`` (N, 4, 4) across the cores.
+@njit(cache=True, nogil=True)
+def solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
+    """:func:`solve_one` for targets ``start..stop-1`` of ``Tt`` (N, 4, 4), GIL released.
 
     ``Q0`` (N, n) start configurations (read when ``cfg[C_USE_Q0]`` is 1), ``Q_out``
-    (N, n) and ``info`` (N, N_INFO) outputs. Every target uses the same random stream
-    ``seed``, so a batch solve returns exactly what the single solves with that seed
-    return.
+    (N, n) and ``info`` (N, N_INFO) outputs. The batch driver
+    (:func:`serialkin.ik.solver.solve`) runs one chunk per thread, one thread per core:
+    the same parallelism as a ``prange`` loop at a fraction of its compile time. Every
+    target uses the same random stream ``seed``, so a batch solve returns exactly what
+    the single solves with that seed return, whatever the chunking.
     """
-    for k in prange(Tt.shape[0]):
+    for k in range(start, stop):
         solve_one(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k])

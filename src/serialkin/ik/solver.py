@@ -4,7 +4,8 @@
 the registry and runs it:
 
 * compiled methods (the Jacobian family) run entirely in
-  :func:`serialkin.ik._kernels.solve_one` / :func:`~serialkin.ik._kernels.solve_batch`;
+  :func:`serialkin.ik._kernels.solve_one`; a batch runs
+  :func:`~serialkin.ik._kernels.solve_chunk` on one thread per core (GIL released);
 * Python methods supply one attempt and :func:`run_attempts` owns the rest.
 
 Both follow the same semantics:
@@ -28,6 +29,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -351,8 +353,39 @@ def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray 
     Q = np.empty((N, n))
     info = np.empty((N, K.N_INFO))
     Q0 = np.zeros((N, n)) if q0 is None else np.array(q0, dtype=np.float64, order="C")
-    K.solve_batch(F, meta, Tt, box, Q0, cfg, seed64, Q, info)
+    _run_chunks(F, meta, Tt, box, Q0, cfg, seed64, Q, info)
     return _result_batch(robot, tgt, spec, Q, info, tol, respect)
+
+
+#: Worker pools by thread count, created on first use (never at import).
+_POOLS: dict[int, ThreadPoolExecutor] = {}
+
+
+def _run_chunks(F: np.ndarray, meta: np.ndarray, Tt: np.ndarray, box: np.ndarray,
+                Q0: np.ndarray, cfg: np.ndarray, seed64: np.uint64, Q: np.ndarray,
+                info: np.ndarray) -> None:
+    """Solve a batch with :func:`~serialkin.ik._kernels.solve_chunk`, one thread per core.
+
+    The targets are cut into 4 chunks per thread (so that a few slow targets do not
+    leave a core idle); the kernel releases the GIL. The number of threads is
+    ``numba.get_num_threads()`` (``NUMBA_NUM_THREADS``).
+    """
+    import numba
+
+    N = Tt.shape[0]
+    threads = max(1, min(numba.get_num_threads(), N // 4))
+    if threads == 1:
+        K.solve_chunk(F, meta, Tt, box, Q0, cfg, seed64, Q, info, 0, N)
+        return
+    pool = _POOLS.get(threads)
+    if pool is None:
+        pool = _POOLS[threads] = ThreadPoolExecutor(max_workers=threads,
+                                                    thread_name_prefix="serialkin-ik")
+    bounds = np.linspace(0, N, 4 * threads + 1).astype(int)
+    futures = [pool.submit(K.solve_chunk, F, meta, Tt, box, Q0, cfg, seed64, Q, info,
+                               int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
+    for f in futures:
+        f.result()
 
 
 def _result_single(robot: Robot, tgt: Target, spec: MethodSpec, q: np.ndarray,
