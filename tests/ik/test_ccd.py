@@ -199,3 +199,26 @@ def test_partial_position_mask():
     assert res.success
     e = pose_error(robot.fk(res.q), T)
     assert np.hypot(e[0], e[1]) <= TOL
+
+
+@pytest.mark.parametrize("target", [[3.0, 0.0], [0.0, -3.0]])
+def test_workspace_boundary_target(target):
+    """A target at full reach (stretched, singular arm) is approached without NaN or error."""
+    robot = models.planar(3)
+    t0 = time.perf_counter()
+    res = robot.ik(target, method="ccd", tol=TOL, seed=1, restarts=2)
+    assert time.perf_counter() - t0 < 5.0
+    assert np.isfinite(res.q).all()
+    # convergence is sublinear at the boundary (documented): millimetres, not micrometres
+    assert res.position_error < 1e-2
+
+
+def test_aligned_wrist_axes_target():
+    """A Puma 560 pose with aligned wrist axes (q5 = 0) is solved to position 1e-6."""
+    robot = models.puma560()
+    q = np.array([0.3, -0.6, 0.4, 0.7, 0.0, -0.5])
+    T = robot.fk(q)
+    res = robot.ik(T[:3, 3], method="ccd", tol=TOL, seed=0)
+    assert_solution(robot, res, T, POSITION, TOL)
+    full = robot.ik(T, method="ccd", tol=TOL, seed=0, restarts=3)
+    assert np.isfinite(full.q).all() and robot.within_limits(full.q)

@@ -166,3 +166,14 @@ def test_same_seed_same_answer():
     batch = robot.ik(T[:, :2, 3], method="fabrik", seed=3, tol=TOL)
     np.testing.assert_array_equal(batch.q[0], a.q)
     assert batch.success.all()
+
+
+@pytest.mark.parametrize("target", [[1.2, 0.0], [0.0, -1.2], [0.6, 0.0]])
+def test_boundary_and_folded_targets(target):
+    """Targets at full reach or needing a folded arm end without NaN, error or hang."""
+    robot = models.planar(3, [0.5, 0.4, 0.3])
+    t0 = time.perf_counter()
+    res = robot.ik(target, method="fabrik", tol=TOL, seed=1, restarts=2)
+    assert time.perf_counter() - t0 < 5.0
+    assert np.isfinite(res.q).all()
+    assert res.position_error < 1e-3

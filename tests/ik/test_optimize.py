@@ -136,3 +136,17 @@ def test_respect_limits_false_uses_no_bounds():
     res = robot.ik(T[:2, 3], method="bfgs", tol=TOL, seed=0, respect_limits=False)
     assert res.success
     assert np.linalg.norm(robot.fk(res.q)[:2, 3] - T[:2, 3]) <= TOL
+
+
+@pytest.mark.parametrize("method", ["bfgs", "powell"])
+def test_singular_targets(method):
+    """Stretched-arm and aligned-wrist targets end finite, inside limits, without error."""
+    planar = models.planar(3)
+    res = planar.ik([3.0, 0.0], method=method, tol=TOL, seed=1, restarts=2, max_iter=100)
+    assert np.isfinite(res.q).all() and res.position_error < 1e-3
+    puma = models.puma560()
+    T = puma.fk(np.array([0.3, -0.6, 0.4, 0.7, 0.0, -0.5]))
+    res = puma.ik(T, method=method, tol=TOL, seed=0, restarts=30 if method == "bfgs" else 3)
+    assert np.isfinite(res.q).all() and puma.within_limits(res.q)
+    if method == "bfgs":
+        assert_solution(puma, res, T, np.ones(6), TOL)

@@ -51,7 +51,10 @@ Implementation notes:
 Documented tolerance: CCD converges linearly, so it reaches position tolerances of
 1e-6 m on position targets in tens to a few hundred sweeps; on full 6-D pose targets it
 is slow and may stop on stagnation before 1e-6 (then ``success`` is False and the shared
-loop restarts it from a random configuration).
+loop restarts it from a random configuration). Near singular configurations (a target at
+the boundary of the workspace, which only the stretched arm reaches) convergence becomes
+sublinear and the stagnation test typically stops at millimetre accuracy; the attempt
+then reports failure with its best configuration.
 """
 
 from __future__ import annotations

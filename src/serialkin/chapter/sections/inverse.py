@@ -173,8 +173,11 @@ def _measured_summary(tables: list[tuple[str, CompareTable]]) -> dict[str, str]:
     for fam, vals in acc.items():
         rates = [v[0] for v in vals]
         times = [v[1] for v in vals]
-        out[fam] = (f"{100 * min(rates):.0f}-{100 * max(rates):.0f} %, "
-                    f"{min(times):.3g}-{max(times):.3g} ms")
+        rate = (f"{100 * min(rates):.0f} %" if min(rates) == max(rates)
+                else f"{100 * min(rates):.0f}-{100 * max(rates):.0f} %")
+        time_ = (f"{min(times):.3g} ms" if len(times) == 1
+                 else f"{min(times):.3g}-{max(times):.3g} ms")
+        out[fam] = f"{rate}, {time_}"
     return out
 
 
