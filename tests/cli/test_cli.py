@@ -16,7 +16,8 @@ from serialkin import Robot, models
 from serialkin.cli.io import CLIError, read_csv_rows, write_text_atomic
 from serialkin.cli.main import cli
 
-SUBCOMMANDS = ("chapter", "models", "fk", "jacobian", "ik", "track", "workspace", "view")
+SUBCOMMANDS = ("chapter", "models", "fk", "jacobian", "ik", "ik-compare", "track", "workspace",
+               "view")
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "robots"
 
 
@@ -384,3 +385,24 @@ def test_robotfile_yaml_equivalent_to_from_dh(tmp_path):
     data = as_json(run("fk", p, "--q", "0.5,0.5", "--json"))
     np.testing.assert_allclose(data["results"][0]["T"], r.fk(np.array([0.5, 0.5])),
                                atol=1e-12)
+
+
+def test_ik_compare_matches_library():
+    """'ik-compare --json' gives the rows of serialkin.ik.compare on the same seeded targets."""
+    from serialkin.cli.compare_cmd import random_targets
+    from serialkin.ik.compare import compare
+
+    data = as_json(run("ik-compare", "three_link", "--targets", "6", "--methods", "lm,dls",
+                       "--seed", "2", "--option", "dls:damping=0.05", "--json"))
+    r = models.get("three_link")
+    ref = compare(r, random_targets(r, 6, "planar_pose", 2), methods=["lm", "dls"], seed=2,
+                  tol=1e-9, method_options={"dls": {"damping": 0.05}})
+    assert data["target_kind"] == "planar_pose" and data["targets"] == 6
+    for row, ref_row in zip(data["rows"], ref.to_dicts()):
+        assert row["method"] == ref_row["method"]
+        assert row["success_rate"] == ref_row["success_rate"]
+        assert row["median_iterations"] == ref_row["median_iterations"]
+    res = run("ik-compare", "ur5", "--kind", "planar", code=2)
+    assert "planar robot" in res.stderr
+    res = run("ik-compare", "ur5", "--option", "damping=0.1", code=2)
+    assert "METHOD:KEY=VALUE" in res.stderr

@@ -103,7 +103,8 @@ _MODELS_CMD_HELP = command_help(
 )
 
 
-@click.command("models", help=_MODELS_CMD_HELP)
+@click.command("models", help=_MODELS_CMD_HELP,
+               short_help="List the built-in robots: DOF, joint types, source.")
 @json_option
 def models_cmd(as_json: bool) -> None:
     """List the built-in robot models: DOF, joint types, convention and source."""
@@ -154,7 +155,8 @@ _FK_CMD_HELP = command_help(
 )
 
 
-@click.command("fk", help=_FK_CMD_HELP)
+@click.command("fk", help=_FK_CMD_HELP,
+               short_help="Forward kinematics: the tool pose for q.")
 @robot_argument
 @click.option("--q", "q_texts", multiple=True, metavar="Q1,Q2,...",
               help="Joint values (repeatable for several configurations). Default: zeros.")
@@ -226,7 +228,8 @@ _JACOBIAN_CMD_HELP = command_help(
 )
 
 
-@click.command("jacobian", help=_JACOBIAN_CMD_HELP)
+@click.command("jacobian", help=_JACOBIAN_CMD_HELP,
+               short_help="Geometric Jacobian, manipulability, condition number.")
 @robot_argument
 @click.option("--q", "q_texts", multiple=True, metavar="Q1,Q2,...",
               help="Joint values (repeatable). Default: zeros.")
@@ -368,7 +371,8 @@ _IK_CMD_HELP = command_help(
 )
 
 
-@click.command("ik", help=_IK_CMD_HELP)
+@click.command("ik", help=_IK_CMD_HELP,
+               short_help="Inverse kinematics by any method, with every option.")
 @click.argument("robot", metavar="ROBOT", required=False)
 @click.option("--target", "-t", "targets", multiple=True, metavar="NUMBERS",
               help="Target (repeatable): x,y,z (position); x,y,z,roll,pitch,yaw (pose); 16 "

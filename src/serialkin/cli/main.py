@@ -10,8 +10,23 @@ import sys
 
 import click
 
+from serialkin.cli.io import command_help
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+# click keeps example blocks unwrapped only after a real backspace character, which a raw
+# docstring does not contain: the help texts are built by command_help instead.
+_CLI_HELP = command_help(
+    "serialkin: kinematics of serial robot manipulators.\n\n"
+    "Every subcommand has --help with examples. ROBOT arguments take a built-in model name "
+    "(serialkin models), a robot file (.yaml/.yml/.json) or a URDF file. Exit codes: 0 "
+    "success, 1 a target or path point not reached, 2 bad input.",
+    ["serialkin models", 'serialkin fk puma560 --q "0,0.5,-0.3,0,0.2,0"',
+     'serialkin ik two_link --target "1.2,0.4" --all',
+     "serialkin workspace two_link --out out/ws", "serialkin track six_link_circle",
+     "serialkin view ur5 --open", "serialkin chapter --out out/chapter"],
+)
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]}, help=_CLI_HELP)
 @click.version_option(package_name="serialkin")
 def cli() -> None:
     r"""serialkin: kinematics of serial robot manipulators.
@@ -23,7 +38,9 @@ def cli() -> None:
     """
 
 
-@cli.command()
+@cli.command(help=command_help("Reproduce the chapter's worked examples into an HTML report.",
+                               ["serialkin chapter --out out/chapter",
+                                "serialkin chapter --section workspace --out out/ch1"]))
 @click.option("--out", "out", default="out/chapter", show_default=True,
               type=click.Path(file_okay=False), help="Output folder for report.html and figures.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
@@ -54,11 +71,13 @@ def chapter(out: str, quiet: bool, sections: tuple[str, ...]) -> None:
 def _register() -> None:
     """Add the subcommands of this package to :data:`cli`."""
     from serialkin.cli.commands import fk_cmd, ik_cmd, jacobian_cmd, models_cmd
+    from serialkin.cli.compare_cmd import compare_cmd
     from serialkin.cli.track_cmd import track_cmd
     from serialkin.cli.view_cmd import view_cmd
     from serialkin.cli.workspace_cmd import workspace_cmd
 
-    for command in (models_cmd, fk_cmd, jacobian_cmd, ik_cmd, track_cmd, workspace_cmd, view_cmd):
+    for command in (models_cmd, fk_cmd, jacobian_cmd, ik_cmd, compare_cmd, track_cmd,
+                    workspace_cmd, view_cmd):
         cli.add_command(command)
 
 

@@ -35,7 +35,8 @@ _TRACK_HELP = command_help(
 )
 
 
-@click.command("track", help=_TRACK_HELP)
+@click.command("track", help=_TRACK_HELP,
+               short_help="Track a scenario's path: trajectory, figures, GIF.")
 @click.argument("scenario", required=False)
 @click.option("--out", "-o", "out", type=click.Path(file_okay=False), default="out/track",
               show_default=True, help="Output folder.")

@@ -51,7 +51,8 @@ def _is_serialkin_csv(p: Path) -> bool:
         return False
 
 
-@click.command("view", help=_VIEW_HELP)
+@click.command("view", help=_VIEW_HELP,
+               short_help="Write (and open) the interactive 3D viewer page.")
 @click.argument("robot", metavar="ROBOT", required=False)
 @click.option("--q", "q_text", default=None, metavar="Q1,Q2,...",
               help="Configuration shown first (default zeros).")

@@ -72,7 +72,8 @@ _WORKSPACE_CMD_HELP = command_help(
 )
 
 
-@click.command("workspace", help=_WORKSPACE_CMD_HELP)
+@click.command("workspace", help=_WORKSPACE_CMD_HELP,
+               short_help="Workspace by sampling: area/volume ± error, plots.")
 @robot_argument
 @click.option("--kind", "-k", type=click.Choice(["reachable", "constant", "inclusive", "total",
                                                  "dexterous"]),
