@@ -255,3 +255,30 @@ def test_analytic_method_errors(panda, two_link):
     res = two_link.ik(np.array([3.0, 0.0]), method="analytic")
     assert not res.success and "no closed-form solution" in res.reason
     assert np.isfinite(res.q).all()
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    n=st.integers(6, 7),
+    convention=st.sampled_from(["standard", "modified"]),
+)
+def test_users_own_random_robot(seed, n, convention):
+    """Any random DH arm (R and P joints): IK of FK(q) for in-limit q succeeds in the limits."""
+    from serialkin import Robot
+    from serialkin.model.dh import DHLink
+
+    rng = np.random.default_rng(seed)
+    rows = []
+    for i in range(n):
+        prismatic = i == 2 and rng.random() < 0.3
+        rows.append(DHLink(
+            a=float(rng.uniform(0, 0.5)), alpha=float(rng.choice([0, np.pi / 2, -np.pi / 2,
+                                                                  rng.uniform(-np.pi, np.pi)])),
+            d=float(rng.uniform(0, 0.4)), theta=0.0, type="P" if prismatic else "R",
+            qlim=(0.1, 0.6) if prismatic else (-np.pi, np.pi)))
+    robot = Robot.from_dh(rows, convention)
+    q = robot.random_q(seed=seed)
+    T = robot.fk(q)
+    res = robot.ik(T, seed=seed)
+    assert_reaches(robot, res, T)
