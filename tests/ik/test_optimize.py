@@ -111,13 +111,15 @@ def test_bounds_keep_q_inside_limits(method):
 
 @pytest.mark.parametrize("method", ["bfgs", "powell"])
 def test_same_seed_same_answer(method):
-    """The same seed gives the same q."""
+    """The same seed gives the same q, and a batch returns what single solves return."""
     robot = models.ur5()
     T = robot.fk(well_conditioned_q(robot, 1, seed=13)[0])
     a = robot.ik(T, method=method, seed=5, tol=1e-4, restarts=3)
     b = robot.ik(T, method=method, seed=5, tol=1e-4, restarts=3)
     np.testing.assert_array_equal(a.q, b.q)
     assert a.iterations == b.iterations
+    batch = robot.ik(np.stack([T, T]), method=method, seed=5, tol=1e-4, restarts=3)
+    np.testing.assert_array_equal(batch.q[1], a.q)
 
 
 def test_powell_xtol_option_is_validated():

@@ -39,7 +39,7 @@ from serialkin.model.robot import Robot
 COLUMNS = (
     "method", "family", "solves", "success rate", "median time [ms]", "mean time [ms]",
     "median iterations", "median pos. error [m]", "max pos. error [m]",
-    "median ori. error [rad]", "max ori. error [rad]",
+    "median ori. error [rad]", "max ori. error [rad]", "in limits",
 )
 
 
@@ -82,6 +82,7 @@ class CompareRow:
             1e3 * self.median_time, 1e3 * self.mean_time, self.median_iterations,
             self.median_position_error, self.max_position_error,
             self.median_orientation_error, self.max_orientation_error,
+            self.within_limits_rate,
         )
 
 

@@ -38,8 +38,14 @@ Unreachable targets: when the target lies farther from the base than the total c
 length, the chain is stretched straight towards it (the least-squares point), and the
 attempt ends with ``success=False``.
 
-Documented tolerance: position error below the requested tolerance (1e-6 m by default);
-FABRIK converges linearly, typically in 5-50 passes for reachable targets.
+Documented tolerance: position error below the requested tolerance (e.g. 1e-6 m);
+FABRIK converges linearly, typically in 5-50 passes for reachable targets away from the
+workspace boundary. Near the boundary (an almost stretched or almost folded arm, e.g. a
+two-link arm within ~0.1 rad of θ2 = 0 or π) the passes shrink the error slowly and
+restarts do not help (the difficulty is the target's); the stagnation test then ends
+the attempt at ~1e-5-1e-4 m and the solve reports failure with its best configuration.
+Segments of zero length (coincident axes) are handled: their joint keeps its angle and
+the next joint takes the turn.
 """
 
 from __future__ import annotations
