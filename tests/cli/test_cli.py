@@ -406,3 +406,18 @@ def test_ik_compare_matches_library():
     assert "planar robot" in res.stderr
     res = run("ik-compare", "ur5", "--option", "damping=0.1", code=2)
     assert "METHOD:KEY=VALUE" in res.stderr
+
+
+def test_ik_mask_q0_degrees_and_no_limits():
+    """--mask drops coordinates, --q0 (in degrees with -d) seeds the solve, --no-limits passes."""
+    r = models.get("ur5")
+    q = r.random_q(seed=7)
+    p = r.fk(q)[:3, 3]
+    target = ",".join(repr(float(v)) for v in [*p, 10.0, 20.0, 30.0])  # unreachable rpy
+    q0 = ",".join(repr(float(v)) for v in np.degrees(q + 0.05))
+    data = as_json(run("ik", "ur5", "-t", target, "-d", "--mask", "1,1,1,0,0,0", "--q0", q0,
+                       "--max-iter", "200", "--restarts", "5", "--no-limits", "--json"))
+    assert data["success"]
+    np.testing.assert_allclose(r.fk(np.array(data["results"][0]["q"]))[:3, 3], p, atol=1e-8)
+    res = run("ik", "ur5", "-t", target, "--mask", "0,0,0,0,0,0", code=2)
+    assert "mask" in res.stderr
