@@ -387,10 +387,12 @@ def test_robotfile_yaml_equivalent_to_from_dh(tmp_path):
                                atol=1e-12)
 
 
-def test_ik_compare_matches_library():
+def test_ik_compare_matches_library(tmp_path, monkeypatch):
     """'ik-compare --json' gives the rows of serialkin.ik.compare on the same seeded targets."""
     from serialkin.cli.compare_cmd import random_targets
     from serialkin.ik.compare import compare
+
+    monkeypatch.chdir(tmp_path)
 
     data = as_json(run("ik-compare", "three_link", "--targets", "6", "--methods", "lm,dls",
                        "--seed", "2", "--option", "dls:damping=0.05", "--json"))
@@ -402,6 +404,10 @@ def test_ik_compare_matches_library():
         assert row["method"] == ref_row["method"]
         assert row["success_rate"] == ref_row["success_rate"]
         assert row["median_iterations"] == ref_row["median_iterations"]
+    run("ik-compare", "two_link", "--targets", "3", "--methods", "lm", "--out",
+        "cmp.csv", "--quiet")
+    lines = Path("cmp.csv").read_text().splitlines()
+    assert lines[0].startswith("method,family,") and lines[1].startswith("lm,jacobian,")
     res = run("ik-compare", "ur5", "--kind", "planar", code=2)
     assert "planar robot" in res.stderr
     res = run("ik-compare", "ur5", "--option", "damping=0.1", code=2)

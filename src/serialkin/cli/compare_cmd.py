@@ -15,7 +15,14 @@ from serialkin.cli.commands import (
     out_option,
     quiet_option,
 )
-from serialkin.cli.io import CLIError, command_help, dumps_json, read_csv_rows, write_output
+from serialkin.cli.io import (
+    CLIError,
+    command_help,
+    dumps_json,
+    read_csv_rows,
+    write_output,
+    write_text_atomic,
+)
 from serialkin.cli.robots import ROBOT_HELP, param_option, parse_params, resolve_robot
 
 _COMPARE_HELP = command_help(
@@ -41,6 +48,24 @@ def random_targets(robot: Any, count: int, kind: str, seed: int) -> np.ndarray:
         return xy.copy()
     phi = np.arctan2(T[:, 1, 0], T[:, 0, 0])
     return np.column_stack([xy, phi])
+
+
+def _write_table(out: str, data: dict[str, Any]) -> Any:
+    """Write the comparison as JSON or as a CSV with one row per method (SI units)."""
+    import csv
+    import io
+    from pathlib import Path
+
+    if Path(out).suffix.lower() != ".csv":
+        return write_output(out, data)
+    rows = data["rows"]
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    keys = list(rows[0]) if rows else ["method"]
+    w.writerow(keys)
+    for row in rows:
+        w.writerow([repr(float(v)) if isinstance(v, float) else v for v in row.values()])
+    return write_text_atomic(out, buf.getvalue())
 
 
 @click.command("ik-compare", help=_COMPARE_HELP,
@@ -108,11 +133,7 @@ def compare_cmd(robot: str, count: int, kind: str, target_file: str | None,
             "targets": table.n_targets, "tol": table.tol, "rows": table.to_dicts(),
             "skipped": [{"method": m, "reason": why} for m, why in table.skipped]}
     if out:
-        rows_d = table.to_dicts()
-        keys = [k for k in (rows_d[0] if rows_d else {}) if k != "method"]
-        header = ["method_index"] + keys
-        values = np.array([[i] + [float(d[k]) for k in keys] for i, d in enumerate(rows_d)])
-        path = write_output(out, data, (header, values.reshape(len(rows_d), len(header))))
+        path = _write_table(out, data)
         if not as_json and not quiet:
             click.echo(f"wrote {path}")
     if as_json:
