@@ -181,7 +181,7 @@ def test_orientation_weight_option():
     phi = math.atan2(T[1, 0], T[0, 0])
     target = [T[0, 3], T[1, 3], phi]
     default = robot.ik(target, method="ccd", tol=1e-5, seed=0)
-    res = robot.ik(target, method="ccd", tol=1e-5, seed=0, orientation_weight=0.1)
+    res = robot.ik(target, method="ccd", tol=1e-5, seed=0, orientation_weight=0.3)
     assert res.success and default.success
     assert res.iterations != default.iterations
     with pytest.raises(ValueError, match="orientation_weight"):

@@ -45,8 +45,9 @@ Implementation notes:
   is matched with weight ``w_o`` (exact for planar arms with (x, y, φ) targets, where the
   unselected rows vanish identically).
 * Units: ``w_p`` is dimensionless, ``w_o`` is in m² (it trades metres against the
-  dimensionless axis mismatch); the default is the square of the robot's characteristic
-  length so that both terms have the same scale.
+  dimensionless axis mismatch); the default is ``(0.1 · L)²`` with L the robot's
+  characteristic length (sum of its link offsets), so that both terms have comparable
+  scales.
 
 Documented tolerance: CCD converges linearly, so it reaches position tolerances of
 1e-6 m on position targets in tens to a few hundred sweeps; on full 6-D pose targets it

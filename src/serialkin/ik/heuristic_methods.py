@@ -65,7 +65,13 @@ def _stall(options: Mapping[str, Any]) -> tuple[int, float]:
 
 def _ccd_attempt(problem: IKProblem, q_start: np.ndarray, max_iter: int,
                  options: Mapping[str, Any]) -> tuple[np.ndarray, int]:
-    """One CCD attempt (see :func:`serialkin.ik.ccd.ccd_attempt`)."""
+    """One CCD attempt (see :func:`serialkin.ik.ccd.ccd_attempt`).
+
+    Options: ``orientation_weight`` w_o [m²] (default ``(orientation_scale · L)²`` with L
+    the :func:`characteristic_length`; scale 0.1 solved the most Puma 560 / UR5 / Panda
+    full-pose targets among 0.05, 0.1, 0.2, 0.3), ``stall_window`` [sweeps] and
+    ``min_progress`` (stagnation test).
+    """
     robot = problem.robot
     w_o = options["orientation_weight"]
     if w_o is None:
@@ -113,8 +119,8 @@ def _fabrik_attempt(problem: IKProblem, q_start: np.ndarray, max_iter: int,
 register_method(MethodSpec(
     name="ccd", family="heuristic",
     summary="cyclic coordinate descent: closed-form one-joint optima, last joint to first",
-    limits=_CLAMP, max_iter=1000, restarts=20,
-    options={"orientation_weight": None, "orientation_scale": 0.2, "stall_window": 50,
+    limits=_CLAMP, max_iter=3000, restarts=20,
+    options={"orientation_weight": None, "orientation_scale": 0.1, "stall_window": 50,
              "min_progress": 0.05},
     attempt=_ccd_attempt,
 ))
