@@ -40,7 +40,14 @@ from serialkin.errors import InputError, InputTypeError
 from serialkin.ik import _kernels as K
 from serialkin.ik.registry import MethodSpec, get_method
 from serialkin.ik.result import IKResult
-from serialkin.ik.target import Target, check_q0, check_tol, parse_target, robot_arrays
+from serialkin.ik.target import (
+    DEFAULT_WEIGHTS,
+    Target,
+    check_q0,
+    check_tol,
+    parse_target,
+    robot_arrays,
+)
 from serialkin.kinematics import _kernels as FK
 from serialkin.model.robot import Robot
 from serialkin.spatial import _kernels as SK
@@ -50,7 +57,8 @@ DEFAULT_TOL = 1e-9
 
 _MASK64 = (1 << 64) - 1
 
-#: Hot-path cache of kernel parameter vectors for default options.
+#: Hot-path caches: kernel configuration vectors and parameter tails for default options.
+_CONFIGS: dict[tuple, np.ndarray] = {}
 _PARAMS: dict[str, tuple[MethodSpec, np.ndarray]] = {}
 
 
@@ -328,15 +336,7 @@ def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray 
                     tol: float, max_iter: int, restarts: int, seed: int, respect: bool,
                     opts: Mapping[str, Any]) -> IKResult:
     box = robot_arrays(robot).box
-    cfg = np.empty(K.N_CFG)
-    cfg[K.C_WEIGHTS:K.C_WEIGHTS + 6] = tgt.weights
-    cfg[K.C_METHOD] = spec.kernel_code
-    cfg[K.C_TOL] = tol
-    cfg[K.C_MAX_ITER] = max_iter
-    cfg[K.C_RESTARTS] = restarts
-    cfg[K.C_RESPECT] = 1.0 if respect else 0.0
-    cfg[K.C_USE_Q0] = 0.0 if q0 is None else 1.0
-    cfg[K.P_DAMPING:] = _method_params(spec, opts)
+    cfg = _kernel_config(spec, tgt, tol, max_iter, restarts, respect, q0 is not None, opts)
     F, meta = robot.chain.F, robot.chain.meta
     n = robot.n
     seed64 = np.uint64(seed)
@@ -386,6 +386,34 @@ def _run_chunks(F: np.ndarray, meta: np.ndarray, Tt: np.ndarray, box: np.ndarray
                                int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
     for f in futures:
         f.result()
+
+
+def _kernel_config(spec: MethodSpec, tgt: Target, tol: float, max_iter: int, restarts: int,
+                   respect: bool, use_q0: bool, opts: Mapping[str, Any]) -> np.ndarray:
+    """The kernel configuration vector ``cfg`` (N_CFG,) (see :mod:`serialkin.ik._kernels`).
+
+    With default weights and options the vector is cached (the kernels never write it).
+    """
+    key = None
+    if opts is spec.options and tgt.weights is DEFAULT_WEIGHTS.get(tgt.kind):
+        key = (spec.name, id(spec), tgt.kind, tol, max_iter, restarts, respect, use_q0)
+        cfg = _CONFIGS.get(key)
+        if cfg is not None:
+            return cfg
+    cfg = np.empty(K.N_CFG)
+    cfg[K.C_WEIGHTS:K.C_WEIGHTS + 6] = tgt.weights
+    cfg[K.C_METHOD] = spec.kernel_code
+    cfg[K.C_TOL] = tol
+    cfg[K.C_MAX_ITER] = max_iter
+    cfg[K.C_RESTARTS] = restarts
+    cfg[K.C_RESPECT] = 1.0 if respect else 0.0
+    cfg[K.C_USE_Q0] = 1.0 if use_q0 else 0.0
+    cfg[K.P_DAMPING:] = _method_params(spec, opts)
+    if key is not None:
+        if len(_CONFIGS) > 256:
+            _CONFIGS.clear()
+        _CONFIGS[key] = cfg
+    return cfg
 
 
 def _result_single(robot: Robot, tgt: Target, spec: MethodSpec, q: np.ndarray,

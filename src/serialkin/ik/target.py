@@ -48,7 +48,8 @@ def _frozen(values: tuple[float, ...]) -> np.ndarray:
     return a
 
 
-_DEFAULT_WEIGHTS = {kind: _frozen(w) for kind, w in KIND_WEIGHTS.items()}
+#: The default weights per target kind, as read-only arrays.
+DEFAULT_WEIGHTS = {kind: _frozen(w) for kind, w in KIND_WEIGHTS.items()}
 
 
 @dataclass(frozen=True, eq=False)
@@ -162,7 +163,7 @@ def parse_mask(mask: object, kind: str) -> np.ndarray:
             coordinate selected that the target does not define (e.g. an orientation
             coordinate for a position target).
     """
-    default = _DEFAULT_WEIGHTS[kind]
+    default = DEFAULT_WEIGHTS[kind]
     if mask is None:
         return default
     w = as_float_array(mask, "mask")
