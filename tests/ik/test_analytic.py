@@ -364,6 +364,23 @@ def test_planar_targets():
     np.testing.assert_allclose(S.sum(axis=1), [0.4, 0.4], atol=1e-12)
 
 
+@pytest.mark.parametrize("flip", [False, True])
+def test_planar_targets_with_base_and_tool(flip):
+    """(x, y, φ) targets on a 3-link arm moved in the plane (or flipped upside down) with a tool."""
+    base = make_transform(rotz(0.7) @ (rotx(np.pi) if flip else np.eye(3)), [0.3, -0.2, 0.5])
+    tool = make_transform(rotz(-0.4), [0.1, 0.05, 0.0])
+    robot = Robot.from_dh(models.three_link(1.0, 0.8, 0.3).dh, base=base, tool=tool)
+    assert classify(robot) == "planar_3r"
+    rng = np.random.default_rng(16)
+    for _ in range(20):
+        q = robot.random_q(seed=rng)
+        T = robot.fk(q)
+        phi = math.atan2(T[1, 0], T[0, 0])
+        S = ik_all(robot, [T[0, 3], T[1, 3], phi])
+        assert _joint_distance(robot, S, q).min() < 1e-9
+        np.testing.assert_allclose(robot.fk(S), np.broadcast_to(T, (len(S), 4, 4)), atol=1e-9)
+
+
 def test_scara_position_and_heading_target():
     """The chapter's SCARA takes (x, y, z, φ): both elbow solutions reach it with heading φ."""
     robot = models.scara()
