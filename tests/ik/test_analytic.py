@@ -381,6 +381,21 @@ def test_planar_targets_with_base_and_tool(flip):
         np.testing.assert_allclose(robot.fk(S), np.broadcast_to(T, (len(S), 4, 4)), atol=1e-9)
 
 
+@pytest.mark.parametrize("order", ["RRRP", "PRRR", "RPRR"])
+def test_scara_joint_orders(order):
+    """SCARAs with the vertical slide anywhere in the chain (e.g. R R R P, P R R R) are solved."""
+    rows, links = [], iter([0.4, 0.3, 0.0])
+    for t in order:
+        if t == "P":
+            rows.append(DHLink(a=0.0, alpha=0.0, d=0.2, type="P", qlim=(-0.3, 0.3)))
+        else:
+            rows.append(DHLink(a=next(links), alpha=0.0, d=0.05, qlim=(-2.8, 2.8)))
+    robot = Robot.from_dh(rows, tool=make_transform(p=[0.02, 0.0, -0.1]))
+    assert classify(robot) == "scara"
+    counts = _check_round_trips(robot, 30, seed=17)
+    assert max(counts) == 2
+
+
 def test_scara_position_and_heading_target():
     """The chapter's SCARA takes (x, y, z, φ): both elbow solutions reach it with heading φ."""
     robot = models.scara()
@@ -487,6 +502,9 @@ def test_all_turns_lists_every_equivalent():
     assert np.all(robot.within_limits(full))
     assert np.all(_joint_distance(robot, base, full[0]).min() < 1e-9)
     assert np.abs(robot.fk(full) - T).max() < 1e-9
+    free = models.two_link()  # unlimited joints: one value each, not infinitely many
+    np.testing.assert_array_equal(ik_all(free, (1.2, 0.5), all_turns=True),
+                                  ik_all(free, (1.2, 0.5)))
 
 
 def test_deterministic_and_sorted():

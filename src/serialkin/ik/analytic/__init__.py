@@ -213,17 +213,22 @@ def _parse_target(p: _Prepared, robot: Robot, target: object) -> tuple[np.ndarra
 
 
 def _expand_turns(sols: np.ndarray, revolute: np.ndarray, qlim: np.ndarray) -> np.ndarray:
-    """Every 2π-equivalent of every row inside the limits, unique and sorted."""
+    """Every 2π-equivalent of every row inside the limits, unique and sorted.
+
+    Joints without a finite range (or with more than 8 turns of range) keep their
+    representative only: their equivalents are unbounded in number.
+    """
     rows = []
     for q in sols:
         options = []
         for j, v in enumerate(q):
-            if not revolute[j]:
+            lo, hi = qlim[j]
+            if not revolute[j] or not (math.isfinite(lo) and math.isfinite(hi)) \
+                    or hi - lo > 16 * math.pi:
                 options.append([v])
                 continue
-            lo, hi = qlim[j]
-            lo_k = math.ceil((max(lo, v - 64 * math.pi) - v) / (2 * math.pi) - 1e-12)
-            hi_k = math.floor((min(hi, v + 64 * math.pi) - v) / (2 * math.pi) + 1e-12)
+            lo_k = math.ceil((lo - v) / (2 * math.pi) - 1e-12)
+            hi_k = math.floor((hi - v) / (2 * math.pi) + 1e-12)
             vals = [v + 2 * math.pi * k for k in range(lo_k, hi_k + 1)]
             options.append([min(max(x, lo), hi) for x in vals] or [v])
         rows.extend(itertools.product(*options))
@@ -246,8 +251,8 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         tol: verification tolerance: each returned row reproduces the target within
             ``tol``·max(1, robot size) metres and ``tol`` in every rotation entry.
         all_turns: also list every 2π-equivalent of each revolute angle inside the limits
-            (e.g. joints with ±2π limits); by default one representative, nearest the
-            middle of the limits.
+            (e.g. joints with ±2π limits; joints without finite limits keep one value);
+            by default one representative, nearest the middle of the limits.
         **options: none other are accepted (an unknown name raises InputError).
 
     Returns:
