@@ -200,9 +200,8 @@ def run_attempts(spec: MethodSpec, problem: IKProblem, q0: np.ndarray | None, ma
     restarts_used)`` for one target.
     """
     robot = problem.robot
-    samp = robot.sampling_limits()
-    slo = np.ascontiguousarray(samp[:, 0])
-    shi = np.ascontiguousarray(samp[:, 1])
+    arrays = robot_arrays(robot)
+    slo, shi = arrays.slo, arrays.shi
     state = np.array([seed], dtype=np.uint64)
     best_q = None
     best_cost = np.inf
@@ -233,9 +232,8 @@ def run_attempts(spec: MethodSpec, problem: IKProblem, q0: np.ndarray | None, ma
         if ok:
             success = True
             break
-    q = np.ascontiguousarray(best_q, dtype=np.float64)
-    lo, hi, _, _, revolute = _limits(robot, problem.respect_limits)
-    K.normalize_into(q, lo, hi, revolute)
+    q = np.array(best_q, dtype=np.float64)
+    K.normalize_into(q, arrays.lo, arrays.hi, arrays.revolute)
     pe, oe = problem.errors(q)
     reason = "" if success else failure_reason(pe, oe, problem.tol, used + 1, total, problem.kind)
     return q, success, total, pe, oe, reason, used
