@@ -167,6 +167,24 @@ def test_round_trip_general_joints_from_urdf(name):
     np.testing.assert_allclose(ik_all(general, T), ik_all(std, T), atol=1e-8)
 
 
+@pytest.mark.parametrize("relative, tip", [
+    ("ur_description/urdf/ur5_robot.urdf", "tool0"),
+    ("ur_description/urdf/ur10_robot.urdf", "ee_link"),
+    ("ur_description/urdf/ur3_robot.urdf", "tool0"),
+    ("z1_description/urdf/z1.urdf", "link06"),
+])
+def test_published_urdf_arms(relative, tip):
+    """Published URDFs (example-robot-data: UR3/5/10, Unitree Z1) are recognised and solved."""
+    from tests.erd import urdf
+
+    path = urdf(relative)
+    if path is None:
+        pytest.skip("example-robot-data is not installed (pip install -e '.[bench]')")
+    robot = Robot.from_urdf(str(path), tip_link=tip)
+    assert classify(robot) == "ur"
+    _check_round_trips(robot, 30, seed=18)
+
+
 VARIANT_ZEROS = {
     # DH entries that must stay 0 for the class; every other a, d is scaled and shifted
     "two_link": (),
