@@ -557,6 +557,7 @@ def test_recognition_ignores_the_name():
     (models.panda(), ["redundant", "robot.ik(target, method='lm')"]),
     (models.iiwa7(), ["redundant"]),
     (models.planar(4), ["redundant", "4 revolute"]),
+    (models.planar(6), ["redundant", "6 revolute"]),
     (Robot.from_dh([DHLink(a=0.3, alpha=0.4, d=0.1 * i) for i in range(6)], name="odd"),
      ["do not meet in one point", "axes 2, 3, 4 are not parallel", "robot.ik"]),
 ])

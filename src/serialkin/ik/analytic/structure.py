@@ -205,7 +205,7 @@ def analyse(robot: Robot) -> Structure:
         return _sin_angle(W[i], W[j]) < ANGLE_TOL
 
     # ---------------------------------------------------------------- parallel family
-    if n <= 4 and all(para(0, j) for j in range(1, n)):
+    if all(para(0, j) for j in range(1, n)):
         return _parallel_family(robot, W, P, M, rev, scale, ltol)
     if n == 6:
         return _six_dof(robot, W, P, M, rev, scale, ltol)
