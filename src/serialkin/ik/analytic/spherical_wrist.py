@@ -15,9 +15,10 @@ problem splits (D. L. Pieper, PhD thesis, Stanford 1968):
    * ``pieper_intersecting`` — axes 1 and 2 meet at ``o``: rotations about them keep
      the distance to ``o``, so ``|exp(ξ3 q3)·c − o| = |p_w − o|`` gives q3 (subproblem 3),
      then q1, q2 by subproblem 2.
-   * ``pieper_general`` — any other R R R arm (axes 1 and 2 skew): the invariants of
-     joint 1 give a quartic in q3 (Pieper), solved as a degree-2 trigonometric
-     polynomial (:func:`general_candidates`), then q2 and q1 in closed form.
+   * ``pieper_general`` — any other R R R arm (axes 1 and 2 skew, or parallel while
+     axes 2 and 3 are not): the invariants of joint 1 give a quartic in q3 (Pieper),
+     solved as a degree-2 trigonometric polynomial (:func:`general_candidates`), then
+     q2 and q1 in closed form.
 2. **Orientation.** ``R4·R5·R6 = (R1 R2 R3)ᵀ·R_T·R_Mᵀ =: X``; ``R4 R5 w6 = X w6`` gives
    q4, q5 (subproblem 2, two solutions: wrist flip) and q6 follows by subproblem 1.
 
