@@ -20,7 +20,7 @@ import numpy as np
 
 from serialkin._checks import check_positive
 from serialkin.ik.optimize import minimize_attempt
-from serialkin.ik.registry import MethodSpec, register_method
+from serialkin.ik.registry import AttemptFn, MethodSpec, register_method
 from serialkin.ik.solver import IKProblem
 
 _BOUNDS = (
@@ -29,7 +29,9 @@ _BOUNDS = (
 )
 
 
-def _attempt(method: str):  # noqa: ANN202 - returns an AttemptFn
+def _attempt(method: str) -> AttemptFn:
+    """The attempt function of ``method`` ('bfgs' or 'powell') for the shared loop."""
+
     def attempt(problem: IKProblem, q_start: np.ndarray, max_iter: int,
                 options: Mapping[str, Any]) -> tuple[np.ndarray, int]:
         robot = problem.robot
