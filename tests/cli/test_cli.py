@@ -278,7 +278,7 @@ def test_workspace_two_link(tmp_path):
     """'workspace' writes figure, points and summary; the area matches within its error."""
     out = tmp_path / "ws"
     data = as_json(run("workspace", "two_link", "--samples", "150000", "--out", out, "-w",
-                       "--json"))
+                       "--save-q", "--json"))
     area = data["area"]
     assert abs(area["value"] - 4 * math.pi) <= area["error"]
     for key in ("figure", "manipulability", "points", "summary"):

@@ -63,8 +63,8 @@ _WORKSPACE_CMD_HELP = command_help(
     "Compute a workspace by sampling, with its area/volume and sampling error.\n\n"
     "Writes to the output folder: workspace_<kind>.png (2D with the boundary for planar "
     "robots, a 3D point cloud otherwise), manipulability_<kind>.png with -w, "
-    "slice_<axis>_<value>.png per --slice, workspace_<kind>.npz (points, q, grid) and "
-    "workspace_<kind>.json (summary). ROBOT is " + ROBOT_HELP + ".",
+    "slice_<axis>_<value>.png per --slice, workspace_<kind>.npz (points, grid; q with "
+    "--save-q) and workspace_<kind>.json (summary). ROBOT is " + ROBOT_HELP + ".",
     ["serialkin workspace two_link --out out/ws",
      "serialkin workspace three_link --kind constant --orientation 30 --degrees",
      "serialkin workspace three_link --kind dexterous --orientations 12",
@@ -102,6 +102,10 @@ _WORKSPACE_CMD_HELP = command_help(
 @click.option("--out", "-o", "out", type=click.Path(file_okay=False), default="out/workspace",
               show_default=True, help="Output folder for figures, points and summary.")
 @click.option("--no-plot", is_flag=True, help="Do not draw figures.")
+@click.option("--points/--no-points", default=True, show_default=True,
+              help="Save the sampled positions and the grid to workspace_<kind>.npz.")
+@click.option("--save-q", is_flag=True, help="Also save each sample's configuration q in "
+              "the .npz (large for big runs).")
 @param_option
 @json_option
 @quiet_option
@@ -110,7 +114,8 @@ def workspace_cmd(robot: str, kind: str, samples: int | None, seed: int, cell: f
                   resolution: int | None, orientation: str | None, max_angle: float | None,
                   orientations: int | None, margin: float, manipulability: bool,
                   slices: tuple[str, ...], degrees: bool, out: str, no_plot: bool,
-                  params: tuple[str, ...], as_json: bool, quiet: bool) -> None:
+                  points: bool, save_q: bool, params: tuple[str, ...], as_json: bool,
+                  quiet: bool) -> None:
     """Compute a workspace by sampling, with its area/volume and sampling error."""
     from serialkin.workspace import compute_workspace
 
@@ -143,13 +148,17 @@ def workspace_cmd(robot: str, kind: str, samples: int | None, seed: int, cell: f
     ws = compute_workspace(r, kind, **opts)
     files: dict[str, str] = {}
 
-    buf = io.BytesIO()
-    np.savez_compressed(buf, points=ws.points, q=ws.q,
-                        manipulability=(ws.manipulability if ws.manipulability is not None
-                                        else np.zeros(0)),
-                        grid_counts=ws.grid.counts, grid_lower=ws.grid.lower,
-                        grid_cell=np.array(ws.grid.cell))
-    files["points"] = str(write_bytes_atomic(folder / f"workspace_{kind}.npz", buf.getvalue()))
+    if points or save_q:
+        arrays = {"points": ws.points, "grid_counts": ws.grid.counts,
+                  "grid_lower": ws.grid.lower, "grid_cell": np.array(ws.grid.cell)}
+        if ws.manipulability is not None:
+            arrays["manipulability"] = ws.manipulability
+        if save_q:
+            arrays["q"] = ws.q
+        buf = io.BytesIO()
+        np.savez_compressed(buf, **arrays)
+        files["points"] = str(write_bytes_atomic(folder / f"workspace_{kind}.npz",
+                                                 buf.getvalue()))
     slice_summaries = []
     if not no_plot:
         import matplotlib
