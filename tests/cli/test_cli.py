@@ -427,3 +427,17 @@ def test_ik_mask_q0_degrees_and_no_limits():
     np.testing.assert_allclose(r.fk(np.array(data["results"][0]["q"]))[:3, 3], p, atol=1e-8)
     res = run("ik", "ur5", "-t", target, "--mask", "0,0,0,0,0,0", code=2)
     assert "mask" in res.stderr
+
+
+def test_track_unreachable_points_exit_1(tmp_path):
+    """A path partly out of reach: exit 1, each failed point on stderr, JSON success false."""
+    sc = tmp_path / "far.yaml"
+    sc.write_text("name: far\nrobot: {planar: {links: 3, length: 0.1}}\n"
+                  "path: {type: circle, center: [0.25, 0], radius: 0.1, step: 0.5}\n")
+    res = run("track", sc, "--out", tmp_path / "o", "--no-animation", "--no-figures",
+              "--json", code=1)
+    data = as_json(res)
+    assert data["success"] is False and data["computed"] == data["path_points"]
+    assert data["failures"] and all(f["error"] > 0.005 for f in data["failures"])
+    assert res.stderr.count("not reached") == len(data["failures"])
+    assert (tmp_path / "o" / "far.csv").is_file()  # nothing of the trajectory is lost
