@@ -208,3 +208,39 @@ def test_limits_respected_by_projection():
         for k, T in enumerate(targets):
             res = narrow.ik(T[:3, 3], method=method, seed=k, restarts=5)
             assert narrow.within_limits(res.q), method
+
+
+@pytest.mark.parametrize("method", FULL_POSE)
+@pytest.mark.parametrize("name", ["stanford", "iiwa7", "scara"])
+def test_other_models_every_method(method, name):
+    """Each method on the other spatial models (prismatic joints, 7R, 4-DOF SCARA poses)."""
+    robot = models.get(name)
+    _, targets = reachable(robot, 3, seed=91)
+    solved = 0
+    for k, T in enumerate(targets):
+        res = robot.ik(T, method=method, seed=k)
+        assert np.isfinite(res.q).all() and robot.within_limits(res.q)
+        if res.success:
+            assert_reaches(robot, res, T)
+            solved += 1
+    assert solved >= 3 - (method in REQUIRED)
+
+
+@pytest.mark.parametrize("method", ("transpose",) + FULL_POSE)
+def test_three_link_planar_pose(method):
+    """Each method reaches (x, y, φ) targets with the chapter's 3-link planar arm.
+
+    The Jacobian transpose converges linearly and crawls near the folded-arm singularity
+    (one of these targets): it may miss one target within its budget.
+    """
+    robot = models.three_link()
+    _, targets = reachable(robot, 3, seed=92)
+    solved = 0
+    for k, T in enumerate(targets):
+        phi = np.arctan2(T[1, 0], T[0, 0])
+        res = robot.ik(np.array([T[0, 3], T[1, 3], phi]), method=method, seed=k)
+        assert np.isfinite(res.q).all()
+        if res.success:
+            assert_reaches(robot, res, T, weights=[1, 1, 0, 0, 0, 1])
+            solved += 1
+    assert solved >= (2 if method == "transpose" else 3)
