@@ -339,7 +339,9 @@ def test_track_scenario(tmp_path):
     ref = load_scenario("six_link_circle").run()
     np.testing.assert_allclose(traj.q, ref.q, atol=1e-12)
     assert (tmp_path / "six_link_circle.gif").read_bytes().startswith(b"GIF8")
-    assert (tmp_path / "six_link_circle.png").read_bytes().startswith(b"\x89PNG")
+    for name in ("", "_motion", "_joints", "_error"):
+        assert (tmp_path / f"six_link_circle{name}.png").read_bytes().startswith(b"\x89PNG")
+    assert not (tmp_path / "six_link_circle_clearance.png").exists()  # no obstacles
     assert "<html" in (tmp_path / "six_link_circle.html").read_text().lower()
     assert run("track", "--list").stdout.split() == sorted(run("track", "--list").stdout.split())
 

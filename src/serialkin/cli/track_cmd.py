@@ -25,9 +25,11 @@ _TRACK_HELP = command_help(
     "SCENARIO is a scenario file (.yaml/.json: robot, path, obstacles, limits, solver; see "
     "serialkin.tracking.scenario) or the name of a shipped scenario (--list). Writes "
     "<name>.csv and/or <name>.npz (the trajectory), <name>.png (motion, joint variables, "
-    "tracking error, clearance), <name>.gif (and .mp4 with --mp4 when ffmpeg is present) "
-    "and, with --viewer, <name>.html (the interactive viewer). Exit code 1 when a path "
-    "point is not reached within the tolerance; 2 on bad input.",
+    "tracking error, clearance in one figure) and each of them alone (<name>_motion.png, "
+    "_joints.png, _error.png, _clearance.png with obstacles), <name>.gif (and .mp4 with "
+    "--mp4 when ffmpeg is present) and, with --viewer, <name>.html (the interactive "
+    "viewer). Exit code 1 when a path point is not reached within the tolerance; 2 on bad "
+    "input.",
     ["serialkin track six_link_circle --out out/track",
      "serialkin track twenty_link_obstacles --format npz --viewer",
      "serialkin track my_scenario.yaml --no-animation --json",
@@ -94,13 +96,29 @@ def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_ani
 
         import matplotlib.pyplot as plt
 
-        from serialkin.viz.trajectory import tracking_figure
+        from serialkin.viz.trajectory import (
+            plot_clearance,
+            plot_joint_trajectories,
+            plot_motion,
+            plot_tracking_error,
+            tracking_figure,
+        )
 
-        fig = tracking_figure(traj, sc.robot, obstacles=sc.obstacles, title=sc.name)
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=100, bbox_inches="tight")
-        plt.close(fig)
-        files["figure"] = str(write_bytes_atomic(folder / f"{stem}.png", buf.getvalue()))
+        def save(fig: Any, key: str, name: str) -> None:
+            buf = io.BytesIO()
+            fig.savefig(buf, format="png", dpi=100, bbox_inches="tight")
+            plt.close(fig)
+            files[key] = str(write_bytes_atomic(folder / name, buf.getvalue()))
+
+        save(tracking_figure(traj, sc.robot, obstacles=sc.obstacles, title=sc.name),
+             "figure", f"{stem}.png")
+        save(plot_motion(sc.robot, traj, obstacles=sc.obstacles,
+                         title=f"{sc.name}: motion").figure, "motion", f"{stem}_motion.png")
+        save(plot_joint_trajectories(traj, robot=sc.robot).figure, "joints",
+             f"{stem}_joints.png")
+        save(plot_tracking_error(traj).figure, "error", f"{stem}_error.png")
+        if traj.clearance.size:
+            save(plot_clearance(traj).figure, "clearance", f"{stem}_clearance.png")
     if not no_animation:
         from serialkin.viz.animate import animate_trajectory, ffmpeg_available
 
