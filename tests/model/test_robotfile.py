@@ -178,3 +178,17 @@ def test_puma_example_matches_builtin_model():
     Q = b.random_q(50, seed=2)
     np.testing.assert_allclose(a.fk(Q), b.fk(Q), atol=1e-12)
     np.testing.assert_allclose(a.qlim, b.qlim, atol=1e-12)
+
+
+@pytest.mark.parametrize("pitch", [0.4, np.pi / 2, -np.pi / 2])
+def test_base_tool_round_trip(tmp_path, pitch):
+    """Base and tool survive save/load as xyz + rpy, also at the rpy gimbal lock."""
+    r = models.get("ur5")
+    r = r.with_base(make_transform(rpy_to_matrix([0.3, pitch, -1.0]), [1.0, 2.0, 3.0]))
+    r = r.with_tool(make_transform(rpy_to_matrix([np.pi, 0.0, 0.2]), [0.0, 0.0, 0.1]))
+    p = save_robot_file(r, tmp_path / "r.yaml", length_unit="mm")
+    doc = yaml.safe_load(p.read_text())
+    assert set(doc["base"]) == {"xyz", "rpy"} and doc["base"]["xyz"] == [1000.0, 2000.0, 3000.0]
+    r2 = load_robot_file(p)
+    np.testing.assert_allclose(r2.base, r.base, atol=1e-12)
+    np.testing.assert_allclose(r2.tool, r.tool, atol=1e-12)

@@ -288,7 +288,9 @@ def load_robot_file(path: str | os.PathLike[str]) -> Any:
 def robot_to_dict(robot: Any, angle_unit: str = "deg", length_unit: str = "m") -> dict[str, Any]:
     """The robot-file mapping of a DH robot in the given units (inverse of robot_from_dict).
 
-    Base and tool are written as 4x4 matrices (lossless) and omitted when identity.
+    Base and tool are written as ``{xyz, rpy}`` in the file's units (rpy from
+    :func:`serialkin.spatial.matrix_to_rpy`, 12 significant decimals) and omitted when
+    they are the identity.
 
     Raises:
         RobotDefinitionError: the robot has no DH table (e.g. it came from a URDF).
@@ -306,7 +308,7 @@ def robot_to_dict(robot: Any, angle_unit: str = "deg", length_unit: str = "m") -
     ang, lin = ANGLE_UNITS[angle_unit], LENGTH_UNITS[length_unit]
 
     def num(x: float) -> float | None:
-        return None if not math.isfinite(x) else float(round(x, 12))
+        return None if not math.isfinite(x) else float(round(x, 12)) + 0.0  # no -0.0
 
     rows = []
     for r in robot.dh:
@@ -322,11 +324,13 @@ def robot_to_dict(robot: Any, angle_unit: str = "deg", length_unit: str = "m") -
     if robot.source:
         out["source"] = robot.source
     out["dh"] = rows
+    from serialkin.spatial import matrix_to_rpy
+
     for key in ("base", "tool"):
         T = np.array(getattr(robot, key), dtype=float)
         if not np.allclose(T, np.eye(4), atol=1e-15):
-            T[:3, 3] /= lin
-            out[key] = [[num(v) for v in r] for r in T]
+            rpy = matrix_to_rpy(T[:3, :3], check=False) / ang
+            out[key] = {"xyz": [num(v / lin) for v in T[:3, 3]], "rpy": [num(v) for v in rpy]}
     return out
 
 
