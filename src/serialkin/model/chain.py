@@ -23,7 +23,8 @@ class Chain:
     Attributes:
         F: (n+1, 4, 4) fixed transforms between joint motions, base and tool included.
         L: (n+1, 4, 4) link-frame offsets (L[0] is the base).
-        meta: (n, 5) axis x, y, z, type (0 R, 1 P), offset.
+        meta: (n, 5) axis x, y, z (always 0, 0, 1 after compilation), type (0 R, 1 P),
+            offset.
     """
 
     F: np.ndarray
@@ -36,12 +37,29 @@ class Chain:
         return self.meta.shape[0]
 
 
+def z_alignment(axis: np.ndarray) -> np.ndarray:
+    """A rotation ``R`` (3, 3) with ``R · e_z = axis`` (unit axis), the identity for +z.
+
+    A motion about/along ``axis`` is then ``R · M_z(q) · Rᵀ``.
+    """
+    c = float(axis[2])
+    if c < 0.0:  # through a half turn about x, keeping 1 + c away from 0
+        H = np.diag([1.0, -1.0, -1.0])
+        return H @ z_alignment(H @ axis)
+    v = np.array([-axis[1], axis[0], 0.0])  # e_z × axis
+    K = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    return np.eye(3) + K + K @ K / (1.0 + c)
+
+
 def compile_chain(joints: Sequence[Joint], base: np.ndarray, tool: np.ndarray) -> Chain:
     """Compile joints ``A_i = P_i·M_i·Q_i`` with base and tool into kernel arrays.
 
     ``T = base · Π_i (P_i · M_i(q_i) · Q_i) · tool`` (eq 11) is regrouped as
     ``F[0]·M_1·F[1]···M_n·F[n]`` with ``F[0] = base·P_1``, ``F[i] = Q_i·P_{i+1}`` and
-    ``F[n] = Q_n·tool``.
+    ``F[n] = Q_n·tool``. Every joint axis is then turned onto +z: with ``R_i`` from
+    :func:`z_alignment`, ``M_i = R_i·M_z(q_i)·R_iᵀ``, so ``F[i-1]`` absorbs ``R_i`` on the
+    right, ``F[i]`` and ``L[i]`` absorb ``R_iᵀ`` on the left, and every compiled axis is
+    (0, 0, 1). The kernels therefore only rotate about / slide along z.
     """
     n = len(joints)
     F = np.empty((n + 1, 4, 4))
@@ -59,6 +77,13 @@ def compile_chain(joints: Sequence[Joint], base: np.ndarray, tool: np.ndarray) -
         L[i + 1] = j.post
         nxt = joints[i + 1].origin if i + 1 < n else tool
         F[i + 1] = j.post @ nxt
+    for i, j in enumerate(joints):
+        R = np.eye(4)
+        R[:3, :3] = z_alignment(j.axis)
+        F[i] = F[i] @ R
+        F[i + 1] = R.T @ F[i + 1]
+        L[i + 1] = R.T @ L[i + 1]
+        meta[i, :3] = (0.0, 0.0, 1.0)
     for a in (F, L, meta):
         a.setflags(write=False)
     return Chain(F=np.ascontiguousarray(F), L=np.ascontiguousarray(L), meta=meta)
