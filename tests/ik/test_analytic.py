@@ -289,6 +289,20 @@ def test_any_arm_with_spherical_wrist(a, alpha, d, seed):
     assert max(counts) <= 8
 
 
+@settings(max_examples=25, deadline=None)
+@given(name=st.sampled_from(["puma560", "ur5", "stanford", "scara", "skew"]),
+       seed=st.integers(0, 2**31 - 1))
+def test_base_and_tool_invariance(name, seed):
+    """ik_all(robot with base B and tool E, B·T·E) equals ik_all(robot, T): same joint values."""
+    rng = np.random.default_rng(seed)
+    robot = ROBOTS[name][0]()
+    B, E = _random_transform(rng, 1.0), _random_transform(rng, 0.2)
+    moved = Robot.from_dh(robot.dh, robot.convention, base=B @ robot.base,
+                          tool=robot.tool @ E)
+    T = robot.fk(robot.random_q(seed=rng))
+    np.testing.assert_allclose(ik_all(moved, B @ T @ E), ik_all(robot, T), atol=1e-8)
+
+
 def test_eight_solutions_without_limits():
     """Unlimited Puma 560 and Pieper arm: 8 solutions per pose; UR5: 8 for most, never more."""
     for robot in (models.puma560(), Robot.from_dh(_pieper_rows())):
