@@ -268,6 +268,22 @@ def jacobian_into(q, F, meta, J, T):
     _finish_columns(J, meta, n, T[0, 3], T[1, 3], T[2, 3])
 
 
+@njit(cache=True)
+def joint_axes_into(q, F, meta, P, W):
+    """World origin ``P[i]`` (3,) and unit axis ``W[i]`` (3,) of every joint i at ``q``.
+
+    These are the lines the joints turn about / slide along (the o_i, z_i of eqs 35-36),
+    used by DH extraction and by closed-form structure recognition.
+    """
+    T = F[0].copy()
+    for i in range(meta.shape[0]):
+        for r in range(3):
+            P[i, r] = T[r, 3]
+            W[i, r] = T[r, 2]
+        _apply_joint(T, meta[i], q[i])
+        _post_multiply(T, F[i + 1])
+
+
 @njit(cache=True, parallel=True)
 def jacobian_batch(Q, F, meta, J, T):
     """Geometric Jacobians (N, 6, n) and poses (N, 4, 4) for a batch ``Q`` (N, n)."""

@@ -74,25 +74,6 @@ def _frame(origin: np.ndarray, z: np.ndarray, x: np.ndarray) -> np.ndarray:
     return T
 
 
-def _joint_lines(robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Joint origins (n, 3), unit axes (n, 3) in the world at q = 0, and the tool pose."""
-    from scipy.spatial.transform import Rotation
-
-    F, meta = robot.chain.F, robot.chain.meta
-    origins, axes = np.empty((robot.n, 3)), np.empty((robot.n, 3))
-    T = F[0].copy()
-    for i in range(robot.n):
-        origins[i] = T[:3, 3]
-        axes[i] = T[:3, :3] @ meta[i, :3]
-        M = np.eye(4)
-        if meta[i, 3] == 1:  # prismatic: offset along the axis
-            M[:3, 3] = meta[i, :3] * meta[i, 4]
-        else:
-            M[:3, :3] = Rotation.from_rotvec(meta[i, :3] * meta[i, 4]).as_matrix()
-        T = T @ M @ F[i + 1]
-    return origins, axes, robot.fk(np.zeros(robot.n))
-
-
 def _std_params(A: np.ndarray) -> tuple[float, float, float, float]:
     """(a, alpha, d, theta) from A = Rz(θ)Tz(d)Tx(a)Rx(α)."""
     theta = np.arctan2(A[1, 0], A[0, 0])
@@ -129,7 +110,8 @@ def extract_dh(robot, convention: str = "standard") -> tuple[list[DHLink], np.nd
 
     check_choice(convention, "convention", CONVENTIONS)
     n = robot.n
-    o, z, T_tool = _joint_lines(robot)
+    o, z = robot.joint_axes()
+    T_tool = robot.fk(np.zeros(n))
     world_x = robot.base[:3, 0]
     frames: list[np.ndarray] = []
     if convention == "standard":

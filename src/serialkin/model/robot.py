@@ -347,6 +347,19 @@ class Robot:
             J = np.concatenate([Rt @ J[:, :3], Rt @ J[:, 3:]], axis=1)
         return J.reshape(a.shape[:-1] + (6, self.n))
 
+    def joint_axes(self, q: object = None) -> tuple[np.ndarray, np.ndarray]:
+        """Joint lines in the world frame: origins (n, 3) [m] and unit axes (n, 3) at ``q``.
+
+        Joint i turns about (slides along) the line through ``origins[i]`` with direction
+        ``axes[i]`` — the o_i and z_i of eqs 35-36. ``q`` defaults to zeros.
+        """
+        a = np.zeros(self.n) if q is None else self.check_q(q)
+        if a.ndim != 1:
+            raise InputError(f"q must have shape ({self.n},), got {a.shape}")
+        P, W = np.empty((self.n, 3)), np.empty((self.n, 3))
+        K.joint_axes_into(np.ascontiguousarray(a), self._F, self._meta, P, W)
+        return P, W
+
     def jacobian_planar(self, q: object, orientation: bool = False) -> np.ndarray:
         """Planar task Jacobian (eqs 30-32 and 38): rows (vx, vy) or (vx, vy, wz), (..., 2|3, n)."""
         rows = [0, 1, 5] if orientation else [0, 1]
