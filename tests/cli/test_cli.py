@@ -443,3 +443,27 @@ def test_track_unreachable_points_exit_1(tmp_path):
     assert data["failures"] and all(f["error"] > 0.005 for f in data["failures"])
     assert res.stderr.count("not reached") == len(data["failures"])
     assert (tmp_path / "o" / "far.csv").is_file()  # nothing of the trajectory is lost
+
+
+def test_models_show_and_save(tmp_path):
+    """'models ROBOT' shows the DH table; --save writes a robot file or URDF that loads back."""
+    text = run("models", "puma560").stdout
+    assert "alpha [deg]" in text and "[-160.0, 160.0] deg" in text
+    r = models.get("ur5")
+    y = tmp_path / "ur5.yaml"
+    run("models", "ur5", "--save", y, "--length-unit", "mm")
+    assert "length: mm" in y.read_text()
+    u = tmp_path / "ur5.urdf"
+    run("models", "ur5", "--save", u)
+    q = r.random_q(seed=3)
+    qs = ",".join(repr(float(v)) for v in q)
+    for f in (y, u):
+        data = as_json(run("fk", f, "--q", qs, "--json"))
+        np.testing.assert_allclose(data["results"][0]["T"], r.fk(q), atol=1e-9)
+    detail = as_json(run("models", u, "--json"))
+    assert "joints" in detail and len(detail["joints"]) == 6
+    assert len(as_json(run("models", "ur5", "--json"))["dh"]) == 6
+    res = run("models", "ur5", "--save", tmp_path / "x.txt", code=2)
+    assert ".urdf" in res.stderr
+    res = run("models", "--save", y, code=2)
+    assert "needs ROBOT" in res.stderr

@@ -39,6 +39,8 @@ def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
             return fn(*args, **kwargs)
         except SerialkinError as exc:
             raise CLIError(str(exc)) from exc
+        except BrokenPipeError:  # output piped into e.g. head: click exits quietly
+            raise
         except PermissionError as exc:
             raise CLIError(f"permission denied: {exc.filename or exc}") from exc
         except OSError as exc:
@@ -98,28 +100,110 @@ def _emit(text: str, quiet: bool) -> None:
 
 # ---------------------------------------------------------------------------- models
 _MODELS_CMD_HELP = command_help(
-    "List the built-in robot models: DOF, joint types, convention and source.",
-    ['serialkin models', 'serialkin models --json'],
+    "List the built-in robot models: DOF, joint types, convention and source.\n\n"
+    "With ROBOT (a model name, robot file or URDF), show that robot: its DH table or joint "
+    "axes, limits, base and tool; --save writes it as a robot file (.yaml/.yml/.json, DH "
+    "robots) or a URDF (.urdf), e.g. to start your own robot from a built-in one.",
+    ["serialkin models", "serialkin models --json", "serialkin models puma560",
+     "serialkin models ur5 --save my_ur5.yaml", "serialkin models panda --save panda.urdf"],
 )
+
+
+def _robot_detail(r: Any) -> dict[str, Any]:
+    info = _robot_info(r)
+    info["qlim"] = r.qlim
+    info["base"] = r.base
+    info["tool"] = r.tool
+    if r.dh is not None:
+        info["dh"] = [{"a": d.a, "alpha": d.alpha, "d": d.d, "theta": d.theta, "type": d.type,
+                       "qlim": list(d.qlim), "name": d.name} for d in r.dh]
+    else:
+        info["joints"] = [{"name": j.name, "type": j.type, "axis": j.axis, "origin": j.origin,
+                           "offset": j.offset, "qlim": list(j.qlim)} for j in r.joints]
+    return info
+
+
+def _show_robot(r: Any) -> None:
+    click.echo(f"{r.name}: {r.n} joints {''.join(r.joint_types)}"
+               + (f", {r.convention} DH" if r.convention else ""))
+    if r.source:
+        click.echo(f"source: {r.source}")
+
+    def lim(lo: float, hi: float, t: str) -> str:
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            return "unlimited"
+        return (f"[{np.degrees(lo):.1f}, {np.degrees(hi):.1f}] deg" if t == "R"
+                else f"[{lo:.4g}, {hi:.4g}] m")
+
+    if r.dh is not None:
+        rows = [(d.name, d.type, d.a, np.degrees(d.alpha), d.d, np.degrees(d.theta),
+                 lim(*d.qlim, d.type)) for d in r.dh]
+        click.echo(format_table(rows, ["joint", "type", "a [m]", "alpha [deg]", "d [m]",
+                                       "theta [deg]", "limits"]))
+    else:
+        rows = [(j.name, j.type, fmt_vector(j.axis, 3), fmt_vector(j.origin[:3, 3], 4),
+                 lim(*j.qlim, j.type)) for j in r.joints]
+        click.echo(format_table(rows, ["joint", "type", "axis", "origin xyz [m]", "limits"]))
+    for key in ("base", "tool"):
+        T = getattr(r, key)
+        if not np.allclose(T, np.eye(4)):
+            click.echo(f"{key}:")
+            click.echo(format_matrix(T))
 
 
 @click.command("models", help=_MODELS_CMD_HELP,
                short_help="List the built-in robots: DOF, joint types, source.")
+@click.argument("robot", metavar="[ROBOT]", required=False)
+@click.option("--save", "save", type=click.Path(dir_okay=False), default=None,
+              help="Write ROBOT to a robot file (.yaml/.yml/.json) or URDF (.urdf).")
+@click.option("--angle-unit", type=click.Choice(["deg", "rad"]), default="deg",
+              show_default=True, help="Angle unit of a saved robot file.")
+@click.option("--length-unit", type=click.Choice(["m", "cm", "mm"]), default="m",
+              show_default=True, help="Length unit of a saved robot file.")
+@param_option
 @json_option
-def models_cmd(as_json: bool) -> None:
-    """List the built-in robot models: DOF, joint types, convention and source."""
+@handle_errors
+def models_cmd(robot: str | None, save: str | None, angle_unit: str, length_unit: str,
+               params: tuple[str, ...], as_json: bool) -> None:
+    """List the built-in robot models, or show / save one robot."""
     from serialkin import models
 
+    if robot is not None:
+        r = resolve_robot(robot, params)
+        if save:
+            from pathlib import Path
+
+            from serialkin.cli.io import ensure_dir, write_text_atomic
+
+            p = Path(save)
+            ensure_dir(p.parent)
+            if p.suffix.lower() == ".urdf":
+                write_text_atomic(p, r.to_urdf())
+            else:
+                from serialkin.model.robotfile import ROBOT_FILE_SUFFIXES, save_robot_file
+
+                if p.suffix.lower() not in ROBOT_FILE_SUFFIXES:
+                    raise CLIError(f"--save {p}: use .yaml, .yml, .json or .urdf")
+                save_robot_file(r, p, angle_unit=angle_unit, length_unit=length_unit)
+            if not as_json:
+                click.echo(f"wrote {p}")
+        if as_json:
+            click.echo(dumps_json(_robot_detail(r)), nl=False)
+        elif not save:
+            _show_robot(r)
+        return
+    if save:
+        raise CLIError("--save needs ROBOT, e.g. serialkin models ur5 --save ur5.yaml")
     entries = []
     for info in models.catalog():
-        robot = info.build() if info.dof is not None else None
+        built = info.build() if info.dof is not None else None
         entries.append({
             "name": info.name,
-            "dof": robot.n if robot else None,
-            "joint_types": "".join(robot.joint_types) if robot else "R…",
+            "dof": built.n if built else None,
+            "joint_types": "".join(built.joint_types) if built else "R…",
             "convention": info.convention,
             "summary": info.summary,
-            "source": robot.source if robot else "planar<N>: N unit links (or --param "
+            "source": built.source if built else "planar<N>: N unit links (or --param "
                                                  "lengths=[...])",
         })
     if as_json:
@@ -131,7 +215,8 @@ def models_cmd(as_json: bool) -> None:
     click.echo("\nSources:")
     for e in entries:
         click.echo(f"  {e['name']}: {e['source']}")
-    click.echo("\nAlso: planar<N> (e.g. planar6), a robot file (.yaml/.json) or a URDF.")
+    click.echo("\nAlso: planar<N> (e.g. planar6), a robot file (.yaml/.json) or a URDF. "
+               "Details of one: serialkin models <name>.")
 
 
 # ---------------------------------------------------------------------------- fk

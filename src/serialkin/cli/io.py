@@ -223,7 +223,7 @@ def format_table(rows: Sequence[Sequence[Any]], header: Sequence[str], digits: i
         if isinstance(v, (bool, np.bool_)):
             return "yes" if v else "no"
         if isinstance(v, (float, np.floating)):
-            return f"{float(v):.{digits}g}" if math.isfinite(v) else str(float(v))
+            return f"{float(v) + 0.0:.{digits}g}" if math.isfinite(v) else str(float(v))
         return str(v)
 
     body = [[cell(v) for v in r] for r in rows]
