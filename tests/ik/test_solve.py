@@ -133,7 +133,8 @@ def test_unreachable_target_fails_cleanly(puma):
     res = puma.ik(T, seed=0, restarts=20, max_iter=50)
     elapsed = time.perf_counter() - t0
     assert not res.success
-    assert "no configuration within" in res.reason and "out of reach" in res.reason
+    assert "no configuration within" in res.reason
+    assert "the target is out of reach: it is 3.04 m from joint 1" in res.reason
     assert np.isfinite(res.q).all() and puma.within_limits(res.q)
     assert res.iterations <= 21 * 50
     assert res.restarts == 20
@@ -149,6 +150,7 @@ def test_target_only_outside_limits_fails(ur5):
     narrow = ur5.with_limits(np.column_stack([np.full(6, -0.5), np.full(6, 0.5)]))
     res = narrow.ik(T, seed=0, restarts=10)
     assert not res.success and res.reason
+    assert "at a limit" in res.reason and "only outside the joint limits" in res.reason
     assert narrow.within_limits(res.q)
     free = narrow.ik(T, seed=0, respect_limits=False)
     assert free.success
@@ -282,3 +284,21 @@ def test_users_own_random_robot(seed, n, convention):
     T = robot.fk(q)
     res = robot.ik(T, seed=seed)
     assert_reaches(robot, res, T)
+
+
+@pytest.mark.parametrize("name", ["puma560", "ur5", "panda", "stanford", "scara"])
+def test_reach_bound_is_an_upper_bound(name):
+    """No sampled configuration puts the tool farther from joint 1 than reach_bound."""
+    from serialkin.ik.solver import reach_bound
+
+    robot = models.get(name)
+    P = robot.fk(robot.random_q(5000, seed=1))[:, :3, 3]
+    dist = np.linalg.norm(P - robot.chain.F[0][:3, 3], axis=1)
+    assert dist.max() <= reach_bound(robot) + 1e-12
+
+
+def test_singular_best_attempt_hint(two_link):
+    """A target just beyond a planar arm's reach ends stretched: the hint names the singularity."""
+    res = two_link.ik(np.array([1.5, 1.5]), seed=0, restarts=3)
+    assert not res.success
+    assert "singular configuration" in res.reason and "out of reach" in res.reason

@@ -179,16 +179,69 @@ def _limits(robot: Robot, respect_limits: bool) -> tuple[np.ndarray, ...]:
     return a.lo, a.hi, a.slo, a.shi, a.revolute
 
 
+def reach_bound(robot: Robot) -> float:
+    """An upper bound on the distance of the tool from joint 1's origin [m].
+
+    By the triangle inequality over the chain ``T = F0·M1·F1···Mn·Fn`` (eq 11), the tool
+    is at most ``Σ_i |t(F_i)| + Σ_prismatic max|q_i + offset_i|`` from the origin of
+    ``F0`` (prismatic ranges from the sampling limits).
+    """
+    F, meta = robot.chain.F, robot.chain.meta
+    r = float(np.linalg.norm(F[1:, :3, 3], axis=1).sum())
+    lim = robot.sampling_limits()
+    for i in range(robot.n):
+        if meta[i, 3] == FK.PRISMATIC:
+            r += float(np.max(np.abs(lim[i] + meta[i, 4])))
+    return r
+
+
+def failure_hint(robot: Robot, q: np.ndarray, weights: np.ndarray, respect_limits: bool,
+                 T_target: np.ndarray | None = None) -> str:
+    """Why the best attempt ``q`` may have stopped short of the target.
+
+    A position target farther from joint 1 than :func:`reach_bound` is out of reach,
+    certainly. Otherwise, at a stationary point of the cost that is not a solution (where
+    the ``lm`` polish ends), either a joint limit is active or the task Jacobian is
+    singular (its rows cannot move the tool along the remaining error): the hint names
+    the joints at a limit, or the singularity (typically the arm stretched towards an
+    out-of-reach target), or else falls back to the general causes.
+    """
+    q = np.asarray(q, dtype=np.float64)
+    if T_target is not None and np.all(np.asarray(weights)[:3] > 0):
+        bound = reach_bound(robot)
+        dist = float(np.linalg.norm(T_target[:3, 3] - robot.chain.F[0][:3, 3]))
+        if dist > bound:
+            return (f"the target is out of reach: it is {dist:.3g} m from joint 1 but no "
+                    f"configuration puts the tool farther than {bound:.3g} m from it")
+    if respect_limits:
+        lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
+        span = np.where(np.isfinite(hi - lo), hi - lo, 1.0)
+        at = np.flatnonzero((np.abs(q - lo) <= 1e-9 * (1 + span))
+                            | (np.abs(q - hi) <= 1e-9 * (1 + span)))
+        if at.size:
+            names = ", ".join(repr(robot.joint_names[i]) for i in at)
+            return (f"the best attempt has joint(s) {names} at a limit: the target may be "
+                    "reachable only outside the joint limits")
+    J = robot.jacobian(q)[np.asarray(weights) > 0]
+    sv = np.linalg.svd(J, compute_uv=False)
+    if sv.size and (sv.size > robot.n or sv[-1] <= 1e-5 * sv[0]):
+        return ("the best attempt is at a singular configuration (e.g. the arm stretched): "
+                "the target looks out of reach")
+    return ("the target may be out of reach, reachable only outside the joint limits, or "
+            "need more restarts / iterations")
+
+
 def failure_reason(pos_err: float, ori_err: float, tol: float, attempts: int,
-                   iterations: int, kind: str) -> str:
-    """The sentence reported when a solve fails."""
+                   iterations: int, kind: str, hint: str = "") -> str:
+    """The sentence reported when a solve fails (``hint``: see :func:`failure_hint`)."""
     what = f"position error {pos_err:.3g} m"
     if kind in ("pose", "planar_pose"):
         what += f", orientation error {ori_err:.3g} rad"
+    hint = hint or ("the target may be out of reach, reachable only outside the joint "
+                    "limits, or need more restarts / iterations")
     return (
         f"no configuration within tol={tol:g} found in {attempts} attempt(s) and {iterations} "
-        f"iterations (best: {what}); the target may be out of reach, reachable only outside "
-        "the joint limits, or need more restarts / iterations"
+        f"iterations (best: {what}); {hint}"
     )
 
 
@@ -235,7 +288,9 @@ def run_attempts(spec: MethodSpec, problem: IKProblem, q0: np.ndarray | None, ma
     q = np.array(best_q, dtype=np.float64)
     K.normalize_into(q, arrays.lo, arrays.hi, arrays.revolute)
     pe, oe = problem.errors(q)
-    reason = "" if success else failure_reason(pe, oe, problem.tol, used + 1, total, problem.kind)
+    reason = "" if success else failure_reason(
+        pe, oe, problem.tol, used + 1, total, problem.kind,
+        failure_hint(robot, q, problem.weights, problem.respect_limits, problem.T_target))
     return q, success, total, pe, oe, reason, used
 
 
@@ -346,7 +401,7 @@ def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray 
         q0k = q0 if q0 is not None and q0.flags.writeable else (
             np.zeros(n) if q0 is None else q0.copy())
         K.solve_one(F, meta, Tt, box, q0k, cfg, seed64, q, info)
-        return _result_single(robot, tgt, spec, q, info, tol)
+        return _result_single(robot, tgt, spec, q, info, tol, respect)
     N = Tt.shape[0]
     Q = np.empty((N, n))
     info = np.empty((N, K.N_INFO))
@@ -415,11 +470,13 @@ def _kernel_config(spec: MethodSpec, tgt: Target, tol: float, max_iter: int, res
 
 
 def _result_single(robot: Robot, tgt: Target, spec: MethodSpec, q: np.ndarray,
-                   info: np.ndarray, tol: float) -> IKResult:
+                   info: np.ndarray, tol: float, respect: bool) -> IKResult:
     ok = bool(info[K.I_SUCCESS])
     pe, oe = float(info[K.I_POS_ERR]), float(info[K.I_ORI_ERR])
     its, used = int(info[K.I_ITERATIONS]), int(info[K.I_RESTARTS])
-    reason = "" if ok else failure_reason(pe, oe, tol, used + 1, its, tgt.kind)
+    reason = "" if ok else failure_reason(
+        pe, oe, tol, used + 1, its, tgt.kind,
+        failure_hint(robot, q, tgt.weights, respect, tgt.T))
     return IKResult(q=q, success=ok, iterations=its, position_error=pe, orientation_error=oe,
                     reason=reason, restarts=used, method=spec.name)
 
@@ -431,7 +488,9 @@ def _result_batch(robot: Robot, tgt: Target, spec: MethodSpec, Q: np.ndarray,
     used = info[:, K.I_RESTARTS].astype(np.int64)
     pe, oe = info[:, K.I_POS_ERR].copy(), info[:, K.I_ORI_ERR].copy()
     reasons = np.array(
-        ["" if ok[k] else failure_reason(pe[k], oe[k], tol, used[k] + 1, its[k], tgt.kind)
+        ["" if ok[k] else failure_reason(pe[k], oe[k], tol, used[k] + 1, its[k], tgt.kind,
+                                         failure_hint(robot, Q[k], tgt.weights, respect,
+                                                      tgt.T[k]))
          for k in range(Q.shape[0])],
         dtype=object,
     ).astype(str)
