@@ -23,6 +23,14 @@ name               step
 
 (``J`` and ``e`` are weighted by the task mask; ``E = ½ eᵀWe``.)
 
+Trade-offs measured by ``benchmarks/bench_ik.py`` (1,000 random full-pose targets on
+Panda, UR5 and Puma 560): ``lm`` solves all of them in about 10 iterations (median);
+the methods with a constant damping floor (``dls``, ``lm_wampler``, ``lm_sugihara``)
+converge only linearly near singular solutions, where they may run out of patience
+(about 1 % of targets); the SVD-based ``pinv``, ``newton``, ``gauss_newton`` and
+``sdls`` are robust but cost more per iteration; ``transpose`` needs thousands of
+iterations and solves only about 3 in 4 full-pose targets within its budget.
+
 Options (keyword arguments of ``robot.ik``; defaults in ``METHODS[name].options``):
 ``damping`` (λ), ``stall_window`` (iterations within which the cost must halve before
 a restart), ``max_step`` (``pinv``: cap on max |Δq_i|; ``sdls``: γ_max), ``rcond``
@@ -85,7 +93,7 @@ register_method(MethodSpec(
     name="lm_sugihara", family="jacobian",
     summary="Levenberg-Marquardt with damping E + λ (Sugihara)",
     limits=_PROJECTION, max_iter=200, restarts=50,
-    options={"damping": 1e-3, "stall_window": 30}, kernel_code=K.LM_SUGIHARA,
+    options={"damping": 1e-4, "stall_window": 30}, kernel_code=K.LM_SUGIHARA,
 ))
 register_method(MethodSpec(
     name="sdls", family="jacobian",
