@@ -102,6 +102,14 @@ def _parallel12_rows():
     return rows
 
 
+def _stanford_offset_rows():
+    """The Stanford arm with a shoulder offset a1 = 0.1 m (axes 1 and 2 no longer meet)."""
+    rows = list(models.stanford().dh)
+    r = rows[0]
+    rows[0] = DHLink(a=0.1, alpha=r.alpha, d=r.d, theta=r.theta, type=r.type, qlim=r.qlim)
+    return rows
+
+
 def _variant(robot: Robot, rng: np.random.Generator, keep_zero: tuple[str, ...] = ()) -> Robot:
     """A user's own robot of the same class: scaled a/d, joint offsets, base and tool."""
     rows = []
@@ -127,6 +135,8 @@ ROBOTS = {
     "pieper": (lambda: Robot.from_dh(_pieper_rows(), name="pieper"), "pieper_intersecting"),
     "skew": (lambda: Robot.from_dh(_skew_rows(), name="skew"), "pieper_general"),
     "par12": (lambda: Robot.from_dh(_parallel12_rows(), name="par12"), "pieper_general"),
+    "stanford_offset": (lambda: Robot.from_dh(_stanford_offset_rows(), name="stanford_offset"),
+                        "stanford_general"),
 }
 
 
@@ -196,6 +206,7 @@ VARIANT_ZEROS = {
     "pieper": ("a1", "a4", "a5", "d5"),
     "skew": ("a4", "a5", "d5"),
     "par12": ("a4", "a5", "d5"),
+    "stanford_offset": ("a4", "a5", "d5"),
 }
 
 
@@ -303,6 +314,28 @@ def test_base_and_tool_invariance(name, seed):
     np.testing.assert_allclose(ik_all(moved, B @ T @ E), ik_all(robot, T), atol=1e-8)
 
 
+@settings(max_examples=30, deadline=None)
+@given(a=st.lists(_zero_or_away(0.05, 0.5), min_size=3, max_size=3),
+       alpha=st.lists(_zero_or_away(0.2, 2.9), min_size=3, max_size=3),
+       d=st.lists(_zero_or_away(0.05, 0.5), min_size=4, max_size=4),
+       theta3=st.floats(-3.0, 3.0), seed=st.integers(0, 2**31 - 1))
+def test_any_rrp_arm_with_spherical_wrist(a, alpha, d, theta3, seed):
+    """Any well-conditioned R R P arm followed by a spherical wrist is solved (Stanford class)."""
+    rows = [DHLink(a=a[0], alpha=alpha[0], d=d[0]), DHLink(a=a[1], alpha=alpha[1], d=d[1]),
+            DHLink(a=a[2], alpha=alpha[2], d=d[2], theta=theta3, type="P", qlim=(-1.0, 1.0)),
+            DHLink(a=0.0, alpha=-H, d=d[3]), DHLink(a=0.0, alpha=H, d=0.0),
+            DHLink(a=0.0, alpha=0.0, d=0.1)]
+    robot = Robot.from_dh(rows, base=_random_transform(np.random.default_rng(seed)))
+    try:
+        kind = classify(robot)
+    except NoClosedFormError as exc:  # degenerate draws: the message says which test failed
+        assert "coincide" in str(exc) or "cannot" in str(exc)
+        return
+    assert kind in ("stanford", "stanford_general")
+    counts = _check_round_trips(robot, 5, seed=seed, tol=1e-8)
+    assert max(counts) <= 8
+
+
 def test_eight_solutions_without_limits():
     """Unlimited Puma 560 and Pieper arm: 8 solutions per pose; UR5: 8 for most, never more."""
     for robot in (models.puma560(), Robot.from_dh(_pieper_rows())):
@@ -313,7 +346,8 @@ def test_eight_solutions_without_limits():
     assert max(counts) == 8 and counts.count(8) >= 20, counts
 
 
-@pytest.mark.parametrize("name", ["ur5", "puma560", "pieper", "skew", "par12"])
+@pytest.mark.parametrize("name", ["ur5", "puma560", "pieper", "skew", "par12",
+                                  "stanford_offset"])
 def test_solution_set_is_complete(name):
     """Least squares from 30 random starts finds no solution missing from ik_all's set."""
     optimize = pytest.importorskip("scipy.optimize")

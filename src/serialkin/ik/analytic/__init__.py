@@ -15,6 +15,7 @@ class                       structure                                           
 ``pieper_intersecting``     6R, spherical wrist, axes 1 and 2 intersect           8
 ``pieper_general``          6R, spherical wrist, other R R R arms (Pieper)         8
 ``stanford``                R R P + spherical wrist, axes 1 and 2 intersect       8
+``stanford_general``        R R P + spherical wrist, other arms                   8
 ``ur``                      6R, axes 2 ∥ 3 ∥ 4, axes 5 and 6 intersect            8
 ==========================  ====================================================  =====
 
@@ -193,7 +194,7 @@ def _parse_target(p: _Prepared, robot: Robot, target: object) -> tuple[np.ndarra
         T[:3, 3] = a
         return T, False
     if a.shape == (3,) and kind in ("puma", "pieper_intersecting", "pieper_general", "stanford",
-                                    "ur", "scara"):
+                                    "stanford_general", "ur", "scara"):
         raise NoClosedFormError(
             f"robot {robot.name!r} ({kind}) has infinitely many solutions for a position-only "
             f"target: the orientation is free. Give ik_all a 4x4 pose, or {NUMERICAL_HINT}")
@@ -292,12 +293,12 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         arm = ("puma", "pieper_intersecting", "pieper_general").index(kind)
         k = solve_spherical_wrist(T, p.W, p.P, p.M, p.aux, arm,
                                   p.revolute, p.qlim, p.mid, p.F, p.meta, tol_p, tol, out)
-    elif kind == "stanford":
+    elif kind in ("stanford", "stanford_general"):
         from serialkin.ik.analytic.stanford import solve_stanford
 
         out = np.empty((8, 6))
-        k = solve_stanford(T, p.W, p.P, p.M, p.aux, p.revolute, p.qlim, p.mid, p.F, p.meta,
-                           tol_p, tol, out)
+        k = solve_stanford(T, p.W, p.P, p.M, p.aux, kind == "stanford_general", p.revolute,
+                           p.qlim, p.mid, p.F, p.meta, tol_p, tol, out)
     else:  # "ur"
         from serialkin.ik.analytic.ur import solve_ur
 

@@ -24,6 +24,8 @@ Recognised classes (:data:`CLASSES`):
     parallel with axes 2, 3 not): up to 8.
 ``stanford``
     R R P with intersecting axes 1, 2 followed by a spherical wrist: up to 8.
+``stanford_general``
+    R R P with a spherical wrist whose axes 1 and 2 do not meet (quartic in the stroke).
 ``ur``
     6R with three consecutive parallel axes 2, 3, 4 (axis 1 not parallel to them) and
     intersecting axes 5, 6 (Universal Robots class): up to 8 solutions.
@@ -59,6 +61,7 @@ CLASSES: dict[str, str] = {
     "pieper_intersecting": "6R, spherical wrist, intersecting axes 1 and 2 (Pieper)",
     "pieper_general": "any other 6R with a spherical wrist (Pieper's quartic)",
     "stanford": "RRP arm with intersecting axes 1 and 2 and a spherical wrist (Stanford arm)",
+    "stanford_general": "any other RRP arm with a spherical wrist",
     "ur": "6R, three parallel axes 2, 3, 4 and intersecting axes 5, 6 (UR class)",
 }
 
@@ -249,6 +252,13 @@ def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons) -> Structure | 
         reasons.append(f"the arm joints are {types[:3]}; closed forms need RRR or RRP")
         return None
     p12 = _sin_angle(W[0], W[1]) < ANGLE_TOL
+    if types[:3] == "RRP":  # the wrist centre slides on the line (wrist, W[2])
+        for k in (0, 1):
+            if _sin_angle(W[k], W[2]) < ANGLE_TOL and \
+                    _point_line_distance(wrist, P[k], W[k]) < ltol:
+                reasons.append(f"the wrist centre slides along axis {k + 1}, which then "
+                               "cannot move it")
+                return None
     if types[:3] == "RRR":
         if _sin_angle(W[0], W[2]) < ANGLE_TOL and _point_line_distance(P[2], P[0], W[0]) < ltol:
             reasons.append("axes 1 and 3 coincide")
@@ -270,8 +280,9 @@ def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons) -> Structure | 
     if p12 and d12 < ltol:
         reasons.append("axes 1 and 2 coincide")
         return None
-    if p12 and types[:3] == "RRP":
-        reasons.append("the arm is R R P with parallel axes 1 and 2")
+    if p12 and types[:3] == "RRP" and abs(W[1] @ W[2]) < ANGLE_TOL:
+        reasons.append("the arm is R R P with parallel axes 1 and 2 and a slide perpendicular "
+                       "to them: the wrist centre cannot leave a plane")
         return None
     if d12 < ltol:
         o = _closest_point(P[0], W[0], P[1], W[1])
@@ -283,10 +294,6 @@ def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons) -> Structure | 
             return None
         return Structure("pieper_intersecting", W, P, M, rev, np.array([wrist, o, v]), none,
                          False, scale)
-    if types[:3] == "RRP":
-        reasons.append(f"the arm is R R P but axes 1 and 2 do not intersect ({d12:.3g} m "
-                       "apart)")
-        return None
     if p12:  # parallel axes 1, 2: any common perpendicular
         r1 = P[0]
         r2 = P[1] + ((P[0] - P[1]) @ W[1]) * W[1]
@@ -295,7 +302,8 @@ def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons) -> Structure | 
         r2 = _closest_point_on_first(P[1], W[1], P[0], W[0])
     nvec = (r2 - r1) / np.linalg.norm(r2 - r1)
     aux = np.array([wrist, r1, r2, nvec, np.cross(W[1], nvec), v])
-    return Structure("pieper_general", W, P, M, rev, aux, none, False, scale)
+    kind = "stanford_general" if types[:3] == "RRP" else "pieper_general"
+    return Structure(kind, W, P, M, rev, aux, none, False, scale)
 
 
 def _six_dof(robot, W, P, M, rev, scale, ltol) -> Structure:
