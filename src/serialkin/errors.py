@@ -29,6 +29,10 @@ class RobotDefinitionError(InputError):
     """
 
 
+class OutputError(SerialkinError, OSError):
+    """An output file or folder cannot be written (the message names the path)."""
+
+
 class SingularityError(SerialkinError, ValueError):
     """A quantity is undefined at this configuration (e.g. a representation singularity)."""
 

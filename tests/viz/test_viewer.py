@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from serialkin import Joint, Robot
-from serialkin.errors import InputError
+from serialkin.errors import InputError, OutputError
 from serialkin.viz.viewer import THREE_REVISION, viewer_data, viewer_html, write_viewer
 
 
@@ -105,8 +105,8 @@ def test_write_viewer_atomic(tmp_path, planar3):
 
 
 def test_write_viewer_unwritable(tmp_path, planar3):
-    """An output folder that cannot be created gives an InputError naming the path."""
+    """An output folder that cannot be created gives an OutputError naming the path."""
     blocker = tmp_path / "file"
     blocker.write_text("x")
-    with pytest.raises(InputError, match="cannot write"):
+    with pytest.raises(OutputError, match="cannot write"):
         write_viewer(planar3, blocker / "sub" / "view.html")

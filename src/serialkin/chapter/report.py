@@ -13,13 +13,14 @@ import html
 import importlib
 import io
 import os
-import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from serialkin._io import write_bytes_atomic, write_text_atomic
 
 #: Section modules in chapter order (module name under serialkin.chapter.sections).
 SECTION_MODULES: tuple[str, ...] = (
@@ -110,24 +111,6 @@ class ReportContext:
     def code(text: str) -> str:
         """Preformatted text (e.g. LaTeX or printed sympy)."""
         return f"<pre>{html.escape(text)}</pre>"
-
-
-def write_bytes_atomic(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file and a rename (never truncated)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write text (UTF-8) atomically, see :func:`write_bytes_atomic`."""
-    write_bytes_atomic(path, text.encode("utf-8"))
 
 
 _CSS = """

@@ -345,7 +345,7 @@ def save_robot_file(robot: Any, path: str | os.PathLike[str], *, angle_unit: str
     Returns:
         The path written.
     """
-    from serialkin.chapter.report import write_text_atomic
+    from serialkin._io import write_text_atomic
 
     p = Path(path)
     if p.suffix.lower() not in ROBOT_FILE_SUFFIXES:

@@ -17,12 +17,12 @@ import csv
 import io
 import json
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path as FsPath
 
 import numpy as np
 
+from serialkin._io import write_bytes_atomic
 from serialkin.errors import InputError
 
 __all__ = ["PathFailure", "Trajectory"]
@@ -39,18 +39,6 @@ class PathFailure:
     def __str__(self) -> str:
         t = ", ".join(f"{v:.4g}" for v in self.target)
         return f"path point {self.index} ({t}) not reached: error {self.error:.4g} m"
-
-
-def _write_atomic(path: FsPath, data: bytes) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        FsPath(tmp).unlink(missing_ok=True)
-        raise
 
 
 @dataclass
@@ -161,9 +149,9 @@ class Trajectory:
                 iterations=self.iterations, reached=self.reached, clearance=self.clearance,
                 limit_margin=self.limit_margin, times=self.times,
                 meta=np.array(json.dumps(self._meta())))
-            _write_atomic(p, buf.getvalue())
+            write_bytes_atomic(p, buf.getvalue())
         elif suffix == ".csv":
-            _write_atomic(p, self._csv().encode("utf-8"))
+            write_bytes_atomic(p, self._csv().encode("utf-8"))
         else:
             raise InputError(f"trajectory file must end in .csv or .npz, got {p.name!r}")
         return p

@@ -22,8 +22,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from serialkin._checks import check_choice, check_int, check_positive
+from serialkin._io import write_bytes_atomic
 from serialkin.errors import InputError, NotSupportedError
-from serialkin.viz._io import write_bytes_atomic
 from serialkin.viz.plot import (
     FRAMES_GID,
     JOINTS_GID,

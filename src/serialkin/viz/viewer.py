@@ -36,8 +36,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from serialkin._checks import as_float_array
+from serialkin._io import write_text_atomic
 from serialkin.errors import InputError
-from serialkin.viz._io import write_text_atomic
 from serialkin.viz.plot import as_obstacle, robot_points, robot_scale
 
 if TYPE_CHECKING:
