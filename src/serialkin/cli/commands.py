@@ -52,9 +52,10 @@ def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
 
 json_option = click.option("--json", "as_json", is_flag=True,
                            help="Print the results as JSON (SI units) instead of a table.")
-quiet_option = click.option("--quiet", "-q", is_flag=True,
-                            help="Print nothing but errors (and JSON with --json); no "
-                                 "progress bar.")
+_QUIET_HELP = "Print nothing but errors (and JSON with --json); no progress bar."
+quiet_option = click.option("--quiet", "-q", is_flag=True, help=_QUIET_HELP)
+#: For commands with a --q option, where a short -q would be confusing.
+quiet_long_option = click.option("--quiet", is_flag=True, help=_QUIET_HELP)
 degrees_option = click.option("--degrees", "-d", is_flag=True,
                               help="Joint angles, rpy and φ in degrees (input and table).")
 out_option = click.option("--out", "-o", "out", type=click.Path(dir_okay=False),
@@ -252,7 +253,7 @@ _FK_CMD_HELP = command_help(
 @param_option
 @json_option
 @out_option
-@quiet_option
+@quiet_long_option
 @handle_errors
 def fk_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frames: bool,
            degrees: bool, params: tuple[str, ...], as_json: bool, out: str | None,
@@ -336,7 +337,7 @@ _JACOBIAN_CMD_HELP = command_help(
 @param_option
 @json_option
 @out_option
-@quiet_option
+@quiet_long_option
 @handle_errors
 def jacobian_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frame: str,
                  link: int | None, point: str | None, planar: bool, task: str, degrees: bool,

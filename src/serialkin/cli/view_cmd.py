@@ -8,7 +8,7 @@ from typing import Any
 import click
 import numpy as np
 
-from serialkin.cli.commands import _angle_factor, handle_errors, json_option, quiet_option
+from serialkin.cli.commands import _angle_factor, handle_errors, json_option, quiet_long_option
 from serialkin.cli.io import CLIError, command_help, dumps_json, ensure_dir, parse_numbers
 from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot
 
@@ -68,7 +68,7 @@ def _is_serialkin_csv(p: Path) -> bool:
 @click.option("--degrees", "-d", is_flag=True, help="--q angles in degrees.")
 @param_option
 @json_option
-@quiet_option
+@quiet_long_option
 @handle_errors
 def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
              scenario: str | None, title: str | None, out: str, open_browser: bool,
