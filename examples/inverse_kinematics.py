@@ -41,6 +41,10 @@ for robot in (sk.models.ur5(), sk.models.panda()):
               f"{r.position_error:>13.1e}{r.orientation_error:>15.1e}{ms:>11.2f}")
         if r.success:  # a success always means FK(q) reproduces the target within tol
             assert robot.within_limits(r.q)
+    # CCD converges linearly: at the default tol = 1e-9 it may spend its whole budget on a
+    # full 6-D pose (success=False, with its best errors); a looser tolerance suits it
+    r = robot.ik(T_target, method="ccd", tol=1e-6, seed=0)
+    print(f"  ccd with tol=1e-6: success={r.success} after {r.iterations} sweeps")
 
 # --- 2. Position-only targets and masks ----------------------------------------------------
 panda = sk.models.panda()
