@@ -261,3 +261,12 @@ def test_planar_boundary_has_outer_and_inner_rims():
     radii = sorted(float(np.linalg.norm(line, axis=1).mean()) for line in lines)
     h = ws.grid.cell
     assert abs(radii[0] - 0.4) < 2 * h and abs(radii[1] - 1.6) < 2 * h
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.floats(0.1, 2.0), st.floats(0.1, 2.0), st.integers(0, 2**31 - 1),
+       st.sampled_from([100_000, 250_000]))
+def test_two_link_bound_holds_for_random_arms(L1, L2, seed, samples):
+    """For random lengths, seeds and sample counts the stated bound contains the true area."""
+    ws = reachable_workspace(_planar(L1, L2), samples, seed=seed, progress=False)
+    assert abs(ws.estimate.value - _annulus(L1, L2)) <= ws.estimate.error
