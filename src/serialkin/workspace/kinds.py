@@ -132,7 +132,7 @@ def _is_planar(robot: Any, planar: bool | None) -> bool:
 
 
 def _cell_size(points: np.ndarray, cell: float | None, resolution: int | None,
-               planar: bool, per_cell: float = 25.0) -> float:
+               planar: bool, per_cell: float = 12.0) -> float:
     """Cell edge [m] for a grid of ``points``.
 
     ``cell`` if given; else the extent / ``resolution``, coarsened when the samples are
