@@ -302,3 +302,21 @@ def test_singular_best_attempt_hint(two_link):
     res = two_link.ik(np.array([1.5, 1.5]), seed=0, restarts=3)
     assert not res.success
     assert "singular configuration" in res.reason and "out of reach" in res.reason
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    mask=st.lists(st.booleans(), min_size=6, max_size=6).filter(any),
+)
+def test_any_mask_property(seed, mask):
+    """For any non-empty mask, IK of FK(q) matches exactly the selected coordinates."""
+    robot = models.ur5()
+    q = robot.random_q(seed=seed)
+    T = robot.fk(q)
+    res = robot.ik(T, mask=mask, seed=seed)
+    assert_reaches(robot, res, T, weights=np.array(mask, float))
+    if not any(mask[:3]):
+        assert res.position_error == 0.0
+    if not any(mask[3:]):
+        assert res.orientation_error == 0.0
