@@ -517,15 +517,22 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol,
                 dq[j] = alpha * g[j]
         elif method == DLS:
             lam2 = params[P_DAMPING] * params[P_DAMPING]
-            for i in range(6):
-                for k in range(i, 6):
-                    s = 0.0
-                    for j in range(n):
-                        s += Jw[i, j] * Jw[k, j]
-                    M6[i, k] = s
-                    M6[k, i] = s
-                M6[i, i] += lam2
-            if not _chol_solve(M6, r, y6, 6):
+            for _retry in range(2):
+                d = 0.0
+                for i in range(6):
+                    for k in range(i, 6):
+                        s = 0.0
+                        for j in range(n):
+                            s += Jw[i, j] * Jw[k, j]
+                        M6[i, k] = s
+                        M6[k, i] = s
+                    d = max(d, M6[i, i])
+                for i in range(6):
+                    M6[i, i] += lam2
+                if _chol_solve(M6, r, y6, 6):
+                    break
+                lam2 += 1e-12 * (1.0 + d)  # singular JJᵀ with λ = 0: retry with a floor
+            else:
                 return it, False, cost
             for j in range(n):
                 s = 0.0
@@ -541,10 +548,18 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol,
                 wn = lam * cost
             else:
                 wn = cost + lam
+            d = 0.0
             for i in range(n):
+                d = max(d, A[i, i])
                 A[i, i] += wn
             if not _chol_solve(A, g, dq, n):
-                return it, False, cost
+                # singular normal matrix with a vanishing damping (e.g. a redundant arm
+                # at convergence): retry with a 1e-12 relative floor
+                _normal(Jw, r, A, g)
+                for i in range(n):
+                    A[i, i] += wn + 1e-12 * (1.0 + d)
+                if not _chol_solve(A, g, dq, n):
+                    return it, False, cost
         elif method == PINV or method == NEWTON:
             _pinv_step(Jw, r, dq, params[P_RCOND])
             if method == PINV:
