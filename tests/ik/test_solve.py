@@ -320,3 +320,22 @@ def test_any_mask_property(seed, mask):
         assert res.position_error == 0.0
     if not any(mask[3:]):
         assert res.orientation_error == 0.0
+
+
+@pytest.mark.peer
+@pytest.mark.parametrize("name", ["ur5", "panda"])
+def test_solution_checked_by_pinocchio(name):
+    """Pinocchio's FK of our IK answers (model from our URDF) reproduces the targets."""
+    pin = pytest.importorskip("pinocchio")
+    robot = models.get(name)
+    model = pin.buildModelFromXML(robot.to_urdf())
+    data = model.createData()
+    fid = model.getFrameId("tool")
+    _, targets = reachable(robot, 10, seed=95)
+    res = robot.ik(targets, seed=0)
+    assert res.success.all()
+    for q, T in zip(res.q, targets):
+        pin.framesForwardKinematics(model, data, q)
+        M = data.oMf[fid]
+        assert np.linalg.norm(M.translation - T[:3, 3]) < ACCURACY
+        assert np.linalg.norm(pin.log3(M.rotation @ T[:3, :3].T)) < ACCURACY
