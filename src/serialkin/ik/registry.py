@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from serialkin._checks import check_choice
+from serialkin.errors import InputError
 
 if TYPE_CHECKING:
     import numpy as np
@@ -54,12 +55,14 @@ class MethodSpec:
         options: method-specific keyword options and their defaults.
         kernel_code: method code of the compiled kernel, or None for a Python method.
         attempt: the Python attempt function (see :data:`AttemptFn`), or None.
-        solve: a callable that solves one target entirely on its own,
+        solve: a callable that solves one target entirely on its own (the closed-form
+            method, which needs neither restarts nor iterations), or None:
             ``solve(robot, problem, q0, options) -> (q, success, iterations, reason)``
             with ``problem`` an :class:`~serialkin.ik.solver.IKProblem` and ``q0`` (n,)
-            or None
-            (used by the closed-form method, which needs neither restarts nor
-            iterations), or None.
+            or None.
+
+    Raises:
+        InputError: not exactly one of ``kernel_code``, ``attempt``, ``solve`` given.
     """
 
     name: str
@@ -76,7 +79,7 @@ class MethodSpec:
 
     def __post_init__(self) -> None:
         if (self.kernel_code is None) + (self.attempt is None) + (self.solve is None) != 2:
-            raise ValueError(
+            raise InputError(
                 f"method {self.name!r} needs exactly one of kernel_code, attempt, solve"
             )
 
