@@ -14,7 +14,6 @@ import json
 import math
 import os
 import sys
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -147,32 +146,20 @@ def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
 
 
 def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
-    """Write bytes atomically (temporary file in the same folder + ``os.replace``)."""
+    """Write bytes atomically after checking the folder; errors become CLIError.
+
+    Delegates to :func:`serialkin._io.write_bytes_atomic` (temporary file in the same
+    folder + rename), the one atomic writer of serialkin.
+    """
+    from serialkin._io import write_bytes_atomic as _write
+    from serialkin.errors import OutputError
+
     p = Path(path)
     ensure_dir(p.parent)
     try:
-        fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=".tmp")
-    except OSError as exc:
-        raise CLIError(f"cannot write {p}: folder {p.parent} is not writable "
-                       f"({exc.strerror or exc})") from exc
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp creates 0600; give the usual mode
-        os.replace(tmp, p)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        raise CLIError(f"cannot write {p} ({exc.strerror or exc})") from exc
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return p
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
+        return _write(p, data)
+    except OutputError as exc:
+        raise CLIError(str(exc)) from exc
 
 
 def ensure_dir(folder: str | os.PathLike[str]) -> Path:
