@@ -24,12 +24,12 @@ from serialkin._io import write_bytes_atomic, write_text_atomic
 
 #: Section modules in chapter order (module name under serialkin.chapter.sections).
 SECTION_MODULES: tuple[str, ...] = (
+    "workspace",
     "rigid_motion",
     "forward",
     "jacobian",
     "inverse",
     "redundancy",
-    "workspace",
 )
 
 
