@@ -136,7 +136,7 @@ def test_unreachable_target_fails_cleanly(puma):
     assert "no configuration within" in res.reason
     assert "the target is out of reach: it is 3.04 m from joint 1" in res.reason
     assert np.isfinite(res.q).all() and puma.within_limits(res.q)
-    assert res.iterations <= 21 * 50
+    assert res.iterations <= 21 * 50 + 50  # attempts, then the lm polish
     assert res.restarts == 20
     assert elapsed < 5.0
     # the best attempt is a genuine attempt: closer than the reach allows is impossible

@@ -75,7 +75,7 @@ register_method(MethodSpec(
     limits="limit-aware step: joints at a limit whose step points outward are frozen and "
     "the step recomputed for the others; then " + _PROJECTION,
     max_iter=100, restarts=100,
-    options={"damping": 0.03, "stall_window": 10, "polish": True}, kernel_code=K.LM,
+    options={"damping": 0.03, "stall_window": 5, "polish": True}, kernel_code=K.LM,
 ))
 register_method(MethodSpec(
     name="lm_wampler", family="jacobian",

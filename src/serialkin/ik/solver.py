@@ -15,7 +15,8 @@ Both follow the same semantics:
   from a configuration drawn uniformly inside the joint limits (unlimited revolute joints:
   [-π, π]; unlimited prismatic joints: [-1, 1] m), at most ``restarts`` times;
 * **budget** — at most ``max_iter`` iterations per attempt, so at most
-  ``(restarts + 1)·max_iter`` in total: a solve always ends;
+  ``(restarts + 1)·max_iter`` in total (plus ``max_iter`` for the final polish of the
+  ``lm`` method): a solve always ends;
 * **tolerance** — success when the position error [m] and the orientation error [rad]
   of the selected task coordinates are both ≤ ``tol`` (default :data:`DEFAULT_TOL`), and
   q is inside the limits when ``respect_limits``;
