@@ -192,7 +192,7 @@ def test_unreachable_every_method(method, two_link):
     assert not res.success and res.reason
     assert np.isfinite(res.q).all()
     spec = ik.METHODS[method]
-    assert res.iterations <= 4 * spec.max_iter
+    assert res.iterations <= 5 * spec.max_iter  # 4 attempts (+ the lm polish)
     # the best attempt is at least close to the nearest reachable point (distance 0.55 m)
     assert 0.5 < res.position_error < 1.2
 
