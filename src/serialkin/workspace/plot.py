@@ -89,16 +89,18 @@ def plot_workspace(ws: Workspace, ax: Any = None, *, color_by_manipulability: bo
         ax.set_ylabel("y [m]")
     else:
         if len(P):
-            colour = {"c": w, "cmap": "viridis"} if w is not None else {"color": "C0"}
-            sc = ax.scatter(P[:, 0], P[:, 1], P[:, 2], s=0.5, alpha=0.35, linewidths=0,
-                            rasterized=True, **colour)
-            if w is not None:
-                plt.colorbar(sc, ax=ax, label="manipulability", shrink=0.6, pad=0.1)
+            # colour by manipulability, or by height for depth
+            colour = w if w is not None else P[:, 2]
+            sc = ax.scatter(P[:, 0], P[:, 1], P[:, 2], s=2.0, alpha=0.5, linewidths=0,
+                            c=colour, cmap="viridis", rasterized=True)
+            plt.colorbar(sc, ax=ax, label="manipulability" if w is not None else "z [m]",
+                         shrink=0.6, pad=0.12)
             lo, hi = P.min(axis=0), P.max(axis=0)
             c, r = (lo + hi) / 2, (hi - lo).max() / 2
             ax.set_xlim(c[0] - r, c[0] + r)
             ax.set_ylim(c[1] - r, c[1] + r)
             ax.set_zlim(c[2] - r, c[2] + r)
+            ax.set_box_aspect((1, 1, 1))
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
         ax.set_zlabel("z [m]")
