@@ -43,6 +43,7 @@ from serialkin.ik.analytic.subproblems import (
     mtv,
     mv,
     planar2r,
+    poly_roots,
     rotation,
     screw,
     sp1_dir,
@@ -245,7 +246,8 @@ def _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas):
     """Real roots θ3 of E(θ3) (degree-2 trigonometric polynomial) into ``thetas``; the count.
 
     The Fourier coefficients c0, c1, c2 of E come exactly from 5 equally spaced samples;
-    the roots of ``z²·E(z)`` (z = e^{iθ}) near the unit circle are polished by Newton's
+    the roots of ``z²·E(z)`` (z = e^{iθ}) near the unit circle
+    (:func:`~serialkin.ik.analytic.subproblems.poly_roots`) are polished by Newton's
     method on E and kept when E vanishes there.
     """
     coef = np.zeros(3, dtype=np.complex128)
@@ -265,12 +267,11 @@ def _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas):
     big = max(abs(poly[0]), abs(poly[1]), abs(poly[2]))
     if big <= 1e-12 * max(scale, 1e-300):
         return 0  # E(θ3) ≡ 0: a continuum of solutions (excluded by the structure test)
-    if abs(poly[0]) > 1e-13 * big:
-        roots = np.roots(poly)
-    else:
-        roots = np.roots(poly[1:4]) if abs(poly[1]) > 1e-13 * big else np.roots(poly[2:3])
+    # when c2 vanishes both ends of z²·E do: drop the z factor (no spurious root z = 0)
+    roots = np.empty(4, dtype=np.complex128)
+    nr = poly_roots(poly if abs(poly[0]) > 1e-13 * big else poly[1:4], roots)
     count = 0
-    for z in roots:
+    for z in roots[:nr]:
         if abs(abs(z) - 1.0) > 1e-3 or count == thetas.shape[0]:
             continue
         th = math.atan2(z.imag, z.real)

@@ -29,6 +29,7 @@ from serialkin.ik.analytic.subproblems import (
     finalize,
     mm,
     mv,
+    poly_roots,
     rotation,
     sp1_dir,
     sp2_dir,
@@ -95,10 +96,11 @@ def general_stanford_candidates(T, W, P, M, aux, out):
     As in :func:`~serialkin.ik.analytic.spherical_wrist.general_candidates` with the
     slide in place of joint 3: u(d) = c + d·w3 − r2 is linear in the stroke d, so
     g1 = (|p_w − r1|² − |u|² − a1²)/(2 a1) is quadratic, g2 = (w1·(p_w − r1) − cα w2·u)/sα
-    linear, and E(d) = g1² + g2² − (|u|² − (w2·u)²) is a quartic in d, solved by its
-    companion matrix and polished by Newton's method; then q2 = atan2(g2, g1) −
-    atan2(m·u, n·u) and q1 by subproblem 1. With parallel axes 1, 2 (sα = 0) the
-    height w2·u(d) = cα·w1·(p_w − r1) gives d directly and g2 = ±sqrt(..).
+    linear, and E(d) = g1² + g2² − (|u|² − (w2·u)²) is a quartic in d, solved by
+    :func:`~serialkin.ik.analytic.subproblems.poly_roots` and polished by Newton's
+    method; then q2 = atan2(g2, g1) − atan2(m·u, n·u) and q1 by subproblem 1. With
+    parallel axes 1, 2 (sα = 0) the height w2·u(d) = cα·w1·(p_w − r1) gives d directly
+    and g2 = ±sqrt(..).
     """
     c = aux[0].copy()
     r1 = aux[1].copy()
@@ -137,7 +139,8 @@ def general_stanford_candidates(T, W, P, M, aux, out):
         N0 = dot3(h0, h0) - wh * wh
         coefs = np.array([K2 * K2, 2.0 * K1 * K2, K1 * K1 + 2.0 * K0 * K2 + L1 * L1 - N2,
                           2.0 * K0 * K1 + 2.0 * L0 * L1 - N1, K0 * K0 + L0 * L0 - N0])
-        roots = np.roots(coefs.astype(np.complex128))
+        roots = np.empty(4, dtype=np.complex128)
+        roots = roots[:poly_roots(coefs.astype(np.complex128), roots)]
         big = 0.0
         for cf in coefs:
             big = max(big, abs(cf))

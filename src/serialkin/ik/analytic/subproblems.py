@@ -366,6 +366,58 @@ def rigid_error(T):
 
 
 @njit(cache=True)
+def poly_roots(coefs, out):
+    """Complex roots of a polynomial of degree <= 4 (Aberth–Ehrlich iteration).
+
+    Args:
+        coefs: (m,) complex coefficients, highest degree first; leading coefficients
+            below 1e-13 of the largest are dropped (the degree falls).
+        out: (4,) complex output.
+
+    Returns:
+        the number of roots written (the degree). Simple roots converge cubically;
+        callers polish the real roots they keep on their own equation.
+    """
+    big = 0.0
+    for c in coefs:
+        big = max(big, abs(c))
+    start = 0
+    while start < coefs.shape[0] and abs(coefs[start]) <= 1e-13 * big:
+        start += 1
+    deg = coefs.shape[0] - 1 - start
+    if deg <= 0:
+        return 0
+    a = coefs[start:] / coefs[start]
+    radius = 0.0
+    for k in range(1, deg + 1):
+        radius = max(radius, abs(a[k]) ** (1.0 / k))
+    for k in range(deg):
+        out[k] = radius * np.exp(1j * (2.0 * math.pi * k / deg + 0.4))
+    for _ in range(100):
+        moved = 0.0
+        for k in range(deg):
+            z = out[k]
+            p = a[0]
+            dp = 0.0 + 0.0j
+            for j in range(1, deg + 1):
+                dp = dp * z + p
+                p = p * z + a[j]
+            if p == 0.0:
+                continue
+            ratio = p / dp if dp != 0.0 else p
+            s = 0.0 + 0.0j
+            for j in range(deg):
+                if j != k:
+                    s += 1.0 / (z - out[j])
+            step = ratio / (1.0 - ratio * s)
+            out[k] = z - step
+            moved = max(moved, abs(step) / max(1.0, abs(z)))
+        if moved < 1e-12:  # the callers polish with Newton's method on their equation
+            break
+    return deg
+
+
+@njit(cache=True)
 def _lex_less(a, b):
     for j in range(a.shape[0]):
         if a[j] < b[j]:
