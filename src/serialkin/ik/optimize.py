@@ -27,8 +27,8 @@ afterwards (same pose). Both methods stop as soon as the selected position and
 orientation errors are within the tolerance (checked in a callback after every
 iteration), else on scipy's own convergence tests (set far below the tolerance) or the
 iteration budget; the shared loop then restarts from a random configuration. Their
-documented tolerance is that of every method: 1e-6 m and 1e-6 rad by default, reached
-on full-pose targets when they converge (use restarts).
+documented tolerance is that of every method (``serialkin.ik.DEFAULT_TOL``: 1e-9 m and
+1e-9 rad), reached on full-pose targets when they converge (use restarts).
 
 They are much slower than the compiled Jacobian methods (a Python call per cost
 evaluation): they are here to make the chapter's comparison measurable, not to be the
