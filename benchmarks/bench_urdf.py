@@ -15,9 +15,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from tests.erd import urdf  # noqa: E402
+
 import serialkin as sk  # noqa: E402
 from serialkin.model.dh_extract import to_dh_robot  # noqa: E402
-from tests.erd import urdf  # noqa: E402
 
 
 def best_us(fn, number: int) -> float:
@@ -36,9 +37,10 @@ def main() -> None:
     for r in (r_urdf, r_dh):  # compile / warm up
         r.fk(q), r.jacobian(q)
     rows = [("import Panda URDF (parse + chain)", t_import, float("nan"))]
-    for label, fn in (("fk", "fk"), ("jacobian", "jacobian")):
-        a = best_us(lambda f=getattr(r_urdf, fn): f(q), 20000)
-        b = best_us(lambda f=getattr(r_dh, fn): f(q), 20000)
+    for label in ("fk", "jacobian"):
+        f_urdf, f_dh = getattr(r_urdf, label), getattr(r_dh, label)
+        a = best_us(lambda f=f_urdf: f(q), 20000)
+        b = best_us(lambda f=f_dh: f(q), 20000)
         rows.append((f"{label} (URDF model | DH model)", a, b))
     print(f"{'measure':40s} {'URDF [us]':>10s} {'DH [us]':>10s} {'ratio':>7s}")
     for name, a, b in rows:
