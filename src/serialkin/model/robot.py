@@ -40,22 +40,40 @@ PARALLEL_MIN_BATCH = 256
 _ENTRY: dict[str, Any] = {}
 
 
-def _entry(name: str, *example: np.ndarray) -> Any:
-    """Compiled entry point of kernel ``name`` for exactly the types of ``example``.
+def _entry(name: str, *example: object) -> Any:
+    """Compiled entry point of kernel ``name`` for exactly the numba types of ``example``.
 
-    Calling it skips numba's per-call type dispatch (about 0.2 µs). The fast paths below
-    call it only with C-contiguous float64 arrays of the right dimensions, the types it
-    was compiled for.
+    Calling it skips numba's per-call type dispatch (about 0.2 µs). The single-call fast
+    paths compile it with ``q`` typed as a 1-D float64 array of any layout ('A'), so any
+    1-D float64 array may be passed; they check dtype, shape and type before calling.
     """
     fn = _ENTRY.get(name)
     if fn is None:
         import numba
 
         dispatcher = getattr(K, name)
-        dispatcher(*example)
         sig = tuple(numba.typeof(a) for a in example)
+        sig = (numba.types.Array(numba.float64, 1, "A"),) + sig[1:]
+        dispatcher.compile(sig)  # loads from numba's cache when it can
         fn = _ENTRY[name] = dispatcher.overloads[sig].entry_point
     return fn
+
+
+_FK = None
+_JAC = None
+
+
+def _fast_kernels() -> tuple[Any, Any]:
+    """Resolve (once) the entry points of the checked FK and Jacobian kernels."""
+    global _FK, _JAC
+    F = np.zeros((2, 4, 4))
+    meta = np.zeros((1, 5))
+    for a in (F, meta):
+        a.setflags(write=False)
+    q, T, J = np.zeros(1), np.empty((4, 4)), np.empty((6, 1))
+    _FK = _entry("fk_checked", q, F, meta, T)
+    _JAC = _entry("jacobian_checked", q, F, meta, J, T)
+    return _FK, _JAC
 
 
 #: Named task-row selections for manipulability and condition number.
@@ -244,10 +262,9 @@ class Robot:
         Returns:
             (4, 4) or (..., 4, 4) homogeneous transforms.
         """
-        if type(q) is np.ndarray and q.dtype is _F64 and q.shape == self._qshape \
-                and q.flags.c_contiguous:
+        if type(q) is np.ndarray and q.dtype is _F64 and q.shape == self._qshape:
             T = np.empty((4, 4))
-            fk = _ENTRY.get("fk_checked") or _entry("fk_checked", q, self._F, self._meta, T)
+            fk = _FK or _fast_kernels()[0]
             if fk(q, self._F, self._meta, T):
                 return T
             raise self._nonfinite(q)
