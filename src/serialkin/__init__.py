@@ -5,14 +5,25 @@ Quick start::
     import numpy as np
     import serialkin as sk
 
-    robot = sk.models.puma560()
+    robot = sk.models.get("puma560")
     T = robot.fk(np.zeros(robot.n))        # (4, 4) tool pose
     J = robot.jacobian(np.zeros(robot.n))  # (6, n), rows [v; ω]
 """
 
-from serialkin import errors, models, spatial
+from serialkin import errors, ik, models, spatial
 from serialkin.errors import SerialkinError
+from serialkin.ik import IKResult
 from serialkin.model import DHLink, Joint, Robot
 
-__all__ = ["DHLink", "Joint", "Robot", "SerialkinError", "errors", "models", "spatial"]
+__all__ = [
+    "DHLink",
+    "IKResult",
+    "Joint",
+    "Robot",
+    "SerialkinError",
+    "errors",
+    "ik",
+    "models",
+    "spatial",
+]
 __version__ = "0.1.0"

@@ -10,6 +10,7 @@ Adding a method family: write a module ``serialkin/ik/<family>.py`` that calls
 package is imported (and so registered) the first time the registry is read.
 """
 
+from serialkin.ik.analytic import classify, ik_all
 from serialkin.ik.compare import CompareTable, compare
 from serialkin.ik.registry import METHODS, MethodSpec, available_methods, register_method
 from serialkin.ik.result import IKResult
@@ -23,7 +24,9 @@ __all__ = [
     "METHODS",
     "MethodSpec",
     "available_methods",
+    "classify",
     "compare",
+    "ik_all",
     "register_method",
     "solve",
 ]

@@ -38,7 +38,6 @@ reported as not recognised, with the measured deviation in the message.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -102,30 +101,14 @@ class Structure:
 def joint_lines(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Joint lines at q = 0 in the world frame, from the compiled chain.
 
-    Joint i's frame just before its motion is ``F[0]·M_1(o_1)·F[1] ··· F[i-1]`` (o =
-    joint offsets, see :mod:`serialkin.kinematics._kernels`); its line has direction
-    ``R·axis_i`` through that frame's origin.
+    These are :meth:`serialkin.Robot.joint_axes` (joint i's frame just before its motion,
+    from the compiled chain) at q = 0.
 
     Returns:
         W (n, 3) unit directions, P (n, 3) points [m], M (4, 4) the pose ``T(0)``.
     """
-    F, meta = robot.chain.F, robot.chain.meta
-    n = robot.n
-    W = np.empty((n, 3))
-    P = np.empty((n, 3))
-    T = F[0].copy()
-    for i in range(n):
-        a = meta[i, :3]
-        W[i] = T[:3, :3] @ a
-        P[i] = T[:3, 3]
-        x = meta[i, 4]
-        A = np.eye(4)
-        if meta[i, 3] == 1:
-            A[:3, 3] = x * a
-        else:
-            K = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
-            A[:3, :3] = np.eye(3) + math.sin(x) * K + (1.0 - math.cos(x)) * (K @ K)
-        T = T @ A @ F[i + 1]
+    P, W = robot.joint_axes()
+    T = robot.fk(np.zeros(robot.n))
     W /= np.linalg.norm(W, axis=1, keepdims=True)
     return W, P, T
 
