@@ -8,6 +8,8 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP_RUN  := $(VENV)/.stamp-run
 STAMP_TEST := $(VENV)/.stamp-test
+STAMP_NUMBA := $(VENV)/.stamp-numba
+SOURCES := $(shell find src -name '*.py')
 
 .PHONY: run test lint bench browser-deps clean
 
@@ -23,7 +25,13 @@ $(STAMP_TEST): pyproject.toml | $(PY)
 	$(PY) -m pip install --quiet -e ".[dev,bench]"
 	touch $@ $(STAMP_RUN)
 
-run: $(STAMP_RUN)
+# numba's on-disk cache only notices edits to a kernel's own file, not to the kernels it
+# calls in other modules: drop every cached kernel whenever any source file changed.
+$(STAMP_NUMBA): $(SOURCES) | $(PY)
+	find src -name '*.nbi' -delete -o -name '*.nbc' -delete
+	touch $@
+
+run: $(STAMP_RUN) $(STAMP_NUMBA)
 	$(VENV)/bin/serialkin chapter --out out/chapter
 
 # Headless Chromium for the viewer tests and ffmpeg for MP4 animations (Debian packages).
@@ -34,7 +42,7 @@ browser-deps:
 	  ( (apt-get update -qq && apt-get install -y -qq chromium chromium-driver ffmpeg >/dev/null) \
 	    || echo "browser-deps: could not install chromium/ffmpeg; those tests will be skipped" )
 
-test: $(STAMP_TEST) browser-deps
+test: $(STAMP_TEST) $(STAMP_NUMBA) browser-deps
 	$(PY) -m pytest -n 2 --dist loadfile
 
 lint: $(STAMP_TEST)
