@@ -63,6 +63,16 @@ out_option = click.option("--out", "-o", "out", type=click.Path(dir_okay=False),
                                "atomically.")
 
 
+def q_options(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """The ``--q`` (repeatable) and ``--q-file`` options, read by :func:`read_q`."""
+    fn = click.option("--q-file", type=click.Path(dir_okay=False),
+                      help="CSV file with one configuration per row (n columns; '-' = "
+                           "stdin).")(fn)
+    return click.option("--q", "q_texts", multiple=True, metavar="Q1,Q2,...",
+                        help="Joint values (repeatable for several configurations). "
+                             "Default: zeros.")(fn)
+
+
 def _angle_factor(robot: Any, degrees: bool) -> np.ndarray:
     """Per-joint factor from the user's unit to SI: π/180 for revolute joints with --degrees."""
     f = np.ones(robot.n)
@@ -97,6 +107,36 @@ def _robot_info(robot: Any) -> dict[str, Any]:
 def _emit(text: str, quiet: bool) -> None:
     if not quiet:
         click.echo(text)
+
+
+def _emit_results(data: dict[str, Any], out: str | None,
+                  csv: Callable[[], tuple[list[str], np.ndarray]], as_json: bool,
+                  quiet: bool) -> bool:
+    """Write ``data`` to ``--out`` and print it as JSON with ``--json``.
+
+    ``csv()`` gives the (header, rows) of a ``.csv`` output file; it is called only
+    with ``--out``. Says ``wrote <path>`` unless ``--json`` or ``--quiet``.
+
+    Returns:
+        True when nothing more goes to standard output (``--json`` or ``--quiet``).
+    """
+    if out:
+        path = write_output(out, data, csv())
+        if not as_json:
+            _emit(f"wrote {path}", quiet)
+    if as_json:
+        click.echo(dumps_json(data), nl=False)
+    return as_json or quiet
+
+
+def _exit_if_unreached(recs: list[dict[str, Any]], why: Callable[[dict[str, Any]], str]
+                       ) -> None:
+    """One stderr line ``target k not reached: why(rec)`` per failed record; exit code 1."""
+    for rec in recs:
+        if not rec["success"]:
+            click.echo(f"target {rec['index']} not reached: {why(rec)}", err=True)
+    if not all(rec["success"] for rec in recs):
+        raise SystemExit(EXIT_NOT_REACHED)
 
 
 # ---------------------------------------------------------------------------- models
@@ -244,10 +284,7 @@ _FK_CMD_HELP = command_help(
 @click.command("fk", help=_FK_CMD_HELP,
                short_help="Forward kinematics: the tool pose for q.")
 @robot_argument
-@click.option("--q", "q_texts", multiple=True, metavar="Q1,Q2,...",
-              help="Joint values (repeatable for several configurations). Default: zeros.")
-@click.option("--q-file", type=click.Path(dir_okay=False),
-              help="CSV file with one configuration per row (n columns; '-' = stdin).")
+@q_options
 @click.option("--frames", is_flag=True, help="Also give every link frame 0..n (eq 11).")
 @degrees_option
 @param_option
@@ -264,18 +301,15 @@ def fk_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frames: boo
     recs = [_fk_record(r, q, frames) for q in Q]
     data = {"robot": _robot_info(r), "units": {"length": "m", "angle": "rad"},
             "results": recs}
-    if out:
+
+    def csv() -> tuple[list[str], np.ndarray]:
         header = ([f"q{i + 1}" for i in range(r.n)] + ["x", "y", "z", "roll", "pitch", "yaw"]
                   + [f"T{i}{j}" for i in range(3) for j in range(4)])
         rows = np.array([np.concatenate([rec["q"], rec["position"], rec["rpy"],
                                          rec["T"][:3].ravel()]) for rec in recs])
-        path = write_output(out, data, (header, rows))
-        if not as_json:
-            _emit(f"wrote {path}", quiet)
-    if as_json:
-        click.echo(dumps_json(data), nl=False)
-        return
-    if quiet:
+        return header, rows
+
+    if _emit_results(data, out, csv, as_json, quiet):
         return
     f = _angle_factor(r, degrees)
     unit = "deg" if degrees else "rad"
@@ -317,10 +351,7 @@ _JACOBIAN_CMD_HELP = command_help(
 @click.command("jacobian", help=_JACOBIAN_CMD_HELP,
                short_help="Geometric Jacobian, manipulability, condition number.")
 @robot_argument
-@click.option("--q", "q_texts", multiple=True, metavar="Q1,Q2,...",
-              help="Joint values (repeatable). Default: zeros.")
-@click.option("--q-file", type=click.Path(dir_okay=False),
-              help="CSV file with one configuration per row (n columns).")
+@q_options
 @click.option("--frame", type=click.Choice(["base", "ee"]), default="base", show_default=True,
               help="Express J in the world/base frame or in the tool frame.")
 @click.option("--link", type=int, default=None,
@@ -369,20 +400,17 @@ def jacobian_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frame
     data = {"robot": _robot_info(r), "frame": frame, "link": link, "point": pt,
             "rows": [names[i] for i in rows_sel], "task": task_name,
             "task_rows": [names[i] for i in task_rows], "results": recs}
-    if out:
+
+    def csv() -> tuple[list[str], np.ndarray]:
         header = [f"q{i + 1}" for i in range(r.n)] + [
             f"J_{names[i]}_{j + 1}" for i in rows_sel for j in range(r.n)
         ] + ["manipulability", "condition_number"]
         table = np.array([np.concatenate([rec["q"], rec["J"].ravel(),
                                           [rec["manipulability"], rec["condition_number"]]])
                           for rec in recs])
-        path = write_output(out, data, (header, table))
-        if not as_json:
-            _emit(f"wrote {path}", quiet)
-    if as_json:
-        click.echo(dumps_json(data), nl=False)
-        return
-    if quiet:
+        return header, table
+
+    if _emit_results(data, out, csv, as_json, quiet):
         return
     f = _angle_factor(r, degrees)
     for k, rec in enumerate(recs):
@@ -531,18 +559,16 @@ def ik_cmd(robot: str | None, targets: tuple[str, ...], target_file: str | None,
     data = {"robot": info, "method": method, "success": ok,
             "solved": sum(rec["success"] for rec in recs), "count": len(recs),
             "units": {"length": "m", "angle": "rad"}, "results": recs}
-    if out:
+
+    def csv() -> tuple[list[str], np.ndarray]:
         header = ["success"] + [f"q{i + 1}" for i in range(r.n)] + [
             "position_error", "orientation_error", "iterations", "restarts"]
         table = np.array([[float(rec["success"]), *rec["q"], rec["position_error"],
                            rec["orientation_error"], rec["iterations"], rec["restarts"]]
                           for rec in recs])
-        path = write_output(out, data, (header, table))
-        if not as_json:
-            _emit(f"wrote {path}", quiet)
-    if as_json:
-        click.echo(dumps_json(data), nl=False)
-    elif not quiet:
+        return header, table
+
+    if not _emit_results(data, out, csv, as_json, quiet):
         unit = "deg" if degrees else "rad"
         trows = [[rec["index"], "yes" if rec["success"] else "NO",
                   fmt_vector(rec["q"] / f, 4),
@@ -551,13 +577,9 @@ def ik_cmd(robot: str | None, targets: tuple[str, ...], target_file: str | None,
         click.echo(f"{r.name}, method {method}:")
         click.echo(format_table(trows, ["#", "ok", f"q [{unit}/m]", "pos err [m]",
                                         "ori err [rad]", "iters", "restarts"], digits=3))
-    for rec in recs:
-        if not rec["success"]:
-            click.echo(f"target {rec['index']} not reached: {rec['reason']} (position error "
-                       f"{rec['position_error']:.3g} m, orientation error "
-                       f"{rec['orientation_error']:.3g} rad)", err=True)
-    if not ok:
-        raise SystemExit(EXIT_NOT_REACHED)
+    _exit_if_unreached(recs, lambda rec: f"{rec['reason']} (position error "
+                                         f"{rec['position_error']:.3g} m, orientation error "
+                                         f"{rec['orientation_error']:.3g} rad)")
 
 
 
@@ -604,23 +626,16 @@ def _ik_all(r: Any, tgts: list[Any], info: dict[str, Any], as_json: bool, out: s
     ok = all(rec["success"] for rec in recs)
     data = {"robot": info, "method": "closed form (all solutions)", "success": ok,
             "units": {"length": "m", "angle": "rad"}, "results": recs}
-    if out:
+
+    def csv() -> tuple[list[str], np.ndarray]:
         header = ["target"] + [f"q{i + 1}" for i in range(r.n)]
         table = np.array([[rec["index"], *q] for rec in recs for q in rec["solutions"]])
-        path = write_output(out, data, (header, table.reshape(-1, r.n + 1)))
-        if not as_json:
-            _emit(f"wrote {path}", quiet)
-    if as_json:
-        click.echo(dumps_json(data), nl=False)
-    elif not quiet:
+        return header, table.reshape(-1, r.n + 1)
+
+    if not _emit_results(data, out, csv, as_json, quiet):
         unit = "deg" if degrees else "rad"
         for rec in recs:
             click.echo(f"target {rec['index']}: {rec['count']} solution(s) [{unit}/m]")
             for q in rec["solutions"]:
                 click.echo("  " + fmt_vector(q / f))
-    for rec in recs:
-        if not rec["success"]:
-            click.echo(f"target {rec['index']} not reached: no closed-form solution inside "
-                       "the joint limits", err=True)
-    if not ok:
-        raise SystemExit(EXIT_NOT_REACHED)
+    _exit_if_unreached(recs, lambda rec: "no closed-form solution inside the joint limits")
