@@ -258,16 +258,8 @@ def constant_orientation_workspace(robot: Any, orientation: object, samples: int
         planar: force 2D/3D (default: ``robot.is_planar``).
         progress: progress bar (None: only on a terminal).
     """
-    pl = _is_planar(robot, planar)
-    R_t = _target_rotation(orientation, pl)
-    N = _default_samples(samples, pl)
-    task = manipulability_task(robot, pl) if manipulability else None
-    Q, P, w = _oriented_samples(robot, R_t, 0.0, N, as_generator(seed), pl, task, progress,
-                                "constant orientation")
-    params = {"orientation": R_t, "manipulability_task": task}
-    if pl:
-        params["phi"] = float(np.arctan2(R_t[1, 0], R_t[0, 0]))
-    return _finish(robot, "constant", pl, Q, P, w, N, seed, cell, resolution, params)
+    return _orientation_range_workspace(robot, "constant", orientation, None, samples, seed,
+                                        cell, resolution, manipulability, planar, progress)
 
 
 def inclusive_orientation_workspace(robot: Any, orientation: object, max_angle: float,
@@ -296,19 +288,37 @@ def inclusive_orientation_workspace(robot: Any, orientation: object, max_angle: 
         planar: force 2D/3D (default: ``robot.is_planar``).
         progress: progress bar (None: only on a terminal).
     """
+    return _orientation_range_workspace(robot, "inclusive", orientation, max_angle, samples,
+                                        seed, cell, resolution, manipulability, planar,
+                                        progress)
+
+
+def _orientation_range_workspace(robot: Any, kind: str, orientation: object,
+                                 max_angle: float | None, samples: int | None, seed: Any,
+                                 cell: float | None, resolution: int | None,
+                                 manipulability: bool, planar: bool | None,
+                                 progress: bool | None) -> Workspace:
+    """Body of the constant- (``max_angle`` None, i.e. 0) and inclusive-orientation kinds.
+
+    Keeps the samples projected onto ``{q : angle(R_target R(q)ᵀ) ≤ max_angle}``.
+    """
     pl = _is_planar(robot, planar)
     R_t = _target_rotation(orientation, pl)
-    ma = check_positive(max_angle, "max_angle", allow_zero=True)
-    if ma > np.pi:
-        raise InputError(f"max_angle must be in [0, π] rad, got {max_angle!r}")
+    params: dict[str, Any] = {"orientation": R_t}
+    ma = 0.0
+    if max_angle is not None:
+        ma = check_positive(max_angle, "max_angle", allow_zero=True)
+        if ma > np.pi:
+            raise InputError(f"max_angle must be in [0, π] rad, got {max_angle!r}")
+        params["max_angle"] = ma
     N = _default_samples(samples, pl)
     task = manipulability_task(robot, pl) if manipulability else None
     Q, P, w = _oriented_samples(robot, R_t, ma, N, as_generator(seed), pl, task, progress,
-                                "inclusive orientation")
-    params: dict[str, Any] = {"orientation": R_t, "max_angle": ma, "manipulability_task": task}
+                                f"{kind} orientation")
+    params["manipulability_task"] = task
     if pl:
         params["phi"] = float(np.arctan2(R_t[1, 0], R_t[0, 0]))
-    return _finish(robot, "inclusive", pl, Q, P, w, N, seed, cell, resolution, params)
+    return _finish(robot, kind, pl, Q, P, w, N, seed, cell, resolution, params)
 
 
 def _orientation_set(orientations: int | Sequence[object], planar: bool, rng: Any
