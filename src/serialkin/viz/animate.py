@@ -227,10 +227,7 @@ def _fix_limits(ax: Any, robot: Robot, P: np.ndarray, path_points: object,
         if pp.shape[1] == 2:
             pp = np.hstack([pp, np.zeros((pp.shape[0], 1))])
         pts.append(pp)
-    for o in obs:
-        ends = [o.center] if o.a is None else [o.a, o.b]
-        for c in ends:
-            pts.append(c[None] + o.radius * np.vstack([np.eye(3), -np.eye(3)]))
+    pts.extend(o.extent_points() for o in obs)
     allp = np.vstack(pts)
     margin = 0.08 * robot_scale(robot)
     lo, hi = allp.min(axis=0) - margin, allp.max(axis=0) + margin

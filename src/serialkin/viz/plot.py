@@ -281,6 +281,16 @@ class Obstacle:
     influence: float = 0.0
     name: str = ""
 
+    def extent_points(self) -> np.ndarray:
+        """Points whose bounding box holds the obstacle's cross-section, for axis limits.
+
+        The centre (a capsule: both end points) moved by ± ``radius`` along x, y and z:
+        (6, 3) or (12, 3) [m]. A cylinder's height is not included.
+        """
+        ends = [self.center] if self.a is None else [self.a, self.b]
+        offsets = self.radius * np.vstack([np.eye(3), -np.eye(3)])
+        return np.vstack([c[None] + offsets for c in ends])
+
 
 _ENDPOINT_NAMES = (("a", "b"), ("p0", "p1"), ("start", "end"), ("p1", "p2"))
 #: Integer ``kind`` codes of :mod:`serialkin.redundancy.obstacles` (circle, sphere, capsule).

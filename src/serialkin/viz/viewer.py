@@ -155,10 +155,7 @@ def viewer_data(
     frame_pts = [pts]
     if P is not None:
         frame_pts.append(P)
-    for o in obs:
-        ends = [o.center] if o.a is None else [o.a, o.b]
-        for c in ends:
-            frame_pts.append(c[None] + o.radius * np.vstack([np.eye(3), -np.eye(3)]))
+    frame_pts.extend(o.extent_points() for o in obs)
     allpts = np.vstack(frame_pts)
     ground_z = float(allpts[:, 2].min()) - (0.002 * scale if planar else 0.0)
     qlim = [[float(v) if np.isfinite(v) else None for v in row] for row in robot.qlim]
