@@ -132,29 +132,6 @@ def random_q_into(state, slo, shi, q):
 
 # ---------------------------------------------------------------- fast input checks
 @njit(cache=True)
-def is_rigid(T, tol):
-    """True when the (4, 4) ``T`` is a rigid transform to ``tol`` (fast target check).
-
-    Finite entries, last row [0, 0, 0, 1], orthonormal rotation block with det +1.
-    """
-    for i in range(4):
-        for j in range(4):
-            if not math.isfinite(T[i, j]):
-                return False
-    if abs(T[3, 0]) > tol or abs(T[3, 1]) > tol or abs(T[3, 2]) > tol or abs(T[3, 3] - 1.0) > tol:
-        return False
-    for i in range(3):
-        for j in range(3):
-            s = T[0, i] * T[0, j] + T[1, i] * T[1, j] + T[2, i] * T[2, j]
-            if abs(s - (1.0 if i == j else 0.0)) > tol:
-                return False
-    det = (T[0, 0] * (T[1, 1] * T[2, 2] - T[1, 2] * T[2, 1])
-           - T[0, 1] * (T[1, 0] * T[2, 2] - T[1, 2] * T[2, 0])
-           + T[0, 2] * (T[1, 0] * T[2, 1] - T[1, 1] * T[2, 0]))
-    return abs(det - 1.0) <= tol
-
-
-@njit(cache=True)
 def inside_limits(q, lo, hi, tol):
     """True when every q_i (finite) lies in [lo_i − tol, hi_i + tol]."""
     for i in range(q.shape[0]):

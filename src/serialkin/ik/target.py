@@ -27,8 +27,9 @@ import numpy as np
 
 from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
 from serialkin.errors import InputError
-from serialkin.ik._kernels import inside_limits, is_rigid
+from serialkin.ik._kernels import inside_limits
 from serialkin.model.robot import Robot
+from serialkin.spatial._kernels import transforms_valid
 
 #: Names of the six task coordinates, in the order of the pose error and Jacobian rows.
 TASK_COORDINATES = ("vx", "vy", "vz", "wx", "wy", "wz")
@@ -198,8 +199,10 @@ def parse_target(robot: Robot, target: object, mask: object = None) -> Target:
             accepted ones, a planar target on a non-planar robot, or a bad mask.
     """
     if (isinstance(target, np.ndarray) and target.shape == (4, 4)
-            and target.dtype == np.float64 and is_rigid(target, ROTATION_TOL)):
-        return Target(np.ascontiguousarray(target), parse_mask(mask, "pose"), "pose")
+            and target.dtype == np.float64):
+        T = np.ascontiguousarray(target)
+        if transforms_valid(T.reshape(1, 4, 4), ROTATION_TOL):
+            return Target(T, parse_mask(mask, "pose"), "pose")
     a = as_float_array(target, "target")
     if a.ndim >= 2 and a.shape[-2:] == (4, 4):
         if a.ndim > 3:
