@@ -40,6 +40,7 @@ from __future__ import annotations
 import json
 import math
 import os
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path as FsPath
@@ -144,6 +145,23 @@ class _Reader:
         if isinstance(v, bool) or not isinstance(v, int) or v < minimum:
             raise self.fail(full, f"must be an integer >= {minimum}, got {v!r}")
         return int(v)
+
+    def present(self, d: dict, where: str, numbers: Iterable[str], integers: Iterable[str],
+                *, positive: bool = False, nonneg: bool = False) -> dict[str, Any]:
+        """The given fields of ``d``: ``numbers`` (see :meth:`number`), then ``integers``.
+
+        Integers must be >= 1; absent or null fields are left out of the result.
+        """
+        out: dict[str, Any] = {}
+        for k in numbers:
+            v = self.number(d, k, where, positive=positive, nonneg=nonneg)
+            if v is not None:
+                out[k] = v
+        for k in integers:
+            i = self.integer(d, k, where)
+            if i is not None:
+                out[k] = i
+        return out
 
     def array(self, v: object, where: str, shape_desc: str, ndim: int | None = None,
               cols: tuple[int, ...] | None = None) -> np.ndarray:
@@ -368,14 +386,8 @@ def scenario_from_dict(data: object, source: str = "<dict>",
     link_radius = 0.0
     if method == "multitask":
         rd.unknown(solver_d, _MT_FIELDS | {"method"}, "solver")
-        kw: dict[str, Any] = {}
-        for k in sorted(_MT_FIELDS - {"max_iter"}):
-            v = rd.number(solver_d, k, "solver", nonneg=True)
-            if v is not None:
-                kw[k] = v
-        mi = rd.integer(solver_d, "max_iter", "solver")
-        if mi is not None:
-            kw["max_iter"] = mi
+        kw = rd.present(solver_d, "solver", sorted(_MT_FIELDS - {"max_iter"}), ["max_iter"],
+                        nonneg=True)
         link_radius = kw.get("link_radius", 0.0)
         try:
             solver: Any = MultiTaskResolver(task=path.task, obstacles=obstacles, **kw)
@@ -383,13 +395,8 @@ def scenario_from_dict(data: object, source: str = "<dict>",
             raise rd.fail("solver", f"is invalid: {exc}") from exc
     else:
         rd.unknown(solver_d, _DLS_FIELDS | {"method", "options"}, "solver")
-        for k in ("damping", "tol", "max_step"):
-            v = rd.number(solver_d, k, "solver", positive=True)
-            if v is not None:
-                options[k] = v
-        mi = rd.integer(solver_d, "max_iter", "solver")
-        if mi is not None:
-            options["max_iter"] = mi
+        options.update(rd.present(solver_d, "solver", ("damping", "tol", "max_step"),
+                                  ["max_iter"], positive=True))
         if method != "dls":
             extra = solver_d.get("options") or {}
             options["ik_options"] = rd.mapping(extra, "solver.options")
