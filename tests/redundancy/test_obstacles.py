@@ -39,6 +39,17 @@ def _brute_clearance(P0, P1, obstacle, samples=4001):
     return d.min() - obstacle.radius
 
 
+def _random_scene(seed):
+    """The spatial RP arm at a random q with a random circle, sphere and capsule."""
+    rng = np.random.default_rng(seed)
+    robot = spatial_rp()
+    q = robot.random_q(seed=rng)
+    obs = [Circle(rng.uniform(-0.4, 0.4, 2), 0.03),
+           Sphere(rng.uniform(-0.4, 0.4, 3), 0.04),
+           Capsule(rng.uniform(-0.4, 0.4, 3), rng.uniform(-0.4, 0.4, 3), 0.02)]
+    return robot, q, obs
+
+
 def test_closest_point_is_clamped_to_the_segment():
     """ERRATA (51)-(52): an obstacle beyond a link's end is closest to the end, not the line."""
     robot = six_link()
@@ -57,12 +68,7 @@ def test_closest_point_is_clamped_to_the_segment():
 @given(seed=SEEDS)
 def test_clearances_match_dense_sampling(seed):
     """Clearances of circles, spheres and capsules equal a brute-force sampled minimum."""
-    rng = np.random.default_rng(seed)
-    robot = spatial_rp()
-    q = robot.random_q(seed=rng)
-    obs = [Circle(rng.uniform(-0.4, 0.4, 2), 0.03),
-           Sphere(rng.uniform(-0.4, 0.4, 3), 0.04),
-           Capsule(rng.uniform(-0.4, 0.4, 3), rng.uniform(-0.4, 0.4, 3), 0.02)]
+    robot, q, obs = _random_scene(seed)
     C = clearances(robot, q, obs)
     P0, P1, _, _ = robot_segments(robot, q)
     assert C.shape == (P0.shape[0], 3)
@@ -78,12 +84,7 @@ def test_clearances_match_dense_sampling(seed):
 @given(seed=SEEDS)
 def test_obstacle_jacobian_rows_match_finite_differences(seed):
     """Eq 55: J_ci q̇ is the approach rate, i.e. J_ci = −∂c_i/∂q (finite differences)."""
-    rng = np.random.default_rng(seed)
-    robot = spatial_rp()
-    q = robot.random_q(seed=rng)
-    obs = [Sphere(rng.uniform(-0.4, 0.4, 3), 0.03),
-           Capsule(rng.uniform(-0.4, 0.4, 3), rng.uniform(-0.4, 0.4, 3), 0.02),
-           Circle(rng.uniform(-0.4, 0.4, 2), 0.03)]
+    robot, q, obs = _random_scene(seed)
     pairs = closest_pairs(robot, q, obs, with_jacobian=True)
     h = 1e-7
     for p in pairs:

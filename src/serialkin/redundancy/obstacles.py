@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -60,8 +61,18 @@ KIND_SPHERE = 1
 KIND_CAPSULE = 2
 
 
-def _check_influence(influence: object) -> float:
-    return check_positive(influence, "influence", allow_zero=True)
+def _normalise(obstacle: Any, **points: int) -> None:
+    """Check and store the fields of a frozen obstacle: copies of its ``points``.
+
+    ``points`` maps a field name to its number of coordinates (2 or 3); ``radius`` must
+    be > 0 and ``influence`` >= 0.
+    """
+    for name, size in points.items():
+        value = as_vector(getattr(obstacle, name), name, size).copy()
+        object.__setattr__(obstacle, name, value)
+    object.__setattr__(obstacle, "radius", check_positive(obstacle.radius, "radius"))
+    object.__setattr__(obstacle, "influence",
+                       check_positive(obstacle.influence, "influence", allow_zero=True))
 
 
 @dataclass(frozen=True)
@@ -82,9 +93,7 @@ class Circle:
     kind: int = field(default=KIND_CIRCLE, init=False, repr=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "center", as_vector(self.center, "center", 2).copy())
-        object.__setattr__(self, "radius", check_positive(self.radius, "radius"))
-        object.__setattr__(self, "influence", _check_influence(self.influence))
+        _normalise(self, center=2)
 
     def encode(self) -> np.ndarray:
         """Row (kind, a(3), b(3), radius) for the compiled distance kernel."""
@@ -111,9 +120,7 @@ class Sphere:
     kind: int = field(default=KIND_SPHERE, init=False, repr=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "center", as_vector(self.center, "center", 3).copy())
-        object.__setattr__(self, "radius", check_positive(self.radius, "radius"))
-        object.__setattr__(self, "influence", _check_influence(self.influence))
+        _normalise(self, center=3)
 
     def encode(self) -> np.ndarray:
         """Row (kind, a(3), b(3), radius) for the compiled distance kernel."""
@@ -138,10 +145,7 @@ class Capsule:
     kind: int = field(default=KIND_CAPSULE, init=False, repr=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "a", as_vector(self.a, "a", 3).copy())
-        object.__setattr__(self, "b", as_vector(self.b, "b", 3).copy())
-        object.__setattr__(self, "radius", check_positive(self.radius, "radius"))
-        object.__setattr__(self, "influence", _check_influence(self.influence))
+        _normalise(self, a=3, b=3)
 
     def encode(self) -> np.ndarray:
         """Row (kind, a(3), b(3), radius) for the compiled distance kernel."""
