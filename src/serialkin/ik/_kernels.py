@@ -7,7 +7,10 @@ targets with the GIL released, so that the batch driver solves across all cores 
 thread per core). It is built on the only FK/Jacobian implementation
 (``serialkin.kinematics._kernels.jacobian_into`` and ``fk_into``) and the only
 pose-error implementation
-(:func:`serialkin.spatial._kernels.pose_error_into`).
+(:func:`serialkin.spatial._kernels.pose_error_into`). The helpers every compiled IK
+method shares live here too: the cost and error norms (:func:`task_cost`,
+:func:`task_errors`), joint-limit projection, the random starts, and the stopping test
+of the heuristic attempts (:func:`stopping_test`, used by CCD and FABRIK).
 
 Notation (shapes): n joints; ``e`` (6,) the pose error ``[p_t − p; log(R_t Rᵀ)^∨]``
 (world frame); ``w`` (6,) the task weights (0 drops a coordinate); ``r = √w ⊙ e`` and
@@ -107,6 +110,12 @@ I_ORI_ERR = 3
 I_RESTARTS = 4
 I_COST = 5
 N_INFO = 6
+
+#: Status codes of the heuristic attempts (:func:`stopping_test`; CCD and FABRIK).
+RUNNING = -1
+CONVERGED = 0
+MAX_ITER = 1
+STAGNATED = 2
 
 TWO_PI = 2.0 * math.pi
 
@@ -211,8 +220,8 @@ def _chol_solve(A, b, x, m):
 
 
 @njit(cache=True, inline="always")
-def _cost(e, w):
-    """E = ½ Σ w_i e_i²."""
+def task_cost(e, w):
+    """The weighted cost ``E = ½ Σ w_i e_i²`` of the pose error ``e`` (6,), weights ``w`` (6,)."""
     c = 0.0
     for i in range(6):
         c += w[i] * e[i] * e[i]
@@ -220,8 +229,8 @@ def _cost(e, w):
 
 
 @njit(cache=True, inline="always")
-def _errors(e, w):
-    """(position error [m], orientation error [rad]) over the selected coordinates."""
+def task_errors(e, w):
+    """(position error [m], orientation error [rad]): the norms of ``e`` (6,) over w_i > 0."""
     p = 0.0
     o = 0.0
     for i in range(3):
@@ -230,6 +239,35 @@ def _errors(e, w):
         if w[i + 3] > 0.0:
             o += e[i + 3] * e[i + 3]
     return math.sqrt(p), math.sqrt(o)
+
+
+@njit(cache=True)
+def stopping_test(T, T_target, w, tol_pos, tol_orient, it, window, min_progress, ref, e):
+    """Stopping test of a heuristic attempt (CCD, FABRIK) after its iteration ``it`` ≥ 1.
+
+    The pose error of ``T`` (4, 4) against ``T_target`` (4, 4) goes into ``e`` (6,), and
+    its norms ``e_p`` [m], ``e_o`` [rad] over the coordinates with ``w_i > 0`` (6,) are
+    tested: **converged** when ``e_p ≤ tol_pos`` and ``e_o ≤ tol_orient``; else the scaled
+    error ``s = e_p/tol_pos + e_o/tol_orient`` is compared every ``window`` iterations with
+    the reference ``ref`` (``s`` at the previous check, at iteration 1 first):
+    **stagnated** when ``s > (1 − min_progress)·ref``.
+
+    Returns:
+        ``(status, ref)``: CONVERGED, STAGNATED or RUNNING, and the reference to pass to
+        the next call (any value before iteration 1).
+    """
+    pose_error_into(T, T_target, e)
+    ep, eo = task_errors(e, w)
+    if ep <= tol_pos and eo <= tol_orient:
+        return CONVERGED, ref
+    score = ep / tol_pos + eo / tol_orient
+    if it == 1:
+        return RUNNING, score
+    if it % window == 0:
+        if score > (1.0 - min_progress) * ref:
+            return STAGNATED, ref
+        return RUNNING, score
+    return RUNNING, ref
 
 
 @njit(cache=True, inline="always")
@@ -424,11 +462,11 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol,
     window = int(params[P_WINDOW])
     jacobian_into(q, F, meta, J, T)
     pose_error_into(T, Tt, e)
-    cost = _cost(e, w)
+    cost = task_cost(e, w)
     ref_cost = cost
     ref_it = 0
     for it in range(max_iter):
-        pe, oe = _errors(e, w)
+        pe, oe = task_errors(e, w)
         if pe <= tol and oe <= tol:
             return it, True, cost
         if not math.isfinite(cost):
@@ -556,14 +594,14 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol,
                 break
             fk_into(qn, F, meta, Tn)
             pose_error_into(Tn, Tt, en)
-            if _cost(en, w) < cost:
+            if task_cost(en, w) < cost:
                 break
             step *= 0.5
         q[:] = qn
         jacobian_into(q, F, meta, J, T)
         pose_error_into(T, Tt, e)
-        cost = _cost(e, w)
-    pe, oe = _errors(e, w)
+        cost = task_cost(e, w)
+    pe, oe = task_errors(e, w)
     return max_iter, (pe <= tol and oe <= tol), cost
 
 
@@ -582,12 +620,12 @@ def _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
     n = q.shape[0]
     jacobian_into(q, F, meta, J, T)
     pose_error_into(T, Tt, e)
-    cost = _cost(e, w)
+    cost = task_cost(e, w)
     mu = -1.0
     nu = 2.0
     quiet = 0
     for it in range(max_iter):
-        pe, oe = _errors(e, w)
+        pe, oe = task_errors(e, w)
         if pe <= tol and oe <= tol:
             return it, True, cost
         _weigh(J, e, sw, Jw, r)
@@ -607,7 +645,7 @@ def _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
             project_into(qn, lo, hi, revolute)
         jacobian_into(qn, F, meta, Jn, Tn)
         pose_error_into(Tn, Tt, en)
-        cost_n = _cost(en, w)
+        cost_n = task_cost(en, w)
         lin = 0.0
         for i in range(6):
             s = 0.0
@@ -632,7 +670,7 @@ def _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
             nu *= 2.0
         if quiet > 10 or mu > 1e16 * (1.0 + d):
             return it + 1, False, cost
-    pe, oe = _errors(e, w)
+    pe, oe = task_errors(e, w)
     return max_iter, (pe <= tol and oe <= tol), cost
 
 
@@ -701,7 +739,7 @@ def solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
         project_into(q_out, lo, hi, revolute)
     fk_into(q_out, F, meta, T)
     pose_error_into(T, Tt, be)
-    best_cost = _cost(be, w)
+    best_cost = task_cost(be, w)
     for attempt in range(restarts + 1):
         used = attempt
         if attempt == 0 and use_q0:
@@ -736,7 +774,7 @@ def solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
             be[:] = e
             success = ok
     normalize_into(q_out, lo, hi, revolute)
-    pe, oe = _errors(be, w)
+    pe, oe = task_errors(be, w)
     info[I_SUCCESS] = 1.0 if success else 0.0
     info[I_ITERATIONS] = total
     info[I_POS_ERR] = pe

@@ -65,15 +65,8 @@ import math
 import numpy as np
 from numba import njit
 
+from serialkin.ik._kernels import MAX_ITER, RUNNING, TWO_PI, stopping_test
 from serialkin.kinematics._kernels import PRISMATIC, jacobian_into
-from serialkin.spatial._kernels import pose_error_into
-
-#: Status codes returned by the kernels.
-CONVERGED = 0
-MAX_ITER = 1
-STAGNATED = 2
-
-TWO_PI = 2.0 * math.pi
 
 
 @njit(cache=True, inline="always")
@@ -214,21 +207,6 @@ def ccd_sweep(q, F, meta, T_target, pos_sel, w_pos, w_orient, lo, hi, J, T):
                 T[2, 3] = az + rw
 
 
-@njit(cache=True, inline="always")
-def _masked_errors(e, sel):
-    """Position and orientation error norms over the selected coordinates of ``e`` (6,).
-
-    ``sel`` (6,) holds 1.0 for selected coordinates and 0.0 for the others.
-    """
-    ep = 0.0
-    for k in range(3):
-        ep += sel[k] * e[k] * e[k]
-    eo = 0.0
-    for k in range(3, 6):
-        eo += sel[k] * e[k] * e[k]
-    return math.sqrt(ep), math.sqrt(eo)
-
-
 @njit(cache=True)
 def ccd_attempt(q, F, meta, T_target, mask, w_orient, lo, hi, tol_pos, tol_orient,
                 max_iter, window, min_progress):
@@ -248,11 +226,12 @@ def ccd_attempt(q, F, meta, T_target, mask, w_orient, lo, hi, tol_pos, tol_orien
         max_iter: sweep budget.
         window: stagnation window in sweeps.
         min_progress: the attempt stops as stagnated when the scaled error
-            ``e_p/tol_p + e_o/tol_o`` did not drop by this fraction over ``window`` sweeps.
+            ``e_p/tol_p + e_o/tol_o`` did not drop by this fraction over ``window`` sweeps
+            (:func:`serialkin.ik._kernels.stopping_test`).
 
     Returns:
-        (sweeps used, status) with status CONVERGED, MAX_ITER or STAGNATED; ``q`` holds the
-        final configuration.
+        (sweeps used, status) with status CONVERGED, MAX_ITER or STAGNATED (codes of
+        :mod:`serialkin.ik._kernels`); ``q`` holds the final configuration.
     """
     n = q.shape[0]
     J = np.empty((6, n))
@@ -267,15 +246,8 @@ def ccd_attempt(q, F, meta, T_target, mask, w_orient, lo, hi, tol_pos, tol_orien
     ref = np.inf
     for it in range(1, max_iter + 1):
         ccd_sweep(q, F, meta, T_target, pos_sel, w_pos, w_o, lo, hi, J, T)
-        pose_error_into(T, T_target, e)
-        ep, eo = _masked_errors(e, sel)
-        if ep <= tol_pos and eo <= tol_orient:
-            return it, CONVERGED
-        score = ep / tol_pos + eo / tol_orient
-        if it == 1:
-            ref = score
-        elif it % window == 0:
-            if score > (1.0 - min_progress) * ref:
-                return it, STAGNATED
-            ref = score
+        status, ref = stopping_test(T, T_target, sel, tol_pos, tol_orient, it, window,
+                                    min_progress, ref, e)
+        if status != RUNNING:
+            return it, status
     return max_iter, MAX_ITER

@@ -56,15 +56,9 @@ import numpy as np
 from numba import njit
 
 from serialkin.errors import NotSupportedError
-from serialkin.ik.ccd import (
-    CONVERGED,
-    MAX_ITER,
-    STAGNATED,
-    _clamp_angle_step,
-    _masked_errors,
-)
+from serialkin.ik._kernels import MAX_ITER, RUNNING, stopping_test
+from serialkin.ik.ccd import _clamp_angle_step
 from serialkin.kinematics._kernels import fk_into, jacobian_into
-from serialkin.spatial._kernels import pose_error_into
 
 #: Axis alignment tolerance (|z_i × z_0|) for "parallel joint axes".
 PARALLEL_TOL = 1e-9
@@ -301,7 +295,8 @@ def fabrik_attempt(q, F, meta, T_target, mask, a, e1, e2, sign, lo, hi, tol_pos,
             :func:`serialkin.ik.ccd.ccd_attempt`).
 
     Returns:
-        (passes used, status) with status CONVERGED, MAX_ITER or STAGNATED.
+        (passes used, status) with status CONVERGED, MAX_ITER or STAGNATED (codes of
+        :mod:`serialkin.ik._kernels`).
     """
     n = q.shape[0]
     J = np.empty((6, n))
@@ -320,15 +315,8 @@ def fabrik_attempt(q, F, meta, T_target, mask, a, e1, e2, sign, lo, hi, tol_pos,
         fabrik_pass(q, F, meta, T_target, pos_sel, use_orient, a, e1, e2, sign, lo, hi,
                     J, T, P, lengths, theta)
         fk_into(q, F, meta, T)
-        pose_error_into(T, T_target, e)
-        ep, eo = _masked_errors(e, sel)
-        if ep <= tol_pos and eo <= tol_orient:
-            return it, CONVERGED
-        score = ep / tol_pos + eo / tol_orient
-        if it == 1:
-            ref = score
-        elif it % window == 0:
-            if score > (1.0 - min_progress) * ref:
-                return it, STAGNATED
-            ref = score
+        status, ref = stopping_test(T, T_target, sel, tol_pos, tol_orient, it, window,
+                                    min_progress, ref, e)
+        if status != RUNNING:
+            return it, status
     return max_iter, MAX_ITER

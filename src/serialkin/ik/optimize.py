@@ -45,6 +45,7 @@ from numba import njit
 from scipy.optimize import minimize
 from threadpoolctl import ThreadpoolController
 
+from serialkin.ik._kernels import task_cost, task_errors
 from serialkin.kinematics._kernels import fk_into, jacobian_into
 from serialkin.spatial._kernels import pose_error_into
 
@@ -86,9 +87,7 @@ def cost_and_gradient(q, F, meta, T_target, w, J, T, e, g):
     """
     jacobian_into(q, F, meta, J, T)
     pose_error_into(T, T_target, e)
-    cost = 0.0
-    for k in range(6):
-        cost += 0.5 * w[k] * e[k] * e[k]
+    cost = task_cost(e, w)
     n = q.shape[0]
     for j in range(n):
         s = 0.0
@@ -116,10 +115,7 @@ def cost_only(q, F, meta, T_target, w, T, e):
     """
     fk_into(q, F, meta, T)
     pose_error_into(T, T_target, e)
-    cost = 0.0
-    for k in range(6):
-        cost += 0.5 * w[k] * e[k] * e[k]
-    return cost
+    return task_cost(e, w)
 
 
 @njit(cache=True)
@@ -127,14 +123,7 @@ def selected_errors(q, F, meta, T_target, w, T, e):
     """Position and orientation error norms [m], [rad] over the coordinates with w > 0."""
     fk_into(q, F, meta, T)
     pose_error_into(T, T_target, e)
-    ep = 0.0
-    eo = 0.0
-    for k in range(3):
-        if w[k] > 0.0:
-            ep += e[k] * e[k]
-        if w[k + 3] > 0.0:
-            eo += e[k + 3] * e[k + 3]
-    return math.sqrt(ep), math.sqrt(eo)
+    return task_errors(e, w)
 
 
 def _bounds(lo: np.ndarray, hi: np.ndarray) -> list[tuple[float | None, float | None]]:
