@@ -50,66 +50,45 @@ _PROJECTION = (
     "projection after every step: a revolute joint is shifted by 2π when that brings it "
     "inside its range, else set to the nearer limit; a prismatic joint is clamped"
 )
+_LIMIT_AWARE = (
+    "limit-aware step: joints at a limit whose step points outward are frozen and "
+    "the step recomputed for the others; then " + _PROJECTION
+)
 
-register_method(MethodSpec(
-    name="transpose", family="jacobian",
-    summary="Jacobian transpose with the Buss/Wolovich step length (slow, linear convergence)",
-    limits=_PROJECTION, max_iter=5000, restarts=5,
-    options={"stall_window": 1000}, kernel_code=K.TRANSPOSE,
-))
-register_method(MethodSpec(
-    name="pinv", family="jacobian",
-    summary="Moore-Penrose pseudoinverse step J⁺e (eq 40), steps capped at max_step",
-    limits=_PROJECTION, max_iter=100, restarts=50,
-    options={"max_step": 0.5, "rcond": 1e-10, "stall_window": 20}, kernel_code=K.PINV,
-))
-register_method(MethodSpec(
-    name="dls", family="jacobian",
-    summary="damped least squares Jᵀ(JJᵀ+λ²I)⁻¹e with fixed damping λ (eq 46)",
-    limits=_PROJECTION, max_iter=200, restarts=50,
-    options={"damping": 0.01, "stall_window": 30}, kernel_code=K.DLS,
-))
-register_method(MethodSpec(
-    name="lm", family="jacobian",
-    summary="Levenberg-Marquardt, damping λE adapted to the error, limit-aware (default)",
-    limits="limit-aware step: joints at a limit whose step points outward are frozen and "
-    "the step recomputed for the others; then " + _PROJECTION,
-    max_iter=100, restarts=100,
-    options={"damping": 0.03, "stall_window": 5, "polish": True}, kernel_code=K.LM,
-))
-register_method(MethodSpec(
-    name="lm_wampler", family="jacobian",
-    summary="Levenberg-Marquardt with constant damping λI (Wampler)",
-    limits=_PROJECTION, max_iter=200, restarts=50,
-    options={"damping": 1e-4, "stall_window": 30}, kernel_code=K.LM_WAMPLER,
-))
-register_method(MethodSpec(
-    name="lm_chan", family="jacobian",
-    summary="Levenberg-Marquardt with error-proportional damping λE (Chan-Lawrence)",
-    limits=_PROJECTION, max_iter=200, restarts=50,
-    options={"damping": 1.0, "stall_window": 30}, kernel_code=K.LM_CHAN,
-))
-register_method(MethodSpec(
-    name="lm_sugihara", family="jacobian",
-    summary="Levenberg-Marquardt with damping E + λ (Sugihara)",
-    limits=_PROJECTION, max_iter=200, restarts=50,
-    options={"damping": 1e-4, "stall_window": 30}, kernel_code=K.LM_SUGIHARA,
-))
-register_method(MethodSpec(
-    name="sdls", family="jacobian",
-    summary="selectively damped least squares by SVD (Buss & Kim)",
-    limits=_PROJECTION, max_iter=500, restarts=30,
-    options={"max_step": math.pi / 4, "stall_window": 60}, kernel_code=K.SDLS,
-))
-register_method(MethodSpec(
-    name="newton", family="jacobian",
-    summary="Newton-Raphson (eq 41): full pseudoinverse step with backtracking line search",
-    limits=_PROJECTION, max_iter=100, restarts=50,
-    options={"rcond": 1e-10, "stall_window": 20}, kernel_code=K.NEWTON,
-))
-register_method(MethodSpec(
-    name="gauss_newton", family="jacobian",
-    summary="Gauss-Newton on the normal equations (JᵀJ)⁺Jᵀe, full step",
-    limits=_PROJECTION, max_iter=100, restarts=50,
-    options={"rcond": 1e-12, "stall_window": 20}, kernel_code=K.GAUSS_NEWTON,
-))
+#: name, kernel code, max_iter, restarts, default options, summary (registration order).
+_TABLE = (
+    ("transpose", K.TRANSPOSE, 5000, 5, {"stall_window": 1000},
+     "Jacobian transpose with the Buss/Wolovich step length (slow, linear convergence)"),
+    ("pinv", K.PINV, 100, 50, {"max_step": 0.5, "rcond": 1e-10, "stall_window": 20},
+     "Moore-Penrose pseudoinverse step J⁺e (eq 40), steps capped at max_step"),
+    ("dls", K.DLS, 200, 50, {"damping": 0.01, "stall_window": 30},
+     "damped least squares Jᵀ(JJᵀ+λ²I)⁻¹e with fixed damping λ (eq 46)"),
+    ("lm", K.LM, 100, 100, {"damping": 0.03, "stall_window": 5, "polish": True},
+     "Levenberg-Marquardt, damping λE adapted to the error, limit-aware (default)"),
+    ("lm_wampler", K.LM_WAMPLER, 200, 50, {"damping": 1e-4, "stall_window": 30},
+     "Levenberg-Marquardt with constant damping λI (Wampler)"),
+    ("lm_chan", K.LM_CHAN, 200, 50, {"damping": 1.0, "stall_window": 30},
+     "Levenberg-Marquardt with error-proportional damping λE (Chan-Lawrence)"),
+    ("lm_sugihara", K.LM_SUGIHARA, 200, 50, {"damping": 1e-4, "stall_window": 30},
+     "Levenberg-Marquardt with damping E + λ (Sugihara)"),
+    ("sdls", K.SDLS, 500, 30, {"max_step": math.pi / 4, "stall_window": 60},
+     "selectively damped least squares by SVD (Buss & Kim)"),
+    ("newton", K.NEWTON, 100, 50, {"rcond": 1e-10, "stall_window": 20},
+     "Newton-Raphson (eq 41): full pseudoinverse step with backtracking line search"),
+    ("gauss_newton", K.GAUSS_NEWTON, 100, 50, {"rcond": 1e-12, "stall_window": 20},
+     "Gauss-Newton on the normal equations (JᵀJ)⁺Jᵀe, full step"),
+)
+
+
+
+def _register_all() -> None:
+    """Register every method of :data:`_TABLE` (family 'jacobian', compiled kernel)."""
+    for name, code, max_iter, restarts, options, summary in _TABLE:
+        register_method(MethodSpec(
+            name=name, family="jacobian", summary=summary,
+            limits=_LIMIT_AWARE if code == K.LM else _PROJECTION,
+            max_iter=max_iter, restarts=restarts, options=options, kernel_code=code,
+        ))
+
+
+_register_all()
