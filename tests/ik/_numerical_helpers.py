@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from serialkin import models
 from serialkin.spatial.pose import pose_error
 
 
@@ -40,3 +41,16 @@ def assert_solution(robot, res, T_target, weights, tol):
     assert pe <= tol * 1.0000001, pe
     assert oe <= tol * 1.0000001, oe
     assert robot.within_limits(res.q, 1e-12)
+
+
+def assert_fails_only_outside_limits(method, **options):
+    """A planar 2-link target reachable only outside the limits fails; q stays inside them.
+
+    The limits [0, 0.5] rad exclude the configuration (-1, -1) that reaches the target;
+    ``options`` go to ``robot.ik`` (seed 0).
+    """
+    robot = models.planar(2, qlim=(0.0, 0.5))
+    T = robot.fk(np.array([-1.0, -1.0]))
+    res = robot.ik(T[:2, 3], method=method, seed=0, **options)
+    assert not res.success and res.reason
+    assert robot.within_limits(res.q)

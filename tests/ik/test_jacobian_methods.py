@@ -147,22 +147,31 @@ def test_weighted_step_uses_mask(near_solution):
     assert np.allclose(res.q, q0 + dq, atol=1e-12)
 
 
+def _solve_each(robot, method, targets):
+    """Solve each target with seed k for the k-th and return the results.
+
+    Asserts that every q is finite and inside the limits and that every success reaches
+    its target.
+    """
+    results = []
+    for k, T in enumerate(targets):
+        res = robot.ik(T, method=method, seed=k)
+        assert np.isfinite(res.q).all() and robot.within_limits(res.q)
+        if res.success:
+            assert_reaches(robot, res, T)
+        results.append(res)
+    return results
+
+
 @pytest.mark.parametrize("method", FULL_POSE)
 @pytest.mark.parametrize("name", ["ur5", "puma560", "panda"])
 def test_full_pose_methods_reach_targets(method, name):
     """Each method reaches full-pose targets to 1e-6 m / rad with q inside the limits."""
     robot = models.get(name)
     _, targets = reachable(robot, 6, seed=31)
-    solved = 0
-    for k, T in enumerate(targets):
-        res = robot.ik(T, method=method, seed=k)
-        assert np.isfinite(res.q).all() and robot.within_limits(res.q)
-        if res.success:
-            assert_reaches(robot, res, T)
-            solved += 1
-        else:
-            assert res.reason
-    assert solved >= REQUIRED.get(method, 6)
+    results = _solve_each(robot, method, targets)
+    assert all(res.success or res.reason for res in results)
+    assert sum(res.success for res in results) >= REQUIRED.get(method, 6)
 
 
 @pytest.mark.parametrize("method", ("transpose",) + FULL_POSE)
@@ -216,14 +225,8 @@ def test_other_models_every_method(method, name):
     """Each method on the other spatial models (prismatic joints, 7R, 4-DOF SCARA poses)."""
     robot = models.get(name)
     _, targets = reachable(robot, 3, seed=91)
-    solved = 0
-    for k, T in enumerate(targets):
-        res = robot.ik(T, method=method, seed=k)
-        assert np.isfinite(res.q).all() and robot.within_limits(res.q)
-        if res.success:
-            assert_reaches(robot, res, T)
-            solved += 1
-    assert solved >= 3 - (method in REQUIRED)
+    results = _solve_each(robot, method, targets)
+    assert sum(res.success for res in results) >= 3 - (method in REQUIRED)
 
 
 @pytest.mark.parametrize("method", ("transpose",) + FULL_POSE)

@@ -13,7 +13,11 @@ from hypothesis import strategies as st
 from serialkin import models
 from serialkin.ik import optimize
 
-from ._numerical_helpers import assert_solution, well_conditioned_q
+from ._numerical_helpers import (
+    assert_fails_only_outside_limits,
+    assert_solution,
+    well_conditioned_q,
+)
 
 TOL = 1e-6
 
@@ -102,11 +106,7 @@ def test_unreachable_target_fails_cleanly(method):
 @pytest.mark.parametrize("method", ["bfgs", "powell"])
 def test_bounds_keep_q_inside_limits(method):
     """A target reachable only outside the limits fails; every returned q is inside them."""
-    robot = models.planar(2, qlim=(0.0, 0.5))
-    T = robot.fk(np.array([-1.0, -1.0]))
-    res = robot.ik(T[:2, 3], method=method, tol=TOL, seed=0, restarts=2, max_iter=50)
-    assert not res.success and res.reason
-    assert robot.within_limits(res.q)
+    assert_fails_only_outside_limits(method, tol=TOL, restarts=2, max_iter=50)
 
 
 @pytest.mark.parametrize("method", ["bfgs", "powell"])
