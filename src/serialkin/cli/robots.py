@@ -6,7 +6,8 @@
   as ``puma`` and ``planar<N>`` accepted), built by :func:`serialkin.models.get`;
   ``--param key=value`` passes keyword arguments to the model function;
 * a robot file ``*.yaml`` / ``*.yml`` / ``*.json`` (:mod:`serialkin.model.robotfile`);
-* a URDF file ``*.urdf`` (:meth:`serialkin.Robot.from_urdf`).
+* a URDF file ``*.urdf`` (:meth:`serialkin.Robot.from_urdf`); ``--param base_link=NAME``
+  and ``--param tip_link=NAME`` choose the chain of a branching tree.
 
 An unknown name gets the nearest names suggested.
 """
@@ -61,15 +62,27 @@ def resolve_robot(spec: str, params: Sequence[str] = ()) -> Any:
     suffix = Path(spec).suffix.lower()
     kwargs = parse_params(params)
     if suffix in (".yaml", ".yml", ".json", ".urdf"):
-        if kwargs:
-            raise CLIError("--param applies to built-in models only, not to robot files")
+        urdf_keys = {"base_link", "tip_link"}
+        if suffix == ".urdf" and set(kwargs) - urdf_keys:
+            raise CLIError(f"--param for a URDF takes base_link=NAME and tip_link=NAME only, got "
+                           f"{', '.join(sorted(set(kwargs) - urdf_keys))}")
+        if suffix != ".urdf" and kwargs:
+            raise CLIError("--param applies to built-in models and URDF links only, not to "
+                           "robot files")
         if not Path(spec).exists():
             raise CLIError(f"robot file {spec} not found")
         try:
             if suffix == ".urdf":
                 from serialkin.model.robot import Robot
 
-                return Robot.from_urdf(spec)
+                links = {k: str(v) for k, v in kwargs.items()}
+                try:
+                    return Robot.from_urdf(spec, **links)
+                except SerialkinError as exc:
+                    if "tip_link" in str(exc) and "tip_link" not in links:
+                        raise CLIError(f"{exc} (on the command line: --param tip_link=NAME)") \
+                            from exc
+                    raise
             from serialkin.model.robotfile import load_robot_file
 
             return load_robot_file(spec)
@@ -98,5 +111,6 @@ def resolve_robot(spec: str, params: Sequence[str] = ()) -> Any:
 robot_argument = click.argument("robot", metavar="ROBOT")
 param_option = click.option(
     "--param", "params", multiple=True, metavar="KEY=VALUE",
-    help="Keyword argument for a built-in model, repeatable (e.g. --param l1=0.4).",
+    help="Keyword argument for a built-in model (e.g. --param l1=0.4), or base_link=/tip_link= "
+         "for a URDF; repeatable.",
 )
