@@ -281,14 +281,21 @@ def _weigh(J, e, sw, Jw, r):
 
 
 @njit(cache=True, inline="always")
-def _normal(Jw, r, A, g):
-    """A = Jwᵀ Jw (n×n) and g = Jwᵀ r (n,)."""
-    n = Jw.shape[1]
-    for i in range(n):
+def _transpose_times(Jw, r, g):
+    """The product g = Jwᵀ r (n,) of Jw (6, n) and r (6,), in place in ``g``."""
+    for i in range(Jw.shape[1]):
         s = 0.0
         for k in range(6):
             s += Jw[k, i] * r[k]
         g[i] = s
+
+
+@njit(cache=True, inline="always")
+def _normal(Jw, r, A, g):
+    """A = Jwᵀ Jw (n×n) and g = Jwᵀ r (n,)."""
+    n = Jw.shape[1]
+    _transpose_times(Jw, r, g)
+    for i in range(n):
         for j in range(i, n):
             s = 0.0
             for k in range(6):
@@ -431,12 +438,7 @@ def _sdls_step(Jw, r, dq, gamma_max):
         scale = gamma / big if big > gamma else 1.0
         for j in range(n):
             dq[j] += scale * phi[j]
-    big = 0.0
-    for j in range(n):
-        big = max(big, abs(dq[j]))
-    if big > gamma_max:
-        for j in range(n):
-            dq[j] *= gamma_max / big
+    _limit_step(dq, gamma_max)
 
 
 @njit(cache=True, inline="always")
@@ -514,11 +516,7 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol,
                 if not changed:
                     break
         elif method == TRANSPOSE:
-            for j in range(n):
-                s = 0.0
-                for i in range(6):
-                    s += Jw[i, j] * r[i]
-                g[j] = s
+            _transpose_times(Jw, r, g)
             num = 0.0
             den = 0.0
             for i in range(6):

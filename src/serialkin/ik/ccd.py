@@ -91,6 +91,36 @@ def _clamp_angle_step(phi, qi, lo, hi):
     return b
 
 
+@njit(cache=True, inline="always")
+def _axis_point(J, i, px, py, pz):
+    """A point on the axis of revolute joint ``i``, from the Jacobian ``J`` (6, n) at ``p``.
+
+    With ``z = J[3:, i]`` (unit) and ``v = J[:3, i] = z × (p − o)`` for any point o of the
+    axis, ``v × z`` is the component of ``p − o`` normal to the axis, so
+    ``p − v × z`` (returned as three floats) is the foot of the perpendicular from ``p``,
+    the end-effector point at which J was evaluated, onto the axis.
+    """
+    vx = J[0, i]
+    vy = J[1, i]
+    vz = J[2, i]
+    zx = J[3, i]
+    zy = J[4, i]
+    zz = J[5, i]
+    return (px - (vy * zz - vz * zy), py - (vz * zx - vx * zz), pz - (vx * zy - vy * zx))
+
+
+@njit(cache=True, inline="always")
+def _pair_terms(w, zx, zy, zz, vx, vy, vz, dx, dy, dz):
+    """One vector pair's weighted share of (k1, k2, k3) in the one-joint cost (module doc).
+
+    ``v`` is a vector the joint turns about the unit axis ``z`` and ``d`` where it should
+    go: returns ``(w (d·z)(v·z), w d·v, w z·(v × d))``.
+    """
+    return (w * (dx * zx + dy * zy + dz * zz) * (vx * zx + vy * zy + vz * zz),
+            w * (dx * vx + dy * vy + dz * vz),
+            w * (zx * (vy * dz - vz * dy) + zy * (vz * dx - vx * dz) + zz * (vx * dy - vy * dx)))
+
+
 @njit(cache=True)
 def ccd_sweep(q, F, meta, T_target, pos_sel, w_pos, w_orient, lo, hi, J, T):
     """One CCD sweep (last joint to first), in place on ``q`` (n,) and the pose ``T`` (4, 4).
@@ -139,39 +169,24 @@ def ccd_sweep(q, F, meta, T_target, pos_sel, w_pos, w_orient, lo, hi, J, T):
         zx = J[3, i]
         zy = J[4, i]
         zz = J[5, i]
-        # point on the axis: a = p0 − (p0 − o)⊥, (p0 − o)⊥ = v0 × z with v0 = J[:3, i]
-        vx0 = J[0, i]
-        vy0 = J[1, i]
-        vz0 = J[2, i]
-        ax = p0x - (vy0 * zz - vz0 * zy)
-        ay = p0y - (vz0 * zx - vx0 * zz)
-        az = p0z - (vx0 * zy - vy0 * zx)
+        # point a on the axis, from the Jacobian at the start of the sweep (pose p0)
+        ax, ay, az = _axis_point(J, i, p0x, p0y, p0z)
         k1 = 0.0
         k2 = 0.0
         k3 = 0.0
-        if w_pos > 0.0:
-            vx = px - ax
-            vy = py - ay
-            vz = pz - az
-            dx = tx - ax
-            dy = ty - ay
-            dz = tz - az
-            k1 += w_pos * (dx * zx + dy * zy + dz * zz) * (vx * zx + vy * zy + vz * zz)
-            k2 += w_pos * (dx * vx + dy * vy + dz * vz)
-            k3 += w_pos * (zx * (vy * dz - vz * dy) + zy * (vz * dx - vx * dz)
-                           + zz * (vx * dy - vy * dx))
-        if w_orient > 0.0:
+        if w_pos > 0.0:  # v = p − a moves to d = p_target − a
+            a1, a2, a3 = _pair_terms(w_pos, zx, zy, zz, px - ax, py - ay, pz - az,
+                                     tx - ax, ty - ay, tz - az)
+            k1 += a1
+            k2 += a2
+            k3 += a3
+        if w_orient > 0.0:  # each column u_j of R moves to that of R_target
             for j in range(3):
-                ux = T[0, j]
-                uy = T[1, j]
-                uz = T[2, j]
-                sx = T_target[0, j]
-                sy = T_target[1, j]
-                sz = T_target[2, j]
-                k1 += w_orient * (sx * zx + sy * zy + sz * zz) * (ux * zx + uy * zy + uz * zz)
-                k2 += w_orient * (sx * ux + sy * uy + sz * uz)
-                k3 += w_orient * (zx * (uy * sz - uz * sy) + zy * (uz * sx - ux * sz)
-                                  + zz * (ux * sy - uy * sx))
+                a1, a2, a3 = _pair_terms(w_orient, zx, zy, zz, T[0, j], T[1, j], T[2, j],
+                                         T_target[0, j], T_target[1, j], T_target[2, j])
+                k1 += a1
+                k2 += a2
+                k3 += a3
         c0 = k2 - k1
         if c0 == 0.0 and k3 == 0.0:
             continue

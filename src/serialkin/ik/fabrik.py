@@ -57,7 +57,7 @@ from numba import njit
 
 from serialkin.errors import NotSupportedError
 from serialkin.ik._kernels import MAX_ITER, RUNNING, stopping_test
-from serialkin.ik.ccd import _clamp_angle_step
+from serialkin.ik.ccd import _axis_point, _clamp_angle_step
 from serialkin.kinematics._kernels import fk_into, jacobian_into
 
 #: Axis alignment tolerance (|z_i × z_0|) for "parallel joint axes".
@@ -117,6 +117,23 @@ def _wrap(x):
     return math.atan2(math.sin(x), math.cos(x))
 
 
+@njit(cache=True, inline="always")
+def _reach(P, a, b, x, y, length):
+    """Place point ``b`` of ``P`` (m, 2) at ``length`` from point ``a`` towards ``(x, y)``.
+
+    The FABRIK step ``P_b = (1 − λ) P_a + λ (x, y)`` with ``λ = length / |(x, y) − P_a|``;
+    ``P_b = P_a`` when ``(x, y)`` is within ZERO_LENGTH of ``P_a`` (no direction).
+    """
+    r = math.sqrt((x - P[a, 0]) ** 2 + (y - P[a, 1]) ** 2)
+    if r < ZERO_LENGTH:
+        P[b, 0] = P[a, 0]
+        P[b, 1] = P[a, 1]
+        return
+    lam = length / r
+    P[b, 0] = (1.0 - lam) * P[a, 0] + lam * x
+    P[b, 1] = (1.0 - lam) * P[a, 1] + lam * y
+
+
 @njit(cache=True)
 def fabrik_pass(q, F, meta, T_target, pos_sel, use_orient, a, e1, e2, sign, lo, hi,
                 J, T, P, lengths, theta):
@@ -152,15 +169,7 @@ def fabrik_pass(q, F, meta, T_target, pos_sel, use_orient, a, e1, e2, sign, lo, 
     pz = T[2, 3]
     # joint points in the plane: o_i = p − (v_i × z_i), v_i = z_i × (p − o_i)
     for i in range(n):
-        vx = J[0, i]
-        vy = J[1, i]
-        vz = J[2, i]
-        zx = J[3, i]
-        zy = J[4, i]
-        zz = J[5, i]
-        ox = px - (vy * zz - vz * zy)
-        oy = py - (vz * zx - vx * zz)
-        oz = pz - (vx * zy - vy * zx)
+        ox, oy, oz = _axis_point(J, i, px, py, pz)
         P[i, 0] = ox * e1[0] + oy * e1[1] + oz * e1[2]
         P[i, 1] = ox * e2[0] + oy * e2[1] + oz * e2[2]
     P[n, 0] = px * e1[0] + py * e1[1] + pz * e1[2]
@@ -217,39 +226,18 @@ def fabrik_pass(q, F, meta, T_target, pos_sel, use_orient, a, e1, e2, sign, lo, 
         if stretched:
             # out of reach: stretch the chain straight towards the target
             for i in range(end):
-                r = math.sqrt((tx - P[i, 0]) ** 2 + (ty - P[i, 1]) ** 2)
-                if r < ZERO_LENGTH:
-                    P[i + 1, 0] = P[i, 0]
-                    P[i + 1, 1] = P[i, 1]
-                    continue
-                lam = lengths[i] / r
-                P[i + 1, 0] = (1.0 - lam) * P[i, 0] + lam * tx
-                P[i + 1, 1] = (1.0 - lam) * P[i, 1] + lam * ty
+                _reach(P, i, i + 1, tx, ty, lengths[i])
         else:
             # forward reaching: tip on the target, then towards the base
             P[end, 0] = tx
             P[end, 1] = ty
             for i in range(end - 1, -1, -1):
-                r = math.sqrt((P[i + 1, 0] - P[i, 0]) ** 2 + (P[i + 1, 1] - P[i, 1]) ** 2)
-                if r < ZERO_LENGTH:
-                    P[i, 0] = P[i + 1, 0]
-                    P[i, 1] = P[i + 1, 1]
-                    continue
-                lam = lengths[i] / r
-                P[i, 0] = (1.0 - lam) * P[i + 1, 0] + lam * P[i, 0]
-                P[i, 1] = (1.0 - lam) * P[i + 1, 1] + lam * P[i, 1]
+                _reach(P, i + 1, i, P[i, 0], P[i, 1], lengths[i])
             # backward reaching: root back on the base, then towards the tip
             P[0, 0] = bx
             P[0, 1] = by
             for i in range(end):
-                r = math.sqrt((P[i + 1, 0] - P[i, 0]) ** 2 + (P[i + 1, 1] - P[i, 1]) ** 2)
-                if r < ZERO_LENGTH:
-                    P[i + 1, 0] = P[i, 0]
-                    P[i + 1, 1] = P[i, 1]
-                    continue
-                lam = lengths[i] / r
-                P[i + 1, 0] = (1.0 - lam) * P[i, 0] + lam * P[i + 1, 0]
-                P[i + 1, 1] = (1.0 - lam) * P[i, 1] + lam * P[i + 1, 1]
+                _reach(P, i, i + 1, P[i + 1, 0], P[i + 1, 1], lengths[i])
     # angle recovery: q_i changes by sign_i · Δ(θ_i − θ_{i−1}) (θ_{−1} fixed)
     prev_old = 0.0
     prev_new = 0.0
