@@ -375,6 +375,28 @@ def test_stanford_negative_stroke_gives_eight():
     assert counts.count(8) >= 15, counts
 
 
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), delta=st.floats(0.0, 2.0))
+def test_sp3_slide_strokes_reach_the_distance(seed, delta):
+    """sp3_slide's strokes d give |h + d·w| = δ, and none exist only when δ < dist(line, 0)."""
+    from serialkin.ik.analytic.subproblems import sp3_slide
+
+    rng = np.random.default_rng(seed)
+    w = rng.normal(size=3)
+    w /= np.linalg.norm(w)
+    h = rng.uniform(-1.0, 1.0, 3)
+    out = np.empty(2)
+    count = sp3_slide(w, h, delta * delta, out)
+    gap = np.linalg.norm(h - (w @ h) * w)  # distance from the origin to the line h + d·w
+    if count == 0:
+        assert delta < gap
+    else:
+        assert delta >= gap - 1e-6
+        for d in out[:count]:
+            assert abs(np.linalg.norm(h + d * w) - delta) < 1e-9
+        assert count == 1 or out[0] > out[1]
+
+
 def test_puma_agrees_with_robotics_toolbox_ikine_a():
     """Every solution of Robotics Toolbox's Puma 560 ikine_a (8 configurations) is in our set."""
     rtb = pytest.importorskip("roboticstoolbox")

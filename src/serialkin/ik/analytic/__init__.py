@@ -97,6 +97,10 @@ class _Prepared:
 
 _PREPARED: weakref.WeakKeyDictionary[Robot, _Prepared] = weakref.WeakKeyDictionary()
 
+#: Spherical-wrist classes: (arm code, joint 3 prismatic) for ``solve_spherical_wrist``.
+_WRIST_ARMS = {"puma": (0, False), "pieper_intersecting": (1, False), "stanford": (1, True),
+               "pieper_general": (2, False), "stanford_general": (2, True)}
+
 
 def structure_of(robot: Robot) -> Structure:
     """The robot's recognised closed-form structure (cached per robot object).
@@ -286,19 +290,13 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         out = np.empty((2, p.n))
         k = solve_scara(T, p.W, p.P, p.M, p.order, p.aux[0], p.aux[1], p.revolute, p.qlim,
                         p.mid, p.F, p.meta, check_rot, tol_p, tol, out)
-    elif kind in ("puma", "pieper_intersecting", "pieper_general"):
+    elif kind in _WRIST_ARMS:
         from serialkin.ik.analytic.spherical_wrist import solve_spherical_wrist
 
         out = np.empty((8, 6))
-        arm = ("puma", "pieper_intersecting", "pieper_general").index(kind)
-        k = solve_spherical_wrist(T, p.W, p.P, p.M, p.aux, arm,
+        arm, prismatic3 = _WRIST_ARMS[kind]
+        k = solve_spherical_wrist(T, p.W, p.P, p.M, p.aux, arm, prismatic3,
                                   p.revolute, p.qlim, p.mid, p.F, p.meta, tol_p, tol, out)
-    elif kind in ("stanford", "stanford_general"):
-        from serialkin.ik.analytic.stanford import solve_stanford
-
-        out = np.empty((8, 6))
-        k = solve_stanford(T, p.W, p.P, p.M, p.aux, kind == "stanford_general", p.revolute,
-                           p.qlim, p.mid, p.F, p.meta, tol_p, tol, out)
     else:  # "ur"
         from serialkin.ik.analytic.ur import solve_ur
 

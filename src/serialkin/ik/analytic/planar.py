@@ -29,7 +29,7 @@ from serialkin.ik.analytic.subproblems import (
     finalize,
     mv,
     planar2r,
-    target_rotation,
+    target_point,
 )
 
 #: Most candidate solutions of the parallel-axis family.
@@ -55,22 +55,18 @@ def planar_candidates(T, W, P, M, order, w, e1, out):
         number of candidates (0, 1 or 2).
     """
     nr = order.shape[0] - 1
-    Rg = target_rotation(T, M)
-    pt = T[:3, 3].copy()
-    pM = M[:3, 3].copy()
     i0 = order[0]
     i1 = order[1]
     sol = np.empty((2, 2))
     if nr == 3:
-        i2 = order[2]
+        c3 = P[order[2]].copy()
+        t, Rg = target_point(T, M, c3)
         v = mv(Rg, e1)
         s = math.atan2(dot3(w, cross3(e1, v)), dot3(e1, v))
-        c3 = P[i2].copy()
-        t = mv(Rg, c3 - pM) + pt
         k = planar2r(w, e1, P[i0].copy(), P[i1].copy(), c3, t, sol)
     else:
         s = 0.0
-        k = planar2r(w, e1, P[i0].copy(), P[i1].copy(), pM, pt, sol)
+        k = planar2r(w, e1, P[i0].copy(), P[i1].copy(), M[:3, 3].copy(), T[:3, 3].copy(), sol)
     for r in range(k):
         out[r, i0] = dot3(W[i0], w) * sol[r, 0]
         out[r, i1] = dot3(W[i1], w) * sol[r, 1]

@@ -2,7 +2,9 @@
 
 When the last three revolute axes meet in one point, the wrist centre ``c`` (that point
 at q = 0) is moved by the first three joints only (joints 4-6 rotate about it), so the
-problem splits (D. L. Pieper, PhD thesis, Stanford 1968):
+problem splits (D. L. Pieper, PhD thesis, Stanford 1968). The first three joints are
+R R R, or R R P (the Stanford arm class: the third joint slides; ``prismatic3`` in the
+functions below, which serve both):
 
 1. **Position.** The target puts the wrist centre at ``p_w = T·M⁻¹·c``; find q1..q3 with
    ``exp(ξ1 q1)·exp(ξ2 q2)·exp(ξ3 q3)·c = p_w``:
@@ -14,15 +16,21 @@ problem splits (D. L. Pieper, PhD thesis, Stanford 1968):
      Shoulder and elbow offsets of any size are covered (Puma 560, KUKA, ABB, Fanuc...).
    * ``pieper_intersecting`` — axes 1 and 2 meet at ``o``: rotations about them keep
      the distance to ``o``, so ``|exp(ξ3 q3)·c − o| = |p_w − o|`` gives q3 (subproblem 3),
-     then q1, q2 by subproblem 2.
+     then q1, q2 by subproblem 2 (:func:`intersecting_candidates`).
+   * ``stanford`` — the same with a slide: ``|c − o + d·w3|² = |p_w − o|²``, i.e.
+     ``d² + 2 (w3·h) d + |h|² − |p_w − o|² = 0`` with ``h = c − o``, gives up to two
+     strokes d (:func:`~serialkin.ik.analytic.subproblems.sp3_slide`); up to 8
+     candidates, usually 4 with a positive stroke.
    * ``pieper_general`` — any other R R R arm (axes 1 and 2 skew, or parallel while
      axes 2 and 3 are not): the invariants of joint 1 give a quartic in q3 (Pieper),
      solved as a degree-2 trigonometric polynomial (:func:`general_candidates`), then
      q2 and q1 in closed form.
+   * ``stanford_general`` — R R P whose axes 1 and 2 do not meet (a shoulder offset):
+     the same invariants give a polynomial quartic in the stroke
+     (:func:`general_candidates` with a prismatic joint 3).
 2. **Orientation.** ``R4·R5·R6 = (R1 R2 R3)ᵀ·R_T·R_Mᵀ =: X``; ``R4 R5 w6 = X w6`` gives
    q4, q5 (subproblem 2, two solutions: wrist flip) and q6 follows by subproblem 1.
 
-The Stanford arm (prismatic third joint) is in :mod:`serialkin.ik.analytic.stanford`.
 At a wrist singularity (axes 4 and 6 aligned) only q4 + q6 is determined: one
 representative with q4 = 0 is returned.
 """
@@ -39,18 +47,19 @@ from serialkin.ik.analytic.subproblems import (
     dot3,
     finalize,
     mm,
-    mtm,
     mtv,
     mv,
     planar2r,
+    polish_real_root,
     poly_roots,
     rotation,
     screw,
     sp1_dir,
     sp2_dir,
     sp3,
+    sp3_slide,
     sp4,
-    target_rotation,
+    target_point,
     transform_point,
 )
 
@@ -59,24 +68,30 @@ MAX_SOLUTIONS = 8
 
 
 @njit(cache=True)
-def wrist_into(Rg, R123, W, v, q1, q2, q3, out, k):
+def wrist_into(Rg, W, v, q1, q2, q3, prismatic3, out, k):
     """Append the wrist solutions (q4, q5, q6) for arm joints (q1, q2, q3) to ``out``.
+
+    The arm's rotation is ``R123 = Rot(w1, q1)·Rot(w2, q2)·Rot(w3, q3)`` (without the
+    last factor when joint 3 is prismatic), and ``X = R123ᵀ·R_g = R4·R5·R6``.
 
     Args:
         Rg: (3, 3) ``R_T·R_Mᵀ``, the rotation the six joints must produce.
-        R123: (3, 3) rotation of the first three joints.
         W: (6, 3) joint directions at q = 0.
         v: (3,) unit vector ⟂ w6.
-        q1: arm joint 1 value.
-        q2: arm joint 2 value.
-        q3: arm joint 3 value [rad or m].
+        q1: arm joint 1 value [rad].
+        q2: arm joint 2 value [rad].
+        q3: arm joint 3 value [rad, or m when prismatic].
+        prismatic3: True when joint 3 slides (Stanford class).
         out: (8, 6) candidate rows; rows k, k+1 are written.
         k: number of rows already in ``out``.
 
     Returns:
         the new number of rows.
     """
-    X = mtm(R123, Rg)
+    R123 = mm(rotation(W[0].copy(), q1), rotation(W[1].copy(), q2))
+    if not prismatic3:
+        R123 = mm(R123, rotation(W[2].copy(), q3))
+    X = mm(R123.T, Rg)
     w4 = W[3].copy()
     w5 = W[4].copy()
     w6 = W[5].copy()
@@ -96,14 +111,6 @@ def wrist_into(Rg, R123, W, v, q1, q2, q3, out, k):
 
 
 @njit(cache=True)
-def _wrist_centre(T, M, c):
-    """Target position of the wrist centre, ``T·M⁻¹·c``, and ``R_T·R_Mᵀ``."""
-    Rg = target_rotation(T, M)
-    pw = mv(Rg, c - M[:3, 3]) + T[:3, 3]
-    return pw, Rg
-
-
-@njit(cache=True)
 def puma_candidates(T, W, P, M, aux, out):
     """Candidates for a ``puma``-class arm; aux = (c, w, e1 ⟂ w, v ⟂ w6). Returns the count."""
     c = aux[0].copy()
@@ -112,7 +119,7 @@ def puma_candidates(T, W, P, M, aux, out):
     v = aux[3].copy()
     w1 = W[0].copy()
     r1 = P[0].copy()
-    pw, Rg = _wrist_centre(T, M, c)
+    pw, Rg = target_point(T, M, c)
     q1s = np.empty(2)
     n1 = sp4(w1, w, pw - r1, dot3(w, c - r1), q1s)
     sol = np.empty((2, 2))
@@ -124,17 +131,20 @@ def puma_candidates(T, W, P, M, aux, out):
         x = transform_point(screw(w1, r1, -q1, False), pw)
         m = planar2r(w, e1, P[1].copy(), P[2].copy(), c, x, sol)
         for j in range(m):
-            q2 = s2 * sol[j, 0]
-            q3 = s3 * sol[j, 1]
-            R123 = mm(mm(rotation(w1, q1), rotation(W[1].copy(), q2)),
-                      rotation(W[2].copy(), q3))
-            k = wrist_into(Rg, R123, W, v, q1, q2, q3, out, k)
+            k = wrist_into(Rg, W, v, q1, s2 * sol[j, 0], s3 * sol[j, 1], False, out, k)
     return k
 
 
 @njit(cache=True)
-def intersecting_candidates(T, W, P, M, aux, out):
-    """Candidates for a ``pieper_intersecting`` arm; aux = (c, o, v). Returns the count."""
+def intersecting_candidates(T, W, P, M, aux, prismatic3, out):
+    """Candidates when axes 1 and 2 meet at o; aux = (c, o, v ⟂ w6). Returns the count.
+
+    Rotations about axes 1 and 2 keep the distance to ``o``, so joint 3 alone must give
+    the wrist centre its target distance ``|p_w − o|``: subproblem 3 for a revolute
+    joint 3 (``pieper_intersecting``), :func:`~serialkin.ik.analytic.subproblems.sp3_slide`
+    for a prismatic one (``prismatic3``, ``stanford``). Up to two values of q3; q1, q2
+    then carry the moved centre onto ``p_w`` (subproblem 2, two solutions each).
+    """
     c = aux[0].copy()
     o = aux[1].copy()
     v = aux[2].copy()
@@ -142,19 +152,25 @@ def intersecting_candidates(T, W, P, M, aux, out):
     w2 = W[1].copy()
     w3 = W[2].copy()
     r3 = P[2].copy()
-    pw, Rg = _wrist_centre(T, M, c)
-    delta = np.sqrt(dot3(pw - o, pw - o))
+    pw, Rg = target_point(T, M, c)
+    h = c - o
+    g = pw - o
     q3s = np.empty(2)
-    n3 = sp3(w3, r3, c, o, delta, q3s)
+    if prismatic3:
+        n3 = sp3_slide(w3, h, dot3(g, g), q3s)
+    else:
+        n3 = sp3(w3, r3, c, o, np.sqrt(dot3(g, g)), q3s)
     sol = np.empty((2, 2))
     k = 0
     for i in range(n3):
         q3 = q3s[i]
-        x = transform_point(screw(w3, r3, q3, False), c)
-        m = sp2_dir(w1, w2, x - o, pw - o, sol)
+        if prismatic3:
+            x = h + q3 * w3
+        else:
+            x = transform_point(screw(w3, r3, q3, False), c) - o
+        m = sp2_dir(w1, w2, x, g, sol)
         for j in range(m):
-            R123 = mm(mm(rotation(w1, sol[j, 0]), rotation(w2, sol[j, 1])), rotation(w3, q3))
-            k = wrist_into(Rg, R123, W, v, sol[j, 0], sol[j, 1], q3, out, k)
+            k = wrist_into(Rg, W, v, sol[j, 0], sol[j, 1], q3, prismatic3, out, k)
     return k
 
 
@@ -170,11 +186,11 @@ def _general_residual(theta, c, w3, r3, r2, w2, a1, ca, sa, rho2, h):
 
 
 @njit(cache=True)
-def general_candidates(T, W, P, M, aux, out):
-    """Candidates for a ``pieper_general`` arm; aux = (c, r1, r2, n, m, v). Returns the count.
+def general_candidates(T, W, P, M, aux, prismatic3, out):
+    """Candidates for a ``pieper_general`` or ``stanford_general`` arm; aux = (c, r1, r2, n, m, v).
 
     Axes 1 and 2 do not meet: r1, r2 are the feet of their common perpendicular, a1 = |r2 − r1|,
-    n = (r2 − r1)/a1, m = w2 × n, and w1 = cα·w2 + sα·m. With u = exp(ξ3 θ3)·c − r2 and
+    n = (r2 − r1)/a1, m = w2 × n, and w1 = cα·w2 + sα·m. With u = exp(ξ3 q3)·c − r2 and
     x = exp(ξ2 θ2)·(r2 + u) the point that joint 1 must turn onto p_w, the invariants of
     joint 1 (distance to r1 and height along w1) give (Pieper; Craig, *Introduction to
     Robotics*, section 4.6)
@@ -182,15 +198,17 @@ def general_candidates(T, W, P, M, aux, out):
     * n·R2 u = g1 = (|p_w − r1|² − |u|² − a1²)/(2 a1),
     * m·R2 u = g2 = (w1·(p_w − r1) − cα w2·u)/sα,
 
-    and since R2 turns the (n, m) components of u rigidly, g1² + g2² = |u|² − (w2·u)²:
-    a trigonometric polynomial E(θ3) of degree 2 (a quartic). Its Fourier coefficients
-    come exactly from 5 samples; the roots of ``z²·E`` (z = e^{iθ3}) on the unit circle,
-    polished by Newton's method, give up to 4 values of θ3; then
-    θ2 = atan2(g2, g1) − atan2(m·u, n·u) and θ1 by subproblem 1.
+    and since R2 turns the (n, m) components of u rigidly, E(q3) = g1² + g2² − (|u|² − (w2·u)²)
+    must vanish. Revolute joint 3 (``pieper_general``): u = Rot(w3, θ3)·(c − r3) + r3 − r2 and
+    E is a trigonometric polynomial of degree 2 (:func:`_quartic_theta3`). Prismatic joint 3
+    (``prismatic3``, ``stanford_general``): u = c + d·w3 − r2 is linear in the stroke d and
+    E(d) a polynomial quartic (:func:`_quartic_stroke`). Up to 4 values of q3; then
+    θ2 = atan2(g2, g1) − atan2(m·u, n·u), θ1 by subproblem 1 and the wrist by
+    :func:`wrist_into`.
 
     When axes 1 and 2 are parallel (sα = 0) the second invariant reads w2·u = cα·w1·(p_w − r1)
-    instead: θ3 by :func:`~serialkin.ik.analytic.subproblems.sp4` (two values) and
-    g2 = ±sqrt(|u|² − (w2·u)² − g1²) (two values of θ2 each).
+    instead: θ3 by :func:`~serialkin.ik.analytic.subproblems.sp4` (two values) or d directly
+    (one), and g2 = ±sqrt(|u|² − (w2·u)² − g1²) (two values of θ2 each).
     """
     c = aux[0].copy()
     r1 = aux[1].copy()
@@ -202,25 +220,32 @@ def general_candidates(T, W, P, M, aux, out):
     w2 = W[1].copy()
     w3 = W[2].copy()
     r3 = P[2].copy()
-    pw, Rg = _wrist_centre(T, M, c)
+    pw, Rg = target_point(T, M, c)
     a1 = dot3(r2 - r1, n)
     ca = dot3(w1, w2)
     sa = dot3(w1, m)
     rho2 = dot3(pw - r1, pw - r1)
     h = dot3(w1, pw - r1)
+    h0 = c - r2
+    parallel = abs(sa) < 1e-9
     thetas = np.empty(4)
-    if abs(sa) < 1e-9:  # axes 1 ∥ 2: w2·u(θ3) = cα·h fixes θ3 (two values), g2 = ±sqrt(..)
+    if prismatic3:
+        nt = _quartic_stroke(h0, w3, w2, a1, ca, sa, rho2, h, parallel, thetas)
+    elif parallel:  # axes 1 ∥ 2: w2·u(θ3) = cα·h fixes θ3 (two values), g2 = ±sqrt(..)
         nt = sp4(w3, c - r3, w2, ca * h - dot3(w2, r3 - r2), thetas)
     else:
         nt = _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas)
     k = 0
     for i in range(nt):
         th = thetas[i]
-        u = mv(rotation(w3, th), c - r3) + r3 - r2
+        if prismatic3:
+            u = h0 + th * w3
+        else:
+            u = mv(rotation(w3, th), c - r3) + r3 - r2
         uu = dot3(u, u)
         wu = dot3(w2, u)
         g1 = (rho2 - uu - a1 * a1) / (2.0 * a1)
-        if abs(sa) < 1e-9:
+        if parallel:
             g2sq = uu - wu * wu - g1 * g1
             if g2sq < -CLAMP * max(uu, 1e-300):
                 continue
@@ -234,10 +259,9 @@ def general_candidates(T, W, P, M, aux, out):
             th2 = math.atan2(gj, g1) - math.atan2(dot3(m, u), dot3(n, u))
             x = mv(rotation(w2, th2), u) + r2
             th1 = sp1_dir(w1, x - r1, pw - r1)
-            R123 = mm(mm(rotation(w1, th1), rotation(w2, th2)), rotation(w3, th))
             if k + 2 > out.shape[0]:
                 return k
-            k = wrist_into(Rg, R123, W, v, th1, th2, th, out, k)
+            k = wrist_into(Rg, W, v, th1, th2, th, prismatic3, out, k)
     return k
 
 
@@ -294,9 +318,55 @@ def _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas):
 
 
 @njit(cache=True)
-def solve_spherical_wrist(T, W, P, M, aux, arm, revolute, qlim, mid, F, meta, tol_p, tol_r,
-                          out):
-    """Every solution of a spherical-wrist 6R arm inside the limits, sorted, into ``out``.
+def _quartic_stroke(h0, b, w2, a1, ca, sa, rho2, h, parallel, strokes):
+    """Real roots d of E(d), joint 3 prismatic (see :func:`general_candidates`); the count.
+
+    With u = h0 + d·b (h0 = c − r2, b = w3): g1 = K2 d² + K1 d + K0, g2 = L1 d + L0 and
+    |u|² − (w2·u)² = N2 d² + N1 d + N0, so E(d) = g1² + g2² − (N2 d² + N1 d + N0) is a
+    quartic, solved by :func:`~serialkin.ik.analytic.subproblems.poly_roots`; the real
+    roots are polished by Newton's method and kept when E vanishes there. With ``parallel``
+    axes 1, 2 the height w2·u(d) = cα·h gives the one stroke d directly.
+    """
+    wb = dot3(w2, b)
+    wh = dot3(w2, h0)
+    ns = 0
+    if parallel:
+        if abs(wb) > 1e-12:
+            strokes[0] = (ca * h - wh) / wb
+            ns = 1
+        return ns
+    K2 = -1.0 / (2.0 * a1)
+    K1 = -dot3(b, h0) / a1
+    K0 = (rho2 - dot3(h0, h0) - a1 * a1) / (2.0 * a1)
+    L1 = -ca * wb / sa
+    L0 = (h - ca * wh) / sa
+    N2 = 1.0 - wb * wb
+    N1 = 2.0 * (dot3(b, h0) - wh * wb)
+    N0 = dot3(h0, h0) - wh * wh
+    coefs = np.array([K2 * K2, 2.0 * K1 * K2, K1 * K1 + 2.0 * K0 * K2 + L1 * L1 - N2,
+                      2.0 * K0 * K1 + 2.0 * L0 * L1 - N1, K0 * K0 + L0 * L0 - N0])
+    roots = np.empty(4, dtype=np.complex128)
+    roots = roots[:poly_roots(coefs.astype(np.complex128), roots)]
+    big = 0.0
+    for cf in coefs:
+        big = max(big, abs(cf))
+    for z in roots:
+        if abs(z.imag) > 1e-4 * max(1.0, abs(z.real)) or ns == strokes.shape[0]:
+            continue
+        d = polish_real_root(coefs, z.real)
+        f = 0.0
+        for cf in coefs:
+            f = f * d + cf
+        if abs(f) <= 1e-9 * big * max(1.0, d * d * d * d):
+            strokes[ns] = d
+            ns += 1
+    return ns
+
+
+@njit(cache=True)
+def solve_spherical_wrist(T, W, P, M, aux, arm, prismatic3, revolute, qlim, mid, F, meta,
+                          tol_p, tol_r, out):
+    """Every solution of a spherical-wrist 6R / R R P arm inside the limits, sorted, into ``out``.
 
     Args:
         T: (4, 4) target pose (world).
@@ -304,7 +374,9 @@ def solve_spherical_wrist(T, W, P, M, aux, arm, revolute, qlim, mid, F, meta, to
         P: (6, 3) a point of each joint line at q = 0 [m].
         M: (4, 4) tool pose at q = 0.
         aux: class data (see the candidate functions).
-        arm: 0 for ``puma``, 1 for ``pieper_intersecting``, 2 for ``pieper_general``.
+        arm: 0 for ``puma``, 1 when axes 1 and 2 meet (``pieper_intersecting``,
+            ``stanford``), 2 otherwise (``pieper_general``, ``stanford_general``).
+        prismatic3: True when joint 3 slides (``stanford``, ``stanford_general``).
         revolute: (6,) booleans, True for revolute joints.
         qlim: (6, 2) joint limits.
         mid: (6,) wrapping centres of the revolute joints.
@@ -321,7 +393,7 @@ def solve_spherical_wrist(T, W, P, M, aux, arm, revolute, qlim, mid, F, meta, to
     if arm == 0:
         k = puma_candidates(T, W, P, M, aux, cand)
     elif arm == 1:
-        k = intersecting_candidates(T, W, P, M, aux, cand)
+        k = intersecting_candidates(T, W, P, M, aux, prismatic3, cand)
     else:
-        k = general_candidates(T, W, P, M, aux, cand)
+        k = general_candidates(T, W, P, M, aux, prismatic3, cand)
     return finalize(cand, k, revolute, qlim, mid, F, meta, T, True, tol_p, tol_r, out)

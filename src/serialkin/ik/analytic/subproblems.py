@@ -13,6 +13,7 @@ the same few geometric subproblems (Paden–Kahan; R. M. Murray, Z. Li, S. S. Sa
 * :func:`sp1_dir` — the rotation about ``w`` that carries one vector onto another;
 * :func:`sp2_dir` — two rotations about intersecting axes carrying ``u`` onto ``v``;
 * :func:`sp3` — the rotation that puts a point at a given distance from another;
+  :func:`sp3_slide` — the same for a translation along a line;
 * :func:`sp4` — the rotation that gives a rotated vector a given projection, ``a·R b = c``;
 * :func:`planar2r` — the two-link planar arm of the chapter (eqs 23-27, corrected per
   the ERRATA), on any pair of parallel axes.
@@ -62,7 +63,10 @@ def cross3(a, b):
 
 @njit(cache=True)
 def mm(A, B):
-    """Matrix product of small matrices (loops, no BLAS), a new array."""
+    """Matrix product of small matrices (loops, no BLAS), a new array.
+
+    ``Aᵀ·B`` is ``mm(A.T, B)`` (a transposed view, same summation order).
+    """
     n, k = A.shape
     m = B.shape[1]
     C = np.zeros((n, m))
@@ -71,21 +75,6 @@ def mm(A, B):
             acc = 0.0
             for t in range(k):
                 acc += A[i, t] * B[t, j]
-            C[i, j] = acc
-    return C
-
-
-@njit(cache=True)
-def mtm(A, B):
-    """``Aᵀ·B`` for small matrices, a new array."""
-    k, n = A.shape
-    m = B.shape[1]
-    C = np.zeros((n, m))
-    for i in range(n):
-        for j in range(m):
-            acc = 0.0
-            for t in range(k):
-                acc += A[t, i] * B[t, j]
             C[i, j] = acc
     return C
 
@@ -116,6 +105,17 @@ def target_rotation(T, M):
         for j in range(3):
             R[i, j] = T[i, 0] * M[j, 0] + T[i, 1] * M[j, 1] + T[i, 2] * M[j, 2]
     return R
+
+
+@njit(cache=True)
+def target_point(T, M, p):
+    """Where the target pose puts a point p fixed to the tool, and the rotation to produce.
+
+    Returns ``(T·M⁻¹·p, R_T·R_Mᵀ)``: the point (3,) [m] for p (3,) given at q = 0, e.g. a
+    spherical wrist's centre, and the (3, 3) rotation the joints must produce.
+    """
+    Rg = target_rotation(T, M)
+    return mv(Rg, p - M[:3, 3]) + T[:3, 3], Rg
 
 
 @njit(cache=True)
@@ -270,6 +270,29 @@ def sp3(w, r, p, q, delta, out):
 
 
 @njit(cache=True)
+def sp3_slide(w, h, delta2, out):
+    """Subproblem 3 for a slide: strokes d with ``|h + d·w|² = δ²`` (w a unit direction).
+
+    ``d² + 2 (w·h) d + |h|² − δ² = 0``, so d = −w·h ± sqrt((w·h)² − |h|² + δ²); a
+    discriminant slightly negative (within :data:`CLAMP`·max(|h|², 1)) counts as zero.
+    Takes ``delta2`` = δ² [m²]; writes d [m] into ``out`` (2,) (the + root first),
+    returns 0, 1 or 2.
+    """
+    b = dot3(w, h)
+    hh = dot3(h, h)
+    disc = b * b - hh + delta2
+    if disc < 0.0:
+        if disc < -CLAMP * max(hh, 1.0):
+            return 0
+        disc = 0.0
+    root = math.sqrt(disc)
+    out[0] = -b + root
+    if root == 0.0:
+        return 1
+    out[1] = -b - root
+    return 2
+
+@njit(cache=True)
 def sp4(w, b, a, c, out):
     """θ with ``a·Rot(w, θ)·b = c``: ``A cos θ + B sin θ = c − (a·w)(w·b)``.
 
@@ -415,6 +438,28 @@ def poly_roots(coefs, out):
         if moved < 1e-12:  # the callers polish with Newton's method on their equation
             break
     return deg
+
+
+@njit(cache=True)
+def polish_real_root(coefs, x):
+    """Newton steps on the real polynomial ``coefs`` (highest degree first) from x.
+
+    At most 8 steps, stopping when a step falls below 1e-15·max(1, |x|) or the
+    derivative vanishes; returns the polished root.
+    """
+    for _ in range(8):
+        f = 0.0
+        df = 0.0
+        for c in coefs:
+            df = df * x + f
+            f = f * x + c
+        if df == 0.0:
+            break
+        step = f / df
+        x -= step
+        if abs(step) <= 1e-15 * max(1.0, abs(x)):
+            break
+    return x
 
 
 @njit(cache=True)

@@ -30,7 +30,6 @@ from serialkin.ik.analytic.subproblems import (
     finalize,
     inv_rigid,
     mm,
-    mtm,
     mtv,
     mv,
     planar2r,
@@ -38,7 +37,7 @@ from serialkin.ik.analytic.subproblems import (
     screw,
     sp1_dir,
     sp4,
-    target_rotation,
+    target_point,
     transform_point,
 )
 
@@ -58,8 +57,7 @@ def ur_candidates(T, W, P, M, aux, out):
     r5 = P[4].copy()
     w6 = W[5].copy()
     r6 = P[5].copy()
-    Rg = target_rotation(T, M)
-    p5 = mv(Rg, p56 - M[:3, 3]) + T[:3, 3]
+    p5, Rg = target_point(T, M, p56)
     w6t = mv(Rg, w6)
     TMinv = mm(T, inv_rigid(M))
     x4 = P[3].copy()
@@ -74,7 +72,7 @@ def ur_candidates(T, W, P, M, aux, out):
     for i in range(n1):
         q1 = q1s[i]
         R1 = rotation(w1, q1)
-        X = mtm(R1, Rg)
+        X = mm(R1.T, Rg)
         n5 = sp4(w5, w6, w, dot3(mv(R1, w), w6t), q5s)
         for j in range(n5):
             q5 = q5s[j]
