@@ -12,6 +12,7 @@ poses are 4x4 homogeneous transforms of the end-effector (tool) in the world fra
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
@@ -201,30 +202,37 @@ class Robot:
 
         return robot_to_urdf(self)
 
+    def _copy(self, **changes: Any) -> Robot:
+        """A new robot with some constructor arguments changed (link names kept)."""
+        args: dict[str, Any] = dict(joints=self.joints, base=self.base, tool=self.tool,
+                                    name=self.name, dh=self.dh, convention=self.convention,
+                                    source=self.source)
+        args.update(changes)
+        robot = Robot(args.pop("joints"), **args)
+        robot.link_names = self.link_names
+        return robot
+
     def with_tool(self, tool: object) -> Robot:
         """A copy of this robot with another tool transform (4, 4)."""
-        return Robot(self.joints, base=self.base, tool=tool, name=self.name, dh=self.dh,
-                     convention=self.convention, source=self.source)
+        return self._copy(tool=tool)
 
     def with_base(self, base: object) -> Robot:
         """A copy of this robot with another base transform (4, 4)."""
-        return Robot(self.joints, base=base, tool=self.tool, name=self.name, dh=self.dh,
-                     convention=self.convention, source=self.source)
+        return self._copy(base=base)
 
     def with_limits(self, qlim: object) -> Robot:
-        """A copy of this robot with other joint limits, shape (n, 2) [rad or m]."""
-        lim = as_float_array(qlim, "qlim") if not np.isinf(np.asarray(qlim, float)).any() \
-            else np.asarray(qlim, float)
+        """A copy of this robot with other joint limits, shape (n, 2) [rad or m], ±inf allowed."""
+        try:
+            lim = np.asarray(qlim, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"qlim must be an ({self.n}, 2) array of numbers, got {qlim!r}") \
+                from exc
         if lim.shape != (self.n, 2):
             raise InputError(f"qlim must have shape ({self.n}, 2), got {lim.shape}")
-        joints = [Joint(axis=j.axis, type=j.type, origin=j.origin, post=j.post, offset=j.offset,
-                        qlim=tuple(lim[i]), name=j.name) for i, j in enumerate(self.joints)]
-        dh = None
-        if self.dh is not None:
-            dh = [DHLink(a=r.a, alpha=r.alpha, d=r.d, theta=r.theta, type=r.type,
-                         qlim=tuple(lim[i]), name=r.name) for i, r in enumerate(self.dh)]
-        return Robot(joints, base=self.base, tool=self.tool, name=self.name, dh=dh,
-                     convention=self.convention, source=self.source)
+        joints = [dataclasses.replace(j, qlim=tuple(lim[i])) for i, j in enumerate(self.joints)]
+        dh = None if self.dh is None else [
+            dataclasses.replace(r, qlim=tuple(lim[i])) for i, r in enumerate(self.dh)]
+        return self._copy(joints=joints, dh=dh)
 
     # ------------------------------------------------------------------ validation
     def check_q(self, q: object, name: str = "q") -> np.ndarray:
