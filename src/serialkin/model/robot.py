@@ -417,11 +417,16 @@ class Robot:
                 'planar' (vx, vy), 'planar_pose' (vx, vy, wz) or a list of row indices.
 
         Returns:
-            float or (...) array; 0 at singular configurations (and when n < m).
+            float or (...) array; 0 at singular configurations (and when n < m). Computed
+            as the product of J's singular values, which equals sqrt(det(J Jᵀ)) and is
+            exactly representable near singularities.
         """
         J = self._task_jacobian(q, task)
-        det = np.linalg.det(J @ np.swapaxes(J, -1, -2))
-        w = np.sqrt(np.maximum(det, 0.0))
+        m, n = J.shape[-2:]
+        if m > n:  # J Jᵀ (m x m) has rank <= n < m
+            w = np.zeros(J.shape[:-2])
+        else:  # sqrt(det(J Jᵀ)) = product of the singular values: exact 0 at singularities
+            w = np.prod(np.linalg.svd(J, compute_uv=False), axis=-1)
         return float(w) if w.ndim == 0 else w
 
     def condition_number(self, q: object, task: str | Sequence[int] = "full") -> np.ndarray | float:
