@@ -123,29 +123,35 @@ def _sincos_scalar(x):
 
 
 @njit(cache=True)
-def _fk_block(Q, F, meta, out, k0, B, T, c, s):
-    """Poses of configurations ``Q[k0:k0+B]`` into ``out``; T (12, _BLOCK), c, s scratch."""
+def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
+    """Poses of configurations ``Q[k0:k0+B]`` into ``out``.
+
+    Scratch: T (12, _BLOCK) the poses' top rows, X (n, _BLOCK) the block's joint values
+    joint-major (so every per-joint loop reads contiguous memory), c, s (_BLOCK,).
+    """
+    n = meta.shape[0]
+    for b in range(B):
+        for i in range(n):
+            X[i, b] = Q[k0 + b, i] + meta[i, 4]
     for j in range(12):
         v = F[0, j // 4, j % 4]
         for b in range(B):
             T[j, b] = v
-    for i in range(meta.shape[0]):
-        off = meta[i, 4]
+    for i in range(n):
+        x = X[i]
         if meta[i, 3] == PRISMATIC:
             for r in range(3):
                 for b in range(B):
-                    T[4 * r + 3, b] += (Q[k0 + b, i] + off) * T[4 * r + 2, b]
+                    T[4 * r + 3, b] += x[b] * T[4 * r + 2, b]
         else:
-            for b in range(B):
-                s[b], c[b] = _sincos(Q[k0 + b, i] + off)
             big = False
             for b in range(B):
-                big |= abs(Q[k0 + b, i] + off) > 1e5
+                s[b], c[b] = _sincos(x[b])
+                big |= abs(x[b]) > 1e5
             if big:
                 for b in range(B):
-                    x = Q[k0 + b, i] + off
-                    s[b] = math.sin(x)
-                    c[b] = math.cos(x)
+                    s[b] = math.sin(x[b])
+                    c[b] = math.cos(x[b])
             for r in range(3):
                 for b in range(B):
                     t0 = T[4 * r, b]
@@ -187,13 +193,14 @@ def fk_batch(Q, F, meta, out):
     per = (N + chunks - 1) // chunks
     for ch in prange(chunks):
         T = np.empty((12, _BLOCK))
+        X = np.empty((meta.shape[0], _BLOCK))
         c = np.empty(_BLOCK)
         s = np.empty(_BLOCK)
         k0 = ch * per
         end = min(N, k0 + per)
         while k0 < end:
             B = min(_BLOCK, end - k0)
-            _fk_block(Q, F, meta, out, k0, B, T, c, s)
+            _fk_block(Q, F, meta, out, k0, B, T, X, c, s)
             k0 += B
 
 
