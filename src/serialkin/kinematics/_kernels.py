@@ -65,22 +65,75 @@ def _apply_joint(T, meta_i, qi):
         T[r, 1] = t1 * c - t0 * s
 
 
+@njit(cache=True, inline="always")
+def _row_times(t0, t1, t2, t3, A):
+    """One row [t0 t1 t2 t3] of a rigid transform times the rigid transform A."""
+    return (t0 * A[0, 0] + t1 * A[1, 0] + t2 * A[2, 0],
+            t0 * A[0, 1] + t1 * A[1, 1] + t2 * A[2, 1],
+            t0 * A[0, 2] + t1 * A[1, 2] + t2 * A[2, 2],
+            t0 * A[0, 3] + t1 * A[1, 3] + t2 * A[2, 3] + t3)
+
+
+@njit(cache=True, inline="always")
+def _chain_walk(q, F, meta, J, record):
+    """Walk the chain holding the pose's 12 entries in registers; return them as a tuple.
+
+    The joints' sin/cos are computed first (independent of the pose, so they pipeline).
+    With ``record``, each joint's world axis z_i and origin o_i (its frame just before its
+    motion) are stored in ``J[3:, i]`` and ``J[:3, i]`` (J (6, n)) on the way.
+    """
+    n = meta.shape[0]
+    sc = np.empty((2, n))
+    for i in range(n):
+        sc[0, i], sc[1, i] = _sincos_scalar(q[i] + meta[i, 4])
+    A = F[0]
+    a0, a1, a2, a3 = A[0, 0], A[0, 1], A[0, 2], A[0, 3]
+    b0, b1, b2, b3 = A[1, 0], A[1, 1], A[1, 2], A[1, 3]
+    c0, c1, c2, c3 = A[2, 0], A[2, 1], A[2, 2], A[2, 3]
+    for i in range(n):
+        if record:
+            J[0, i], J[1, i], J[2, i] = a3, b3, c3
+            J[3, i], J[4, i], J[5, i] = a2, b2, c2
+        if meta[i, 3] == PRISMATIC:
+            x = q[i] + meta[i, 4]
+            a3 += x * a2
+            b3 += x * b2
+            c3 += x * c2
+        else:
+            s = sc[0, i]
+            c = sc[1, i]
+            a0, a1 = a0 * c + a1 * s, a1 * c - a0 * s
+            b0, b1 = b0 * c + b1 * s, b1 * c - b0 * s
+            c0, c1 = c0 * c + c1 * s, c1 * c - c0 * s
+        A = F[i + 1]
+        a0, a1, a2, a3 = _row_times(a0, a1, a2, a3, A)
+        b0, b1, b2, b3 = _row_times(b0, b1, b2, b3, A)
+        c0, c1, c2, c3 = _row_times(c0, c1, c2, c3, A)
+    return a0, a1, a2, a3, b0, b1, b2, b3, c0, c1, c2, c3
+
+
+@njit(cache=True, inline="always")
+def _store_pose(t, T):
+    for k in range(12):
+        T[k // 4, k % 4] = t[k]
+    T[3, 0] = 0.0
+    T[3, 1] = 0.0
+    T[3, 2] = 0.0
+    T[3, 3] = 1.0
+
+
 @njit(cache=True)
 def fk_into(q, F, meta, T):
     """End-effector pose (eq 11) into ``T`` (4, 4) for one configuration ``q`` (n,)."""
-    n = meta.shape[0]
-    T[:, :] = F[0]
-    for i in range(n):
-        _apply_joint(T, meta[i], q[i])
-        _post_multiply(T, F[i + 1])
+    _store_pose(_chain_walk(q, F, meta, T, False), T)
 
 
 # --- sin/cos, and batches: blocks of configurations in structure-of-arrays form -----------
 #
 # libm's sin/cos are scalar calls (about 10 ns each) and dominate FK. Every kernel here
 # evaluates them with a branch-free Taylor polynomial after Cody–Waite reduction by π/2
-# (about 3x cheaper), which LLVM also vectorises across a block of configurations. π/2 is split
-# into three parts (P1, P2 with 32 significant bits, so k·P1 and k·P2 are exact for
+# (about 3x cheaper), which LLVM also vectorises across a block of configurations. π/2 is
+# split into three parts (P1, P2 with 32 significant bits, so k·P1 and k·P2 are exact for
 # |k| < 2^20); on |r| ≤ π/4 the truncated series (sin to r^15, cos to r^16) is accurate to
 # a few 1e-17; the result agrees with libm to about 2 ulp (tested). Angles beyond
 # |x| > 1e5 rad fall back to libm.
@@ -273,13 +326,9 @@ def jacobian_into(q, F, meta, J, T):
     (4, 4). Joint *i*'s axis and origin are those of its frame just before its motion
     (for standard DH, frame i-1: the chapter's z_{i-1}, p_{i-1}).
     """
-    n = meta.shape[0]
-    T[:, :] = F[0]
-    for i in range(n):
-        _record_joint(J, i, T, meta[i])
-        _apply_joint(T, meta[i], q[i])
-        _post_multiply(T, F[i + 1])
-    _finish_columns(J, meta, n, T[0, 3], T[1, 3], T[2, 3])
+    t = _chain_walk(q, F, meta, J, True)
+    _store_pose(t, T)
+    _finish_columns(J, meta, meta.shape[0], t[3], t[7], t[11])
 
 
 @njit(cache=True)
