@@ -39,7 +39,8 @@ run: $(STAMP_RUN) $(STAMP_NUMBA)
 browser-deps:
 	@command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1 \
 	  && command -v ffmpeg >/dev/null 2>&1 || \
-	  ( (apt-get update -qq && apt-get install -y -qq chromium chromium-driver ffmpeg >/dev/null) \
+	  ( (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+	      chromium chromium-driver ffmpeg >/dev/null) \
 	    || echo "browser-deps: could not install chromium/ffmpeg; those tests will be skipped" )
 
 test: $(STAMP_TEST) $(STAMP_NUMBA) browser-deps
