@@ -13,24 +13,29 @@ import html
 import importlib
 import io
 import os
+import re
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from serialkin._io import write_bytes_atomic, write_text_atomic
+from serialkin.errors import InputError
 
 #: Section modules in chapter order (module name under serialkin.chapter.sections).
 SECTION_MODULES: tuple[str, ...] = (
     "workspace",
     "rigid_motion",
     "forward",
-    "jacobian",
     "inverse",
+    "jacobian",
+    "numerical",
     "redundancy",
 )
+
+_NUMBER = re.compile(r"^\s*(\d+(?:\.\d+)*)\.?\s+(.*)$", re.DOTALL)
 
 
 @dataclass
@@ -38,16 +43,126 @@ class Section:
     """One section of the report.
 
     Attributes:
-        title: heading, e.g. "3. Forward kinematics".
-        equations: the chapter equation numbers it implements, e.g. "eqs 10-18".
+        title: heading with the chapter's number first, e.g. "3 Forward kinematics" or
+            "5.1 Analytical Jacobian" (a trailing dot after the number is accepted). The
+            report prints the number once, in the contents and in the heading. A section
+            whose number repeats the previous section's (e.g. a second "5.3 ...") continues
+            it: it is shown under the same heading with ``part`` as its sub-heading.
+        equations: the chapter equation numbers it demonstrates, e.g. "eqs 10-18".
         html: body HTML (use :class:`ReportContext` helpers to make tables and figures).
-        anchor: HTML id.
+        anchor: HTML id (default: the module name, then ``<module>-<k>``).
+        part: sub-heading when the section continues a previous number (optional).
     """
 
     title: str
     equations: str
     html: str
     anchor: str = ""
+    part: str = ""
+
+    @property
+    def number(self) -> str:
+        """The chapter's section number, e.g. "5.1" ("" when the title has none)."""
+        m = _NUMBER.match(self.title)
+        return m.group(1) if m else ""
+
+    @property
+    def name(self) -> str:
+        """The title without its number."""
+        m = _NUMBER.match(self.title)
+        return m.group(2).strip() if m else self.title.strip()
+
+
+@dataclass(frozen=True)
+class Timing:
+    """A warm wall-clock measurement: median and spread of repeated runs.
+
+    Attributes:
+        median: median time of one call [s].
+        low: fastest run [s] (the spread is the full range, min..max).
+        high: slowest run [s].
+        n: number of timed runs.
+        warm: True when untimed warm-up calls preceded the timed ones (JIT compiled, caches
+            filled).
+    """
+
+    median: float
+    low: float
+    high: float
+    n: int
+    warm: bool = True
+
+    @property
+    def text(self) -> str:
+        """E.g. "0.91 ms (median of 7 warm runs, spread 0.85–0.97 ms)"."""
+        scale, unit = _time_unit(self.median)
+        kind = "warm runs" if self.warm else "runs, first one cold"
+        return (f"{_fmt3(self.median * scale)} {unit} (median of {self.n} {kind}, spread "
+                f"{_fmt3(self.low * scale)}–{_fmt3(self.high * scale)} {unit})")
+
+    def __str__(self) -> str:
+        return self.text
+
+
+def _time_unit(seconds: float) -> tuple[float, str]:
+    """Scale and unit for ``seconds``: s from 1 s, ms from 0.1 ms, else µs."""
+    if seconds >= 1.0:
+        return 1.0, "s"
+    if seconds >= 1e-4:
+        return 1e3, "ms"
+    return 1e6, "µs"
+
+
+def _fmt3(value: float) -> str:
+    """Three significant digits, no exponent for the ranges :func:`_time_unit` produces."""
+    return f"{value:.3g}" if value < 1000 else f"{value:.0f}"
+
+
+class Html(str):
+    """A string of markup that :meth:`ReportContext.table` inserts as it is (not escaped)."""
+
+    __slots__ = ()
+
+    def __html__(self) -> str:
+        return str(self)
+
+
+def _no_negative_zero(text: str) -> str:
+    """Drop the sign of a formatted number that rounds to zero ("-0.0000" → "0.0000")."""
+    if text.startswith("-"):
+        try:
+            if float(text) == 0.0:
+                return text[1:]
+        except ValueError:
+            pass
+    return text
+
+
+def format_number(value: float, fmt: str = "{:.6g}") -> str:
+    """Format a number with ``fmt``, never printing a negative zero."""
+    return _no_negative_zero(fmt.format(value))
+
+
+_NUMERIC_TEXT = re.compile(
+    r"^[+\-−]?(?:\d[\d,\u202f ]*(?:\.\d*)?|\.\d+)(?:[eE][+\-−]?\d+)?"
+    r"(?:\s*(?:%|°|s|ms|µs|m|mm|rad|m²|×))?$|^[+\-−]?(?:∞|inf|nan)$"
+)
+
+
+def _is_numeric(value: object) -> bool:
+    """True for numbers and for text that reads as one number (right-aligned in tables)."""
+    if isinstance(value, bool):
+        return False
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        return True
+    return isinstance(value, str) and not hasattr(value, "__html__") and bool(
+        _NUMERIC_TEXT.match(value.strip()))
+
+
+def _latex_to_mathml(latex: str, display: str) -> str:
+    from latex2mathml.converter import convert
+
+    return convert(latex, display=display)
 
 
 @dataclass
@@ -57,7 +172,62 @@ class ReportContext:
     outdir: Path
     quiet: bool = False
     figures: list[str] = field(default_factory=list)
+    timings: list[Timing] = field(default_factory=list)
 
+    # --- mathematics -------------------------------------------------------------------------
+    @staticmethod
+    def eq(latex: str, number: str | None = None) -> str:
+        """A display equation: LaTeX rendered as MathML, the chapter's number on the right.
+
+        Args:
+            latex: the equation in LaTeX (amsmath subset understood by latex2mathml; sympy's
+                ``sp.latex`` output works).
+            number: the chapter's equation number, e.g. "49" (shown as "(49)"), or None.
+
+        Returns:
+            HTML: a block whose equation scrolls sideways when wider than the page.
+        """
+        math = _latex_to_mathml(latex, "block")
+        num = (f'<span class="eqno">({html.escape(str(number))})</span>'
+               if number is not None else "")
+        return f'<div class="eqn"><div class="eqbody">{math}</div>{num}</div>'
+
+    @staticmethod
+    def imath(latex: str) -> str:
+        """Inline mathematics: LaTeX rendered as MathML inside the running text."""
+        return _latex_to_mathml(latex, "inline")
+
+    # --- timings -------------------------------------------------------------------------------
+    def timing(self, fn: Callable[[], object], *, warmup: int = 1, repeat: int = 7) -> Timing:
+        """Time ``fn()``: ``warmup`` untimed calls, then ``repeat`` timed ones.
+
+        Returns:
+            :class:`Timing` with the median and the full range (min..max) of the timed
+            calls [s]; ``warm`` is True when ``warmup >= 1``.
+        """
+        if repeat < 1:
+            raise InputError(f"repeat must be at least 1, got {repeat}")
+        for _ in range(max(0, warmup)):
+            fn()
+        runs = []
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            fn()
+            runs.append(time.perf_counter() - t0)
+        t = Timing(median=float(np.median(runs)), low=float(min(runs)),
+                   high=float(max(runs)), n=repeat, warm=warmup >= 1)
+        self.timings.append(t)
+        return t
+
+    # --- reproduction --------------------------------------------------------------------------
+    @staticmethod
+    def reproduce(code: str, shell: bool = False) -> str:
+        """A "Reproduce" box with the Python snippet or ``serialkin ...`` command."""
+        kind = "shell" if shell else "Python"
+        return (f'<div class="repro"><span class="repro-label">Reproduce ({kind})</span>'
+                f'<pre><code>{html.escape(code.strip())}</code></pre></div>')
+
+    # --- figures -------------------------------------------------------------------------------
     def figure(self, fig: object, name: str, caption: str = "") -> str:
         """Save a matplotlib figure as ``figures/<name>.png``; return an <img> block (inline)."""
         import matplotlib.pyplot as plt
@@ -81,52 +251,179 @@ class ReportContext:
             f'<figcaption>{cap} <a href="{rel}">({filename})</a></figcaption></figure>'
         )
 
+    # --- tables --------------------------------------------------------------------------------
     @staticmethod
     def table(rows: Sequence[Sequence[object]], header: Sequence[str] | None = None,
               fmt: str = "{:.6g}") -> str:
-        """An HTML table; floats formatted with ``fmt``."""
+        """An HTML table: numbers right-aligned, text left-aligned, no negative zero.
+
+        Floats are formatted with ``fmt``; strings that read as one number (e.g. "1.2e-05",
+        "98 %") count as numbers; :class:`Html` cells (e.g. MathML, a matrix) are inserted
+        unescaped. A header cell is aligned like its column.
+        """
 
         def cell(v: object) -> str:
+            if hasattr(v, "__html__"):
+                return v.__html__()  # type: ignore[attr-defined]
             if isinstance(v, (float, np.floating)):
-                return fmt.format(v)
+                return format_number(float(v), fmt)
+            if isinstance(v, str):
+                return html.escape(_no_negative_zero(v))
             return html.escape(str(v))
+
+        ncol = max([len(r) for r in rows] + [len(header or ())])
+        numeric = [bool(rows) and all(_is_numeric(r[j]) for r in rows if j < len(r))
+                   for j in range(ncol)]
+
+        def align(j: int, v: object) -> str:
+            return ' class="num"' if _is_numeric(v) else ' class="txt"'
 
         head = ""
         if header:
-            head = "<tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in header) + "</tr>"
-        body = "".join("<tr>" + "".join(f"<td>{cell(v)}</td>" for v in r) + "</tr>" for r in rows)
-        return f"<table>{head}{body}</table>"
+            head = "<thead><tr>" + "".join(
+                f'<th class="{"num" if numeric[j] else "txt"}">{html.escape(h)}</th>'
+                for j, h in enumerate(header)) + "</tr></thead>"
+        body = "".join("<tr>" + "".join(f"<td{align(j, v)}>{cell(v)}</td>"
+                                        for j, v in enumerate(r)) + "</tr>" for r in rows)
+        return f"<table>{head}<tbody>{body}</tbody></table>"
 
     @staticmethod
     def matrix(M: object, fmt: str = "{:.4f}") -> str:
-        """A numeric matrix as a bordered HTML table."""
+        """A numeric matrix as a bracketed HTML table (right-aligned, no negative zero)."""
         a = np.atleast_2d(np.asarray(M, dtype=float))
         body = "".join(
-            "<tr>" + "".join(f"<td>{fmt.format(0.0 if abs(v) < 5e-13 else v)}</td>" for v in r)
-            + "</tr>" for r in a
+            "<tr>" + "".join(
+                f"<td>{format_number(0.0 if abs(v) < 5e-13 else float(v), fmt)}</td>"
+                for v in r) + "</tr>" for r in a
         )
-        return f'<table class="matrix">{body}</table>'
+        return Html(f'<table class="matrix">{body}</table>')
 
     @staticmethod
     def code(text: str) -> str:
-        """Preformatted text (e.g. LaTeX or printed sympy)."""
+        """Preformatted text (program output; never mathematics: use :meth:`eq`)."""
         return f"<pre>{html.escape(text)}</pre>"
 
 
 _CSS = """
-body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
+body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;
+line-height:1.45}
 h1{border-bottom:2px solid #345}h2{margin-top:2em;border-bottom:1px solid #ccc}
 .eq{color:#555;font-size:90%}table{border-collapse:collapse;margin:0.6em 0}
-td,th{border:1px solid #bbb;padding:2px 8px;text-align:right}th{background:#eef}
-table.matrix td{border:none;border-left:1px solid #999;border-right:1px solid #999}
+td,th{border:1px solid #bbb;padding:2px 8px;vertical-align:middle}th{background:#eef}
+td.num,th.num{text-align:right;font-variant-numeric:tabular-nums}td.txt,th.txt{text-align:left}
+table.matrix{border-left:2px solid #555;border-right:2px solid #555;border-radius:3px}
+table.matrix td{border:none;text-align:right;font-variant-numeric:tabular-nums;padding:1px 8px}
 figure{margin:1em 0}img{max-width:100%}pre{background:#f6f6f6;padding:0.6em;overflow-x:auto}
+.eqn{display:flex;align-items:center;margin:0.6em 0}
+.eqbody{flex:1 1 auto;min-width:0;overflow-x:auto;overflow-y:hidden;padding:2px 0}
+.eqno{flex:none;margin-left:1.5em;color:#333}
+math[display=block]{font-size:1.08em}
+.repro{border:1px solid #9ab;border-left:4px solid #357;background:#f4f8fb;margin:1em 0;
+padding:0.3em 0.8em}.repro pre{background:none;margin:0.3em 0;padding:0}
+.repro-label{font-weight:600;font-size:90%;color:#357}
+.meta{font-size:90%;color:#444}.meta td,.meta th{border:none;padding:0 1em 0 0}
+nav ul{list-style:none;padding-left:0}nav li.sub{padding-left:2em}
 .err{color:#a00}
 """
+
+
+def build_metadata() -> list[tuple[str, str]]:
+    """(label, value) pairs describing this build: versions, git commit, date, CPUs."""
+    import platform
+    import subprocess
+    from datetime import UTC, datetime
+
+    import numba
+
+    import serialkin
+
+    try:
+        from importlib.metadata import version
+
+        sk_version = version("serialkin")
+    except Exception:  # noqa: BLE001 - not installed: fall back to the module's attribute
+        sk_version = serialkin.__version__
+    commit = "not available (not a git checkout)"
+    try:
+        here = Path(__file__).resolve().parent
+        res = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], cwd=here,
+                             capture_output=True, text=True, timeout=5, check=False)
+        if res.returncode == 0 and res.stdout.strip():
+            commit = res.stdout.strip()
+            dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                                   cwd=here, capture_output=True, text=True, timeout=5,
+                                   check=False)
+            if dirty.returncode == 0 and dirty.stdout.strip():
+                commit += " (with uncommitted changes)"
+    except (OSError, subprocess.SubprocessError):
+        pass
+    return [
+        ("serialkin", sk_version),
+        ("git commit", commit),
+        ("built", datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")),
+        ("Python", platform.python_version()),
+        ("numpy", np.__version__),
+        ("numba", numba.__version__),
+        ("CPUs", str(os.cpu_count())),
+    ]
+
+
+def _sections_of(result: Section | Sequence[Section]) -> list[Section]:
+    return [result] if isinstance(result, Section) else list(result)
+
+
+def _render(parts: list[tuple[str, Section]], seconds: float) -> str:
+    """The whole page: header with build metadata, contents, sections."""
+    toc: list[str] = []
+    body: list[str] = []
+    previous = None
+    counts: dict[str, int] = {}
+    for module, sec in parts:
+        k = counts.get(module, 0)
+        counts[module] = k + 1
+        anchor = sec.anchor or (module if k == 0 else f"{module}-{k}")
+        number = sec.number
+        continues = bool(number) and number == previous
+        previous = number or previous
+        eqs = html.escape(sec.equations)
+        if continues:
+            heading = sec.part or sec.name
+            toc.append(f'<li class="sub"><a href="#{anchor}">{html.escape(heading)}</a> '
+                       f'<span class="eq">({eqs})</span></li>')
+            body.append(f'<section id="{anchor}"><h3 class="part">{html.escape(heading)}</h3>'
+                        f'<p class="eq">Demonstrates: {eqs}</p>{sec.html}</section>')
+            continue
+        label = f"{number} {sec.name}" if number else sec.name
+        css = ' class="sub"' if "." in number else ""
+        toc.append(f'<li{css}><a href="#{anchor}">{html.escape(label)}</a> '
+                   f'<span class="eq">({eqs})</span></li>')
+        part = f'<h3 class="part">{html.escape(sec.part)}</h3>' if sec.part else ""
+        body.append(f'<section id="{anchor}"><h2>{html.escape(label)}</h2>'
+                    f'<p class="eq">Demonstrates: {eqs}</p>{part}{sec.html}</section>')
+    meta = build_metadata() + [("build time", f"{seconds:.1f} s")]
+    meta_html = ('<table class="meta">' + "".join(
+        f"<tr><th>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>" for k, v in meta)
+        + "</table>")
+    return (
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+        "<title>Kinematics of Serial Manipulators — reproduced by serialkin</title>"
+        f"<style>{_CSS}</style></head><body>"
+        "<h1>Kinematics of Serial Manipulators — reproduced by serialkin</h1>"
+        "<p>Every number and figure below is computed by serialkin when this report is "
+        "built (<code>serialkin chapter</code>); equations carry the chapter's numbers and "
+        "the corrected forms of the ERRATA are used. Times are wall-clock medians of warm "
+        "runs (after an untimed warm-up call) with their full range (min–max).</p>"
+        f"{meta_html}<nav><h2 id='contents'>Contents</h2><ul>{''.join(toc)}</ul></nav>"
+        f"{''.join(body)}</body></html>"
+    )
 
 
 def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
                  sections: Sequence[str] | None = None) -> Path:
     """Run every section builder and write ``<outdir>/report.html``; return its path.
+
+    Each module of :data:`SECTION_MODULES` has ``build(ctx) -> Section | list[Section]``;
+    sections are shown in the chapter's order with the chapter's numbers.
 
     Args:
         outdir: output folder (created when missing).
@@ -135,39 +432,22 @@ def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
     """
     from tqdm import tqdm
 
+    start = time.perf_counter()
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
     ctx = ReportContext(outdir=out, quiet=quiet)
     names = list(sections) if sections else list(SECTION_MODULES)
-    parts: list[Section] = []
+    parts: list[tuple[str, Section]] = []
     bar = tqdm(names, desc="chapter", disable=quiet or None, unit="section")
     for name in bar:
         bar.set_postfix_str(name)
         t0 = time.perf_counter()
         module = importlib.import_module(f"serialkin.chapter.sections.{name}")
-        sec = module.build(ctx)
-        sec.anchor = sec.anchor or name
-        sec.html += f'<p class="eq">Computed in {time.perf_counter() - t0:.2f} s.</p>'
-        parts.append(sec)
-    toc = "".join(
-        f'<li><a href="#{s.anchor}">{html.escape(s.title)}</a> '
-        f'<span class="eq">({html.escape(s.equations)})</span></li>' for s in parts
-    )
-    body = "".join(
-        f'<section id="{s.anchor}"><h2>{html.escape(s.title)}</h2>'
-        f'<p class="eq">Implements: {html.escape(s.equations)}</p>{s.html}</section>'
-        for s in parts
-    )
-    page = (
-        "<!DOCTYPE html><html><head><meta charset='utf-8'>"
-        "<title>Kinematics of Serial Manipulators — reproduced by serialkin</title>"
-        f"<style>{_CSS}</style></head><body>"
-        "<h1>Kinematics of Serial Manipulators — reproduced by serialkin</h1>"
-        "<p>Every number and figure below is computed by serialkin when this report is "
-        "built (<code>serialkin chapter</code>); the corrected equations of the ERRATA "
-        "are used.</p>"
-        f"<ol>{toc}</ol>{body}</body></html>"
-    )
+        built = _sections_of(module.build(ctx))
+        built[-1].html += (f'<p class="eq">Section built in {time.perf_counter() - t0:.2f} s '
+                           "(wall clock, this machine).</p>")
+        parts.extend((name, sec) for sec in built)
+    page = _render(parts, time.perf_counter() - start)
     path = out / "report.html"
     write_text_atomic(path, page)
     return path

@@ -1,4 +1,4 @@
-"""Report section 4, inverse kinematics (eqs 19-27) and the numerical families of 5.3.
+"""Report section 4, inverse kinematics (eqs 19-27), recomputed by serialkin.
 
 Contents:
 
@@ -8,31 +8,23 @@ Contents:
   against :func:`serialkin.ik.analytic.ik_all` (``robot.ik_all``); the misprinted eq 26
   evaluated too, to show why it is wrong;
 * Figure 5 regenerated: both elbow configurations reaching the same point, with α and β;
-* a round-trip check of the closed form on random configurations;
-* the numerical families of section 5.3 measured side by side by
-  :func:`serialkin.ik.compare.compare` on a planar 3-link arm, the Puma 560 and the UR5
-  (every number in those tables is measured when the report is built), and a short table
-  of the trade-offs.
+* a round-trip check of the closed form on random configurations.
+
+The numerical families (section 5.3) are in :mod:`serialkin.chapter.sections.numerical`.
 """
 
 from __future__ import annotations
 
-import html
 import math
 
 import numpy as np
 
 from serialkin import models
 from serialkin.chapter.report import ReportContext, Section
-from serialkin.ik.compare import CompareTable, compare
 
 #: Worked example of eqs 23-27 (the chapter gives no numbers): link lengths and target.
 L1, L2 = 1.0, 0.7
 TARGET = (1.2, 0.6)
-#: Tolerance of the comparison (the accuracy bar of the IK issue) [m, rad].
-COMPARE_TOL = 1e-6
-#: Targets per robot in the comparison (kept small: BFGS/Powell are slow).
-N_PLANAR, N_SPATIAL = 20, 10
 
 
 def two_link_closed_form(x: float, y: float, l1: float, l2: float) -> dict[str, float]:
@@ -114,73 +106,6 @@ def _round_trip(robot, count: int = 500) -> tuple[float, float]:
     return worst_q, worst_p
 
 
-def comparison_tables() -> list[tuple[str, CompareTable]]:
-    """Run :func:`compare` on the three robots of the section (seeded, reproducible)."""
-    out = []
-    planar = models.planar(3, [1.0, 0.8, 0.5])
-    T = planar.fk(planar.random_q(N_PLANAR, seed=42))
-    out.append(("Planar 3-link arm (L = 1.0, 0.8, 0.5 m, unlimited), (x, y) targets",
-                compare(planar, T[:, :2, 3], tol=COMPARE_TOL, seed=0)))
-    for robot in (models.puma560(), models.ur5()):
-        T = robot.fk(robot.random_q(N_SPATIAL, seed=42))
-        out.append((f"{robot.name}, full 6-D pose targets",
-                    compare(robot, T, tol=COMPARE_TOL, seed=0)))
-    return out
-
-
-#: Trade-offs of the families (general properties; the measured columns come from the
-#: tables above when the report is built).
-TRADE_OFFS = (
-    ("Jacobian transpose (transpose)", "one J, no solve", "linear, slow near the solution",
-     "no inversion, so no blow-up; crawls", "projection"),
-    ("Pseudoinverse / Newton / Gauss-Newton (pinv, newton, gauss_newton)",
-     "J and an SVD / normal equations", "quadratic near a regular solution",
-     "steps explode without a cut-off or damping", "projection"),
-    ("Damped least squares / Levenberg-Marquardt (dls, lm, lm_*, sdls)",
-     "J and one small solve", "fast; adaptive damping keeps it quadratic",
-     "robust: damping bounds the step", "projection"),
-    ("Minimisation (bfgs, powell)", "scipy iteration in Python: cost (+ gradient)",
-     "superlinear (BFGS) / slow (Powell)", "unaffected (no inversion)", "bounds"),
-    ("Cyclic coordinate descent (ccd)", "one J per sweep + O(n) closed forms",
-     "linear; slow for full poses", "robust far from the target", "clamping"),
-    ("FABRIK (fabrik)", "2 passes over the points + one FK", "linear",
-     "robust; planar revolute chains only", "clamping in angle recovery"),
-)
-
-
-def _family_of(method: str) -> str:
-    if method == "transpose":
-        return TRADE_OFFS[0][0]
-    if method in ("pinv", "newton", "gauss_newton"):
-        return TRADE_OFFS[1][0]
-    if method in ("bfgs", "powell"):
-        return TRADE_OFFS[3][0]
-    if method == "ccd":
-        return TRADE_OFFS[4][0]
-    if method == "fabrik":
-        return TRADE_OFFS[5][0]
-    return TRADE_OFFS[2][0]
-
-
-def _measured_summary(tables: list[tuple[str, CompareTable]]) -> dict[str, str]:
-    """Per family: measured success rate range and median time range over all tables."""
-    acc: dict[str, list[tuple[float, float]]] = {}
-    for _, table in tables:
-        for row in table.rows:
-            acc.setdefault(_family_of(row.method), []).append(
-                (row.success_rate, 1e3 * row.median_time))
-    out = {}
-    for fam, vals in acc.items():
-        rates = [v[0] for v in vals]
-        times = [v[1] for v in vals]
-        rate = (f"{100 * min(rates):.0f} %" if min(rates) == max(rates)
-                else f"{100 * min(rates):.0f}-{100 * max(rates):.0f} %")
-        time_ = (f"{min(times):.3g} ms" if len(times) == 1
-                 else f"{min(times):.3g}-{max(times):.3g} ms")
-        out[fam] = f"{rate}, {time_}"
-    return out
-
-
 def build(ctx: ReportContext) -> Section:
     """Compute section 4's examples and the section 5.3 comparison; return the section."""
     parts: list[str] = []
@@ -241,45 +166,5 @@ def build(ctx: ReportContext) -> Section:
         f"{worst_p:.2e} m.</p>"
     )
 
-    # --- section 5.3: the numerical families ------------------------------------------------
-    parts.append(
-        "<h3>Numerical families (section 5.3), measured</h3>"
-        "<p>Section 5.3 lists the numerical approaches: linearisation by the Jacobian "
-        "(transpose, Moore-Penrose pseudoinverse eq 40, damped least squares / "
-        "Levenberg-Marquardt eq 46 with the ERRATA's JJᵀ, selectively damped least squares "
-        "by SVD), Newton methods (eq 41), minimisation (Powell, BFGS) and the heuristics CCD "
-        "and FABRIK. serialkin implements each behind one interface "
-        "(<code>robot.ik(target, method=...)</code>) with the same targets, tolerance, "
-        "restarts from seeded random configurations and joint-limit handling, so "
-        "<code>serialkin.ik.compare</code> can run them on the same targets from the same "
-        f"starts. Success means FK of the answer within {COMPARE_TOL:g} m and "
-        f"{COMPARE_TOL:g} rad of the target with q inside the joint limits. Times are wall "
-        "times per solve on the machine that built this report (restarts included); "
-        "targets are FK of seeded random configurations inside the limits.</p>"
-    )
-    tables = comparison_tables()
-    for title, table in tables:
-        parts.append(f"<h4>{html.escape(title)}</h4>" + table.to_html())
-
-    measured = _measured_summary(tables)
-    parts.append(
-        "<h4>Trade-offs</h4><p>The first four columns are properties of the algorithms; the "
-        "last is measured in the tables above (range over the robots where the family ran: "
-        "success rate, median time per solve).</p>" + ctx.table(
-            [row + (measured.get(row[0], "not run"),) for row in TRADE_OFFS],
-            ["family (methods)", "cost per iteration", "convergence", "near singularities",
-             "joint limits", "measured here"]))
-    parts.append(
-        "<p>Reading the tables: the damped (Levenberg-Marquardt) family combines the "
-        "Jacobian methods' quadratic convergence with bounded steps near singularities, "
-        "which is why it is the default (<code>method='lm'</code>). The Jacobian transpose "
-        "converges linearly: compare its median iterations with the others'. BFGS and "
-        "Powell reach the same accuracy but pay for a Python-level optimiser (Powell also "
-        "for the lack of gradients). CCD is cheap per sweep and excellent for position "
-        "targets, but full poses trade position against orientation joint by joint and "
-        "converge slowly. "
-        "FABRIK is exact and fast on planar revolute chains and is skipped (with the reason "
-        "shown) on spatial arms.</p>"
-    )
-    return Section(title="4. Inverse kinematics", equations="eqs 19-27 (corrected), 40-46",
+    return Section(title="4 Inverse kinematics", equations="eqs 19-27 (23, 26, 27 corrected)",
                    html="".join(parts))

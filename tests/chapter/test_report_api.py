@@ -1,0 +1,136 @@
+"""The report's helpers: MathML equations, warm timings, reproduce boxes, table alignment."""
+
+from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from serialkin.chapter.report import Html, ReportContext, Section, Timing, format_number
+from serialkin.errors import InputError
+
+MATHML = "{http://www.w3.org/1998/Math/MathML}"
+
+
+def _math_elements(fragment: str) -> list[ET.Element]:
+    root = ET.fromstring(f"<div>{fragment}</div>")
+    return list(root.iter(f"{MATHML}math"))
+
+
+def test_eq_is_valid_mathml_with_number():
+    """eq() gives well-formed XML with one block <math> and the number shown once, on the right."""
+    out = ReportContext.eq(r"\dot{\mathbf{q}} = \mathbf{J}^{\dagger}(\mathbf{q}) \dot{\mathbf{x}}",
+                           number="40")
+    maths = _math_elements(out)
+    assert len(maths) == 1
+    assert maths[0].get("display") == "block"
+    assert out.count("(40)") == 1 and 'class="eqno"' in out
+    assert "\\" not in out  # no LaTeX survives
+
+
+def test_eq_without_number_and_imath_inline():
+    """No number → no eqno span; imath() is one inline <math>."""
+    assert "eqno" not in ReportContext.eq("x = 1")
+    maths = _math_elements(ReportContext.imath(r"\theta_1"))
+    assert len(maths) == 1 and maths[0].get("display") == "inline"
+
+
+def test_eq_escapes_markup_characters():
+    """<, > and & in the LaTeX become character references, never raw markup."""
+    out = ReportContext.eq(r"a < b \text{ and } c > d")
+    maths = _math_elements(out)  # parses, so nothing is left unescaped
+    text = "".join(maths[0].itertext())
+    assert "<" in text and ">" in text
+    assert "<b" not in out.replace("<mrow", "")  # no stray tag from the input
+    assert ReportContext.eq("x", number="<1>").count("&lt;1&gt;") == 1
+
+
+def test_sympy_matrix_converts():
+    """The LaTeX of a sympy matrix becomes a MathML <mtable> with the right shape."""
+    import sympy as sp
+
+    q = sp.Symbol("q_1", real=True)
+    out = ReportContext.eq(sp.latex(sp.Matrix([[sp.cos(q), -sp.sin(q)], [sp.sin(q), sp.cos(q)]])))
+    root = _math_elements(out)[0]
+    assert len(list(root.iter(f"{MATHML}mtr"))) == 2
+    assert len(list(root.iter(f"{MATHML}mtd"))) == 4
+
+
+def test_timing_warms_up_before_timing(tmp_path):
+    """A function whose first call is slow does not show in a warm Timing's runs."""
+    import time
+
+    calls = []
+
+    def fn():
+        if not calls:
+            time.sleep(0.2)  # the "compilation" of the first call
+        calls.append(1)
+
+    ctx = ReportContext(outdir=tmp_path)
+    t = ctx.timing(fn, warmup=1, repeat=5)
+    assert len(calls) == 6
+    assert t.warm and t.n == 5
+    assert t.high < 0.2 and t.low <= t.median <= t.high
+    assert "median of 5 warm runs" in t.text and "spread" in t.text
+    assert ctx.timings == [t]
+    cold = ReportContext(outdir=tmp_path).timing(lambda: None, warmup=0, repeat=3)
+    assert not cold.warm
+    with pytest.raises(InputError, match="repeat"):
+        ctx.timing(fn, repeat=0)
+
+
+def test_timing_text_units():
+    """Timing.text picks µs, ms or s and prints the spread in the same unit."""
+    assert Timing(9.1e-4, 8.5e-4, 9.7e-4, 7).text == (
+        "0.91 ms (median of 7 warm runs, spread 0.85–0.97 ms)")
+    assert Timing(2.5e-6, 2e-6, 3e-6, 3).text.startswith("2.5 µs")
+    assert Timing(1.5, 1.2, 2.0, 3).text.startswith("1.5 s")
+
+
+def test_reproduce_escapes_code():
+    """The reproduce box shows the code escaped inside <pre><code>, labelled by kind."""
+    out = ReportContext.reproduce("serialkin fk scara --q '1 < 2'", shell=True)
+    assert "Reproduce (shell)" in out and "1 &lt; 2" in out and "<pre><code>" in out
+    assert "Reproduce (Python)" in ReportContext.reproduce("import serialkin")
+
+
+def _cells(table: str) -> list[tuple[str, str]]:
+    return re.findall(r'<t[dh] class="(num|txt)">(.*?)</t[dh]>', table)
+
+
+def test_table_alignment():
+    """Numbers (also numeric strings) are right-aligned, text left-aligned, header follows."""
+    out = ReportContext.table([("a", 1.5, "2.0e-05", "98 %"), ("b", 2, "∞", "7 ms")],
+                              ["name", "x", "y", "z"])
+    cells = _cells(out)
+    assert cells[:4] == [("txt", "name"), ("num", "x"), ("num", "y"), ("num", "z")]
+    assert cells[4:8] == [("txt", "a"), ("num", "1.5"), ("num", "2.0e-05"), ("num", "98 %")]
+
+
+def test_no_negative_zero():
+    """Values that round to zero never print with a minus sign, in tables and matrices."""
+    assert format_number(-1e-9, "{:.4f}") == "0.0000"
+    assert format_number(-0.0) == "0"
+    assert format_number(-0.5, "{:.1f}") == "-0.5"
+    out = ReportContext.table([(-1e-7, "-0.0000")], fmt="{:.4f}")
+    assert "-0.0000" not in out and out.count("0.0000") == 2
+    m = ReportContext.matrix(np.array([[-1e-9, -0.25], [-0.0, 1.0]]))
+    assert "-0.0000" not in m and "-0.2500" in m
+    assert isinstance(m, Html)
+
+
+def test_html_cells_not_escaped():
+    """Html cells (a matrix, MathML) are inserted as markup."""
+    out = ReportContext.table([("R", ReportContext.matrix(np.eye(2)))])
+    assert '<table class="matrix">' in out
+
+
+def test_section_number_parsing():
+    """The chapter number is parsed from the title with or without a trailing dot."""
+    assert Section("5.1 Analytical Jacobian", "", "").number == "5.1"
+    assert Section("3. Forward kinematics", "", "").number == "3"
+    assert Section("3. Forward kinematics", "", "").name == "Forward kinematics"
+    assert Section("Appendix", "", "").number == ""
