@@ -40,12 +40,21 @@ def test_misprinted_eq_26_fails_on_the_worked_example():
 
 
 @pytest.mark.slow
-def test_section_builds_with_figure_and_tables(tmp_path):
-    """build() returns the section with Figure 5 saved and one comparison table per robot."""
+def test_section_builds_with_figure(tmp_path):
+    """build() returns section 4 with Figure 5 saved."""
     ctx = ReportContext(outdir=tmp_path, quiet=True)
     sec = inverse.build(ctx)
-    assert sec.title.startswith("4.")
+    assert sec.number == "4"
     assert (tmp_path / "figures" / "inverse_two_link.png").stat().st_size > 1000
+
+
+@pytest.mark.slow
+def test_numerical_families_have_one_table_per_robot(tmp_path):
+    """Section 5.3's comparison has one table per robot, FABRIK skipped on spatial arms."""
+    from serialkin.chapter.sections import numerical
+
+    sec = numerical.build(ReportContext(outdir=tmp_path, quiet=True))
+    assert sec.number == "5.3"
     assert sec.html.count("<caption>IK methods on") == 3
     assert "skipped" in sec.html and "fabrik" in sec.html
     assert "Trade-offs" in sec.html
