@@ -158,6 +158,41 @@ def _set_equal_3d(ax: Any, pts: np.ndarray, margin: float) -> None:
 
 
 # ---------------------------------------------------------------------- the robot
+def _mechanism_points(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """Skeleton that follows the mechanism: along each joint axis first, then across.
+
+    Walks ``T = F[0]·M_1(q_1)·F[1]···M_n(q_n)·F[n]`` (eq 11). After each joint motion
+    ``M_i`` the pose's z axis is joint i's axis; the fixed offset ``F[i]`` is drawn as two
+    segments, its component along that axis (the DH offset d, e.g. a SCARA's column) and
+    then the rest (the DH length a). Returns (k, 3) points [m], consecutive duplicates
+    removed, ending at the tool point.
+    """
+    from serialkin.kinematics._kernels import PRISMATIC
+
+    F, meta = robot.chain.F, robot.chain.meta
+    W = F[0].copy()
+    pts = [robot.chain.L[0][:3, 3].copy(), W[:3, 3].copy()]
+    for i in range(robot.n):
+        x = float(q[i]) + float(meta[i, 4])
+        M = np.eye(4)
+        if int(meta[i, 3]) == PRISMATIC:
+            M[2, 3] = x
+        else:
+            c, s_ = np.cos(x), np.sin(x)
+            M[:2, :2] = [[c, -s_], [s_, c]]
+        W = W @ M
+        pts.append(W[:3, 3].copy())
+        along = float(F[i + 1][2, 3])
+        pts.append(W[:3, 3] + along * W[:3, 2])
+        W = W @ F[i + 1]
+        pts.append(W[:3, 3].copy())
+    out = [pts[0]]
+    for p_ in pts[1:]:
+        if np.linalg.norm(p_ - out[-1]) > 1e-12:
+            out.append(p_)
+    return np.array(out)
+
+
 def plot_robot(
     robot: Robot,
     q: object,
@@ -171,6 +206,7 @@ def plot_robot(
     linewidth: float = 2.5,
     frame_scale: float | None = None,
     markersize: float = 6.0,
+    mechanism: bool = False,
 ) -> Axes:
     """Draw the robot in configuration ``q``.
 
@@ -192,6 +228,9 @@ def plot_robot(
         linewidth: link line width [points].
         frame_scale: triad axis length [m] (default 8 % of :func:`robot_scale`).
         markersize: joint marker size [points] (0 hides joint, base and tool markers).
+        mechanism: draw the links as the mechanism is built instead of straight between
+            frame origins: each link runs along its joint axis first (the DH offset d, e.g.
+            a SCARA's vertical column) and then across (the DH length a).
 
     Returns:
         The axes drawn into. The link line has ``gid='serialkin-links'``, the joint
@@ -214,7 +253,8 @@ def plot_robot(
     tri = 0.08 * scale if frame_scale is None else check_positive(frame_scale, "frame_scale")
     dims = 2 if two_d else 3
 
-    ax.plot(*pts[:, :dims].T, "-", color=color, alpha=alpha, lw=linewidth, label=label,
+    line = _mechanism_points(robot, qv) if mechanism else pts
+    ax.plot(*line[:, :dims].T, "-", color=color, alpha=alpha, lw=linewidth, label=label,
             gid=LINKS_GID, solid_capstyle="round")
     ms = float(markersize)
     if ms > 0:

@@ -112,21 +112,26 @@ def build(ctx: ReportContext) -> Section:
     alpha, beta, gamma = 30 * DEG, 45 * DEG, 60 * DEG
 
     # --- eqs 4-6 -----------------------------------------------------------------------
-    parts.append("<h3>Elementary rotations (eqs 4-6)</h3><p>Evaluated at α = 30°, β = 45°, "
-                 "γ = 60° by <code>rotx</code>, <code>roty</code>, <code>rotz</code>; the last "
-                 "column is the largest deviation from the matrix typed from the chapter.</p>")
+    parts.append(
+        "<h3>Elementary rotations (eqs 4-6)</h3><p>The chapter's rotations about x, y and z:</p>"
+        + ctx.eq(r"\mathbf{R}_x = \begin{bmatrix}1 & 0 & 0\\ 0 & \cos\alpha & -\sin\alpha"
+                 r"\\ 0 & \sin\alpha & \cos\alpha\end{bmatrix}", "4")
+        + ctx.eq(r"\mathbf{R}_y = \begin{bmatrix}\cos\beta & 0 & \sin\beta\\ 0 & 1 & 0"
+                 r"\\ -\sin\beta & 0 & \cos\beta\end{bmatrix}", "5")
+        + ctx.eq(r"\mathbf{R}_z = \begin{bmatrix}\cos\gamma & -\sin\gamma & 0\\ "
+                 r"\sin\gamma & \cos\gamma & 0\\ 0 & 0 & 1\end{bmatrix}", "6")
+        + "<p>Evaluated at " + ctx.imath(r"\alpha = 30^\circ,\ \beta = 45^\circ,\ "
+                                         r"\gamma = 60^\circ")
+        + " by <code>rotx</code>, <code>roty</code>, <code>rotz</code>; the last column is "
+        "the largest deviation from the matrix typed from the chapter.</p>")
     rows = []
     elem = {"x": rotx(alpha), "y": roty(beta), "z": rotz(gamma)}
     for (axis, R), t in zip(elem.items(), (alpha, beta, gamma), strict=True):
         dev = np.abs(R - _printed_elementary(axis, t)).max()
         rows.append((f"R{axis}({t / DEG:.0f}°)", ctx.matrix(R), f"{dev:.1e}"))
-    parts.append(
-        "<table>" + "<tr><th>rotation</th><th>matrix</th><th>|R − printed|</th></tr>"
-        + "".join(f"<tr><td>{a}</td><td>{m}</td><td>{d}</td></tr>" for a, m, d in rows)
-        + "</table>"
-    )
+    parts.append(ctx.table(rows, ["rotation", "matrix", "|R − printed|"]))
 
-    # --- composition, eq 3, eqs 8-9 ------------------------------------------------------
+    # --- composition, eqs 1-3, eqs 8-9 -------------------------------------------------
     R = rotz(gamma) @ roty(beta) @ rotx(alpha)
     R_other = rotx(alpha) @ roty(beta) @ rotz(gamma)
     p1 = np.array([0.3, 0.2, 0.1])
@@ -140,23 +145,50 @@ def build(ctx: ReportContext) -> Section:
     dots = np.array([[np.eye(3)[j] @ units[k] for k in range(3)] for j in range(3)])
     p_eq1 = sum(p1[k] * units[k] for k in range(3))
     parts.append(
-        "<h3>Composition and change of frame (eqs 3, 8, 9)</h3>"
-        "<p>R = Rz(60°) · Ry(45°) · Rx(30°) (rotations about the fixed axes x, then y, then "
-        "z; this is the roll-pitch-yaw convention used throughout serialkin):</p>"
+        "<h3>Change of frame (eqs 1-3)</h3><p>A vector written in the unit vectors of the "
+        "reference frame and of frame 1,</p>"
+        + ctx.eq(r"\mathbf{p} = p_{xr}\mathbf{i}_r + p_{yr}\mathbf{j}_r + p_{zr}\mathbf{k}_r"
+                 r" = p_{x1}\mathbf{i}_1 + p_{y1}\mathbf{j}_1 + p_{z1}\mathbf{k}_1", "1")
+        + "<p>has reference coordinates given by the scalar products of the unit vectors "
+        "(eq 2), in matrix form</p>"
+        + ctx.eq(r"\begin{bmatrix}p_{xr}\\ p_{yr}\\ p_{zr}\end{bmatrix} = \begin{bmatrix}"
+                 r"\mathbf{i}_r\cdot\mathbf{i}_1 & \mathbf{i}_r\cdot\mathbf{j}_1 & "
+                 r"\mathbf{i}_r\cdot\mathbf{k}_1\\ \mathbf{j}_r\cdot\mathbf{i}_1 & "
+                 r"\mathbf{j}_r\cdot\mathbf{j}_1 & \mathbf{j}_r\cdot\mathbf{k}_1\\ "
+                 r"\mathbf{k}_r\cdot\mathbf{i}_1 & \mathbf{k}_r\cdot\mathbf{j}_1 & "
+                 r"\mathbf{k}_r\cdot\mathbf{k}_1\end{bmatrix}\begin{bmatrix}p_{x1}\\ p_{y1}"
+                 r"\\ p_{z1}\end{bmatrix} = \mathbf{R}_{r1}\,\mathbf{p}_1", "3")
+        + "<p>Take frame 1 turned by "
+        + ctx.imath(r"\mathbf{R}_{r1} = \mathbf{R}_z(60^\circ)\,\mathbf{R}_y(45^\circ)\,"
+                    r"\mathbf{R}_x(30^\circ)")
+        + " (rotations about the fixed axes x, then y, then z: the roll-pitch-yaw convention "
+        "used throughout serialkin):</p>"
         + ctx.matrix(R)
-        + f"<p>Rotations do not commute: |Rz Ry Rx − Rx Ry Rz|max = "
-        f"{np.abs(R - R_other).max():.4f}.</p>"
-        f"<p>With origin o = {o.tolist()} m, the homogeneous transform (eq 9) is</p>"
+        + "<p>Computing the nine scalar products of eq 3 one by one reproduces "
+        + ctx.imath(r"\mathbf{R}_{r1}") + f" to {np.abs(dots - R).max():.1e}, and eq 1 "
+        "(the sum of frame 1's unit vectors weighted by "
+        + ctx.imath(r"\mathbf{p}_1") + ") equals " + ctx.imath(r"\mathbf{R}_{r1}\mathbf{p}_1")
+        + f" to {np.abs(p_eq1 - R @ p1).max():.1e}. Rotations do not commute: "
+        + ctx.imath(r"\max|\mathbf{R}_z\mathbf{R}_y\mathbf{R}_x - "
+                    r"\mathbf{R}_x\mathbf{R}_y\mathbf{R}_z|")
+        + f" = {np.abs(R - R_other).max():.4f}.</p>"
+        "<h3>Rotation and translation (eqs 8-9)</h3>"
+        + ctx.eq(r"\begin{bmatrix}x_r\\ y_r\\ z_r\end{bmatrix} = \mathbf{R}\begin{bmatrix}"
+                 r"x_1\\ y_1\\ z_1\end{bmatrix} + \begin{bmatrix}p_x\\ p_y\\ p_z\end{bmatrix}",
+                 "8")
+        + ctx.eq(r"\begin{bmatrix}x_r\\ y_r\\ z_r\\ 1\end{bmatrix} = \begin{bmatrix}"
+                 r"\mathbf{R} & \mathbf{p}\\ \mathbf{0}^T & 1\end{bmatrix}\begin{bmatrix}"
+                 r"x_1\\ y_1\\ z_1\\ 1\end{bmatrix}", "9")
+        + f"<p>With the rotation above and origin p = {o.tolist()} m, the homogeneous "
+        "transform of eq 9 (<code>make_transform(R, p)</code>) is</p>"
         + ctx.matrix(T)
-        + "<p>Eqs 1-3: the entries of R are the scalar products of the reference unit "
-        "vectors with those of frame 1 (i_r · i_1, i_r · j_1, ...); computing them one by one "
-        f"reproduces R to {np.abs(dots - R).max():.1e}, and p = p_x1 i_1 + p_y1 j_1 + p_z1 k_1 "
-        f"(eq 1 written in frame 1) equals R p₁ to {np.abs(p_eq1 - R @ p1).max():.1e}.</p>"
-        + f"<p>The point p₁ = {p1.tolist()} m of frame 1 has world coordinates "
-        f"R p₁ + o = {np.round(pr_eq8, 6).tolist()} (eq 8) and T [p₁; 1] = "
-        f"{np.round(pr_eq9, 6).tolist()} (eq 9); difference {np.abs(pr_eq8 - pr_eq9).max():.1e}. "
-        f"The inverse [[Rᵀ, −Rᵀo], [0, 1]] satisfies |T⁻¹T − I|max = "
-        f"{np.abs(Tinv @ T - np.eye(4)).max():.1e} and maps the point back with error "
+        + f"<p>The point with frame-1 coordinates {p1.tolist()} m has reference coordinates "
+        f"{np.round(pr_eq8, 6).tolist()} by eq 8 and {np.round(pr_eq9, 6).tolist()} by eq 9; "
+        f"difference {np.abs(pr_eq8 - pr_eq9).max():.1e}. The inverse "
+        + ctx.imath(r"\mathbf{T}^{-1} = \begin{bmatrix}\mathbf{R}^T & -\mathbf{R}^T\mathbf{p}"
+                    r"\\ \mathbf{0}^T & 1\end{bmatrix}")
+        + " satisfies " + ctx.imath(r"\max|\mathbf{T}^{-1}\mathbf{T} - \mathbf{I}_4|")
+        + f" = {np.abs(Tinv @ T - np.eye(4)).max():.1e} and maps the point back with error "
         f"{np.abs((Tinv @ np.append(pr_eq9, 1.0))[:3] - p1).max():.1e}.</p>"
     )
 
@@ -166,9 +198,11 @@ def build(ctx: ReportContext) -> Section:
     checks = [("Rx(30°)", elem["x"]), ("Ry(45°)", elem["y"]), ("Rz(60°)", elem["z"]),
               ("Rz Ry Rx", R), ("rotation block of T", T[:3, :3]),
               ("10,000 random rpy compositions (seed 2024)", many)]
-    parts.append("<h3>Orthonormality (eq 7)</h3>" + ctx.table(
-        [(name, *_orthonormality(M)) for name, M in checks],
-        ["matrix", "max |RᵀR − I₃|", "max |det R − 1|"], fmt="{:.1e}"))
+    parts.append(
+        "<h3>Orthonormality (eq 7)</h3>"
+        + ctx.eq(r"\mathbf{R}^T\mathbf{R} = \mathbf{I}_3,\qquad \det\mathbf{R} = 1", "7")
+        + ctx.table([(name, *_orthonormality(M)) for name, M in checks],
+                    ["matrix", "max |RᵀR − I₃|", "max |det R − 1|"], fmt="{:.1e}"))
 
     # --- conversion table ------------------------------------------------------------------
     rpy = matrix_to_rpy(R)
@@ -223,4 +257,10 @@ def build(ctx: ReportContext) -> Section:
                             "Rotated frames computed by serialkin: (a) the chapter's Figure 2, a "
                             "frame rotated by q = 30° about z_r; (b) the frame T of eq 9 "
                             "(Rz(60°)Ry(45°)Rx(30°), origin o) and the point p."))
+    parts.append(ctx.reproduce(
+        "import numpy as np\n"
+        "from serialkin.spatial import rotx, roty, rotz, make_transform, inv_transform\n"
+        "R = rotz(np.radians(60)) @ roty(np.radians(45)) @ rotx(np.radians(30))\n"
+        "T = make_transform(R, [0.5, 0.4, 0.3])                      # eq 9\n"
+        "print(T @ [0.3, 0.2, 0.1, 1.0], inv_transform(T) @ T)          # eq 8, T⁻¹T = I"))
     return Section(title="2. Rigid body motion", equations="eqs 1-9", html="".join(parts))
