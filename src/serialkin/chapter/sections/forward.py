@@ -11,13 +11,11 @@ table of built-in models with their sources.
 
 from __future__ import annotations
 
-import html
-
 import numpy as np
 import sympy as sp
 
 from serialkin import models
-from serialkin.chapter.report import ReportContext, Section
+from serialkin.chapter.report import Html, ReportContext, Section, format_number
 from serialkin.kinematics.symbolic import derive
 from serialkin.model.dh import link_transform, standard_to_modified
 from serialkin.model.robot import Robot
@@ -43,22 +41,34 @@ def scara_symbolic(robot: Robot):
 
 
 def _figure_scara(ctx: ReportContext, robot: Robot, q: np.ndarray) -> str:
+    """Figure 4: the SCARA drawn as built (column, two horizontal arms, vertical quill)."""
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     from serialkin.viz.plot import plot_robot
 
-    fig = plt.figure(figsize=(10, 4.6))
+    fig = plt.figure(figsize=(10, 4.8))
     ax1 = fig.add_subplot(1, 2, 1, projection="3d")
-    plot_robot(robot, q, ax=ax1, frames=True, label="q sample")
-    ax1.set_title("SCARA at the sample q, DH frames 0-4 and tool (x red, y green, z blue)",
-                  fontsize=8)
+    plot_robot(robot, q, ax=ax1, frames=True, mechanism=True, linewidth=4)
+    ax1.set_title("SCARA at the sample q with its DH frames 0-4 and tool\n"
+                  "(x red, y green, z blue)", fontsize=9)
     ax2 = fig.add_subplot(1, 2, 2, projection="3d")
-    rng = np.random.default_rng(3)
-    for i, qi in enumerate(robot.random_q(6, seed=rng)):
-        plot_robot(robot, qi, ax=ax2, color=f"C{i % 10}", alpha=0.8, markersize=3)
-    ax2.set_title("six random configurations inside the joint limits (seed 3)", fontsize=8)
-    return ctx.figure(fig, "forward_scara", "Figure 4 regenerated: the SCARA (RRPR) of "
-                      "Table 1 drawn from fk_all (eq 11).")
+    for i, qi in enumerate(robot.random_q(5, seed=3)):
+        plot_robot(robot, qi, ax=ax2, color=f"C{i % 10}", alpha=0.85, markersize=3,
+                   mechanism=True)
+    ax2.set_title("five random configurations inside the joint limits (seed 3)", fontsize=9)
+    for ax in (ax1, ax2):
+        ax.set_xlim(-0.7, 0.7)
+        ax.set_ylim(-0.7, 0.7)
+        ax.set_zlim(0.0, 0.6)
+        ax.set_box_aspect((1.4, 1.4, 0.75))
+        ax.view_init(elev=22, azim=-60)
+        for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+            axis.set_major_locator(MaxNLocator(4))
+        ax.tick_params(labelsize=7)
+    return ctx.figure(fig, "forward_scara", "Figure 4 regenerated: the SCARA (RRPR) of Table 1 "
+                      "drawn from its kinematic chain (eq 11): vertical column d1, horizontal "
+                      "arms L1 and L2, vertical quill (prismatic q3 and offset d2).")
 
 
 def _figure_frames(ctx: ReportContext, robot: Robot, q: np.ndarray) -> str:
@@ -90,25 +100,121 @@ def _figure_frames(ctx: ReportContext, robot: Robot, q: np.ndarray) -> str:
                       "frame 3 flips z downwards (α3 = π).")
 
 
-def build(ctx: ReportContext) -> Section:
-    """Compute section 3's examples and return the report section."""
+def _section_3(ctx: ReportContext) -> Section:
+    """Section 3 (and 3.1): eqs 10-12 on the PUMA 560."""
+    puma = models.puma560()
+    q = np.array([0.3, -0.6, 0.9, 0.4, -0.7, 1.1])
+    A = [link_transform(r, qi, "standard") for r, qi in zip(puma.dh, q, strict=True)]
+    H = puma.base.copy()
+    for Ai in A:
+        H = H @ Ai
+    H = H @ puma.tool
+    T_fk = puma.fk(q)
+    frames = puma.fk_all(q)
+    rows = []
+    for i, Ai in enumerate(A):
+        R = Ai[:3, :3]
+        rows.append((f"A{i + 1}", float(np.abs(R.T @ R - np.eye(3)).max()),
+                     float(np.abs(Ai[3] - [0, 0, 0, 1]).max()),
+                     float(np.abs(frames[i] @ Ai - frames[i + 1]).max())))
+    qtxt = ", ".join(f"{v:g}" for v in q)
+    html_ = (
+        "<p>The pose of the end effector in the base frame is a homogeneous matrix "
+        "(eq 10), the product of the link matrices along the open chain (eq 11), each of "
+        "which holds the pose of link frame i in frame i−1 (eq 12):</p>"
+        + ctx.eq(r"\mathbf{H} = \begin{bmatrix}{}^{0}\mathbf{R}_{n} & {}^{0}\mathbf{o}_{n}"
+                 r"\\ \mathbf{0}^T & 1\end{bmatrix}", "10")
+        + ctx.eq(r"\mathbf{H} = {}^{0}\mathbf{T}_{n} = \prod_{i=1}^{N}\mathbf{A}_{i}", "11")
+        + ctx.eq(r"\mathbf{A}_{i} = \begin{bmatrix}{}^{i-1}\mathbf{R}_{i} & "
+                 r"{}^{i-1}\mathbf{o}_{i}\\ \mathbf{0}^T & 1\end{bmatrix}", "12")
+        + "<h3>3.1 Open kinematic chain: eqs 10-12 on the PUMA 560</h3>"
+        f"<p>At q = ({qtxt}) rad, the six link matrices "
+        "<code>link_transform(row, q_i)</code> multiplied in order (eq 11) give</p>"
+        + ctx.matrix(H)
+        + "<p>and the compiled kernel <code>robot.fk(q)</code> agrees to "
+        f"{np.abs(H - T_fk).max():.1e}. Its blocks are the rotation "
+        + ctx.imath(r"{}^{0}\mathbf{R}_{6}")
+        + f" (max |RᵀR − I| = {np.abs(H[:3, :3].T @ H[:3, :3] - np.eye(3)).max():.1e}) and "
+        "the tool position " + ctx.imath(r"{}^{0}\mathbf{o}_{6}")
+        + f" = ({H[0, 3]:.4f}, {H[1, 3]:.4f}, {H[2, 3]:.4f}) m (eq 10). Each "
+        + ctx.imath(r"\mathbf{A}_i") + " has the form of eq 12 and maps frame i−1 onto "
+        "frame i (the partial products are <code>robot.fk_all(q)</code>):</p>"
+        + ctx.table(rows, ["link", "max |RᵀR − I| of its rotation block",
+                           "max |last row − [0 0 0 1]|",
+                           "max |0T(i−1) · A_i − 0T_i|"], fmt="{:.1e}")
+        + ctx.reproduce(
+            "import numpy as np, serialkin as sk\n"
+            "robot = sk.models.puma560()\n"
+            f"print(robot.fk(np.array([{qtxt}])))          # eq 11\n"
+            "print(robot.fk_all(np.zeros(6))[:, :3, 3])     # frame origins 0..6")
+    )
+    return Section(title="3. Forward kinematics", equations="eqs 10-12",
+                   html=html_)
+
+
+def _section_3_2(ctx: ReportContext) -> Section:
+    """Section 3.2: the DH link matrix, standard vs modified, and the built-in models."""
+    puma = models.puma560()
+    m_rows, m_base, m_tool = standard_to_modified(puma.dh, puma.base, puma.tool)
+    puma_m = Robot.from_dh(m_rows, "modified", base=m_base, tool=m_tool, name="puma560-mdh")
+    Q = puma.random_q(1000, seed=7)
+    diff = float(np.abs(puma_m.fk(Q) - puma.fk(Q)).max())
+    parts = [
+        "<p>With the four DH parameters (a<sub>i</sub>, α<sub>i</sub>, d<sub>i</sub>, "
+        "ϑ<sub>i</sub>) the link matrix of eq 12 is a product of elementary motions "
+        "(eqs 4, 6 and translations):</p>",
+        ctx.eq(r"\mathbf{A}_i = \mathbf{R}_z(\vartheta_i)\,\mathbf{T}_z(d_i)\,"
+               r"\mathbf{T}_x(a_i)\,\mathbf{R}_x(\alpha_i) = \begin{bmatrix}"
+               r"\cos\vartheta_i & -\sin\vartheta_i\cos\alpha_i & \sin\vartheta_i\sin\alpha_i"
+               r" & a_i\cos\vartheta_i\\ \sin\vartheta_i & \cos\vartheta_i\cos\alpha_i & "
+               r"-\cos\vartheta_i\sin\alpha_i & a_i\sin\vartheta_i\\ 0 & \sin\alpha_i & "
+               r"\cos\alpha_i & d_i\\ 0 & 0 & 0 & 1\end{bmatrix}"),
+        "<p>ϑ<sub>i</sub> is the joint variable of a revolute joint, d<sub>i</sub> that of a "
+        "prismatic one. <b>Standard and modified DH.</b> The PUMA 560 (standard DH) "
+        "rewritten in modified (Craig) DH by <code>serialkin.model.dh.standard_to_modified"
+        "</code> (row i takes a<sub>i−1</sub>, α<sub>i−1</sub>; the last row's "
+        "Tx(a)Rx(α) moves into the tool) gives the same tool pose: max difference over "
+        f"1,000 random configurations (seed 7) = {diff:.1e}.</p>",
+    ]
+    rows_m = []
+    for info in models.catalog():
+        r = info.build(6) if info.name == "planar" else info.build()
+        pz = r.fk(np.zeros(r.n))[:3, 3]
+        rows_m.append((info.name, r.n, "".join(r.joint_types), r.convention or "joints",
+                       f"({format_number(pz[0], '{:.4f}')}, {format_number(pz[1], '{:.4f}')},"
+                       f" {format_number(pz[2], '{:.4f}')})", r.source))
+    parts.append("<h3>Built-in models</h3><p><code>serialkin.models</code>; tool position at "
+                 "q = 0 (planar shown with 6 unit links).</p>" + ctx.table(
+                     rows_m, ["name", "n", "joints", "DH", "p(q = 0) [m]", "source"]))
+    parts.append(ctx.reproduce(
+        'serialkin models\nserialkin fk puma560 --q "0.3, -0.6, 0.9, 0.4, -0.7, 1.1" --frames',
+        shell=True))
+    return Section(title="3.2 Denavit-Hartenberg convention",
+                   equations="eq 12 in DH form, eqs 4 and 6", html="".join(parts))
+
+
+def _latex_q(q: np.ndarray) -> str:
+    return (rf"\mathbf{{q}} = ({q[0] / DEG:.0f}^\circ,\ {q[1] / DEG:.0f}^\circ,\ "
+            rf"{q[2]:.2f}\,\mathrm{{m}},\ {q[3] / DEG:.0f}^\circ)")
+
+
+def _section_3_2_1(ctx: ReportContext) -> Section:
+    """Section 3.2.1: the SCARA example (Table 1, eqs 13-18)."""
     parts: list[str] = []
     robot = models.scara(**SCARA_PARAMS)
     q = SCARA_Q
     s = _symbols()
-
-    # --- Table 1 -------------------------------------------------------------------------
     parts.append(
-        "<h3>SCARA: Table 1</h3><p>The chapter's SCARA (RRPR) in standard DH "
-        "(A<sub>i</sub> = Rz(θ<sub>i</sub>)·Tz(d<sub>i</sub>)·Tx(a<sub>i</sub>)·"
-        "Rx(α<sub>i</sub>)), built by <code>serialkin.models.scara()</code>. The chapter gives "
-        "no numbers; this report uses d1 = {d1} m, d2 = {d2} m, L1 = {l1} m, L2 = {l2} m."
-        "</p>".format(**SCARA_PARAMS)
+        "<h3>Table 1</h3><p>The chapter's SCARA (RRPR) in standard DH, built by "
+        "<code>serialkin.models.scara()</code>. The chapter gives no numbers; this report "
+        "uses d1 = {d1} m, d2 = {d2} m, L1 = {l1} m, L2 = {l2} m.</p>".format(**SCARA_PARAMS)
     )
     parts.append(ctx.table(
-        [("1", "L1", "0", "d1", "q1"), ("2", "L2", "0", "0", "q2"),
-         ("3", "0", "π", "d2 + q3", "0"), ("4", "0", "0", "0", "q4")],
-        ["link", "a_i", "α_i", "d_i", "θ_i"]))
+        [("1", Html(ctx.imath("L_1")), "0", Html(ctx.imath("d_1")), Html(ctx.imath("q_1"))),
+         ("2", Html(ctx.imath("L_2")), "0", "0", Html(ctx.imath("q_2"))),
+         ("3", "0", Html(ctx.imath(r"\pi")), Html(ctx.imath("d_2 + q_3")), "0"),
+         ("4", "0", "0", "0", Html(ctx.imath("q_4")))],
+        ["link", "a_i", "α_i", "d_i", "ϑ_i"]))
     parts.append("<p>As built (numbers, joint type and limits):</p>" + ctx.table(
         [(i + 1, r.a, r.alpha, r.d, r.theta, r.type, f"[{r.qlim[0]:.4g}, {r.qlim[1]:.4g}]")
          for i, r in enumerate(robot.dh)],
@@ -116,22 +222,27 @@ def build(ctx: ReportContext) -> Section:
 
     # --- symbolic eqs 13-18 ----------------------------------------------------------------
     kin = scara_symbolic(robot)
-    A = kin.A
-    tex_A = "\n\n".join(
-        rf"{{}}^{{{i}}}\mathbf{{A}}_{{{i + 1}}} = {sp.latex(M)}" for i, M in enumerate(A)
-    )
+    labels = ("13", "14-15", "16", "16")
     parts.append(
         "<h3>Link matrices, symbolic (eqs 13-16)</h3><p>Derived by "
-        "<code>serialkin.kinematics.symbolic.derive(scara, params='lengths')</code> from the DH "
-        "formula and simplified (LaTeX):</p>" + ctx.code(tex_A)
+        "<code>serialkin.kinematics.symbolic.derive(scara, params='lengths')</code> from the "
+        "DH matrix of section 3.2 and simplified:</p>"
+        + "".join(ctx.eq(rf"{{}}^{{{i}}}\mathbf{{A}}_{{{i + 1}}} = {sp.latex(M)}", labels[i])
+                  for i, M in enumerate(kin.A))
     )
     parts.append(
         "<h3>End-effector transform (eqs 17-18)</h3><p>Eq 17 is printed as "
-        "0T4 = 0A2 · 1A2 · 2A3 · 3A4; the ERRATA corrects it to "
-        "<b>0T4 = 0A1 · 1A2 · 2A3 · 3A4</b>, which gives (simplified):</p>"
-        + ctx.code(kin.pretty()) + ctx.code(sp.latex(kin.T))
-        + "<p>so the end-effector position (eq 18) is p = (L1 cos q1 + L2 cos(q1+q2), "
-        "L1 sin q1 + L2 sin(q1+q2), d1 + d2 + q3) and the tool z axis points down.</p>"
+        + ctx.imath(r"{}^{0}\mathbf{T}_4 = {}^{0}\mathbf{A}_2\,{}^{1}\mathbf{A}_2\,"
+                    r"{}^{2}\mathbf{A}_3\,{}^{3}\mathbf{A}_4")
+        + "; the ERRATA corrects the first factor:</p>"
+        + ctx.eq(r"{}^{0}\mathbf{T}_4 = {}^{0}\mathbf{A}_1\,{}^{1}\mathbf{A}_2\,"
+                 r"{}^{2}\mathbf{A}_3\,{}^{3}\mathbf{A}_4", "17, corrected")
+        + "<p>which gives (simplified)</p>"
+        + ctx.eq(rf"{{}}^{{0}}\mathbf{{T}}_4 = {sp.latex(kin.T)}", "18")
+        + "<p>so the end-effector position is "
+        + ctx.imath(r"{}^{0}\mathbf{o}_4 = (L_1\cos q_1 + L_2\cos(q_1+q_2),\ "
+                    r"L_1\sin q_1 + L_2\sin(q_1+q_2),\ d_1 + d_2 + q_3)")
+        + " and the tool z axis points down (row 3 of the rotation is (0, 0, −1)).</p>"
     )
 
     # --- numeric ----------------------------------------------------------------------------
@@ -143,13 +254,13 @@ def build(ctx: ReportContext) -> Section:
     T_sym = np.array(kin.T.subs(subs).subs(dict(zip(kin.q, q, strict=True))).evalf(),
                      dtype=float)
     misprint = (A_num[0] @ A_num[1]) @ A_num[1] @ A_num[2] @ A_num[3]
-    qtxt = (f"q = ({q[0] / DEG:.0f}°, {q[1] / DEG:.0f}°, {q[2]:.2f} m, {q[3] / DEG:.0f}°)")
-    rows = "".join(
-        f"<tr><td>{i}A{i + 1}</td><td>{ctx.matrix(M)}</td></tr>" for i, M in enumerate(A_num)
-    )
+    rows = [(Html(ctx.imath(rf"{{}}^{{{i}}}\mathbf{{A}}_{{{i + 1}}}")), ctx.matrix(M))
+            for i, M in enumerate(A_num)]
     parts.append(
-        f"<h3>Evaluated at {html.escape(qtxt)}</h3><table>{rows}</table>"
-        "<p>0T4 by the compiled kernel (<code>robot.fk(q)</code>):</p>" + ctx.matrix(T_fk)
+        "<h3>Evaluated at " + ctx.imath(_latex_q(q)) + "</h3>"
+        + ctx.table(rows, ["matrix", "value"])
+        + "<p>" + ctx.imath(r"{}^{0}\mathbf{T}_4")
+        + " by the compiled kernel (<code>robot.fk(q)</code>):</p>" + ctx.matrix(T_fk)
         + ctx.table([
             ("|fk − 0A1·1A2·2A3·3A4| (corrected eq 17)", float(np.abs(T_fk - T_prod).max())),
             ("|fk − symbolic 0T4 evaluated|", float(np.abs(T_fk - T_sym).max())),
@@ -161,35 +272,18 @@ def build(ctx: ReportContext) -> Section:
         + "<p>The printed eq 17 (with 0A2 in place of 0A1) gives a different pose; the "
         "corrected product agrees with the kernel to rounding.</p>"
     )
-
-    # --- same robot in modified DH --------------------------------------------------------
-    puma = models.puma560()
-    m_rows, m_base, m_tool = standard_to_modified(puma.dh, puma.base, puma.tool)
-    puma_m = Robot.from_dh(m_rows, "modified", base=m_base, tool=m_tool, name="puma560-mdh")
-    Q = puma.random_q(1000, seed=7)
-    diff = float(np.abs(puma_m.fk(Q) - puma.fk(Q)).max())
-    parts.append(
-        "<h3>Standard and modified DH</h3><p>The PUMA 560 (standard DH) rewritten in "
-        "modified (Craig) DH by <code>serialkin.model.dh.standard_to_modified</code> "
-        "(row i takes a<sub>i−1</sub>, α<sub>i−1</sub>; the last row's Tx(a)Rx(α) moves "
-        f"into the tool) gives the same tool pose: max difference over 1,000 random "
-        f"configurations (seed 7) = {diff:.1e}.</p>"
-    )
-
-    # --- figures ------------------------------------------------------------------------------
     parts.append(_figure_scara(ctx, robot, q))
     parts.append(_figure_frames(ctx, robot, q))
+    parts.append(ctx.reproduce(
+        "import numpy as np, serialkin as sk\n"
+        "from serialkin.kinematics.symbolic import derive\n"
+        "robot = sk.models.scara(d1=0.4, d2=0.1, l1=0.35, l2=0.30)\n"
+        "print(derive(robot, params='lengths').T)                        # eq 18\n"
+        "print(robot.fk(np.array([np.radians(30), np.radians(-45), -0.05, np.radians(60)])))"))
+    return Section(title="3.2.1 Example: the SCARA", equations="Table 1, eqs 13-18 (17 "
+                   "corrected), eq 7", html="".join(parts))
 
-    # --- built-in models ------------------------------------------------------------------------
-    rows_m = []
-    for info in models.catalog():
-        r = info.build(6) if info.name == "planar" else info.build()
-        p = r.fk(np.zeros(r.n))[:3, 3]
-        rows_m.append((info.name, r.n, "".join(r.joint_types), r.convention,
-                       f"({p[0]:.4f}, {p[1]:.4f}, {p[2]:.4f})", r.source))
-    parts.append("<h3>Built-in models</h3><p><code>serialkin.models</code>; tool position at "
-                 "q = 0 (planar shown with 6 unit links).</p>" + ctx.table(
-                     rows_m, ["name", "n", "joints", "DH", "p(q=0) [m]", "source"]))
 
-    return Section(title="3. Forward kinematics", equations="eqs 7, 10-18, Table 1",
-                   html="".join(parts))
+def build(ctx: ReportContext) -> list[Section]:
+    """Compute section 3's examples: sections 3 (with 3.1), 3.2 and 3.2.1."""
+    return [_section_3(ctx), _section_3_2(ctx), _section_3_2_1(ctx)]
