@@ -15,12 +15,13 @@ The numerical families (section 5.3) are in :mod:`serialkin.chapter.sections.num
 
 from __future__ import annotations
 
+import html
 import math
 
 import numpy as np
 
 from serialkin import models
-from serialkin.chapter.report import ReportContext, Section
+from serialkin.chapter.report import Html, ReportContext, Section
 
 #: Worked example of eqs 23-27 (the chapter gives no numbers): link lengths and target.
 L1, L2 = 1.0, 0.7
@@ -106,32 +107,100 @@ def _round_trip(robot, count: int = 500) -> tuple[float, float]:
     return worst_q, worst_p
 
 
-def build(ctx: ReportContext) -> Section:
-    """Compute section 4's examples and the section 5.3 comparison; return the section."""
+def _section_4(ctx: ReportContext) -> Section:
+    """Section 4: x = f(q) and q = f⁻¹(x) (eqs 19-20): several, infinitely many or no q."""
+    ur5 = models.ur5()
+    q_ur = np.array([0.4, -1.1, 1.3, -0.6, 0.9, 0.2])
+    T = ur5.fk(q_ur)
+    sols = ur5.ik_all(T)
+    rows_ur = [(k + 1, *(np.round(np.degrees(qk), 1)), float(np.abs(ur5.fk(qk) - T).max()))
+               for k, qk in enumerate(sols)]
+    three = models.three_link(1.0, 0.8, 0.5)
+    target = three.fk(np.array([0.3, 0.6, -0.4]))[:2, 3]
+    rows_3 = []
+    for seed in range(4):
+        res = three.ik(target, seed=seed, q0=three.random_q(seed=seed))
+        rows_3.append((seed, *(np.round(np.degrees(res.q), 2)),
+                       float(np.linalg.norm(three.fk(res.q)[:2, 3] - target)),
+                       "yes" if res.success else "no"))
+    two = models.two_link(L1, L2)
+    far = np.array([2.0, 0.5])
+    res_far = two.ik(far, seed=0)
+    html_ = (
+        "<p>Forward kinematics is a function of the joint variables; inverse kinematics "
+        "asks for its inverse:</p>"
+        + ctx.eq(r"\mathbf{x} = \mathbf{f}(\mathbf{q})", "19")
+        + ctx.eq(r"\mathbf{q} = \mathbf{f}^{-1}(\mathbf{x})", "20")
+        + "<p>Unlike f, f⁻¹ is not a function: a target can have several solutions, "
+        "infinitely many (a redundant arm) or none (outside the workspace). All three, "
+        "computed:</p>"
+        f"<p><b>Several.</b> The UR5 at q = ({', '.join(f'{v:g}' for v in q_ur)}) rad; "
+        f"its closed-form solver <code>robot.ik_all(T)</code> returns {len(sols)} "
+        "configurations with the same tool pose (angles in degrees):</p>"
+        + ctx.table(rows_ur, ["#", "q1", "q2", "q3", "q4", "q5", "q6", "max |f(q) − T|"],
+                    fmt="{:.3g}")
+        + "<p><b>Infinitely many.</b> The planar three-link arm (L = 1.0, 0.8, 0.5 m) and a "
+        f"position target ({target[0]:.4f}, {target[1]:.4f}) m: n = 3 joints for m = 2 task "
+        "coordinates, so the solutions form a curve; <code>robot.ik</code> started from four "
+        "seeded random configurations lands on four different points of it:</p>"
+        + ctx.table(rows_3, ["seed", "q1 [°]", "q2 [°]", "q3 [°]", "|f(q) − x| [m]",
+                             "success"], fmt="{:.3g}")
+        + f"<p><b>None.</b> The two-link arm (L1 = {L1} m, L2 = {L2} m) cannot reach "
+        f"x = ({far[0]}, {far[1]}) m (|x| = {np.linalg.norm(far):.3f} m &gt; L1 + L2): "
+        f"<code>ik_all</code> returns {len(two.ik_all(far))} solutions and "
+        f"<code>robot.ik</code> reports success = {res_far.success}, reason: "
+        f"“{html.escape(res_far.reason)}”.</p>"
+        + ctx.reproduce(
+            "import numpy as np, serialkin as sk\n"
+            "ur5 = sk.models.ur5()\n"
+            f"T = ur5.fk(np.array([{', '.join(f'{v:g}' for v in q_ur)}]))\n"
+            "print(ur5.ik_all(T))                          # eq 20: several solutions\n"
+            "print(sk.models.two_link(1.0, 0.7).ik([2.0, 0.5]).reason)   # none")
+    )
+    return Section(title="4. Inverse kinematics", equations="eqs 19-20", html=html_)
+
+
+def build(ctx: ReportContext) -> list[Section]:
+    """Compute section 4's examples: sections 4 (eqs 19-20) and 4.1 (eqs 21-27)."""
+    return [_section_4(ctx), _section_4_1(ctx)]
+
+
+def _section_4_1(ctx: ReportContext) -> Section:
+    """Section 4.1: the two-link closed form, eqs 21-27 as corrected in the ERRATA."""
     parts: list[str] = []
     robot = models.two_link(L1, L2)
     x, y = TARGET
     cf = two_link_closed_form(x, y, L1, L2)
 
     parts.append(
-        "<h3>Closed form of the two-link arm (eqs 21-27, corrected)</h3>"
-        "<p>Forward kinematics (eqs 21-22): x = L1 cos θ1 + L2 cos(θ1+θ2), "
-        "y = L1 sin θ1 + L2 sin(θ1+θ2). The chapter's inverse (eqs 23-27) carries two "
-        "misprints (ERRATA): eq 23 must define <b>r = sqrt(x² + y²)</b> and eq 26 must read "
-        "<b>β = arccos((L1² − L2² + r²)/(2 L1 r))</b>; and the two solutions pair as "
-        "<b>θ1 = α − β with θ2 = +arccos(..)</b> and <b>θ1 = α + β with θ2 = −arccos(..)</b>."
-        f" Worked example (the chapter gives no numbers): L1 = {L1} m, L2 = {L2} m, "
-        f"target x<sub>E</sub> = ({x}, {y}) m.</p>"
+        "<p>The two-link arm of Figure 5 has the forward kinematics</p>"
+        + ctx.eq(r"x = L_1\cos\vartheta_1 + L_2\cos(\vartheta_1 + \vartheta_2)", "21")
+        + ctx.eq(r"y = L_1\sin\vartheta_1 + L_2\sin(\vartheta_1 + \vartheta_2)", "22")
+        + "<p>and the inverse below. The chapter's eqs 23 and 26 carry misprints (ERRATA: "
+        "as printed, " + ctx.imath(r"c = x^2 + y^2") + " and "
+        + ctx.imath(r"\beta = \arccos\frac{L_1^2 - L_2^2 + c^2}{2L_1c}")
+        + "); the corrected forms, with the two solutions paired by sign, are</p>"
+        + ctx.eq(r"r = \sqrt{x^2 + y^2}", "23, corrected")
+        + ctx.eq(r"\alpha = \operatorname{atan2}(y, x)", "24")
+        + ctx.eq(r"\vartheta_2 = \pm\arccos\left(\frac{x^2 + y^2 - L_1^2 - L_2^2}"
+                 r"{2L_1L_2}\right)", "25")
+        + ctx.eq(r"\beta = \arccos\left(\frac{L_1^2 - L_2^2 + r^2}{2L_1r}\right)",
+                 "26, corrected")
+        + ctx.eq(r"\vartheta_1 = \alpha \mp \beta\quad(\text{upper signs together: }"
+                 r"\vartheta_1 = \alpha - \beta \text{ with } \vartheta_2 = +\arccos(\cdot))",
+                 "27")
+        + f"<p>Worked example (the chapter gives no numbers): L1 = {L1} m, L2 = {L2} m, "
+        f"target x<sub>E</sub> = ({x}, {y}) m, step by step:</p>"
     )
     parts.append(ctx.table(
-        [("23 (corrected)", "r = sqrt(x² + y²)", cf["r"]),
-         ("24", "α = atan2(y, x)", cf["alpha"]),
-         ("25", "cos θ2 = (x² + y² − L1² − L2²)/(2 L1 L2)", cf["cos_theta2"]),
-         ("25", "θ2 = ±arccos(..)", cf["theta2_plus"]),
-         ("26 (corrected)", "cos β = (L1² − L2² + r²)/(2 L1 r)", cf["cos_beta"]),
-         ("26", "β = arccos(..)", cf["beta"]),
-         ("27", "θ1 = α − β (with θ2 = +arccos)", cf["theta1_a"]),
-         ("27, twin", "θ1 = α + β (with θ2 = −arccos)", cf["theta1_b"])],
+        [("23 (corrected)", Html(ctx.imath(r"r")), cf["r"]),
+         ("24", Html(ctx.imath(r"\alpha")), cf["alpha"]),
+         ("25", Html(ctx.imath(r"\cos\vartheta_2")), cf["cos_theta2"]),
+         ("25", Html(ctx.imath(r"\vartheta_2 = +\arccos(\cdot)")), cf["theta2_plus"]),
+         ("26 (corrected)", Html(ctx.imath(r"\cos\beta")), cf["cos_beta"]),
+         ("26", Html(ctx.imath(r"\beta")), cf["beta"]),
+         ("27", Html(ctx.imath(r"\vartheta_1 = \alpha - \beta")), cf["theta1_a"]),
+         ("27, twin", Html(ctx.imath(r"\vartheta_1 = \alpha + \beta")), cf["theta1_b"])],
         ["eq", "quantity", "value [m or rad]"]))
     bad = _misprinted_cos_beta(x, y, L1, L2)
     parts.append(
@@ -166,5 +235,8 @@ def build(ctx: ReportContext) -> Section:
         f"{worst_p:.2e} m.</p>"
     )
 
-    return Section(title="4 Inverse kinematics", equations="eqs 19-27 (23, 26, 27 corrected)",
-                   html="".join(parts))
+    parts.append(ctx.reproduce(
+        "import serialkin as sk\n"
+        f"print(sk.models.two_link({L1}, {L2}).ik_all([{x}, {y}]))   # both elbows, eqs 23-27"))
+    return Section(title="4.1 Closed-form solution of inverse kinematics",
+                   equations="eqs 21-27 (23, 26, 27 corrected), Figure 5", html="".join(parts))
