@@ -10,8 +10,6 @@ both mechanisms with their velocity (manipulability) ellipses.
 
 from __future__ import annotations
 
-import html
-
 import numpy as np
 import sympy as sp
 
@@ -97,12 +95,159 @@ def _figure_manipulability(ctx: ReportContext, two: Robot) -> str:
                       "arm vanishes at the stretched and folded singularities q2 = 0, ±180°.")
 
 
-def build(ctx: ReportContext) -> Section:
-    """Compute section 5's examples and return the report section."""
-    parts: list[str] = []
+def _fd_columns(f, q: np.ndarray, h: float = 1e-6) -> np.ndarray:
+    """Central finite differences of a vector function f(q), (m, n)."""
+    cols = []
+    for i in range(len(q)):
+        e = np.zeros(len(q))
+        e[i] = h
+        cols.append((f(q + e) - f(q - e)) / (2 * h))
+    return np.column_stack(cols)
+
+
+def _section_5(ctx: ReportContext) -> Section:
+    html_ = (
+        "<p>Differential kinematics relates joint velocities to end-effector velocities "
+        "through a Jacobian: the analytical Jacobian differentiates the task coordinates "
+        "x = f(q) of eq 19 (section 5.1); the geometric Jacobian is built from the joint "
+        "axes and gives the linear and angular velocity (section 5.2). Both are computed by "
+        "the same compiled kernels that do forward kinematics, and checked here against "
+        "sympy's derivatives and against finite differences.</p>"
+    )
+    return Section(title="5. Differential kinematics", equations="eqs 28-38", html=html_)
+
+
+def _section_5_1(ctx: ReportContext, three: Robot) -> Section:
+    parts: list[str] = [
+        ctx.eq(r"\dot{\mathbf{x}} = \frac{\partial\mathbf{f}(\mathbf{q})}{\partial\mathbf{q}}"
+               r"\frac{d\mathbf{q}}{dt} = \mathbf{J}(\mathbf{q})\,\dot{\mathbf{q}}", "28"),
+        ctx.eq(r"\mathbf{J}(\mathbf{q}) = \begin{bmatrix}\frac{\partial x_1}{\partial q_1} & "
+               r"\cdots & \frac{\partial x_1}{\partial q_n}\\ \vdots & \ddots & \vdots\\ "
+               r"\frac{\partial x_m}{\partial q_1} & \cdots & \frac{\partial x_m}"
+               r"{\partial q_n}\end{bmatrix}", "29"),
+    ]
+    kin3 = _renamed(three)
+    x3 = kin3.task("planar")
+    Ja = kin3.jacobian("planar")
+    Jpose = kin3.jacobian("planar_pose")
+    f_a = kin3.lambdify(Ja)
+    Jnum = three.jacobian_planar(THREE_LINK_Q)
+    Q = three.random_q(200, seed=5)
+    err_many = max(float(np.abs(f_a(q) - three.jacobian_planar(q)).max()) for q in Q)
+    parts.append(
+        "<h3>The three-link arm (Figure 6, eqs 30-32)</h3>"
+        "<p>Position of E from the symbolic forward kinematics "
+        "(<code>derive(three_link, params='lengths').task('planar')</code>):</p>"
+        + ctx.eq(r"\begin{bmatrix}x_E\\ y_E\end{bmatrix} = " + sp.latex(x3), "30-31")
+        + "<p>and its Jacobian by symbolic differentiation (<code>.jacobian('planar')</code>), "
+        "the entries the chapter lists under eq 32:</p>"
+        + ctx.eq(r"\mathbf{J}(\mathbf{q}) = " + sp.latex(Ja), "32")
+        + "<p>With the heading φ = q1 + q2 + q3 as a third task coordinate the extra row is "
+        + ctx.imath(sp.latex(Jpose[2, :])) + ".</p>"
+        + f"<p>Evaluated with L = {THREE_LINK} m at q = "
+        f"({', '.join(f'{v / DEG:.0f}°' for v in THREE_LINK_Q)}):</p>"
+        + ctx.matrix(f_a(THREE_LINK_Q))
+        + ctx.table([
+            ("|J_symbolic − J_geometric[vx, vy]| at the sample q",
+             float(np.abs(f_a(THREE_LINK_Q) - Jnum).max())),
+            ("same, max over 200 random q (seed 5)", err_many),
+            ("|J_geometric[vx, vy] − finite differences of fk|",
+             float(np.abs(Jnum - _fd_planar(three, THREE_LINK_Q)).max())),
+        ], ["check", "max abs difference"], fmt="{:.2e}")
+        + "<p>For a planar arm the analytical and geometric Jacobians coincide (the heading "
+        "rate is ω<sub>z</sub>); for a spatial arm they differ in the rotational rows "
+        "(section 5.2).</p>"
+        + ctx.reproduce(
+            "import numpy as np, serialkin as sk\n"
+            "from serialkin.kinematics.symbolic import derive\n"
+            "arm = sk.models.three_link(1.0, 0.8, 0.5)\n"
+            "print(derive(arm, params='lengths').jacobian('planar'))      # eq 32\n"
+            "print(arm.jacobian_planar(np.radians([20, 40, -30])))")
+    )
+    return Section(title="5.1 Analytical Jacobian", equations="eqs 28-32, Figure 6",
+                   html="".join(parts))
+
+
+def _prismatic_column(ctx: ReportContext) -> str:
+    """Eq 36 on the SCARA: the prismatic joint's column is [z_2; 0]."""
+    from serialkin.chapter.sections.forward import SCARA_PARAMS, SCARA_Q
+
+    scara = models.scara(**SCARA_PARAMS)
+    J = scara.jacobian(SCARA_Q)
+    z2 = scara.fk_all(SCARA_Q)[2, :3, 2]
+    col = J[:, 2]
+    fd = _fd_columns(lambda q: scara.fk(q)[:3, 3], SCARA_Q)[:, 2]
+    return (
+        "<h3>Prismatic joint (eq 36) on the SCARA</h3>"
+        + ctx.eq(r"\begin{bmatrix}\mathbf{J}_{vi}\\ \mathbf{J}_{\omega i}\end{bmatrix} = "
+                 r"\begin{bmatrix}{}^{0}\mathbf{z}_{i-1}\\ \mathbf{0}\end{bmatrix}", "36")
+        + "<p>The SCARA of section 3.2.1 at the same q; its third joint (the quill) is "
+        "prismatic. Column 3 of <code>robot.jacobian(q)</code> (rows "
+        + ctx.imath(r"v_x, v_y, v_z, \omega_x, \omega_y, \omega_z") + ") and the axis "
+        + ctx.imath(r"{}^{0}\mathbf{z}_2") + " of DH frame 2 (<code>fk_all(q)[2]</code>):</p>"
+        + ctx.table([("J[:, 3]", *col), ("[z2; 0]", *z2, 0.0, 0.0, 0.0),
+                     ("finite differences ∂p/∂q3", *fd, "", "", "")],
+                    ["", "v_x", "v_y", "v_z", "ω_x", "ω_y", "ω_z"], fmt="{:.6f}")
+        + f"<p>|J[:, 3] − [z2; 0]| = {np.abs(col - np.r_[z2, 0, 0, 0]).max():.1e}: sliding "
+        "the quill moves the tool along the vertical axis and turns nothing.</p>"
+    )
+
+
+def _analytic_vs_geometric(ctx: ReportContext) -> str:
+    """On the PUMA 560: J_A = blockdiag(I, E⁻¹) J, checked by finite differences."""
+    from serialkin.kinematics.analytic import rate_matrix, rotation_coordinates
+
+    puma = models.puma560()
+    q = np.array([0.3, -0.6, 0.9, 0.4, -0.7, 1.1])
+    J = puma.jacobian(q)
+    JA = puma.jacobian_analytic(q, "rpy")
+    phi = rotation_coordinates(puma.fk(q)[:3, :3], "rpy")
+    E = rate_matrix(phi, "rpy")
+
+    def x_of(qq: np.ndarray) -> np.ndarray:
+        T = puma.fk(qq)
+        return np.r_[T[:3, 3], rotation_coordinates(T[:3, :3], "rpy")]
+
+    fd = _fd_columns(x_of, q)
+    return (
+        "<h3>Analytical vs geometric Jacobian on a spatial arm</h3>"
+        "<p>Eq 34 notes that the two Jacobians differ in the rotational part. For the "
+        "PUMA 560 at q = (" + ", ".join(f"{v:g}" for v in q) + ") rad with roll-pitch-yaw "
+        "angles " + ctx.imath(r"\boldsymbol{\phi}") + " as orientation coordinates, "
+        + ctx.imath(r"\boldsymbol{\omega} = \mathbf{E}(\boldsymbol{\phi})\,"
+                    r"\dot{\boldsymbol{\phi}}") + " and</p>"
+        + ctx.eq(r"\mathbf{J}_A(\mathbf{q}) = \begin{bmatrix}\mathbf{I}_3 & \mathbf{0}\\ "
+                 r"\mathbf{0} & \mathbf{E}(\boldsymbol{\phi})^{-1}\end{bmatrix}"
+                 r"\mathbf{J}(\mathbf{q})")
+        + "<p>Geometric Jacobian <code>robot.jacobian(q)</code> (rows v, ω):</p>"
+        + ctx.matrix(J)
+        + "<p>Analytical Jacobian <code>robot.jacobian_analytic(q, 'rpy')</code> (rows p, "
+        "roll, pitch, yaw):</p>" + ctx.matrix(JA)
+        + ctx.table([
+            ("position rows: |J_A[:3] − J[:3]|", float(np.abs(JA[:3] - J[:3]).max())),
+            ("rotation rows: |J_A[3:] − J[3:]| (they differ)",
+             float(np.abs(JA[3:] - J[3:]).max())),
+            ("|E(φ) J_A[3:] − J[3:]|", float(np.abs(E @ JA[3:] - J[3:]).max())),
+            ("|J_A − finite differences of (p, rpy(R))|", float(np.abs(JA - fd).max())),
+        ], ["check", "max abs difference"], fmt="{:.2e}")
+    )
+
+
+def _section_5_2(ctx: ReportContext, two: Robot, three: Robot) -> Section:
+    parts: list[str] = [
+        ctx.eq(r"\mathbf{J} = \begin{bmatrix}\mathbf{J}_v\\ \mathbf{J}_\omega\end{bmatrix} = "
+               r"\begin{bmatrix}\mathbf{J}_{v1} & \cdots & \mathbf{J}_{vn}\\ "
+               r"\mathbf{J}_{\omega 1} & \cdots & \mathbf{J}_{\omega n}\end{bmatrix}", "33"),
+        ctx.eq(r"\mathbf{v} = \mathbf{J}_{v1}\dot{q}_1 + \ldots + \mathbf{J}_{vn}\dot{q}_n,"
+               r"\qquad \boldsymbol{\omega} = \mathbf{J}_{\omega 1}\dot{q}_1 + \ldots + "
+               r"\mathbf{J}_{\omega n}\dot{q}_n", "34"),
+        "<p>Column i for a revolute joint:</p>",
+        ctx.eq(r"\begin{bmatrix}\mathbf{J}_{vi}\\ \mathbf{J}_{\omega i}\end{bmatrix} = "
+               r"\begin{bmatrix}{}^{0}\mathbf{z}_{i-1}\times({}^{0}\mathbf{p}_n - "
+               r"{}^{0}\mathbf{p}_{i-1})\\ {}^{0}\mathbf{z}_{i-1}\end{bmatrix}", "35"),
+    ]
 
     # --- two-link geometric Jacobian, eqs 37-38 -------------------------------------------
-    two = models.two_link(*TWO_LINK)
     kin2 = _renamed(two)
     Jg = kin2.geometric_jacobian()
     L1, L2 = TWO_LINK
@@ -115,13 +260,16 @@ def build(ctx: ReportContext) -> Section:
     J2 = two.jacobian(TWO_LINK_Q)
     f_sym = kin2.lambdify(Jg)
     parts.append(
-        "<h3>Geometric Jacobian of the two-link arm (eqs 37-38)</h3>"
-        "<p>Column i is [z<sub>i−1</sub> × (p<sub>2</sub> − p<sub>i−1</sub>); "
-        "z<sub>i−1</sub>] (eq 35). Derived symbolically by "
+        "<h3>The two-link arm (Figure 7, eqs 37-38)</h3>"
+        + ctx.eq(r"\mathbf{J}(\mathbf{q}) = \begin{bmatrix}\mathbf{z}_0\times(\mathbf{p}_2 - "
+                 r"\mathbf{p}_0) & \mathbf{z}_1\times(\mathbf{p}_2 - \mathbf{p}_1)\\ "
+                 r"\mathbf{z}_0 & \mathbf{z}_1\end{bmatrix}", "37")
+        + "<p>derived symbolically by "
         "<code>derive(two_link, params='lengths').geometric_jacobian()</code>:</p>"
-        + ctx.code(kin2.pretty(Jg)) + ctx.code(sp.latex(Jg))
+        + ctx.eq(r"\mathbf{J}(\mathbf{q}) = " + sp.latex(Jg), "38")
         + f"<p>Evaluated with L1 = {L1} m, L2 = {L2} m at q = ({q1 / DEG:.0f}°, "
-        f"{q2 / DEG:.0f}°) by <code>robot.jacobian(q)</code> (rows vx, vy, vz, ωx, ωy, ωz):</p>"
+        f"{q2 / DEG:.0f}°) by <code>robot.jacobian(q)</code> (rows v<sub>x</sub>, "
+        "v<sub>y</sub>, v<sub>z</sub>, ω<sub>x</sub>, ω<sub>y</sub>, ω<sub>z</sub>):</p>"
         + ctx.matrix(J2)
         + ctx.table([
             ("|J − eq 38|", float(np.abs(J2 - eq38).max())),
@@ -133,41 +281,8 @@ def build(ctx: ReportContext) -> Section:
         "position task only the first two rows are kept "
         "(<code>robot.jacobian_planar(q)</code>).</p>"
     )
-
-    # --- three-link analytical Jacobian, eqs 30-32 ----------------------------------------
-    three = models.three_link(*THREE_LINK)
-    kin3 = _renamed(three)
-    x3 = kin3.task("planar")
-    Ja = kin3.jacobian("planar")
-    Jpose = kin3.jacobian("planar_pose")
-    f_a = kin3.lambdify(Ja)
-    Jnum = three.jacobian_planar(THREE_LINK_Q)
-    rng = np.random.default_rng(5)
-    Q = three.random_q(1000, seed=rng)
-    err_many = max(float(np.abs(f_a(q) - three.jacobian_planar(q)).max()) for q in Q[:200])
-    parts.append(
-        "<h3>Analytical Jacobian of the three-link arm (eqs 30-32)</h3>"
-        "<p>Position of E (eqs 30-31), from the symbolic forward kinematics:</p>"
-        + ctx.code(kin3.pretty(x3))
-        + "<p>J = ∂(x<sub>E</sub>, y<sub>E</sub>)/∂q (eqs 29, 32):</p>"
-        + ctx.code(kin3.pretty(Ja)) + ctx.code(sp.latex(Ja))
-        + "<p>With the heading φ = q1 + q2 + q3 as a third task coordinate the extra row is "
-        f"{html.escape(str(list(Jpose[2, :])))}.</p>"
-        + f"<p>Evaluated with L = {THREE_LINK} m at q = "
-        f"({', '.join(f'{v / DEG:.0f}°' for v in THREE_LINK_Q)}), the analytical Jacobian "
-        "and the position rows of the geometric Jacobian (eqs 33-35) agree:</p>"
-        + ctx.matrix(f_a(THREE_LINK_Q))
-        + ctx.table([
-            ("|J_analytic − J_geometric[vx, vy]| at the sample q",
-             float(np.abs(f_a(THREE_LINK_Q) - Jnum).max())),
-            ("same, max over 200 random q (seed 5)", err_many),
-            ("|J_geometric[vx, vy] − finite differences|",
-             float(np.abs(Jnum - _fd_planar(three, THREE_LINK_Q)).max())),
-        ], ["check", "max abs difference"], fmt="{:.2e}")
-        + "<p>For a planar arm the analytical and geometric Jacobians coincide: the heading "
-        "rate is ω<sub>z</sub>. In 3D they differ in the rotational part (section 5.2), "
-        "see <code>robot.jacobian_analytic(q, rep)</code>.</p>"
-    )
+    parts.append(_prismatic_column(ctx))
+    parts.append(_analytic_vs_geometric(ctx))
 
     # --- manipulability, eq 43 --------------------------------------------------------------
     rows = []
@@ -185,13 +300,30 @@ def build(ctx: ReportContext) -> Section:
         c = robot.condition_number(q, task=task)
         rows.append((name, task, f"{w:.4g}", "∞" if not np.isfinite(c) else f"{c:.4g}"))
     parts.append(
-        "<h3>Manipulability (eq 43) and condition number</h3><p>w = sqrt(det(J Jᵀ)) of the "
-        "task Jacobian and σ<sub>max</sub>/σ<sub>min</sub>; for the two-link arm "
-        f"w = L1 L2 |sin q2| = {L1 * L2 * abs(np.sin(q2)):.4g} m² at the sample q.</p>"
+        "<h3>Rank, singularities and manipulability</h3><p>Where J loses rank the arm is "
+        "singular. The manipulability of section 5.3,</p>"
+        + ctx.eq(r"H(\mathbf{q}) = \sqrt{\det\left(\mathbf{J}(\mathbf{q})\mathbf{J}^T"
+                 r"(\mathbf{q})\right)}", "43")
+        + "<p>and the condition number σ<sub>max</sub>/σ<sub>min</sub> of the task "
+        "Jacobian measure the distance from singularities; for the two-link arm "
+        + ctx.imath(r"H = L_1L_2|\sin q_2|")
+        + f" = {L1 * L2 * abs(np.sin(q2)):.4g} m² at the sample q.</p>"
         + ctx.table(rows, ["robot, configuration", "task rows", "w", "condition number"])
     )
-
     parts.append(_figure_mechanisms(ctx, two, three))
     parts.append(_figure_manipulability(ctx, two))
-    return Section(title="5. Differential kinematics: Jacobians",
-                   equations="eqs 28-38, 43", html="".join(parts))
+    parts.append(ctx.reproduce(
+        'serialkin jacobian two_link --q "30, 60" --degrees --param l1=1.0 --param l2=0.7\n'
+        'serialkin jacobian scara --q "30, -45, -0.05, 60" --degrees '
+        '--param d1=0.4 --param d2=0.1 --param l1=0.35 --param l2=0.30\n'
+        'serialkin jacobian puma560 --q "0.3, -0.6, 0.9, 0.4, -0.7, 1.1"', shell=True))
+    return Section(title="5.2 Geometric Jacobian",
+                   equations="eqs 33-38 (36 on the SCARA), J_A vs J on the PUMA 560, eq 43",
+                   html="".join(parts))
+
+
+def build(ctx: ReportContext) -> list[Section]:
+    """Compute section 5's examples: sections 5, 5.1 and 5.2."""
+    two = models.two_link(*TWO_LINK)
+    three = models.three_link(*THREE_LINK)
+    return [_section_5(ctx), _section_5_1(ctx, three), _section_5_2(ctx, two, three)]
