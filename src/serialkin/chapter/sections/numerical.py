@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import html
 
+import numpy as np
+
 from serialkin import models
 from serialkin.chapter.report import ReportContext, Section
 from serialkin.ik.compare import CompareTable, compare
@@ -90,9 +92,85 @@ def _measured_summary(tables: list[tuple[str, CompareTable]]) -> dict[str, str]:
     return out
 
 
+def _newton_demo(ctx: ReportContext) -> str:
+    """Eq 41 on the UR5: position error after k Newton steps from a nearby start."""
+    ur5 = models.ur5()
+    q = np.array([0.4, -1.1, 1.3, -0.6, 0.9, 0.2])
+    T = ur5.fk(q)
+    q0 = q + 0.15
+    rows = []
+    for k in range(1, 7):
+        res = ur5.ik(T, method="newton", q0=q0, max_iter=k, restarts=0, tol=1e-15)
+        rows.append((k, res.position_error, res.orientation_error))
+    return (
+        "<h3>Newton-Raphson (eq 41)</h3><p>For a scalar equation f(x) = 0 one step is</p>"
+        + ctx.eq(r"x_1 = x_0 - \frac{f(x_0)}{f'(x_0)}", "41")
+        + "<p>and for inverse kinematics, with the pose error e(q) between the target and "
+        "f(q) and the Jacobian in place of f′, "
+        + ctx.imath(r"\mathbf{q}_{k+1} = \mathbf{q}_k + \mathbf{J}^{\dagger}(\mathbf{q}_k)\,"
+                    r"\mathbf{e}(\mathbf{q}_k)")
+        + " (<code>method='newton'</code>). The UR5, target f(q) for q = (0.4, −1.1, 1.3, "
+        "−0.6, 0.9, 0.2) rad, started at q + 0.15 rad in every joint, errors after k "
+        "steps: the number of correct digits roughly doubles per step (quadratic "
+        "convergence) until rounding.</p>"
+        + ctx.table(rows, ["steps k", "position error [m]", "orientation error [rad]"],
+                    fmt="{:.2e}")
+    )
+
+
+def _obstacle_objective(ctx: ReportContext) -> str:
+    """Eq 45 on a planar 3-link arm and a circular obstacle, checked by brute force."""
+    from serialkin.redundancy import Circle, obstacle_distance
+    from serialkin.redundancy.objectives import finite_difference_gradient
+
+    arm = models.three_link(1.0, 0.8, 0.5)
+    obstacle = Circle(center=np.array([1.2, 1.3]), radius=0.25)
+    H = obstacle_distance(arm, [obstacle])
+    rows = []
+    for q in (np.array([0.3, 0.6, -0.4]), np.array([0.0, 0.3, 0.9]),
+              np.array([-0.2, 1.0, 1.0])):
+        pts = arm.fk_all(q)[:, :2, 3]
+        t = np.linspace(0.0, 1.0, 2001)[:, None]
+        a = np.vstack([p0 + t * (p1 - p0) for p0, p1 in zip(pts[:-1], pts[1:])])
+        ang = np.linspace(0.0, 2 * np.pi, 3601)
+        b = obstacle.center + obstacle.radius * np.c_[np.cos(ang), np.sin(ang)]
+        d2 = np.min(np.sum((a[:, None, :] - b[None, ::4, :]) ** 2, axis=-1))
+        d_exact = np.min(np.linalg.norm(a - obstacle.center, axis=1)) - obstacle.radius
+        g = H.gradient(q)
+        g_fd = finite_difference_gradient(H.value, q)
+        rows.append((", ".join(f"{v:g}" for v in q), H.value(q), d_exact * abs(d_exact),
+                     d2, float(np.abs(g - g_fd).max())))
+    return (
+        "<h3>Obstacle-avoidance objective (eq 45)</h3>"
+        + ctx.eq(r"H(\mathbf{q}) = \min_{\mathbf{a}\in\text{robot},\ \mathbf{b}\in"
+                 r"\text{obstacle}}\left\|\mathbf{a}(\mathbf{q}) - \mathbf{b}\right\|^2", "45")
+        + "<p>On the planar three-link arm (L = 1.0, 0.8, 0.5 m) and a circle of radius "
+        "0.25 m at (1.2, 1.3) m: <code>redundancy.obstacle_distance(arm, [circle])</code> "
+        "computes H from the closest points of the link segments (eqs 51-56, corrected); "
+        "it is compared with a brute-force minimum over 6,000 points on the links and 900 "
+        "on the circle, and with the point-to-centre distance minus the radius. Its "
+        "gradient (used as " + ctx.imath(r"\dot{\mathbf{q}}_0") + " in eq 42) is checked "
+        "against central finite differences.</p>"
+        + "<p>(serialkin keeps the sign of the clearance, H = c·|c|, so that H still grows "
+        "when a link has entered the obstacle.)</p>"
+        + ctx.table(rows, ["q [rad]", "H(q) [m²]", "(min |a − centre| − r)² [m²]",
+                           "brute force [m²]", "|∇H − finite differences|"], fmt="{:.6g}")
+    )
+
+
 def build(ctx: ReportContext) -> Section:
     """Measure the numerical IK families of section 5.3 and return the section's first part."""
-    parts: list[str] = []
+    parts: list[str] = [
+        "<p>A redundant arm has more joints n than task coordinates m; its inverse "
+        "kinematics is solved numerically from the differential relation</p>",
+        ctx.eq(r"\dot{\mathbf{x}} = \mathbf{J}(\mathbf{q})\,\dot{\mathbf{q}}", "39"),
+        "<p>inverted with the Moore-Penrose pseudoinverse (minimum-norm joint velocity)</p>",
+        ctx.eq(r"\dot{\mathbf{q}} = \mathbf{J}^{\dagger}(\mathbf{q})\,\dot{\mathbf{x}},"
+               r"\qquad \mathbf{J}^{\dagger} = \mathbf{J}^T\left(\mathbf{J}\mathbf{J}^T"
+               r"\right)^{-1}\ (m < n),\quad \mathbf{J}^{\dagger} = \left(\mathbf{J}^T"
+               r"\mathbf{J}\right)^{-1}\mathbf{J}^T\ (m > n)", "40"),
+        _newton_demo(ctx),
+    ]
     # --- section 5.3: the numerical families ------------------------------------------------
     parts.append(
         "<h3>Numerical families (section 5.3), measured</h3>"
@@ -133,6 +211,12 @@ def build(ctx: ReportContext) -> Section:
         "FABRIK is exact and fast on planar revolute chains and is skipped (with the reason "
         "shown) on spatial arms.</p>"
     )
+    parts.append(_obstacle_objective(ctx))
+    parts.append(ctx.reproduce(
+        "import serialkin as sk\n"
+        "from serialkin.ik.compare import compare\n"
+        "robot = sk.models.puma560()\n"
+        "print(compare(robot, robot.fk(robot.random_q(10, seed=42)), tol=1e-6, seed=0))"))
     return Section(title="5.3 Kinematically redundant manipulators",
                    part="Numerical inverse kinematics, measured",
                    equations="eqs 39-41, 45", html="".join(parts))
