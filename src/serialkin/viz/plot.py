@@ -440,6 +440,7 @@ def plot_obstacles(
     alpha: float = 0.35,
     edgecolor: Any = "0.25",
     influence: bool | float = False,
+    labels: bool = False,
 ) -> Any:
     """Draw obstacles: circles/capsule outlines on 2D axes, surfaces on 3D axes.
 
@@ -452,9 +453,11 @@ def plot_obstacles(
         influence: in 2D, also draw a dashed circle of radius ``radius + influence`` (the
             distance of influence, Figure 10): True uses each obstacle's own
             ``influence``, a number [m] is used for all, False draws none.
+        labels: in 2D, write each obstacle's ``name`` at its centre (the tables' A, B, ...).
 
     Returns:
-        The axes. Every obstacle artist has ``gid='serialkin-obstacle'``.
+        The axes. Every obstacle artist has ``gid='serialkin-obstacle'`` (labels
+        ``'serialkin-obstacle-label'``).
     """
     from matplotlib.patches import Circle, Polygon
 
@@ -474,6 +477,10 @@ def plot_obstacles(
                     ax.add_patch(Circle(tuple(o.center[:2]), o.radius + extra,
                                         fill=False, ec=edgecolor, ls="--", lw=0.8,
                                         gid=OBSTACLE_GID + "-influence"))
+            if labels and o.name:
+                ax.text(float(o.center[0]), float(o.center[1]), o.name, ha="center",
+                        va="center", fontsize="medium", fontweight="bold", color="0.1",
+                        gid=OBSTACLE_GID + "-label")
             continue
         box = getattr(ax, "_serialkin_box", None)
         tall = float(box[1][2] - box[0][2]) if box is not None else 0.0

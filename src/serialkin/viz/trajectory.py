@@ -156,12 +156,31 @@ def plot_joint_trajectories(
     if p > 1:
         ax.set_xlim(x[0], x[-1])
     if n <= 10:
-        ax.legend(loc="best", fontsize="small", ncol=2 if n > 5 else 1)
+        outside_legend(ax, ncol=2 if n > 5 else 1)
     else:
         norm = mpl.colors.Normalize(vmin=1, vmax=n)
         sm = mpl.cm.ScalarMappable(norm=norm, cmap="viridis")
-        ax.figure.colorbar(sm, ax=ax, label="joint index")
+        bar = ax.figure.colorbar(sm, ax=ax, label="joint index")
+        bar.set_ticks(joint_index_ticks(n))
     return ax
+
+
+def joint_index_ticks(n: int) -> list[int]:
+    """Integer colour-bar ticks for joints 1..n: 1, the multiples of a round step, n."""
+    step = 1 if n <= 10 else 5 if n <= 50 else 10 * int(np.ceil(n / 100))
+    ticks = sorted({1, n, *range(step, n + 1, step)})
+    return [t for t in ticks if t == n or n - t >= step / 2 or t == 1]
+
+
+def outside_legend(ax: Any, **options: Any) -> Any:
+    """Put the legend to the right of the axes, so it never covers data; returns it."""
+    handles, _ = ax.get_legend_handles_labels()
+    if not handles:
+        return None
+    kw = {"loc": "upper left", "bbox_to_anchor": (1.02, 1.0), "fontsize": "small",
+          "borderaxespad": 0.0}
+    kw.update(options)
+    return ax.legend(**kw)
 
 
 # ---------------------------------------------------------------------- tracking error
@@ -339,7 +358,7 @@ def plot_clearance(
     if title:
         ax.set_title(title)
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize="small", ncol=2 if m > 4 else 1)
+    outside_legend(ax)
     return ax
 
 
@@ -356,6 +375,9 @@ def plot_motion(
     planar: bool | None = None,
     cmap: str = "Blues",
     title: str | None = None,
+    q0: object = None,
+    influence: bool | float = False,
+    labels: bool = False,
 ) -> Axes:
     """Draw the arm at configurations along the path, fading from light to dark.
 
@@ -373,9 +395,14 @@ def plot_motion(
         planar: force 2D/3D (see :func:`serialkin.viz.plot.plot_robot`).
         cmap: colormap for the arm poses (first light, last dark).
         title: axes title.
+        q0: start configuration (n,) before the first path point, drawn dashed in
+            orange-red and labelled "start pose q0" (None: not drawn).
+        influence: draw the obstacles' influence zones (see
+            :func:`~serialkin.viz.plot.plot_obstacles`).
+        labels: write the obstacles' names at their centres.
 
     Returns:
-        The axes.
+        The axes; the legend (path, trace, start pose) sits right of the axes.
     """
     import matplotlib as mpl
 
@@ -397,8 +424,16 @@ def plot_motion(
         ax = plot_robot(robot, Q[k], ax, planar=planar, color=colours[j],
                         linewidth=2.2 if last else 1.1, markersize=5.0 if last else 2.5,
                         alpha=0.9)
+    if q0 is not None:
+        start = robot_points(robot, robot.check_q(q0, "q0"))
+        if is_3d_axes(ax):
+            ax.plot(start[:, 0], start[:, 1], start[:, 2], "--o", color="tab:red", lw=1.4,
+                    ms=2.5, label="start pose q0", gid="serialkin-start")
+        else:
+            ax.plot(start[:, 0], start[:, 1], "--o", color="tab:red", lw=1.4, ms=2.5,
+                    label="start pose q0", gid="serialkin-start")
     if obstacles is not None:
-        plot_obstacles(ax, obstacles)
+        plot_obstacles(ax, obstacles, influence=influence, labels=labels)
     if path_points is not None:
         plot_path(ax, path_points, linewidth=3.0)
     if trace:
@@ -411,8 +446,8 @@ def plot_motion(
                     label="end-effector trace", gid="serialkin-trace")
     if title:
         ax.set_title(title)
-    if path_points is not None or trace:
-        ax.legend(loc="best", fontsize="small")
+    if path_points is not None or trace or q0 is not None:
+        outside_legend(ax)
     return ax
 
 
