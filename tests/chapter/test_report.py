@@ -1,4 +1,4 @@
-"""The full chapter report builds, contains every section and every figure it links to."""
+"""The full chapter report builds in the chapter's order, self-contained, with every figure."""
 
 from __future__ import annotations
 
@@ -6,29 +6,71 @@ import re
 
 import pytest
 
-from serialkin.chapter.report import SECTION_MODULES, build_report
+from serialkin.chapter.report import SECTION_MODULES
 
 pytestmark = pytest.mark.slow
 
-
-@pytest.fixture(scope="module")
-def report(tmp_path_factory):
-    out = tmp_path_factory.mktemp("chapter")
-    path = build_report(out, quiet=True)
-    return out, path.read_text(encoding="utf-8")
+#: Sections whose examples this part of the report owns; each ends with a reproduce box.
+_WITH_REPRODUCE = ("rigid_motion", "forward", "inverse", "jacobian", "numerical")
 
 
-def test_every_section_present(report):
-    """Each section module appears once as a <section> with the equations it implements."""
-    _, html = report
+def _numbers(html: str) -> list[tuple[int, ...]]:
+    heads = re.findall(r"<h2>(\d+(?:\.\d+)*) [^<]*</h2>", html)
+    return [tuple(int(x) for x in h.split(".")) for h in heads]
+
+
+def test_every_section_present(built_report):
+    """Each section module appears once as a <section> naming the equations it demonstrates."""
+    _, html = built_report
     for name in SECTION_MODULES:
         assert html.count(f'<section id="{name}">') == 1, name
-    assert html.count('<p class="eq">Implements:') == len(SECTION_MODULES)
+    sections = html.count("<section id=")
+    assert html.count('<p class="eq">Demonstrates:') == sections >= len(SECTION_MODULES)
 
 
-def test_every_linked_figure_exists(report):
+def test_chapter_numbering_once_and_in_order(built_report):
+    """Headings carry the chapter's numbers once, strictly increasing: 1, 2, 3, …, 5.3."""
+    _, html = built_report
+    nums = _numbers(html)
+    assert nums == sorted(set(nums)), nums
+    for want in [(1,), (2,), (3,), (3, 2, 1), (4,), (4, 1), (5,), (5, 1), (5, 2), (5, 3)]:
+        assert want in nums, want
+    assert not re.search(r"<h2>\d+(\.\d+)*\.? \d+\.", html)  # no doubled numbers
+    toc = re.search(r"<nav>.*?</nav>", html, re.S).group(0)
+    assert "<ol" not in toc  # one numbering: the chapter's, not a list's
+
+
+def test_header_has_build_metadata(built_report):
+    """The header names serialkin's version, the commit, the date, versions, CPUs, build time."""
+    _, html = built_report
+    meta = re.search(r'<table class="meta">(.*?)</table>', html, re.S).group(1)
+    for label in ("serialkin", "git commit", "built", "Python", "numpy", "numba", "CPUs",
+                  "build time"):
+        assert f"<th>{label}</th>" in meta, label
+
+
+def test_examples_end_with_reproduce(built_report):
+    """Each of these sections' examples has a Reproduce box (command or snippet)."""
+    _, html = built_report
+    for name in _WITH_REPRODUCE:
+        body = re.search(rf'<section id="{name}(-\d+)?">(.*?)</section>', html, re.S).group(2)
+        assert "Reproduce (" in body, name
+    assert html.count('class="repro"') >= 10
+
+
+def test_no_raw_latex_or_negative_zero(built_report):
+    """No LaTeX source outside MathML and no "-0.0000" anywhere in the report's text."""
+    _, html = built_report
+    text = re.sub(r"<math.*?</math>", "", html, flags=re.S)
+    text = re.sub(r"<(style|pre)[^>]*>.*?</\1>", "", text, flags=re.S)
+    text = re.sub(r'src="data:[^"]+"', "", text)
+    assert not re.search(r"\\(frac|begin|theta|mathbf|left|sqrt|dot)\b", text)
+    assert not re.search(r"(?<![\w.])-0\.0+(?![\d])", re.sub(r"<[^>]+>", " ", text))
+
+
+def test_every_linked_figure_exists(built_report):
     """Every figure file the report links to was written and is a non-empty PNG or GIF."""
-    out, html = report
+    out, html = built_report
     files = set(re.findall(r'href="(figures/[^"]+)"', html))
     assert len(files) >= 15  # figures 4, 5, 8, 9, 11, 12 and the sections' own
     for rel in files:
@@ -39,9 +81,11 @@ def test_every_linked_figure_exists(report):
     assert any(f.endswith(".gif") for f in files)
 
 
-def test_report_is_self_contained(report):
-    """Images are embedded as data URIs and nothing is loaded from the network."""
-    _, html = report
+def test_report_is_self_contained_and_small(built_report):
+    """Images are data URIs, nothing loads from the network, and the file is at most 5 MB."""
+    out, html = built_report
     assert "data:image/png;base64," in html
     assert not re.search(r'<(img|script|link)[^>]+(src|href)="https?://', html)
+    assert "<script" not in html  # MathML is native: no JavaScript at all
     assert "Traceback" not in html
+    assert (out / "report.html").stat().st_size <= 5_000_000

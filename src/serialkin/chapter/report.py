@@ -235,7 +235,7 @@ class ReportContext:
         buf = io.BytesIO()
         fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")  # type: ignore[attr-defined]
         plt.close(fig)  # type: ignore[arg-type]
-        return self.file_figure(buf.getvalue(), f"{name}.png", caption)
+        return self.file_figure(compact_png(buf.getvalue()), f"{name}.png", caption)
 
     def file_figure(self, data: bytes, filename: str, caption: str = "") -> str:
         """Store image bytes (PNG or GIF) under ``figures/``; return an inline <figure> block."""
@@ -302,6 +302,27 @@ class ReportContext:
     def code(text: str) -> str:
         """Preformatted text (program output; never mathematics: use :meth:`eq`)."""
         return f"<pre>{html.escape(text)}</pre>"
+
+
+def compact_png(data: bytes) -> bytes:
+    """Re-encode a PNG with a 256-colour palette (about 3× smaller for line plots).
+
+    Pillow's fast octree quantiser; palette entries within 6 levels of white are snapped
+    to pure white so backgrounds stay white.
+    """
+    from PIL import Image
+
+    with Image.open(io.BytesIO(data)) as im:
+        rgb = im.convert("RGB")
+    q = rgb.quantize(colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
+    pal = q.getpalette() or []
+    for k in range(0, len(pal) - 2, 3):
+        if min(pal[k:k + 3]) >= 249:
+            pal[k:k + 3] = [255, 255, 255]
+    q.putpalette(pal)
+    out = io.BytesIO()
+    q.save(out, format="PNG")
+    return out.getvalue()
 
 
 _CSS = """

@@ -72,6 +72,7 @@ def _draw_frame(ax: object, T: np.ndarray, label: str, color: str, length: float
 def _figure(R_q: np.ndarray, q: float, T1: np.ndarray, p1: np.ndarray) -> object:
     """Two 3D panels: (a) frame 0 rotated by q about z_r (Figure 2); (b) frame 1 = T1 and p."""
     from matplotlib.figure import Figure
+    from matplotlib.ticker import MaxNLocator
 
     fig = Figure(figsize=(11, 5))
     ax = fig.add_subplot(1, 2, 1, projection="3d")
@@ -103,6 +104,9 @@ def _figure(R_q: np.ndarray, q: float, T1: np.ndarray, p1: np.ndarray) -> object
         a.set_ylabel("y")
         a.set_zlabel("z")
         a.set_box_aspect((1, 1, 1) if a is ax2 else (2.2, 2.2, 1.2))
+        for axis in (a.xaxis, a.yaxis, a.zaxis):
+            axis.set_major_locator(MaxNLocator(4))
+        a.tick_params(labelsize=8)
     return fig
 
 
