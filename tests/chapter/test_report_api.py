@@ -134,3 +134,12 @@ def test_section_number_parsing():
     assert Section("3. Forward kinematics", "", "").number == "3"
     assert Section("3. Forward kinematics", "", "").name == "Forward kinematics"
     assert Section("Appendix", "", "").number == ""
+
+
+def test_table_alignment_is_per_column():
+    """A column mixing text and numbers is a text column: every cell left-aligned."""
+    out = ReportContext.table([("23 (corrected)", 1.0), ("24", 2.0), ("", 3.0)], ["eq", "v"])
+    cells = _cells(out)
+    assert [c for c, _ in cells] == ["txt", "num", "txt", "num", "txt", "num", "txt", "num"]
+    out = ReportContext.table([("1.5", ""), ("2", 0.5)], [Html("<i>x</i>"), "y"])
+    assert '<th class="num"><i>x</i></th>' in out and _cells(out)[3] == ("num", "")

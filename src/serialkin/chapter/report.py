@@ -159,6 +159,10 @@ def _is_numeric(value: object) -> bool:
         _NUMERIC_TEXT.match(value.strip()))
 
 
+def _is_blank(value: object) -> bool:
+    return isinstance(value, str) and not hasattr(value, "__html__") and not value.strip()
+
+
 def _latex_to_mathml(latex: str, display: str) -> str:
     from latex2mathml.converter import convert
 
@@ -253,12 +257,13 @@ class ReportContext:
 
     # --- tables --------------------------------------------------------------------------------
     @staticmethod
-    def table(rows: Sequence[Sequence[object]], header: Sequence[str] | None = None,
+    def table(rows: Sequence[Sequence[object]], header: Sequence[object] | None = None,
               fmt: str = "{:.6g}") -> str:
-        """An HTML table: numbers right-aligned, text left-aligned, no negative zero.
+        """An HTML table: numeric columns right-aligned, text columns left-aligned.
 
-        Floats are formatted with ``fmt``; strings that read as one number (e.g. "1.2e-05",
-        "98 %") count as numbers; :class:`Html` cells (e.g. MathML, a matrix) are inserted
+        A column is numeric when every non-empty cell is a number or a string that reads as
+        one (e.g. "1.2e-05", "98 %"). Floats are formatted with ``fmt``, never as a negative
+        zero; :class:`Html` cells and header cells (e.g. MathML, a matrix) are inserted
         unescaped. A header cell is aligned like its column.
         """
 
@@ -272,18 +277,20 @@ class ReportContext:
             return html.escape(str(v))
 
         ncol = max([len(r) for r in rows] + [len(header or ())])
-        numeric = [bool(rows) and all(_is_numeric(r[j]) for r in rows if j < len(r))
-                   for j in range(ncol)]
+        numeric = [any(j < len(r) for r in rows) and all(
+            _is_numeric(r[j]) for r in rows if j < len(r) and not _is_blank(r[j]))
+            for j in range(ncol)]
+        cls = ["num" if x else "txt" for x in numeric]
 
-        def align(j: int, v: object) -> str:
-            return ' class="num"' if _is_numeric(v) else ' class="txt"'
+        def head_cell(h: object) -> str:
+            return h.__html__() if hasattr(h, "__html__") else html.escape(str(h))  # type: ignore[attr-defined]
 
         head = ""
         if header:
             head = "<thead><tr>" + "".join(
-                f'<th class="{"num" if numeric[j] else "txt"}">{html.escape(h)}</th>'
-                for j, h in enumerate(header)) + "</tr></thead>"
-        body = "".join("<tr>" + "".join(f"<td{align(j, v)}>{cell(v)}</td>"
+                f'<th class="{cls[j]}">{head_cell(h)}</th>' for j, h in enumerate(header)
+            ) + "</tr></thead>"
+        body = "".join("<tr>" + "".join(f'<td class="{cls[j]}">{cell(v)}</td>'
                                         for j, v in enumerate(r)) + "</tr>" for r in rows)
         return f"<table>{head}<tbody>{body}</tbody></table>"
 
@@ -338,7 +345,8 @@ figure{margin:1em 0}img{max-width:100%}pre{background:#f6f6f6;padding:0.6em;over
 .eqn{display:flex;align-items:center;margin:0.6em 0}
 .eqbody{flex:1 1 auto;min-width:0;overflow-x:auto;overflow-y:hidden;padding:2px 0}
 .eqno{flex:none;margin-left:1.5em;color:#333}
-math[display=block]{font-size:1.08em}
+math{font-family:"STIX Two Math","Latin Modern Math","Cambria Math","DejaVu Math TeX Gyre",
+math}math[display=block]{font-size:1.08em}
 .repro{border:1px solid #9ab;border-left:4px solid #357;background:#f4f8fb;margin:1em 0;
 padding:0.3em 0.8em}.repro pre{background:none;margin:0.3em 0;padding:0}
 .repro-label{font-weight:600;font-size:90%;color:#357}

@@ -209,12 +209,11 @@ def _section_3_2_1(ctx: ReportContext) -> Section:
         "<code>serialkin.models.scara()</code>. The chapter gives no numbers; this report "
         "uses d1 = {d1} m, d2 = {d2} m, L1 = {l1} m, L2 = {l2} m.</p>".format(**SCARA_PARAMS)
     )
+    table1 = [("L_1", "0", "d_1", "q_1"), ("L_2", "0", "0", "q_2"),
+              ("0", r"\pi", "d_2 + q_3", "0"), ("0", "0", "0", "q_4")]
     parts.append(ctx.table(
-        [("1", Html(ctx.imath("L_1")), "0", Html(ctx.imath("d_1")), Html(ctx.imath("q_1"))),
-         ("2", Html(ctx.imath("L_2")), "0", "0", Html(ctx.imath("q_2"))),
-         ("3", "0", Html(ctx.imath(r"\pi")), Html(ctx.imath("d_2 + q_3")), "0"),
-         ("4", "0", "0", "0", Html(ctx.imath("q_4")))],
-        ["link", "a_i", "α_i", "d_i", "ϑ_i"]))
+        [(str(i + 1), *(Html(ctx.imath(c)) for c in row)) for i, row in enumerate(table1)],
+        ["link", *(Html(ctx.imath(h)) for h in ("a_i", r"\alpha_i", "d_i", r"\vartheta_i"))]))
     parts.append("<p>As built (numbers, joint type and limits):</p>" + ctx.table(
         [(i + 1, r.a, r.alpha, r.d, r.theta, r.type, f"[{r.qlim[0]:.4g}, {r.qlim[1]:.4g}]")
          for i, r in enumerate(robot.dh)],

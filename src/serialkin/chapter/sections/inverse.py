@@ -181,7 +181,7 @@ def _section_4_1(ctx: ReportContext) -> Section:
         + ctx.imath(r"\beta = \arccos\frac{L_1^2 - L_2^2 + c^2}{2L_1c}")
         + "); the corrected forms, with the two solutions paired by sign, are</p>"
         + ctx.eq(r"r = \sqrt{x^2 + y^2}", "23, corrected")
-        + ctx.eq(r"\alpha = \operatorname{atan2}(y, x)", "24")
+        + ctx.eq(r"\alpha = \mathrm{atan2}(y, x)", "24")
         + ctx.eq(r"\vartheta_2 = \pm\arccos\left(\frac{x^2 + y^2 - L_1^2 - L_2^2}"
                  r"{2L_1L_2}\right)", "25")
         + ctx.eq(r"\beta = \arccos\left(\frac{L_1^2 - L_2^2 + r^2}{2L_1r}\right)",
