@@ -41,10 +41,10 @@ def test_misprinted_eq_26_fails_on_the_worked_example():
 
 @pytest.mark.slow
 def test_section_builds_with_figure(tmp_path):
-    """build() returns section 4 with Figure 5 saved."""
+    """build() returns sections 4 and 4.1 with Figure 5 saved."""
     ctx = ReportContext(outdir=tmp_path, quiet=True)
-    sec = inverse.build(ctx)
-    assert sec.number == "4"
+    secs = inverse.build(ctx)
+    assert [sec.number for sec in secs] == ["4", "4.1"]
     assert (tmp_path / "figures" / "inverse_two_link.png").stat().st_size > 1000
 
 
