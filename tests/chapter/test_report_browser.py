@@ -77,3 +77,18 @@ def test_headings_in_chapter_order(page):
             for h in heads]
     assert nums == sorted(nums) and len(set(nums)) == len(nums), heads
     assert nums[0] == (1,) and nums[-1] == (5, 3)
+
+
+def test_wide_content_scrolls_inside_its_box(page):
+    """Nothing widens the page: wide equations scroll inside their own box, never cut off."""
+    page_width, view = page.execute_script(
+        "return [document.documentElement.scrollWidth, window.innerWidth]")
+    assert page_width <= view, (page_width, view)
+    boxes = page.execute_script(
+        "return Array.from(document.querySelectorAll('.eqbody')).map(b => ["
+        "b.scrollWidth, b.clientWidth, getComputedStyle(b).overflowX,"
+        "b.querySelector('math').getBoundingClientRect().width])")
+    assert boxes
+    for scroll_w, client_w, overflow, math_w in boxes:
+        assert scroll_w >= math_w - 1  # the whole equation is reachable
+        assert scroll_w <= client_w or overflow == "auto"
