@@ -339,7 +339,9 @@ h1{border-bottom:2px solid #345}h2{margin-top:2em;border-bottom:1px solid #ccc}
 .eq{color:#555;font-size:90%}table{border-collapse:collapse;margin:0.6em 0}
 td,th{border:1px solid #bbb;padding:2px 8px;vertical-align:middle}th{background:#eef}
 td.num,th.num{text-align:right;font-variant-numeric:tabular-nums}td.txt,th.txt{text-align:left}
-table.matrix{border-left:2px solid #555;border-right:2px solid #555;border-radius:3px}
+table.matrix{border-left:2px solid #555;border-right:2px solid #555;--k:linear-gradient(#555,#555);
+background:var(--k) left top/6px 2px no-repeat,var(--k) left bottom/6px 2px no-repeat,
+var(--k) right top/6px 2px no-repeat,var(--k) right bottom/6px 2px no-repeat}
 table.matrix td{border:none;text-align:right;font-variant-numeric:tabular-nums;padding:1px 8px}
 figure{margin:1em 0}img{max-width:100%}pre{background:#f6f6f6;padding:0.6em;overflow-x:auto}
 .eqn{display:flex;align-items:center;margin:0.6em 0}
@@ -350,7 +352,8 @@ math}math[display=block]{font-size:1.08em}
 .repro{border:1px solid #9ab;border-left:4px solid #357;background:#f4f8fb;margin:1em 0;
 padding:0.3em 0.8em}.repro pre{background:none;margin:0.3em 0;padding:0}
 .repro-label{font-weight:600;font-size:90%;color:#357}
-.meta{font-size:90%;color:#444}.meta td,.meta th{border:none;padding:0 1em 0 0}
+.meta{font-size:90%;color:#444}.meta td,.meta th{border:none;padding:0 1em 0 0;text-align:left}
+.meta th{background:none;font-weight:600}
 nav ul{list-style:none;padding-left:0}nav li.sub{padding-left:2em}
 .err{color:#a00}
 """
@@ -430,7 +433,7 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float) -> str
         body.append(f'<section id="{anchor}"><h2>{html.escape(label)}</h2>'
                     f'<p class="eq">Demonstrates: {eqs}</p>{part}{sec.html}</section>')
     meta = build_metadata() + [
-        ("build time", f"{seconds:.1f} s wall clock, {cpu:.1f} s CPU (sections only)")]
+        ("build time", f"{seconds:.1f} s wall clock, {cpu:.1f} s CPU (report builder, after imports)")]
     meta_html = ('<table class="meta">' + "".join(
         f"<tr><th>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>" for k, v in meta)
         + "</table>")
