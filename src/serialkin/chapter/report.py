@@ -433,7 +433,8 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float) -> str
         body.append(f'<section id="{anchor}"><h2>{html.escape(label)}</h2>'
                     f'<p class="eq">Demonstrates: {eqs}</p>{part}{sec.html}</section>')
     meta = build_metadata() + [
-        ("build time", f"{seconds:.1f} s wall clock, {cpu:.1f} s CPU (report builder, after imports)")]
+        ("build time",
+         f"{seconds:.1f} s wall clock, {cpu:.1f} s CPU (report builder, after imports)")]
     meta_html = ('<table class="meta">' + "".join(
         f"<tr><th>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>" for k, v in meta)
         + "</table>")
