@@ -79,17 +79,18 @@ def _figure_manipulability(ctx: ReportContext, two: Robot) -> str:
     w = two.manipulability(Q, task="planar")
     c = two.condition_number(Q, task="planar")
     fig, ax = plt.subplots(figsize=(7, 3.6))
-    ax.plot(q2 / DEG, w, label="w = sqrt(det J Jᵀ) (eq 43)")
+    ax.plot(q2 / DEG, w, label=r"$w = \sqrt{\det(J J^T)}$ (eq 43)")
     ax.plot(q2[::24] / DEG, TWO_LINK[0] * TWO_LINK[1] * np.abs(np.sin(q2[::24])), "k.",
-            label="L1 L2 |sin q2|")
+            label=r"$L_1 L_2 |\sin q_2|$")
     ax.set_xlabel("q2 [deg]")
     ax.set_ylabel("w [m²]")
     ax2 = ax.twinx()
     ax2.semilogy(q2 / DEG, np.where(np.isfinite(c), c, np.nan), "C1--", lw=1,
                  label="condition number")
     ax2.set_ylabel("condition number")
-    ax.legend(loc="upper left", fontsize=8)
-    ax2.legend(loc="upper right", fontsize=8)
+    handles = ax.get_legend_handles_labels()[0] + ax2.get_legend_handles_labels()[0]
+    ax.legend(handles, [h.get_label() for h in handles], loc="upper center",
+              bbox_to_anchor=(0.5, -0.16), ncol=3, fontsize=8, frameon=False)
     ax.set_title("Two-link arm: manipulability and condition number vs q2")
     return ctx.figure(fig, "jacobian_manipulability", "Manipulability (eq 43) of the two-link "
                       "arm vanishes at the stretched and folded singularities q2 = 0, ±180°.")
