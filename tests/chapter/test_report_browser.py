@@ -61,7 +61,7 @@ def test_contents_links_resolve_to_headings(page):
     pairs = page.execute_script(
         "return Array.from(document.querySelectorAll('nav a')).map(a => {"
         "const id = a.getAttribute('href').slice(1); const el = document.getElementById(id);"
-        "const h = el ? el.querySelector('h2, h3') : null;"
+        "const h = !el ? null : el.matches('h2, h3') ? el : el.querySelector('h2, h3');"
         "return [id, a.textContent, h ? h.textContent : null]; })")
     assert len(pairs) >= 12
     for anchor, label, heading in pairs:

@@ -355,6 +355,7 @@ padding:0.3em 0.8em}.repro pre{background:none;margin:0.3em 0;padding:0}
 .meta{font-size:90%;color:#444}.meta td,.meta th{border:none;padding:0 1em 0 0;text-align:left}
 .meta th{background:none;font-weight:600}
 nav ul{list-style:none;padding-left:0}nav li.sub{padding-left:2em}
+nav li.part{padding-left:4em}
 .err{color:#a00}
 """
 
@@ -419,8 +420,8 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float) -> str
         previous = number or previous
         eqs = html.escape(sec.equations)
         if continues:
-            heading = sec.part or sec.name
-            toc.append(f'<li class="sub"><a href="#{anchor}">{html.escape(heading)}</a> '
+            heading = sec.part or f"{sec.name} (continued)"
+            toc.append(f'<li class="part"><a href="#{anchor}">{html.escape(heading)}</a> '
                        f'<span class="eq">({eqs})</span></li>')
             body.append(f'<section id="{anchor}"><h3 class="part">{html.escape(heading)}</h3>'
                         f'<p class="eq">Demonstrates: {eqs}</p>{sec.html}</section>')
@@ -429,7 +430,11 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float) -> str
         css = ' class="sub"' if "." in number else ""
         toc.append(f'<li{css}><a href="#{anchor}">{html.escape(label)}</a> '
                    f'<span class="eq">({eqs})</span></li>')
-        part = f'<h3 class="part">{html.escape(sec.part)}</h3>' if sec.part else ""
+        part = ""
+        if sec.part:
+            part = f'<h3 class="part" id="{anchor}-part">{html.escape(sec.part)}</h3>'
+            toc.append(f'<li class="part"><a href="#{anchor}-part">{html.escape(sec.part)}'
+                       "</a></li>")
         body.append(f'<section id="{anchor}"><h2>{html.escape(label)}</h2>'
                     f'<p class="eq">Demonstrates: {eqs}</p>{part}{sec.html}</section>')
     meta = build_metadata() + [
