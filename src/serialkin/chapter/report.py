@@ -143,6 +143,12 @@ def format_number(value: float, fmt: str = "{:.6g}") -> str:
     return _no_negative_zero(fmt.format(value))
 
 
+def format_vector(values: object, fmt: str = "{:.6g}") -> str:
+    """A vector as "(a, b, c)" with :func:`format_number` (no negative zero, no "0.")."""
+    flat = np.asarray(values, dtype=float).ravel()
+    return "(" + ", ".join(format_number(float(v), fmt) for v in flat) + ")"
+
+
 _NUMERIC_TEXT = re.compile(
     r"^[+\-−]?(?:\d[\d,\u202f ]*(?:\.\d*)?|\.\d+)(?:[eE][+\-−]?\d+)?"
     r"(?:\s*(?:%|°|s|ms|µs|m|mm|rad|m²|×))?$|^[+\-−]?(?:∞|inf|nan)$"

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from serialkin.chapter.report import ReportContext, Section
+from serialkin.chapter.report import ReportContext, Section, format_vector
 from serialkin.spatial import (
     inv_transform,
     make_transform,
@@ -183,11 +183,11 @@ def build(ctx: ReportContext) -> Section:
         + ctx.eq(r"\begin{bmatrix}x_r\\ y_r\\ z_r\\ 1\end{bmatrix} = \begin{bmatrix}"
                  r"\mathbf{R} & \mathbf{p}\\ \mathbf{0}^T & 1\end{bmatrix}\begin{bmatrix}"
                  r"x_1\\ y_1\\ z_1\\ 1\end{bmatrix}", "9")
-        + f"<p>With the rotation above and origin p = {o.tolist()} m, the homogeneous "
+        + f"<p>With the rotation above and origin p = {format_vector(o)} m, the homogeneous "
         "transform of eq 9 (<code>make_transform(R, p)</code>) is</p>"
         + ctx.matrix(T)
-        + f"<p>The point with frame-1 coordinates {p1.tolist()} m has reference coordinates "
-        f"{np.round(pr_eq8, 6).tolist()} by eq 8 and {np.round(pr_eq9, 6).tolist()} by eq 9; "
+        + f"<p>The point with frame-1 coordinates {format_vector(p1)} m has reference coordinates "
+        f"{format_vector(pr_eq8)} by eq 8 and {format_vector(pr_eq9)} by eq 9; "
         f"difference {np.abs(pr_eq8 - pr_eq9).max():.1e}. The inverse "
         + ctx.imath(r"\mathbf{T}^{-1} = \begin{bmatrix}\mathbf{R}^T & -\mathbf{R}^T\mathbf{p}"
                     r"\\ \mathbf{0}^T & 1\end{bmatrix}")
@@ -225,13 +225,13 @@ def build(ctx: ReportContext) -> Section:
     rpy_l = matrix_to_rpy(locked)
     half = axis_angle_to_matrix([0.0, 0.6, 0.8], np.pi)
     q_half = matrix_to_quaternion(half)
-    conv_rows = [(n, np.array2string(np.round(v, 6), separator=", "),
+    conv_rows = [(n, format_vector(v),
                   f"{np.abs(back - R).max():.1e}") for n, v, back in conv]
     conv_rows.append(("rpy at the gimbal lock: (0.5, π/2, 0.2) → (roll − yaw, π/2, 0)",
-                      np.array2string(np.round(rpy_l, 6), separator=", "),
+                      format_vector(rpy_l),
                       f"{np.abs(rpy_to_matrix(rpy_l) - locked).max():.1e}"))
     conv_rows.append(("quaternion of a half turn about (0, 0.6, 0.8): w = 0, angle π",
-                      np.array2string(np.round(q_half, 6), separator=", "),
+                      format_vector(q_half),
                       f"{np.abs(quaternion_to_matrix(q_half) - half).max():.1e}"))
     parts.append(
         "<h3>Orientation representations</h3><p>The rotation R above in every representation "
@@ -247,11 +247,14 @@ def build(ctx: ReportContext) -> Section:
     d, th = pose_distance(T, T2)
     parts.append(
         "<h3>Twist coordinates and pose error</h3>"
-        f"<p>The twist [v; ω] with exp(ξ) = T is ξ = "
-        f"{np.array2string(np.round(xi, 6), separator=', ')} (|exp(ξ) − T|max = "
+        "<p>The twist " + ctx.imath(r"\boldsymbol{\xi} = [\mathbf{v}; \boldsymbol{\omega}]")
+        + " with " + ctx.imath(r"\exp(\boldsymbol{\xi}) = \mathbf{T}") + " is ξ = "
+        f"{format_vector(xi)} (max |exp(ξ) − T| = "
         f"{np.abs(se3_exp(xi) - T).max():.1e}). Turning T by 0.1 rad about the world z axis "
-        f"gives the pose error e = [p_target − p; log(R_target Rᵀ)] = "
-        f"{np.array2string(np.round(e, 6), separator=', ')}: position distance {float(d):.4f} m,"
+        "gives the pose error "
+        + ctx.imath(r"\mathbf{e} = [\mathbf{p}_{target} - \mathbf{p};\ "
+                    r"\log(\mathbf{R}_{target}\mathbf{R}^T)^\vee]")
+        + f" = {format_vector(e)}: position distance {float(d):.4f} m,"
         f" angle {float(th):.4f} rad. Every IK solver drives this 6-vector to zero.</p>"
     )
 
