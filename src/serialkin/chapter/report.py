@@ -1,9 +1,25 @@
 """The chapter report: every worked example of the chapter, recomputed, in one HTML file.
 
 Each section of the report is a module in :mod:`serialkin.chapter.sections` with a
-function ``build(ctx: ReportContext) -> Section``. :func:`build_report` runs them in
-chapter order and writes ``report.html`` (figures embedded as data URIs, so the file is
-self-contained) plus every figure as a file under ``figures/``.
+function ``build(ctx: ReportContext) -> Section | list[Section]``. :func:`build_report`
+runs them in chapter order and writes ``report.html`` (figures embedded as data URIs, so
+the file is self-contained and at most a few MB) plus every figure under ``figures/``.
+
+What :class:`ReportContext` gives a section:
+
+* ``ctx.eq(latex, number)`` / ``ctx.imath(latex)``: mathematics as MathML (converted from
+  LaTeX by ``latex2mathml``; native in Chromium and Firefox, no JavaScript, no network),
+  display equations with the chapter's number on the right, scrolling sideways when wide;
+* ``ctx.timing(fn)``: a warm measurement (untimed warm-up, then the median and the
+  min..max range of repeated calls) as a :class:`Timing`;
+* ``ctx.reproduce(code, shell)``: the snippet or ``serialkin`` command that reproduces an
+  example;
+* ``ctx.table`` / ``ctx.matrix`` / ``ctx.figure``: aligned tables without negative zeros,
+  bracketed numeric matrices, PNG figures quantised to a 256-colour palette.
+
+Sections are numbered as in the chapter: a section's title starts with the chapter's
+number ("5.1 Analytical Jacobian"); the page header records the versions, git commit,
+date, CPU count and build time.
 """
 
 from __future__ import annotations
