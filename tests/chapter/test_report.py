@@ -33,7 +33,8 @@ def test_chapter_numbering_once_and_in_order(built_report):
     _, html = built_report
     nums = _numbers(html)
     assert nums == sorted(set(nums)), nums
-    for want in [(1,), (2,), (3,), (3, 2, 1), (4,), (4, 1), (5,), (5, 1), (5, 2), (5, 3)]:
+    for want in [(1,), (2,), (3,), (3, 1), (3, 2), (3, 2, 1), (4,), (4, 1), (5,), (5, 1), (5, 2),
+                 (5, 3)]:
         assert want in nums, want
     assert not re.search(r"<h2>\d+(\.\d+)*\.? \d+\.", html)  # no doubled numbers
     toc = re.search(r"<nav>.*?</nav>", html, re.S).group(0)
@@ -95,3 +96,11 @@ def test_report_is_self_contained_and_small(built_report):
     assert "<script" not in html  # MathML is native: no JavaScript at all
     assert "Traceback" not in html
     assert (out / "report.html").stat().st_size <= 5_000_000
+
+
+def test_every_timing_is_warm(built_report):
+    """Every timing the report prints is a median of warm runs with its spread."""
+    _, html = built_report
+    timings = re.findall(r"median of \d+ ([^,]*), spread", html)
+    assert timings
+    assert set(timings) == {"warm runs"}, set(timings)

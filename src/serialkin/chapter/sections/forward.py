@@ -100,8 +100,8 @@ def _figure_frames(ctx: ReportContext, robot: Robot, q: np.ndarray) -> str:
                       "frame 3 flips z downwards (α3 = π).")
 
 
-def _section_3(ctx: ReportContext) -> Section:
-    """Section 3 (and 3.1): eqs 10-12 on the PUMA 560."""
+def _section_3_1(ctx: ReportContext) -> Section:
+    """Section 3.1: eqs 10-12 on the PUMA 560."""
     puma = models.puma560()
     q = np.array([0.3, -0.6, 0.9, 0.4, -0.7, 1.1])
     A = [link_transform(r, qi, "standard") for r, qi in zip(puma.dh, q, strict=True)]
@@ -119,7 +119,9 @@ def _section_3(ctx: ReportContext) -> Section:
                      float(np.abs(frames[i] @ Ai - frames[i + 1]).max())))
     qtxt = ", ".join(f"{v:g}" for v in q)
     html_ = (
-        "<p>The pose of the end effector in the base frame is a homogeneous matrix "
+        "<p>The links are connected by revolute or prismatic joints, each with one joint "
+        "variable q<sub>i</sub>; a frame is attached to every link. The pose of the end "
+        "effector in the base frame is a homogeneous matrix "
         "(eq 10), the product of the link matrices along the open chain (eq 11), each of "
         "which holds the pose of link frame i in frame i−1 (eq 12):</p>"
         + ctx.eq(r"\mathbf{H} = \begin{bmatrix}{}^{0}\mathbf{R}_{n} & {}^{0}\mathbf{o}_{n}"
@@ -127,7 +129,7 @@ def _section_3(ctx: ReportContext) -> Section:
         + ctx.eq(r"\mathbf{H} = {}^{0}\mathbf{T}_{n} = \prod_{i=1}^{N}\mathbf{A}_{i}", "11")
         + ctx.eq(r"\mathbf{A}_{i} = \begin{bmatrix}{}^{i-1}\mathbf{R}_{i} & "
                  r"{}^{i-1}\mathbf{o}_{i}\\ \mathbf{0}^T & 1\end{bmatrix}", "12")
-        + "<h3>3.1 Open kinematic chain: eqs 10-12 on the PUMA 560</h3>"
+        + "<h3>Eqs 10-12 on the PUMA 560</h3>"
         f"<p>At q = ({qtxt}) rad, the six link matrices "
         "<code>link_transform(row, q_i)</code> multiplied in order (eq 11) give</p>"
         + ctx.matrix(H)
@@ -148,8 +150,7 @@ def _section_3(ctx: ReportContext) -> Section:
             f"print(robot.fk(np.array([{qtxt}])))          # eq 11\n"
             "print(robot.fk_all(np.zeros(6))[:, :3, 3])     # frame origins 0..6")
     )
-    return Section(title="3. Forward kinematics", equations="eqs 10-12",
-                   html=html_)
+    return Section(title="3.1 Open kinematic chain", equations="eqs 10-12", html=html_)
 
 
 def _section_3_2(ctx: ReportContext) -> Section:
@@ -284,5 +285,13 @@ def _section_3_2_1(ctx: ReportContext) -> Section:
 
 
 def build(ctx: ReportContext) -> list[Section]:
-    """Compute section 3's examples: sections 3 (with 3.1), 3.2 and 3.2.1."""
-    return [_section_3(ctx), _section_3_2(ctx), _section_3_2_1(ctx)]
+    """Compute section 3's examples: sections 3, 3.1, 3.2 and 3.2.1."""
+    intro = Section(
+        title="3. Forward kinematics", equations="eqs 10-18, Table 1",
+        html="<p>The forward kinematic model gives the position and orientation of the end "
+             "effector in the base frame from the joint variables: for an open chain, a "
+             "product of one homogeneous matrix per link (3.1), each written with the four "
+             "Denavit-Hartenberg parameters (3.2), worked out for the chapter's SCARA "
+             "(3.2.1). Every matrix below is computed by serialkin's kernels and checked "
+             "against the product of the individual matrices and against sympy.</p>")
+    return [intro, _section_3_1(ctx), _section_3_2(ctx), _section_3_2_1(ctx)]
