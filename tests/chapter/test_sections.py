@@ -30,3 +30,31 @@ def test_sections_in_chapter_numbering(ctx):
 
     numbers = [s.number for mod in (forward, inverse, jacobian) for s in mod.build(ctx)]
     assert numbers == ["3", "3.1", "3.2", "3.2.1", "4", "4.1", "5", "5.1", "5.2"]
+
+
+@pytest.mark.slow
+def test_worker_processes_build_the_same_report(tmp_path):
+    """jobs=2 (spawned workers) gives the same sections as jobs=1, in the chapter's order."""
+    import re
+
+    from serialkin.chapter.report import build_report
+
+    pages = []
+    for jobs in (1, 2):
+        path = build_report(tmp_path / f"j{jobs}", quiet=True, jobs=jobs,
+                            sections=["inverse", "rigid_motion"])
+        pages.append(path.read_text(encoding="utf-8"))
+    heads = [re.findall(r"<h2>([^<]*)</h2>", p) for p in pages]
+    assert heads[0] == heads[1] == ["2 Rigid body motion", "4 Inverse kinematics",
+                                    "4.1 Closed-form solution of inverse kinematics"]
+    assert "2 worker processes" in pages[1] and "one process" in pages[0]
+    assert (tmp_path / "j2" / "figures" / "inverse_two_link.png").stat().st_size > 1000
+
+
+def test_jobs_must_be_positive(tmp_path):
+    """jobs=0 is refused with the library's input error naming the argument."""
+    from serialkin.chapter.report import build_report
+    from serialkin.errors import InputError
+
+    with pytest.raises(InputError, match="jobs"):
+        build_report(tmp_path, quiet=True, jobs=0, sections=["rigid_motion"])
