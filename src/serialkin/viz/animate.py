@@ -3,8 +3,9 @@
 Each frame draws the robot at one configuration (as :func:`serialkin.viz.plot.plot_robot`:
 link-frame origins and the tool point, eq 11), the target path in green, the obstacles,
 the end-effector trace so far in orange and a "step k / p" label. The axes limits are fixed
-from the whole trajectory so the view does not jump. Frames are rendered with matplotlib
-and encoded by its ``PillowWriter`` (GIF) or ``FFMpegWriter`` (MP4, H.264).
+from the whole trajectory so the view does not jump. GIF frames are blitted (the static
+scene is rendered once, each frame redraws only the moving robot, trace and label) and
+encoded by Pillow; MP4 frames are rendered by matplotlib's ``FFMpegWriter`` (H.264).
 
 :func:`animate_trajectory` returns the encoded bytes (e.g. for
 :meth:`serialkin.chapter.report.ReportContext.file_figure`); :func:`save_animation`
@@ -13,6 +14,7 @@ writes them to a file atomically (temporary file + rename).
 
 from __future__ import annotations
 
+import io
 import shutil
 import tempfile
 from collections.abc import Iterable
@@ -189,14 +191,6 @@ def animate_trajectory(
             label.set_text(f"step {idx[k] + 1} / {Q.shape[0]}")
             return []
 
-        anim = animation.FuncAnimation(fig, draw, frames=len(idx), blit=False,
-                                       repeat=False, cache_frame_data=False)
-        writer: Any
-        if fmt == "gif":
-            writer = animation.PillowWriter(fps=fps)
-        else:
-            writer = animation.FFMpegWriter(fps=fps, codec="libx264",
-                                            extra_args=["-pix_fmt", "yuv420p"])
         bar = None
         callback = None
         if progress:
@@ -207,15 +201,56 @@ def animate_trajectory(
             def callback(i: int, n: int) -> None:
                 bar.update(1)
 
-        with tempfile.TemporaryDirectory(prefix="serialkin-anim-") as tmp:
-            out = Path(tmp) / f"animation.{fmt}"
-            anim.save(str(out), writer=writer, dpi=dpi, progress_callback=callback)
-            data = out.read_bytes()
+        if fmt == "gif":
+            moving = [lines[LINKS_GID], lines[JOINTS_GID], lines["serialkin-tool"], label]
+            moving += ([trace_line] if trace_line is not None else [])
+            moving += [seg for segs in triads for seg in segs]
+            data = _gif_blitted(fig, ax, moving, draw, len(idx), fps, callback)
+        else:
+            anim = animation.FuncAnimation(fig, draw, frames=len(idx), blit=False,
+                                           repeat=False, cache_frame_data=False)
+            writer = animation.FFMpegWriter(fps=fps, codec="libx264",
+                                            extra_args=["-pix_fmt", "yuv420p"])
+            with tempfile.TemporaryDirectory(prefix="serialkin-anim-") as tmp:
+                out = Path(tmp) / f"animation.{fmt}"
+                anim.save(str(out), writer=writer, dpi=dpi, progress_callback=callback)
+                data = out.read_bytes()
         if bar is not None:
             bar.close()
         return data
     finally:
         plt.close(fig)
+
+
+def _gif_blitted(fig: Any, ax: Any, moving: list[Any], draw: Any, count: int, fps: float,
+                 callback: Any = None) -> bytes:
+    """Encode ``count`` frames as a GIF, redrawing only the ``moving`` artists per frame.
+
+    The static scene (obstacles, path, axes) is rendered once; each frame restores it, lets
+    ``draw(k)`` update the moving artists and draws just those (blitting), then keeps the
+    RGBA pixels. Pillow writes the GIF (looping, ``1/fps`` s per frame).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image
+
+    canvas = FigureCanvasAgg(fig)
+    for artist in moving:
+        artist.set_animated(True)
+    canvas.draw()
+    background = canvas.copy_from_bbox(fig.bbox)
+    frames = []
+    for k in range(count):
+        canvas.restore_region(background)
+        draw(k)
+        for artist in moving:
+            ax.draw_artist(artist)
+        frames.append(Image.fromarray(np.asarray(canvas.buffer_rgba()).copy(), "RGBA"))
+        if callback is not None:
+            callback(k, count)
+    buf = io.BytesIO()
+    frames[0].save(buf, format="GIF", save_all=True, append_images=frames[1:],
+                   duration=max(1, int(round(1000.0 / fps))), loop=0)
+    return buf.getvalue()
 
 
 def _fix_limits(ax: Any, robot: Robot, P: np.ndarray, path_points: object,
