@@ -195,8 +195,9 @@ def _section_3_2(ctx: ReportContext) -> Section:
 
 
 def _latex_q(q: np.ndarray) -> str:
-    return (rf"\mathbf{{q}} = ({q[0] / DEG:.0f}^\circ,\ {q[1] / DEG:.0f}^\circ,\ "
-            rf"{q[2]:.2f}\,\mathrm{{m}},\ {q[3] / DEG:.0f}^\circ)")
+    """The SCARA configuration as LaTeX; each value braced so a minus sign is unary."""
+    return (rf"\mathbf{{q}} = ({{{q[0] / DEG:.0f}}}^\circ,\ {{{q[1] / DEG:.0f}}}^\circ,\ "
+            rf"{{{q[2]:.2f}}}\,\text{{m}},\ {{{q[3] / DEG:.0f}}}^\circ)")
 
 
 def _section_3_2_1(ctx: ReportContext) -> Section:
