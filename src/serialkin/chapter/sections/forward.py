@@ -76,23 +76,28 @@ def _figure_frames(ctx: ReportContext, robot: Robot, q: np.ndarray) -> str:
     import matplotlib.pyplot as plt
 
     frames = robot.fk_all(q)
-    fig, ax = plt.subplots(figsize=(5, 4.6))
+    fig, ax = plt.subplots(figsize=(6, 4.2))
     pts = frames[:, :3, 3]
     ax.plot(pts[:, 0], pts[:, 1], "-o", color="0.4", lw=2, mfc="white")
     L = 0.08
-    labels: dict[tuple[float, float], list[str]] = {}
+    groups: dict[tuple[float, float], list[int]] = {}
+    lines = []
     for i, T in enumerate(frames):
         o = T[:3, 3]
         for k, c in ((0, "r"), (1, "g")):
             d = T[:3, k] * L
             ax.annotate("", xy=(o[0] + d[0], o[1] + d[1]), xytext=(o[0], o[1]),
                         arrowprops={"arrowstyle": "->", "color": c, "lw": 1.4})
-        zsign = "up" if T[2, 2] > 0 else "down"
-        key = (round(float(o[0]), 6), round(float(o[1]), 6))
-        labels.setdefault(key, []).append(f"{{{i}}} z {zsign}, h = {o[2]:.2f} m")
-    for (x, y), text in labels.items():
-        ax.text(x + 0.012, y - 0.02, "\n".join(text), fontsize=8, va="top")
-    ax.set_aspect("equal", adjustable="datalim")
+        groups.setdefault((round(float(o[0]), 6), round(float(o[1]), 6)), []).append(i)
+        lines.append(f"frame {i}: z {'up' if T[2, 2] > 0 else 'down'}, height {o[2]:.2f} m")
+    for (x, y), idx in groups.items():
+        ax.annotate(", ".join(map(str, idx)), (x, y), xytext=(-6, -14),
+                    textcoords="offset points", fontsize=9, ha="right", color="0.2")
+    ax.text(0.02, 0.98, "\n".join(lines), transform=ax.transAxes, fontsize=8, va="top",
+            bbox={"boxstyle": "round", "fc": "white", "ec": "0.7"})
+    ax.set_xlim(-0.08, 0.72)
+    ax.set_ylim(-0.12, 0.42)
+    ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_title("Top view: frame origins, x (red) and y (green) axes")
