@@ -17,7 +17,7 @@ import numpy as np
 
 from serialkin import models
 from serialkin.chapter.report import ReportContext, Section
-from serialkin.ik.compare import CompareTable, compare
+from serialkin.ik.compare import COLUMNS, CompareTable, compare
 
 #: Tolerance of the comparison (the accuracy bar of the IK issue) [m, rad].
 COMPARE_TOL = 1e-6
@@ -158,6 +158,19 @@ def _obstacle_objective(ctx: ReportContext) -> str:
     )
 
 
+def _compare_html(ctx: ReportContext, table: CompareTable) -> str:
+    """A comparison table through ``ctx.table`` (aligned columns), skipped methods below."""
+    caption = (f"<caption>IK methods on {html.escape(table.robot)}: {table.n_targets} "
+               f"{html.escape(table.target_kind)} targets, tol {table.tol:g}</caption>")
+    body = ctx.table([r.cells() for r in table.rows], list(COLUMNS), fmt="{:.3g}")
+    out = body.replace("<table>", "<table>" + caption, 1)
+    if table.skipped:
+        items = "".join(f"<li><b>{html.escape(m)}</b>: {html.escape(r)}</li>"
+                        for m, r in table.skipped)
+        out += f'<ul class="skipped">{items}</ul>'
+    return out
+
+
 def _default_solver_timings(ctx: ReportContext) -> list[tuple[str, str, str, str]]:
     """Warm median and spread of ``robot.ik(target)`` (method 'lm') on one target each."""
     rows = []
@@ -202,7 +215,7 @@ def build(ctx: ReportContext) -> Section:
     )
     tables = comparison_tables()
     for title, table in tables:
-        parts.append(f"<h4>{html.escape(title)}</h4>" + table.to_html())
+        parts.append(f"<h4>{html.escape(title)}</h4>" + _compare_html(ctx, table))
     parts.append(
         "<p>The comparison times are warm too: each method solves the first target once, "
         "untimed, before the timed solves; the median and mean are over the targets. For "
