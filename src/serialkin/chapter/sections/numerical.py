@@ -3,7 +3,8 @@
 Contents: the Jacobian control law (eqs 39-40) and one Newton-Raphson iteration (eq 41)
 shown on the chapter's formulas; the numerical families of section 5.3 measured side by
 side by :func:`serialkin.ik.compare.compare` on a planar 3-link arm, the Puma 560 and the
-UR5 (every number in those tables is measured when the report is built), a table of the
+UR5 (every number in those tables is measured when the report is built), the default
+solver's warm timing per robot (median and spread, ``ctx.timing``), a table of the
 trade-offs; the obstacle-distance objective of eq 45 evaluated and checked. The redundancy
 resolution itself (eqs 42-56, the 6- and 20-link examples) follows in
 :mod:`serialkin.chapter.sections.redundancy`.
