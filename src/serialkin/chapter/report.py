@@ -451,15 +451,15 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
             continue
         label = f"{number} {sec.name}" if number else sec.name
         css = ' class="sub"' if "." in number else ""
-        toc.append(f'<li{css}><a href="#{anchor}">{html.escape(label)}</a> '
-                   f'<span class="eq">({eqs})</span></li>')
+        eqs_toc = "" if sec.part else f' <span class="eq">({eqs})</span>'
+        toc.append(f'<li{css}><a href="#{anchor}">{html.escape(label)}</a>{eqs_toc}</li>')
         part = ""
         if sec.part:
             part = f'<h3 class="part" id="{anchor}-part">{html.escape(sec.part)}</h3>'
             toc.append(f'<li class="part"><a href="#{anchor}-part">{html.escape(sec.part)}'
-                       "</a></li>")
-        body.append(f'<section id="{anchor}"><h2>{html.escape(label)}</h2>'
-                    f'<p class="eq">Demonstrates: {eqs}</p>{part}{sec.html}</section>')
+                       f'</a> <span class="eq">({eqs})</span></li>')
+        body.append(f'<section id="{anchor}"><h2>{html.escape(label)}</h2>{part}'
+                    f'<p class="eq">Demonstrates: {eqs}</p>{sec.html}</section>')
     meta = build_metadata() + [
         ("build time", f"{seconds:.1f} s wall clock ({workers}); the sections took "
                        f"{cpu:.1f} s CPU in all")]
