@@ -157,18 +157,23 @@ class OccupancyGrid:
             unseen=unseen, dim=self.dim,
         )
 
-    def boundary(self) -> list[np.ndarray]:
+    def boundary(self, fill_gaps: bool = False) -> list[np.ndarray]:
         """Closed boundary polylines of the occupied region (2D grids only), each (k, 2) [m].
 
         The 0.5 level set of the occupancy indicator sampled at cell centres (marching
         squares, via ``contourpy``): it runs between occupied and empty cells. Outer
         boundaries and the rims of holes (e.g. the inner circle of an annulus) are all returned.
+
+        Args:
+            fill_gaps: first fill the enclosed empty regions that are plausibly cells no
+                sample happened to hit (:func:`sampling_gaps`), so only true holes get a rim.
         """
         if self.dim != 2:
             raise InputError("boundary() needs a 2D grid; use a planar slice of a 3D workspace")
         import contourpy
 
-        occ = np.pad(self.occupied.astype(float), 1)
+        occ = self.occupied | sampling_gaps(self.counts) if fill_gaps else self.occupied
+        occ = np.pad(occ.astype(float), 1)
         x = self.lower[0] + self.cell * (np.arange(occ.shape[0]) - 0.5)
         y = self.lower[1] + self.cell * (np.arange(occ.shape[1]) - 0.5)
         gen = contourpy.contour_generator(x, y, occ.T, line_type=contourpy.LineType.Separate)
@@ -182,6 +187,45 @@ class OccupancyGrid:
         np.maximum.at(out, flat, values[inside])
         out[~np.isfinite(out)] = np.nan
         return out.reshape(self.shape)
+
+
+#: An enclosed empty region is a sampling gap (not a hole) when, at the density of the
+#: samples around it, all its cells would be empty with at least this probability.
+GAP_PROBABILITY = 1e-9
+
+
+def sampling_gaps(counts: np.ndarray, p_min: float = GAP_PROBABILITY) -> np.ndarray:
+    """Cells of enclosed empty regions that are plausibly sampling gaps, boolean (2D or 3D).
+
+    An empty region (face-connected, ``scipy.ndimage.label``) not touching the grid's
+    border is a gap when ``exp(−λ k) ≥ p_min``: k its cells, λ the mean sample count of
+    the occupied cells next to it (Poisson: the chance that k cells of that density all
+    stay empty). A cell or two no sample hit where samples are sparse is a gap; a hole of a
+    few cells among densely hit cells (a true hole of the workspace) is not.
+    """
+    from scipy import ndimage
+
+    c = np.asarray(counts)
+    occ = c > 0
+    labels, count = ndimage.label(~occ)
+    if count == 0:
+        return np.zeros_like(occ)
+    border = np.zeros(count + 1, dtype=bool)
+    for axis in range(occ.ndim):
+        for end in (0, -1):
+            border[np.unique(np.take(labels, end, axis=axis))] = True
+    nsum = np.zeros(c.shape, dtype=float)  # counts of the face neighbours of every cell
+    nocc = np.zeros(c.shape, dtype=float)  # number of occupied face neighbours
+    for axis in range(occ.ndim):
+        for shift in (1, -1):
+            nsum += np.roll(np.where(occ, c, 0), shift, axis=axis)
+            nocc += np.roll(occ, shift, axis=axis)
+    idx = np.arange(count + 1)
+    size = ndimage.sum(np.ones(c.shape), labels, idx)
+    lam = ndimage.sum(nsum, labels, idx) / np.maximum(ndimage.sum(nocc, labels, idx), 1.0)
+    gap = (np.exp(-lam * size) >= p_min) & ~border
+    gap[0] = False
+    return gap[labels]
 
 
 def grid_bounds(points: np.ndarray, cell: float) -> tuple[np.ndarray, tuple[int, ...]]:

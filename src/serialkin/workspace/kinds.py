@@ -96,9 +96,14 @@ class Workspace:
         """2 (planar) or 3."""
         return 2 if self.planar else 3
 
-    def boundary(self) -> list[np.ndarray]:
-        """Boundary polylines (k, 2) [m] of a planar workspace (see OccupancyGrid.boundary)."""
-        return self.grid.boundary()
+    def boundary(self, fill_gaps: bool = True) -> list[np.ndarray]:
+        """Boundary polylines (k, 2) [m] of a planar workspace (see OccupancyGrid.boundary).
+
+        Args:
+            fill_gaps: give no rim to cells no sample happened to hit (sampling gaps, see
+                :func:`~serialkin.workspace.grid.sampling_gaps`); true holes keep theirs.
+        """
+        return self.grid.boundary(fill_gaps)
 
     def manipulability_map(self) -> np.ndarray:
         """Per-cell maximum manipulability over the samples in the cell; NaN where empty."""
@@ -339,7 +344,8 @@ def dexterous_workspace(robot: Any, orientations: int | Sequence[object] | None 
                         min_manipulability: float | None = None, seed: Any = 0,
                         cell: float | None = None, resolution: int | None = None,
                         planar: bool | None = None, progress: bool | None = None,
-                        kind: str = "dexterous") -> Workspace:
+                        kind: str = "dexterous", grid: OccupancyGrid | None = None
+                        ) -> Workspace:
     """Dexterous workspace: every sampled orientation, away from singularities.
 
     For each orientation ``R_k`` the constant-orientation samples are computed and those
@@ -371,14 +377,28 @@ def dexterous_workspace(robot: Any, orientations: int | Sequence[object] | None 
         planar: force 2D/3D (default: ``robot.is_planar``).
         progress: progress bar (None: only on a terminal).
         kind: 'dexterous' or 'total' (label only).
+        grid: count on this grid (its cell, lower corner and shape) instead of one sized
+            for these samples. With the total-orientation workspace's grid and the same
+            seed, orientations and samples, the dexterous cells are a subset of the
+            total-orientation cells by construction (the samples are a subset), so the
+            dexterous area never exceeds the total-orientation area.
     """
     pl = _is_planar(robot, planar)
+    margin = check_positive(singularity_margin, "singularity_margin", allow_zero=True)
+    sampled = _orientation_samples(robot, orientations, samples, seed, pl, progress)
+    return _intersect_orientations(robot, sampled, margin, min_manipulability, seed, cell,
+                                   resolution, pl, kind, grid)
+
+
+def _orientation_samples(robot: Any, orientations: int | Sequence[object] | None,
+                         samples: int | None, seed: Any, pl: bool, progress: bool | None
+                         ) -> dict[str, Any]:
+    """Constant-orientation samples for every orientation of the set (see dexterous_workspace)."""
     rng = as_generator(seed) if seed is not None else as_generator(None)
     if orientations is None:
         orientations = 12 if pl else 8
     Rs = _orientation_set(orientations, pl, rng)
     K = len(Rs)
-    margin = check_positive(singularity_margin, "singularity_margin", allow_zero=True)
     if samples is None:
         per = max(100_000, _default_samples(None, pl) // K)
     else:
@@ -388,6 +408,16 @@ def dexterous_workspace(robot: Any, orientations: int | Sequence[object] | None 
     for k, R_t in enumerate(Rs):
         parts.append(_oriented_samples(robot, R_t, 0.0, per, rng, pl, task, progress,
                                        f"orientation {k + 1}/{K}"))
+    return {"Rs": Rs, "per": per, "task": task, "parts": parts}
+
+
+def _intersect_orientations(robot: Any, sampled: dict[str, Any], margin: float,
+                            min_manipulability: float | None, seed: Any, cell: float | None,
+                            resolution: int | None, pl: bool, kind: str,
+                            grid: OccupancyGrid | None) -> Workspace:
+    """The cells occupied for every orientation by samples with w ≥ w_min (one grid)."""
+    Rs, per, task, parts = sampled["Rs"], sampled["per"], sampled["task"], sampled["parts"]
+    K = len(Rs)
     w_all = np.concatenate([p[2] for p in parts]) if parts else np.zeros(0)
     w_max = float(w_all.max()) if w_all.size else 0.0
     w_min = (check_positive(min_manipulability, "min_manipulability", allow_zero=True)
@@ -401,9 +431,13 @@ def dexterous_workspace(robot: Any, orientations: int | Sequence[object] | None 
     if all_pts.shape[0] == 0:
         return _finish(robot, kind, pl, np.zeros((0, robot.n)), np.zeros((0, 3)), np.zeros(0),
                        per * K, seed, cell, resolution, params)
-    # one common grid, coarse enough for the sparsest orientation's samples
-    h = max(_cell_size(P[:, :dim], cell, resolution, pl) for _, P, _ in kept if len(P))
-    lower, shape = grid_bounds(all_pts, h)
+    if grid is not None:
+        if grid.dim != dim:
+            raise InputError(f"grid must be {dim}-dimensional for this robot, got {grid.dim}D")
+        h, lower, shape = grid.cell, grid.lower, grid.shape
+    else:  # one common grid, coarse enough for the sparsest orientation's samples
+        h = max(_cell_size(P[:, :dim], cell, resolution, pl) for _, P, _ in kept if len(P))
+        lower, shape = grid_bounds(all_pts, h)
     counts = None
     unseen = 0.0
     for _, P, _ in kept:
@@ -440,6 +474,37 @@ def total_orientation_workspace(robot: Any, orientations: int | Sequence[object]
     """
     options.setdefault("singularity_margin", 0.0)
     return dexterous_workspace(robot, orientations, samples, kind="total", **options)
+
+
+def total_and_dexterous_workspaces(robot: Any,
+                                   orientations: int | Sequence[object] | None = None,
+                                   samples: int | None = None, *,
+                                   singularity_margin: float = 0.05,
+                                   min_manipulability: float | None = None, seed: Any = 0,
+                                   cell: float | None = None, resolution: int | None = None,
+                                   planar: bool | None = None, progress: bool | None = None
+                                   ) -> tuple[Workspace, Workspace]:
+    """The total-orientation and the dexterous workspace from one set of samples, one grid.
+
+    The constant-orientation samples of every orientation are drawn once (as in
+    :func:`dexterous_workspace`); the total-orientation workspace keeps all of them, the
+    dexterous one those with ``w ≥ w_min``, counted on the total-orientation grid. So the
+    dexterous cells are a subset of the total-orientation cells by construction (and its
+    area estimate never exceeds the total-orientation one), at the cost of one sampling.
+
+    Args: as :func:`dexterous_workspace`.
+
+    Returns:
+        (total-orientation workspace, dexterous workspace).
+    """
+    pl = _is_planar(robot, planar)
+    margin = check_positive(singularity_margin, "singularity_margin", allow_zero=True)
+    sampled = _orientation_samples(robot, orientations, samples, seed, pl, progress)
+    total = _intersect_orientations(robot, sampled, 0.0, None, seed, cell, resolution, pl,
+                                    "total", None)
+    dext = _intersect_orientations(robot, sampled, margin, min_manipulability, seed, cell,
+                                   resolution, pl, "dexterous", total.grid)
+    return total, dext
 
 
 def compute_workspace(robot: Any, kind: str = "reachable", **options: Any) -> Workspace:
@@ -488,9 +553,9 @@ class WorkspaceSlice:
     grid: OccupancyGrid
     estimate: MeasureEstimate
 
-    def boundary(self) -> list[np.ndarray]:
-        """Boundary polylines (k, 2) of the cross-section [m]."""
-        return self.grid.boundary()
+    def boundary(self, fill_gaps: bool = True) -> list[np.ndarray]:
+        """Boundary polylines (k, 2) of the cross-section [m] (gaps as in Workspace.boundary)."""
+        return self.grid.boundary(fill_gaps)
 
 
 def workspace_slice(ws: Workspace, axis: str = "z", value: float = 0.0,

@@ -25,12 +25,11 @@ from serialkin.chapter.report import ReportContext, Section
 from serialkin.spatial import rpy_to_matrix
 from serialkin.workspace import (
     constant_orientation_workspace,
-    dexterous_workspace,
     inclusive_orientation_workspace,
     reachable_workspace,
-    total_orientation_workspace,
     workspace_slice,
 )
+from serialkin.workspace.kinds import total_and_dexterous_workspaces
 
 SEED = 2024
 
@@ -127,48 +126,54 @@ def build(ctx: ReportContext) -> Section:
         "by the batched FK kernel and binned on an occupancy grid. The area estimate Â "
         "counts interior cells fully and boundary cells by half; the error bound ε adds "
         "half the boundary cells and the Chao1 estimate of cells no sample hit "
-        "(see <code>serialkin.workspace.grid</code>). The closed form is "
-        "π((L1+L2)² − (L1−L2)²) = 4π L1 L2.</p>"
+        "(see <code>serialkin.workspace.grid</code>). The closed form is</p>"
+        + ctx.eq(r"A = \pi\left((L_1 + L_2)^2 - (L_1 - L_2)^2\right) = 4\pi L_1 L_2")
     )
     rows = []
     for L1, L2 in ((1.0, 1.0), (1.0, 0.6), (0.7, 0.4), (0.5, 0.9)):
-        ws = reachable_workspace(models.two_link(L1, L2), 300_000, seed=SEED,
+        ws = reachable_workspace(models.two_link(L1, L2), 150_000, seed=SEED,
                                  progress=progress)
         exact = _annulus(L1, L2)
         e = ws.estimate
         rows.append((L1, L2, exact, e.value, e.error, abs(e.value - exact),
                      "yes" if abs(e.value - exact) <= e.error else "NO", e.cell))
-    parts.append(ctx.table(rows, ["L1 [m]", "L2 [m]", "π((L1+L2)²−(L1−L2)²) [m²]",
-                                  "sampled Â [m²]", "error bound ε [m²]", "|Â − exact|",
+    parts.append(ctx.table(rows, ["L1 [m]", "L2 [m]", "closed form A [m²]",
+                                  "sampled Â [m²]", "error bound ε [m²]", "|Â − A|",
                                   "within ε", "cell [m]"]))
     two = models.two_link(1.0, 0.6)
-    ws2 = reachable_workspace(two, 300_000, seed=SEED, manipulability=True, progress=progress)
+    ws2 = reachable_workspace(two, 200_000, seed=SEED, manipulability=True, progress=progress)
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.2))
     plot_workspace(ws2, axes[0], robot=two, q=[0.6, 1.1])
     plot_manipulability_map(ws2, axes[1])
     fig.tight_layout()
+    parts.append("<p>The manipulability of eq 43 of the 2-link arm is "
+                 + ctx.imath(r"w = \sqrt{\det\left(\mathbf{J}\mathbf{J}^T\right)}"
+                             r" = L_1 L_2 \left|\sin q_2\right|")
+                 + ": zero on both boundary circles, the singular configurations "
+                 + ctx.imath(r"q_2 = 0, \pi") + ".</p>")
     parts.append(ctx.figure(fig, "workspace_two_link",
                             "2-link arm (L1 = 1 m, L2 = 0.6 m): maximal workspace with its "
-                            "boundary (left) and the manipulability w = L1 L2 |sin q2| per cell "
-                            "(right, eq 43): zero on both boundary circles, the singular "
-                            "configurations q2 = 0, π."))
+                            "boundary (left) and the manipulability per cell (right, eq 43)."))
+    parts.append(ctx.reproduce("serialkin workspace two_link --out out/ws -w", shell=True))
 
     # --- 3-link arm: every kind ---------------------------------------------------------
     L = (1.0, 0.8, 0.3)
     three = models.three_link(*L)
     phi = 0.0
+    # one sampling, one grid: dexterous ⊆ total-orientation cell by cell
+    total, dexterous = total_and_dexterous_workspaces(three, 12, 40_000, seed=SEED,
+                                                      singularity_margin=0.05,
+                                                      progress=progress)
     kinds = [
-        ("maximal (reachable)", reachable_workspace(three, 300_000, seed=SEED,
+        ("maximal (reachable)", reachable_workspace(three, 200_000, seed=SEED,
                                                     progress=progress),
          _three_link_reachable(L)),
         ("constant orientation φ = 0", constant_orientation_workspace(
-            three, phi, 150_000, seed=SEED, progress=progress), _annulus(L[0], L[1])),
+            three, phi, 80_000, seed=SEED, progress=progress), _annulus(L[0], L[1])),
         ("inclusive orientation |φ| ≤ 30°", inclusive_orientation_workspace(
-            three, phi, math.radians(30), 150_000, seed=SEED, progress=progress), None),
-        ("total orientation (12 headings)", total_orientation_workspace(
-            three, 12, 60_000, seed=SEED, progress=progress), _three_link_total(L)),
-        ("dexterous (12 headings, w ≥ 5 % of max)", dexterous_workspace(
-            three, 12, 60_000, seed=SEED, singularity_margin=0.05, progress=progress), None),
+            three, phi, math.radians(30), 80_000, seed=SEED, progress=progress), None),
+        ("total orientation (12 headings)", total, _three_link_total(L)),
+        ("dexterous (12 headings, w ≥ 5 % of max)", dexterous, None),
     ]
     parts.append(
         f"<h3>Workspace kinds of the 3-link arm (L = {L} m)</h3>"
@@ -177,9 +182,20 @@ def build(ctx: ReportContext) -> Section:
         "total-orientation and dexterous workspaces intersect the constant-orientation "
         "occupancy grids of 12 evenly spaced headings, the dexterous one keeping only "
         "samples whose manipulability (planar pose task) is at least 5 % of the largest. "
-        "Closed forms: maximal = annulus up to L1+L2+L3; constant orientation = the 2-link "
-        "annulus of L1, L2 about the wrist; total orientation = |p| ∈ [|L1−L2|+L3, "
-        "L1+L2−L3] plus the disc |p| ≤ L3 − |L1−L2| when positive.</p>"
+        "The dexterous workspace is computed from the same samples as the total-orientation "
+        "one and counted on the same grid (<code>total_and_dexterous_workspaces</code>), so "
+        "its cells are a subset of the total-orientation cells by construction and its area "
+        "cannot exceed it (computed on "
+        "separate grids sized for their own samples, the two estimates differ by their "
+        "sampling errors and a subset could print larger than its superset). "
+        "Closed forms, with " + ctx.imath(r"d = |L_1 - L_2|") + ": maximal, the annulus "
+        + ctx.imath(r"\max(0, 2\max_i L_i - \textstyle\sum_i L_i) \le |\mathbf{p}| \le"
+                    r" L_1 + L_2 + L_3") + "; constant orientation, the 2-link annulus "
+        + ctx.imath(r"d \le |\mathbf{p} - L_3\mathbf{e}_\varphi| \le L_1 + L_2")
+        + " about the wrist; total orientation, "
+        + ctx.imath(r"d + L_3 \le |\mathbf{p}| \le L_1 + L_2 - L_3")
+        + " plus the disc " + ctx.imath(r"|\mathbf{p}| \le L_3 - d") + " when "
+        + ctx.imath(r"L_3 > d") + ".</p>"
     )
     rows = []
     for label, ws, exact in kinds:
@@ -189,9 +205,18 @@ def build(ctx: ReportContext) -> Section:
                      ws.points.shape[0]))
     parts.append(ctx.table(rows, ["kind", "area Â [m²]", "error ε [m²]", "closed form [m²]",
                                   "within ε", "samples kept"]))
+    extra = int((dexterous.grid.occupied & ~total.grid.occupied).sum())
+    te, de = total.estimate, dexterous.estimate
+    parts.append(
+        "<p>Inclusion check on the common grid (cell "
+        f"{te.cell * 1e3:.3g} mm): {int(dexterous.grid.occupied.sum())} dexterous cells, "
+        f"{int(total.grid.occupied.sum())} total-orientation cells, {extra} dexterous cells "
+        f"outside the total-orientation set; areas {de.value:.4f} ± {de.error:.2g} m² ≤ "
+        f"{te.value:.4f} ± {te.error:.2g} m². Each ± is the sampling error bound: half the "
+        "boundary cells plus the Chao1 estimate of cells no sample hit.</p>")
     fig, axes = plt.subplots(2, 3, figsize=(15, 9.6))
     for ax, (label, ws, _) in zip(axes.ravel(), kinds):
-        plot_workspace(ws, ax, color_by_manipulability=False, max_points=15_000,
+        plot_workspace(ws, ax, color_by_manipulability=False, max_points=8_000,
                        title=f"{label}\n{ws.estimate.value:.3f} ± {ws.estimate.error:.2g} m²")
     plot_workspace_kinds([kinds[0][1], kinds[1][1], kinds[4][1]], axes.ravel()[5],
                          labels=["maximal", "constant φ = 0", "dexterous"],
@@ -199,14 +224,22 @@ def build(ctx: ReportContext) -> Section:
     fig.tight_layout()
     parts.append(ctx.figure(fig, "workspace_three_link_kinds",
                             "3-link arm: the workspace kinds of section 1 with their "
-                            "boundaries and areas; bottom right, three of them overlaid."))
+                            "boundaries and areas; bottom right, three of them overlaid. "
+                            "Enclosed gaps of a few cells that no sample hit are not outlined "
+                            "(only true holes are)."))
+    parts.append(ctx.reproduce(
+        "from serialkin import models\n"
+        "from serialkin.workspace.kinds import total_and_dexterous_workspaces\n"
+        "arm = models.three_link(1.0, 0.8, 0.3)\n"
+        "tot, dex = total_and_dexterous_workspaces(arm, 12, 40_000, seed=2024,"
+        " singularity_margin=0.05)"))
 
     # --- spatial robot ------------------------------------------------------------------
     puma = models.puma560()
-    ws3 = reachable_workspace(puma, 400_000, seed=SEED, progress=progress)
+    ws3 = reachable_workspace(puma, 300_000, seed=SEED, progress=progress)
     down = rpy_to_matrix([math.pi, 0.0, 0.0])  # tool z axis pointing down
-    wsc = constant_orientation_workspace(puma, down, 120_000, seed=SEED, progress=progress)
-    wsi = inclusive_orientation_workspace(puma, down, math.radians(30), 120_000, seed=SEED,
+    wsc = constant_orientation_workspace(puma, down, 60_000, seed=SEED, progress=progress)
+    wsi = inclusive_orientation_workspace(puma, down, math.radians(30), 60_000, seed=SEED,
                                           progress=progress)
     slices = [workspace_slice(ws3, "z", z) for z in (0.2, 0.67, 1.1)]
     parts.append(
@@ -229,9 +262,9 @@ def build(ctx: ReportContext) -> Section:
     )
     fig = plt.figure(figsize=(15, 5.2))
     ax = fig.add_subplot(1, 3, 1, projection="3d")
-    plot_workspace(ws3, ax, max_points=12_000)
+    plot_workspace(ws3, ax, max_points=8_000)
     ax = fig.add_subplot(1, 3, 2, projection="3d")
-    plot_workspace(wsc, ax, max_points=12_000)
+    plot_workspace(wsc, ax, max_points=8_000)
     plot_slice(slices[1], ax=fig.add_subplot(1, 3, 3), title=(
         f"slice z = {slices[1].value:.2f} m: "
         f"{slices[1].estimate.value:.3f} ± {slices[1].estimate.error:.2g} m²"))
@@ -247,6 +280,8 @@ def build(ctx: ReportContext) -> Section:
     parts.append(ctx.figure(fig, "workspace_puma560_slices",
                             "PUMA 560 maximal workspace: horizontal slices with their "
                             "boundaries and cross-section areas."))
+    parts.append(ctx.reproduce("serialkin workspace puma560 --samples 400000 --slice z=0.67 "
+                               "--out out/ws", shell=True))
     plt.close("all")
     return Section(
         title="1. Degrees of freedom, joint space and workspace",
