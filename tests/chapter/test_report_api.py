@@ -143,3 +143,39 @@ def test_table_alignment_is_per_column():
     assert [c for c, _ in cells] == ["txt", "num", "txt", "num", "txt", "num", "txt", "num"]
     out = ReportContext.table([("1.5", ""), ("2", 0.5)], [Html("<i>x</i>"), "y"])
     assert '<th class="num"><i>x</i></th>' in out and _cells(out)[3] == ("num", "")
+
+
+def test_compact_png_keeps_white_and_shrinks(tmp_path):
+    """A matplotlib PNG re-encoded with a palette stays a PNG, keeps white white, shrinks."""
+    import io
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from PIL import Image
+
+    from serialkin.chapter.report import compact_png
+
+    fig, ax = plt.subplots()
+    x = np.linspace(0, 6, 400)
+    for k in range(6):
+        ax.plot(x, np.sin(x + k), label=f"curve {k}")
+    ax.legend()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    plt.close(fig)
+    out = compact_png(buf.getvalue())
+    assert out[:4] == b"\x89PNG" and len(out) < len(buf.getvalue())
+    with Image.open(io.BytesIO(out)) as im:
+        assert im.mode == "P"
+        assert im.convert("RGB").getpixel((2, 2)) == (255, 255, 255)
+
+
+def test_format_vector_has_no_negative_zero():
+    """format_vector prints "(a, b)" with the number format and never "-0"."""
+    from serialkin.chapter.report import format_vector
+
+    assert format_vector([-0.0, 0.5, -2.0]) == "(0, 0.5, -2)"
+    assert format_vector([-1e-12, 0.25], "{:.3f}") == "(0.000, 0.250)"
+    assert format_vector(np.array([[-0.0, 1.23456]]), "{:.2f}") == "(0.00, 1.23)"

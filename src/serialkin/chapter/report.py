@@ -566,3 +566,17 @@ def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
     path = out / "report.html"
     write_text_atomic(path, page)
     return path
+
+
+__all__ = [
+    "SECTION_MODULES",
+    "Html",
+    "ReportContext",
+    "Section",
+    "Timing",
+    "build_metadata",
+    "build_report",
+    "compact_png",
+    "format_number",
+    "format_vector",
+]
