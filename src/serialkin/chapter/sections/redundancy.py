@@ -542,7 +542,7 @@ def _figure10_part(ctx: ReportContext, sc: Scenario, tc: Any) -> Section:
     r = 2.6 * (obs.radius + obs.influence)
     ax.set_xlim(c[0] - r, c[0] + r)
     ax.set_ylim(c[1] - r, c[1] + r)
-    ax.set_aspect("equal")
+    ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_title(f"Figure 10: link {link} and obstacle {obs.name} (path point {k})")

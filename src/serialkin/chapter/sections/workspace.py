@@ -161,7 +161,7 @@ def build(ctx: ReportContext) -> Section:
     three = models.three_link(*L)
     phi = 0.0
     # one sampling, one grid: dexterous ⊆ total-orientation cell by cell
-    total, dexterous = total_and_dexterous_workspaces(three, 12, 40_000, seed=SEED,
+    total, dexterous = total_and_dexterous_workspaces(three, 12, 30_000, seed=SEED,
                                                       singularity_margin=0.05,
                                                       progress=progress)
     kinds = [
@@ -169,9 +169,9 @@ def build(ctx: ReportContext) -> Section:
                                                     progress=progress),
          _three_link_reachable(L)),
         ("constant orientation φ = 0", constant_orientation_workspace(
-            three, phi, 80_000, seed=SEED, progress=progress), _annulus(L[0], L[1])),
+            three, phi, 60_000, seed=SEED, progress=progress), _annulus(L[0], L[1])),
         ("inclusive orientation |φ| ≤ 30°", inclusive_orientation_workspace(
-            three, phi, math.radians(30), 80_000, seed=SEED, progress=progress), None),
+            three, phi, math.radians(30), 60_000, seed=SEED, progress=progress), None),
         ("total orientation (12 headings)", total, _three_link_total(L)),
         ("dexterous (12 headings, w ≥ 5 % of max)", dexterous, None),
     ]
@@ -214,7 +214,7 @@ def build(ctx: ReportContext) -> Section:
         f"outside the total-orientation set; areas {de.value:.4f} ± {de.error:.2g} m² ≤ "
         f"{te.value:.4f} ± {te.error:.2g} m². Each ± is the sampling error bound: half the "
         "boundary cells plus the Chao1 estimate of cells no sample hit.</p>")
-    fig, axes = plt.subplots(2, 3, figsize=(15, 9.6))
+    fig, axes = plt.subplots(2, 3, figsize=(13, 8.4))
     for ax, (label, ws, _) in zip(axes.ravel(), kinds):
         plot_workspace(ws, ax, color_by_manipulability=False, max_points=8_000,
                        title=f"{label}\n{ws.estimate.value:.3f} ± {ws.estimate.error:.2g} m²")
@@ -231,15 +231,15 @@ def build(ctx: ReportContext) -> Section:
         "from serialkin import models\n"
         "from serialkin.workspace.kinds import total_and_dexterous_workspaces\n"
         "arm = models.three_link(1.0, 0.8, 0.3)\n"
-        "tot, dex = total_and_dexterous_workspaces(arm, 12, 40_000, seed=2024,"
+        "tot, dex = total_and_dexterous_workspaces(arm, 12, 30_000, seed=2024,"
         " singularity_margin=0.05)"))
 
     # --- spatial robot ------------------------------------------------------------------
     puma = models.puma560()
     ws3 = reachable_workspace(puma, 300_000, seed=SEED, progress=progress)
     down = rpy_to_matrix([math.pi, 0.0, 0.0])  # tool z axis pointing down
-    wsc = constant_orientation_workspace(puma, down, 60_000, seed=SEED, progress=progress)
-    wsi = inclusive_orientation_workspace(puma, down, math.radians(30), 60_000, seed=SEED,
+    wsc = constant_orientation_workspace(puma, down, 40_000, seed=SEED, progress=progress)
+    wsi = inclusive_orientation_workspace(puma, down, math.radians(30), 40_000, seed=SEED,
                                           progress=progress)
     slices = [workspace_slice(ws3, "z", z) for z in (0.2, 0.67, 1.1)]
     parts.append(
@@ -260,7 +260,7 @@ def build(ctx: ReportContext) -> Section:
                 s.points.shape[0]) for s in slices],
             ["set", "volume [m³] / area [m²]", "error bound", "samples"])
     )
-    fig = plt.figure(figsize=(15, 5.2))
+    fig = plt.figure(figsize=(13, 4.6))
     ax = fig.add_subplot(1, 3, 1, projection="3d")
     plot_workspace(ws3, ax, max_points=8_000)
     ax = fig.add_subplot(1, 3, 2, projection="3d")
@@ -273,7 +273,7 @@ def build(ctx: ReportContext) -> Section:
                             "PUMA 560: maximal workspace (left), constant-orientation "
                             "workspace with the tool pointing down (middle) and the maximal "
                             "workspace's slice at shoulder height (right)."))
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8))
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
     for ax, s in zip(axes, slices):
         plot_slice(s, ax=ax)
     fig.tight_layout()
