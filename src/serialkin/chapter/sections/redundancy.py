@@ -690,9 +690,9 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
         "weight, the eq 49 maximum, or the singularity damping, leaving λ_min = "
         f"{res.damping:g} m). Each task matters: without the obstacle task the arm passes "
         "through obstacles; without the joint-limit task joint 1 leaves its range in phase 2; "
-        "without the singularity task the stretched arm of phase 1 chatters and misses path "
-        "points by more than the ±5 mm tolerance (3.4 mm beyond the reach is the least error "
-        "possible there).</p>"
+        "without the singularity task the (nearly) stretched arm of phases 1 and 2 chatters "
+        "and misses path points by more than the ±5 mm tolerance (at the point 3.4 mm beyond "
+        "the reach that is the least error possible; the damped arm stays within it).</p>"
         + ctx.table(arows, ["run", "max |q − q_all| [°]", "min clearance [mm]",
                             "worst limit violation [°]", "max tracking error [mm]",
                             "points outside ±5 mm"]))
