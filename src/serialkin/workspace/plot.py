@@ -195,7 +195,8 @@ def plot_workspace_kinds(workspaces: Sequence[Workspace], ax: Any = None, *,
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.legend(fontsize=8, loc="upper right")
+    # below the axes: a legend must never cover the workspaces it describes
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=1)
     if title:
         ax.set_title(title, fontsize=10)
     return ax
