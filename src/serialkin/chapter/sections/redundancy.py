@@ -575,23 +575,31 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
     res = sc.solver
     names = [o.name for o in sc.obstacles]
     parts = [
-        "<p>20 links of L = 16.75 mm (reach R = 20L = 0.335 m). The chapter gives neither the "
-        "path, nor q0, nor the obstacles (ERRATA); our design has one phase per secondary task "
-        "of eq 48, so that each of them acts somewhere: from q0 = (75°, −2°, …, −2°) (1) "
-        "straight out to 1.01R, 3.4 mm beyond the reach: the arm stretches into the singular "
-        "configuration; (2) along the boundary at 0.998R from 60° to 125°: the nearly "
-        "straight arm points where joint 1 points, so joint 1 meets its +100° limit and the "
-        "next joints must bend instead; (3) back over the top and along a wave between four "
-        "obstacles A-D. The polyline is sampled every 6 mm "
-        f"({len(sc.path)} points). Both cases use eq 48 with W = I; (b) adds only a constant "
-        f"damping λ = {sb.solver.damping:g} m; (c) has the joint limits ±100° (eq 49, "
-        f"W_L up to {res.joint_limit_weight:g}, buffer {res.limit_buffer:.0%} of the range), "
-        f"the obstacle task (W_c up to {res.obstacle_weight:g}, influence "
+        "<p>20 links of L = 16.75 mm (reach " + ctx.imath(r"R = 20L = 0.335\ \mathrm{m}")
+        + "). The chapter gives neither the path, nor q0, nor the obstacles (ERRATA); our "
+        "design has one phase per secondary task of eq 48, so that each of them acts "
+        "somewhere: from q0 = (75°, −2°, …, −2°) (1) straight out to 1.01R, 3.4 mm beyond the "
+        "reach: the arm stretches into the singular configuration; (2) along the boundary at "
+        "0.998R from 60° to 125°: the nearly straight arm points where joint 1 points, so "
+        "joint 1 meets its +100° limit and the next joints must bend instead; (3) back over "
+        "the top and along a wave between four obstacles A-D. The polyline is sampled every "
+        f"6 mm ({len(sc.path)} points). Both cases use eq 48 with "
+        + ctx.imath(r"\mathbf{W} = \mathbf{I}") + "; (b) adds only a constant damping "
+        + ctx.imath(r"\mathbf{W}_s = \lambda^2\mathbf{I}") + f", λ = {sb.solver.damping:g} m; "
+        "(c) has the joint limits ±100° (eq 49, "
+        + ctx.imath(r"W_{L,\max} = " + f"{res.joint_limit_weight:g}")
+        + f", buffer {res.limit_buffer:.0%} of the range), the obstacle task (weight up to "
+        + ctx.imath(r"W_{c,\max} = " + f"{res.obstacle_weight:g}") + " at contact, "
+        "distances of influence "
         + ", ".join(f"{o.name} {o.influence * 1e3:.0f} mm" for o in sc.obstacles)
-        + f") and the singularity task (λ_min = {res.damping:g} m, plus "
-        + ctx.imath(r"\lambda_s = " + f"{res.singularity_damping:g}"
-                    + r"\,(1 - w/w_0)") + f" when w &lt; w₀ = {res.manipulability_threshold:g}), "
-        "in the chapter's faithful mode " + ctx.imath(r"\mathbf{x}_c = \mathbf{x}_L = \mathbf{0}")
+        + ") and the singularity task "
+        + ctx.imath(r"\mathbf{W}_s = (\lambda_{\min}^2 + \lambda_s^2)\,\mathbf{I}")
+        + " with " + ctx.imath(r"\lambda_{\min} = " + f"{res.damping:g}" + r"\ \mathrm{m}")
+        + " and " + ctx.imath(r"\lambda_s = " + f"{res.singularity_damping:g}"
+                              + r"\,(1 - w/w_0)")
+        + " when " + ctx.imath(r"w < w_0 = " + f"{res.manipulability_threshold:g}")
+        + " (w of eq 43), in the chapter's faithful mode "
+        + ctx.imath(r"\mathbf{x}_c = \mathbf{x}_L = \mathbf{0}")
         + f"; at most {res.max_iter} iterations per point.</p>",
     ]
     rows = []
