@@ -117,6 +117,11 @@ def build(ctx: ReportContext) -> Section:
         "of task coordinates the tool can actually move in (2 for the 2-link arm, 4 for "
         "the SCARA: x, y, z and the yaw). A robot with n &gt; m is kinematically redundant "
         "(section 5.3). S¹ is an unlimited revolute joint.</p>" + _dof_table(ctx)
+        + ctx.reproduce(
+            "import numpy as np\n"
+            "from serialkin import models\n"
+            "r = models.scara(); J = r.jacobian(r.random_q(8, seed=2024))\n"
+            "print(r.n, max(np.linalg.matrix_rank(Jk, tol=1e-9) for Jk in J))  # n, m")
     )
 
     # --- 2-link arm: area against the closed form --------------------------------------
