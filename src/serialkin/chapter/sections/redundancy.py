@@ -403,37 +403,43 @@ def _weights_part(ctx: ReportContext, sc: Scenario, tc: Any) -> Section:
                             "Eq 49 — the joint-limit weight as a function of the joint "
                             "angle: 0 inside, smoothstep across the buffer, maximal at and "
                             "beyond the limit."))
-    # eq 48 by hand at the point where the most tasks act
+    # eq 48 by hand at two path points: limits + singularity (phase 2), limits + obstacles
     act = task_activity(sc, tc)
-    score = ((act["obstacle"] > 0).astype(int) + (act["limit"] > 0).astype(int)
-             + (act["singularity"] > 0).astype(int))
-    k = int(np.lexsort((act["limit"], score))[-1])
-    q = tc.q[k]
-    x = sc.robot.fk(q)[:2, 3]
-    target = sc.path.points[min(k + 1, len(sc.path) - 1)]
-    dx = target - x
-    xdot = dx * min(1.0, res.max_task_step / max(np.linalg.norm(dx), 1e-12))
-    hand = eq48_by_hand(sc, q, xdot)
-    lib = res.velocity(sc.robot, q, xdot)
-    nz = np.flatnonzero(hand["W_L"] > 0)
-    wl_text = ", ".join(f"W_L{i + 1} = {hand['W_L'][i]:.3g} (q{i + 1} = {q[i] * DEG:.1f}°)"
-                        for i in nz) or "all 0"
+    picks = []
+    for other in ("singularity", "obstacle"):
+        both = (act["limit"] > 0) & (act[other] > 0)
+        if both.any():
+            picks.append(int(np.flatnonzero(both)[np.argmax(act[other][both])]))
+    cols = []
+    for k in picks:
+        q = tc.q[k]
+        x = sc.robot.fk(q)[:2, 3]
+        dx = sc.path.points[min(k + 1, len(sc.path) - 1)] - x
+        xdot = dx * min(1.0, res.max_task_step / max(np.linalg.norm(dx), 1e-12))
+        hand = eq48_by_hand(sc, q, xdot)
+        lib = res.velocity(sc.robot, q, xdot)
+        nz = np.flatnonzero(hand["W_L"] > 0)
+        cols.append((
+            ", ".join(f"W_L{i + 1} = {hand['W_L'][i]:.3g} (q{i + 1} = {q[i] * DEG:.1f}°)"
+                      for i in nz) or "all 0",
+            f"{hand['J_c'].shape[0]} (weights up to {hand['W_c'].max():.3g})"
+            if hand["W_c"].size else "0",
+            f"w = {hand['w']:.4g}, λ_s = {hand['lambda_s'] * 1e3:.3g} mm",
+            f"{np.linalg.norm(hand['qdot'] - lib) / np.linalg.norm(lib):.1e}"))
+    labels = ["non-zero W_Li of eq 50 (the others are 0)",
+              "obstacle rows J_ci within the distance of influence",
+              Html("manipulability w (eq 43), singularity damping " + ctx.imath(r"\lambda_s")),
+              "‖q̇ by hand − q̇ library‖ / ‖q̇‖"]
     parts.append(
-        f"<p>Eqs 48-50 at path point {k} of the constrained run (Figure 12), with ẋ towards "
+        "<p>Eqs 48-50 at path points " + " and ".join(str(k) for k in picks)
+        + " of the constrained run (Figure 12; the joint-limit task acts at both, with the "
+        "singularity task at the first and the obstacle task at the second), with ẋ towards "
         "the next path point: eq 48 assembled by hand with numpy from "
         "<code>joint_limit_weights</code> (eq 49), the diagonal of eq 50, the obstacle rows of "
         "eq 55 and the resolver's " + ctx.imath(r"\mathbf{W}_s") + ", against the library's "
         "compiled <code>MultiTaskResolver.velocity</code>:</p>"
-        + ctx.table([
-            ("non-zero W_Li of eq 50 (the others are 0)", wl_text),
-            ("obstacle rows J_ci within the influence distance",
-             f"{hand['J_c'].shape[0]} (weights up to {hand['W_c'].max():.3g})"
-             if hand["W_c"].size else "0"),
-            (Html("manipulability w, singularity damping " + ctx.imath(r"\lambda_s")),
-             f"w = {hand['w']:.4g}, λ_s = {hand['lambda_s']:.3g} m"),
-            ("‖q̇ by hand − q̇ library‖ / ‖q̇‖",
-             f"{np.linalg.norm(hand['qdot'] - lib) / np.linalg.norm(lib):.1e}"),
-        ], ["quantity", "value"]))
+        + ctx.table([(lab, *[c[i] for c in cols]) for i, lab in enumerate(labels)],
+                    ["quantity", *[f"path point {k}" for k in picks]]))
     parts.append(ctx.reproduce(
         "import numpy as np\n"
         "from serialkin.redundancy import joint_limit_weights\n"
@@ -496,7 +502,9 @@ def _figure10_part(ctx: ReportContext, sc: Scenario, tc: Any) -> Section:
             (Html(ctx.imath(r"\mathbf{e}_i")), f"({e_i[0]:.4f}, {e_i[1]:.4f})"),
             (Html(ctx.imath(r"\mathbf{s}_0") + ", radius"),
              f"({s0[0]:.4f}, {s0[1]:.4f}) m, {obs.radius * 1e3:.3g} mm"),
-            (Html(ctx.imath(r"p_i") + " (eq 51)"), f"{p_i * 1e3:.3f} mm of {ell * 1e3:.2f} mm"),
+            (Html(ctx.imath(r"p_i") + " (eq 51)"), f"{p_i * 1e3:.3f} mm of {ell * 1e3:.2f} mm"
+             + (" (clamped: the closest point is an end of the link)"
+                if min(p_i, ell - p_i) < 1e-9 else "")),
             (Html(ctx.imath(r"\mathbf{s}_{ci}") + " (eq 52)"),
              f"({s_ci[0]:.4f}, {s_ci[1]:.4f}) m"),
             (Html(ctx.imath(r"d_{ci}") + " (eq 53)"),
