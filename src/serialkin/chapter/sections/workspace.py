@@ -136,7 +136,7 @@ def build(ctx: ReportContext) -> Section:
     )
     rows = []
     for L1, L2 in ((1.0, 1.0), (1.0, 0.6), (0.7, 0.4), (0.5, 0.9)):
-        ws = reachable_workspace(models.two_link(L1, L2), 150_000, seed=SEED,
+        ws = reachable_workspace(models.two_link(L1, L2), 100_000, seed=SEED,
                                  progress=progress)
         exact = _annulus(L1, L2)
         e = ws.estimate
@@ -166,7 +166,7 @@ def build(ctx: ReportContext) -> Section:
     three = models.three_link(*L)
     phi = 0.0
     # one sampling, one grid: dexterous ⊆ total-orientation cell by cell
-    total, dexterous = total_and_dexterous_workspaces(three, 12, 30_000, seed=SEED,
+    total, dexterous = total_and_dexterous_workspaces(three, 12, 20_000, seed=SEED,
                                                       singularity_margin=0.05,
                                                       progress=progress)
     kinds = [
@@ -221,7 +221,7 @@ def build(ctx: ReportContext) -> Section:
         "boundary cells plus the Chao1 estimate of cells no sample hit.</p>")
     fig, axes = plt.subplots(2, 3, figsize=(13, 8.4))
     for ax, (label, ws, _) in zip(axes.ravel(), kinds):
-        plot_workspace(ws, ax, color_by_manipulability=False, max_points=8_000,
+        plot_workspace(ws, ax, color_by_manipulability=False, max_points=5_000,
                        title=f"{label}\n{ws.estimate.value:.3f} ± {ws.estimate.error:.2g} m²")
     plot_workspace_kinds([kinds[0][1], kinds[1][1], kinds[4][1]], axes.ravel()[5],
                          labels=["maximal", "constant φ = 0", "dexterous"],
@@ -236,15 +236,15 @@ def build(ctx: ReportContext) -> Section:
         "from serialkin import models\n"
         "from serialkin.workspace.kinds import total_and_dexterous_workspaces\n"
         "arm = models.three_link(1.0, 0.8, 0.3)\n"
-        "tot, dex = total_and_dexterous_workspaces(arm, 12, 30_000, seed=2024,"
+        "tot, dex = total_and_dexterous_workspaces(arm, 12, 20_000, seed=2024,"
         " singularity_margin=0.05)"))
 
     # --- spatial robot ------------------------------------------------------------------
     puma = models.puma560()
     ws3 = reachable_workspace(puma, 300_000, seed=SEED, progress=progress)
     down = rpy_to_matrix([math.pi, 0.0, 0.0])  # tool z axis pointing down
-    wsc = constant_orientation_workspace(puma, down, 40_000, seed=SEED, progress=progress)
-    wsi = inclusive_orientation_workspace(puma, down, math.radians(30), 40_000, seed=SEED,
+    wsc = constant_orientation_workspace(puma, down, 25_000, seed=SEED, progress=progress)
+    wsi = inclusive_orientation_workspace(puma, down, math.radians(30), 25_000, seed=SEED,
                                           progress=progress)
     slices = [workspace_slice(ws3, "z", z) for z in (0.2, 0.67, 1.1)]
     parts.append(
@@ -267,9 +267,9 @@ def build(ctx: ReportContext) -> Section:
     )
     fig = plt.figure(figsize=(13, 4.6))
     ax = fig.add_subplot(1, 3, 1, projection="3d")
-    plot_workspace(ws3, ax, max_points=8_000)
+    plot_workspace(ws3, ax, max_points=5_000)
     ax = fig.add_subplot(1, 3, 2, projection="3d")
-    plot_workspace(wsc, ax, max_points=8_000)
+    plot_workspace(wsc, ax, max_points=5_000)
     plot_slice(slices[1], ax=fig.add_subplot(1, 3, 3), title=(
         f"slice z = {slices[1].value:.2f} m: "
         f"{slices[1].estimate.value:.3f} ± {slices[1].estimate.error:.2g} m²"))
