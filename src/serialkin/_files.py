@@ -361,7 +361,8 @@ class Field:
     def fail(self, problem: str) -> SerialkinError:
         """The error ``"<origin>: field '<path>' <problem>"`` (not raised)."""
         who = f"field {self.path!r}" if self.path else "the document"
-        return self.error(f"{self.origin}: {who} {problem}")
+        return self.error(f"{self.origin}: {who} {problem}" if self.origin else
+                          f"{who} {problem}")
 
     def expected(self, what: str) -> SerialkinError:
         """The error ``... must be <what>, got <short repr of the value>`` (not raised)."""
@@ -405,7 +406,7 @@ class Field:
                         short_repr(e, 40)[1:-1]
                     hints.append(f"{label!r}" + (f" (did you mean {near[0]!r}?)" if near
                                                  else ""))
-                where = f"{self.origin}: "
+                where = f"{self.origin}: " if self.origin else ""
                 raise self.error(f"{where}unknown field(s) {', '.join(hints)}; allowed: "
                                  f"{', '.join(options)}")
         for key in required:
