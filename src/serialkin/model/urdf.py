@@ -15,12 +15,14 @@ after the motion. That is exactly :class:`~serialkin.model.joint.Joint` with
 from __future__ import annotations
 
 import os
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from serialkin._checks import short_repr
 from serialkin.errors import NotSupportedError, RobotDefinitionError
 from serialkin.model.joint import Joint
 from serialkin.spatial.transforms import make_transform, rotx, roty, rotz
@@ -69,14 +71,23 @@ def _origin(el: ET.Element | None, where: str) -> np.ndarray:
 
 
 def _read_xml(path_or_string: str | os.PathLike[str]) -> tuple[ET.Element, str]:
+    """Parse a URDF file or string; the XML parser honours the declared encoding.
+
+    A file is read as bytes (at most :data:`serialkin._files.MAX_FILE_BYTES`) so that
+    ``<?xml ... encoding="ISO-8859-1"?>`` is decoded as declared (UTF-8 by default).
+    """
+    from serialkin._files import read_bytes
+
     text = str(path_or_string)
+    data: str | bytes
     if text.lstrip().startswith("<"):
         source, data = "<string>", text
     else:
         path = Path(text)
-        if not path.is_file():
+        if not path.exists():
             raise RobotDefinitionError(f"URDF file {text!r} does not exist")
-        source, data = str(path), path.read_text(encoding="utf-8")
+        source = str(path)
+        data = read_bytes(path, what="URDF file", error=RobotDefinitionError)
     try:
         root = ET.fromstring(data)
     except ET.ParseError as exc:
@@ -84,6 +95,8 @@ def _read_xml(path_or_string: str | os.PathLike[str]) -> tuple[ET.Element, str]:
         raise RobotDefinitionError(
             f"{source}: malformed XML at line {line}, column {col}: {exc}"
         ) from exc
+    except (ValueError, LookupError) as exc:  # e.g. an encoding Python does not know
+        raise RobotDefinitionError(f"{source}: cannot read the XML ({exc})") from exc
     if root.tag != "robot":
         raise RobotDefinitionError(f"{source}: the root element must be <robot>, got <{root.tag}>")
     return root, source
@@ -181,6 +194,7 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
             f"{source}: expected one root link, found {len(roots)}"
             + (f" ({', '.join(roots)})" if roots else "; the joints form a loop")
         )
+    _check_tree(roots[0], children, source)
     base = base_link or roots[0]
     if base not in link_set:
         raise RobotDefinitionError(f"{source}: base_link {base!r} is not a link of the robot")
@@ -236,6 +250,26 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
     return robot
 
 
+def _check_tree(root: str, children: dict[str, list[str]], source: str) -> None:
+    """Refuse links not reachable from the root: with one parent per link, they form a loop.
+
+    A loop anywhere in the description is refused, on the chain or off it.
+    """
+    reached = {root}
+    todo = [root]
+    while todo:
+        for c in children[todo.pop()]:
+            if c not in reached:
+                reached.add(c)
+                todo.append(c)
+    if len(reached) != len(children):
+        loop = sorted(set(children) - reached)
+        shown = ", ".join(short_repr(x, 40) for x in loop[:5]) + (" ..." if len(loop) > 5 else "")
+        raise RobotDefinitionError(
+            f"{source}: the joints form a loop through link(s) {shown} (not reachable from "
+            f"the root link {root!r}); a URDF must be a tree")
+
+
 def _is_below(link: str, base: str, by_child: dict[str, _UJoint]) -> bool:
     seen = set()
     while link != base:
@@ -250,7 +284,21 @@ def _fmt(v: float) -> str:
     return repr(float(v))
 
 
-def _origin_xml(T: np.ndarray) -> str:
+#: Characters XML 1.0 cannot hold at all (even escaped): most C0 controls, surrogates.
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+
+
+def _xml_name(text: str, what: str) -> str:
+    """A name for an XML attribute; refuse characters no XML document can contain."""
+    m = _NOT_XML.search(text)
+    if m is not None:
+        raise RobotDefinitionError(
+            f"{what} {short_repr(text, 60)} contains the character U+{ord(m.group()):04X}, "
+            "which XML (and so URDF) cannot hold; rename it")
+    return text
+
+
+def _origin_el(parent: ET.Element, T: np.ndarray) -> None:
     import warnings
 
     from scipy.spatial.transform import Rotation
@@ -258,8 +306,8 @@ def _origin_xml(T: np.ndarray) -> str:
     with warnings.catch_warnings():  # at gimbal lock scipy picks roll = 0: still exact
         warnings.simplefilter("ignore", UserWarning)
         rpy = Rotation.from_matrix(T[:3, :3]).as_euler("xyz")  # extrinsic xyz = Rz·Ry·Rx
-    xyz = " ".join(_fmt(v) for v in T[:3, 3])
-    return f'<origin xyz="{xyz}" rpy="{" ".join(_fmt(v) for v in rpy)}"/>'
+    ET.SubElement(parent, "origin", xyz=" ".join(_fmt(v) for v in T[:3, 3]),
+                  rpy=" ".join(_fmt(v) for v in rpy))
 
 
 def robot_to_urdf(robot) -> str:
@@ -269,7 +317,12 @@ def robot_to_urdf(robot) -> str:
     base included for the first joint) composed with the joint offset, so that
     :func:`robot_from_urdf` reproduces the same forward kinematics; the tool becomes a
     fixed joint to a link named ``tool``. Infinite revolute limits export as
-    ``continuous`` joints.
+    ``continuous`` joints. The document is built with :mod:`xml.etree.ElementTree`,
+    which escapes every name (``&``, ``<``, quotes, newlines): no name can add markup.
+
+    Raises:
+        RobotDefinitionError: a robot, joint or link name holds a character XML cannot
+            represent (a control character other than tab, newline and carriage return).
     """
     from scipy.spatial.transform import Rotation
 
@@ -277,33 +330,39 @@ def robot_to_urdf(robot) -> str:
     names = getattr(robot, "link_names", None)
     if names is None or len(names) < robot.n + 1:
         names = ["base_link"] + [f"link{i + 1}" for i in range(robot.n)]
-    lines = ['<?xml version="1.0"?>', f'<robot name="{robot.name}">']
-    lines += [f'  <link name="{n}"/>' for n in names[: robot.n + 1]]
-    lines.append('  <link name="tool"/>')
+    names = [_xml_name(str(n), "link name") for n in names[: robot.n + 1]]
+    tool_link = "tool"
+    while tool_link in names:  # a robot whose own links include 'tool'
+        tool_link = "_" + tool_link
+    joint_names = [_xml_name(str(n), "joint name") for n in robot.joint_names]
+    tool_joint = "tool_fixed"
+    while tool_joint in joint_names:
+        tool_joint = "_" + tool_joint
+    root = ET.Element("robot", name=_xml_name(str(robot.name), "robot name"))
+    for n in [*names, tool_link]:
+        ET.SubElement(root, "link", name=n)
     for i, j in enumerate(robot.joints):
         M = np.eye(4)
         if j.type == "R":
             M[:3, :3] = Rotation.from_rotvec(meta[i, :3] * j.offset).as_matrix()
         else:
             M[:3, 3] = meta[i, :3] * j.offset
-        origin = F[i] @ M
         lo, hi = j.qlim
-        if j.type == "R" and not (np.isfinite(lo) or np.isfinite(hi)):
-            jtype, limit = "continuous", ""
-        else:
-            jtype = "revolute" if j.type == "R" else "prismatic"
-            lo_s = _fmt(lo if np.isfinite(lo) else -1e9)
-            hi_s = _fmt(hi if np.isfinite(hi) else 1e9)
-            limit = f'<limit lower="{lo_s}" upper="{hi_s}" effort="0" velocity="0"/>'
-        axis = " ".join(_fmt(v) for v in meta[i, :3])
-        lines.append(
-            f'  <joint name="{robot.joint_names[i]}" type="{jtype}">'
-            f'<parent link="{names[i]}"/><child link="{names[i + 1]}"/>'
-            f'{_origin_xml(origin)}<axis xyz="{axis}"/>{limit}</joint>'
-        )
-    lines.append(
-        f'  <joint name="tool_fixed" type="fixed"><parent link="{names[robot.n]}"/>'
-        f'<child link="tool"/>{_origin_xml(F[robot.n])}</joint>'
-    )
-    lines.append("</robot>")
-    return "\n".join(lines) + "\n"
+        continuous = j.type == "R" and not (np.isfinite(lo) or np.isfinite(hi))
+        jtype = "continuous" if continuous else ("revolute" if j.type == "R" else "prismatic")
+        el = ET.SubElement(root, "joint", name=joint_names[i], type=jtype)
+        ET.SubElement(el, "parent", link=names[i])
+        ET.SubElement(el, "child", link=names[i + 1])
+        _origin_el(el, F[i] @ M)
+        ET.SubElement(el, "axis", xyz=" ".join(_fmt(v) for v in meta[i, :3]))
+        if not continuous:
+            ET.SubElement(el, "limit", lower=_fmt(lo if np.isfinite(lo) else -1e9),
+                          upper=_fmt(hi if np.isfinite(hi) else 1e9), effort="0",
+                          velocity="0")
+    el = ET.SubElement(root, "joint", name=tool_joint, type="fixed")
+    ET.SubElement(el, "parent", link=names[robot.n])
+    ET.SubElement(el, "child", link=tool_link)
+    _origin_el(el, F[robot.n])
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") \
+        + "\n"
