@@ -264,6 +264,8 @@ def parse_yaml(text: str, origin: str, *, error: ErrorType = InputError) -> obje
             return loader.get_single_data()
         finally:
             loader.dispose()
+    except SerialkinError:
+        raise
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
