@@ -253,7 +253,7 @@ _ARRAYS = ("q", "poses", "targets", "errors", "iterations", "reached", "clearanc
 
 
 def _bad(p: FsPath, why: str) -> InputError:
-    return InputError(f"{p}: not a valid serialkin trajectory: {why}")
+    return InputError(f"{p}: not a serialkin trajectory: {why}")
 
 
 def _read_npz(p: FsPath, data: bytes) -> tuple[dict, object]:
