@@ -281,8 +281,9 @@ def save_robot_file(robot: Any, path: str | os.PathLike[str], *, angle_unit: str
         import yaml
 
         # The dumper quotes and escapes every name and free text: nothing a name holds
-        # (newlines, ':', '#', quotes) can add a line or a key to the file.
+        # (newlines, ':', '#', quotes) can add a line or a key to the file. Non-ASCII is
+        # escaped too (allow_unicode would write U+0085 raw, which reads back as a space).
         text = "# serialkin robot file\n" + yaml.safe_dump(
-            data, sort_keys=False, default_flow_style=None, allow_unicode=True)
+            data, sort_keys=False, default_flow_style=None)
     write_text_atomic(p, text)
     return p
