@@ -54,6 +54,11 @@ ALIAS_BOMB = "\n".join(
 ) + "\n"
 
 
+#: Characters an XML document can hold (XML 1.0 forbids most C0 controls).
+_XML_OK_TEXT = st.characters(blacklist_categories=("Cs",), blacklist_characters="".join(
+    map(chr, [*range(0, 9), 11, 12, *range(14, 32), 0xFFFE, 0xFFFF])))
+
+
 @contextlib.contextmanager
 def guard(seconds: float = GUARD_S) -> Iterator[None]:
     """Interrupt the block with TimeoutError if it runs longer than ``seconds`` (a hang)."""
@@ -330,6 +335,33 @@ def test_fuzz_raw_bytes_into_every_loader(tmp_path, blob):
 
 
 # ----------------------------------------------------------------------- URDF
+_URDF_SLOTS = ("robot.name", "link.name", "joint.name", "joint.type", "parent.link",
+               "child.link", "origin.xyz", "origin.rpy", "axis.xyz", "limit.lower",
+               "limit.upper")
+
+
+@settings(max_examples=60, deadline=None)
+@given(slot=st.sampled_from(_URDF_SLOTS),
+       value=st.text(alphabet=_XML_OK_TEXT, max_size=30)
+       | st.lists(st.floats() | st.integers(), max_size=4).map(
+           lambda v: " ".join(map(str, v))))
+def test_fuzz_urdf_attributes(slot, value):
+    """Any attribute of a valid URDF replaced by junk: a robot or a library error."""
+    root = ET.fromstring(
+        "<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='revolute'>"
+        "<parent link='a'/><child link='b'/><origin xyz='0 0 0.1' rpy='0 0 0'/>"
+        "<axis xyz='0 0 1'/><limit lower='-1' upper='1'/></joint></robot>")
+    tag, attr = slot.split(".")
+    el = root if tag == "robot" else root.find(f".//{tag}")
+    el.set(attr, value)
+    with guard():
+        try:
+            r = sk.Robot.from_urdf(ET.tostring(root, encoding="unicode"))
+        except SerialkinError:
+            return
+    assert np.isfinite(r.fk(np.zeros(r.n))).all()
+
+
 def test_urdf_declared_latin1_encoding_loads(tmp_path):
     """A URDF declaring encoding="ISO-8859-1" (valid XML) loads with its names decoded."""
     text = ('<?xml version="1.0" encoding="ISO-8859-1"?>\n<robot name="caf\xe9">'
@@ -381,11 +413,7 @@ def test_urdf_refuses_names_xml_cannot_hold():
 
 
 # ----------------------------------------------------------------------- writers
-_XML_OK = st.characters(blacklist_categories=("Cs",),
-                        blacklist_characters="".join(map(chr, [*range(0, 9), 11, 12,
-                                                               *range(14, 32), 0xFFFE,
-                                                               0xFFFF])))
-_names = st.text(alphabet=_XML_OK | st.sampled_from(list("\n\"'<>&:#{}[]- ")), min_size=1,
+_names = st.text(alphabet=_XML_OK_TEXT | st.sampled_from(list("\n\"'<>&:#{}[]- ")), min_size=1,
                  max_size=16).filter(lambda s: s.strip() != "")
 
 

@@ -14,6 +14,7 @@ after the motion. That is exactly :class:`~serialkin.model.joint.Joint` with
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import xml.etree.ElementTree as ET
@@ -23,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from serialkin._checks import short_repr
+from serialkin._files import MAX_NUMBER
 from serialkin.errors import NotSupportedError, RobotDefinitionError
 from serialkin.model.joint import Joint
 from serialkin.spatial.transforms import make_transform, rotx, roty, rotz
@@ -44,16 +46,19 @@ class _UJoint:
     unsupported: str = ""
 
 
-def _floats(text: str | None, count: int, default: tuple[float, ...], where: str) -> np.ndarray:
+def _floats(text: str | None, count: int, default: tuple[float, ...], where: str,
+            bound: float = math.inf) -> np.ndarray:
+    """``count`` finite numbers from an attribute, each with magnitude at most ``bound``."""
     if text is None:
         return np.array(default, dtype=float)
     parts = text.split()
+    want = f"{count} finite numbers" + (f" with |x| <= {bound:g}" if bound < math.inf else "")
     try:
-        vals = np.array([float(p) for p in parts])
-    except ValueError as exc:
-        raise RobotDefinitionError(f"{where}: expected {count} numbers, got {text!r}") from exc
-    if vals.shape != (count,) or not np.isfinite(vals).all():
-        raise RobotDefinitionError(f"{where}: expected {count} finite numbers, got {text!r}")
+        vals = np.array([float(p) for p in parts[: count + 1]])
+    except ValueError:
+        raise RobotDefinitionError(f"{where}: expected {want}, got {short_repr(text)}") from None
+    if len(parts) != count or not np.isfinite(vals).all() or np.abs(vals).max() > bound:
+        raise RobotDefinitionError(f"{where}: expected {want}, got {short_repr(text)}")
     return vals
 
 
@@ -65,8 +70,8 @@ def rpy_to_matrix(rpy: np.ndarray) -> np.ndarray:
 def _origin(el: ET.Element | None, where: str) -> np.ndarray:
     if el is None:
         return np.eye(4)
-    xyz = _floats(el.get("xyz"), 3, (0.0, 0.0, 0.0), f"{where} <origin xyz>")
-    rpy = _floats(el.get("rpy"), 3, (0.0, 0.0, 0.0), f"{where} <origin rpy>")
+    xyz = _floats(el.get("xyz"), 3, (0.0, 0.0, 0.0), f"{where} <origin xyz>", MAX_NUMBER)
+    rpy = _floats(el.get("rpy"), 3, (0.0, 0.0, 0.0), f"{where} <origin rpy>", MAX_NUMBER)
     return make_transform(rpy_to_matrix(rpy), xyz)
 
 
@@ -85,7 +90,7 @@ def _read_xml(path_or_string: str | os.PathLike[str]) -> tuple[ET.Element, str]:
     else:
         path = Path(text)
         if not path.exists():
-            raise RobotDefinitionError(f"URDF file {text!r} does not exist")
+            raise RobotDefinitionError(f"URDF file {short_repr(text)} does not exist")
         source = str(path)
         data = read_bytes(path, what="URDF file", error=RobotDefinitionError)
     try:
@@ -106,19 +111,20 @@ def _parse_joint(el: ET.Element, source: str) -> _UJoint:
     name = el.get("name")
     if not name:
         raise RobotDefinitionError(f"{source}: a <joint> has no name attribute")
-    where = f"{source}: joint {name!r}"
+    where = f"{source}: joint {short_repr(name)}"
     jtype = el.get("type")
     if jtype is None:
         raise RobotDefinitionError(f"{where} has no type attribute")
     unsupported = ""
     if jtype in _UNSUPPORTED:
-        unsupported = (f"{where} is of type {jtype!r}, which is not supported (serial chains "
-                       "of revolute, continuous, prismatic and fixed joints)")
+        unsupported = (f"{where} is of type {short_repr(jtype)}, which is not supported "
+                       "(serial chains of revolute, continuous, prismatic and fixed joints)")
     elif el.find("mimic") is not None:
         unsupported = f"{where} has a <mimic> element; mimic joints are not supported"
     if jtype not in _MOVING and jtype != "fixed" and not unsupported:
         raise RobotDefinitionError(
-            f"{where} has unknown type {jtype!r}; expected revolute, continuous, prismatic or fixed"
+            f"{where} has unknown type {short_repr(jtype)}; expected revolute, continuous, "
+            "prismatic or fixed"
         )
     parent, child = el.find("parent"), el.find("child")
     if parent is None or parent.get("link") is None:
@@ -126,7 +132,7 @@ def _parse_joint(el: ET.Element, source: str) -> _UJoint:
     if child is None or child.get("link") is None:
         raise RobotDefinitionError(f"{where} has no <child link=...>")
     axis = _floats(el.find("axis").get("xyz") if el.find("axis") is not None else None, 3,
-                   (1.0, 0.0, 0.0), f"{where} <axis xyz>")
+                   (1.0, 0.0, 0.0), f"{where} <axis xyz>", MAX_NUMBER)
     if jtype in _MOVING and np.linalg.norm(axis) < 1e-12:
         raise RobotDefinitionError(f"{where} has a zero <axis xyz>; expected a nonzero 3-vector")
     lower, upper = -np.inf, np.inf
@@ -178,13 +184,15 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
         for role, link in (("parent", j.parent), ("child", j.child)):
             if link not in link_set:
                 raise RobotDefinitionError(
-                    f"{source}: joint {j.name!r} refers to {role} link {link!r}, "
+                    f"{source}: joint {short_repr(j.name)} refers to {role} link "
+                    f"{short_repr(link)}, "
                     "which does not exist"
                 )
         if j.child in by_child:
             raise RobotDefinitionError(
-                f"{source}: link {j.child!r} is the child of two joints "
-                f"({by_child[j.child].name!r} and {j.name!r}); the description has a loop"
+                f"{source}: link {short_repr(j.child)} is the child of two joints "
+                f"({short_repr(by_child[j.child].name)} and {short_repr(j.name)}); the "
+                "description has a loop"
             )
         by_child[j.child] = j
         children[j.parent].append(j.child)
@@ -192,38 +200,41 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
     if len(roots) != 1:
         raise RobotDefinitionError(
             f"{source}: expected one root link, found {len(roots)}"
-            + (f" ({', '.join(roots)})" if roots else "; the joints form a loop")
+            + (f" ({_names(roots)})" if roots else "; the joints form a loop")
         )
     _check_tree(roots[0], children, source)
     base = base_link or roots[0]
     if base not in link_set:
-        raise RobotDefinitionError(f"{source}: base_link {base!r} is not a link of the robot")
+        raise RobotDefinitionError(
+            f"{source}: base_link {short_repr(base)} is not a link of the robot")
     if tip_link is None:
         leaves = [n for n in links if not children[n] and n != base]
         below = [n for n in leaves if _is_below(n, base, by_child)]
         if len(below) != 1:
             raise RobotDefinitionError(
-                f"{source}: the tree below {base!r} branches into {len(below)} leaves "
-                f"({', '.join(below)}); pass tip_link= one of them"
+                f"{source}: the tree below {short_repr(base)} branches into {len(below)} leaves "
+                f"({_names(below)}); pass tip_link= one of them"
             )
         tip = below[0]
     else:
         tip = tip_link
         if tip not in link_set:
-            raise RobotDefinitionError(f"{source}: tip_link {tip!r} is not a link of the robot")
+            raise RobotDefinitionError(
+                f"{source}: tip_link {short_repr(tip)} is not a link of the robot")
     chain: list[_UJoint] = []
     link = tip
     seen = {tip}
     while link != base:
         if link not in by_child:
             raise RobotDefinitionError(
-                f"{source}: tip_link {tip!r} is not below base_link {base!r}"
+                f"{source}: tip_link {short_repr(tip)} is not below base_link {short_repr(base)}"
             )
         j = by_child[link]
         chain.append(j)
         link = j.parent
         if link in seen:
-            raise RobotDefinitionError(f"{source}: the joints form a loop at link {link!r}")
+            raise RobotDefinitionError(
+                f"{source}: the joints form a loop at link {short_repr(link)}")
         seen.add(link)
     chain.reverse()
     for j in chain:
@@ -242,12 +253,18 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
         fixed = np.eye(4)
     if not out:
         raise RobotDefinitionError(
-            f"{source}: no moving joint between {base!r} and {tip!r}"
+            f"{source}: no moving joint between {short_repr(base)} and {short_repr(tip)}"
         )
     robot = Robot(out, tool=fixed, name=root.get("name") or "urdf_robot",
                   source=f"URDF {source} ({base} -> {tip})")
     robot.link_names = tuple(link_names) + ((tip,) if link_names[-1] != tip else ())
     return robot
+
+
+def _names(names: list[str]) -> str:
+    """At most ten names, each shown bounded (messages stay short for any file)."""
+    shown = ", ".join(short_repr(n, 40) for n in names[:10])
+    return shown + (f" ... ({len(names)} in all)" if len(names) > 10 else "")
 
 
 def _check_tree(root: str, children: dict[str, list[str]], source: str) -> None:
@@ -264,10 +281,9 @@ def _check_tree(root: str, children: dict[str, list[str]], source: str) -> None:
                 todo.append(c)
     if len(reached) != len(children):
         loop = sorted(set(children) - reached)
-        shown = ", ".join(short_repr(x, 40) for x in loop[:5]) + (" ..." if len(loop) > 5 else "")
         raise RobotDefinitionError(
-            f"{source}: the joints form a loop through link(s) {shown} (not reachable from "
-            f"the root link {root!r}); a URDF must be a tree")
+            f"{source}: the joints form a loop through link(s) {_names(loop)} (not reachable from "
+            f"the root link {short_repr(root)}); a URDF must be a tree")
 
 
 def _is_below(link: str, base: str, by_child: dict[str, _UJoint]) -> bool:
