@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from serialkin._checks import short_repr
 from serialkin._files import Field, load_document
 from serialkin.errors import RobotDefinitionError
 from serialkin.model.dh import CONVENTIONS, DHLink
@@ -223,7 +224,7 @@ def robot_to_dict(robot: Any, angle_unit: str = "deg", length_unit: str = "m") -
     check_choice(length_unit, "length_unit", LENGTH_UNITS)
     if robot.dh is None:
         raise RobotDefinitionError(
-            f"robot {robot.name!r} has no DH table; a robot file needs one "
+            f"robot {short_repr(robot.name)} has no DH table; a robot file needs one "
             "(save a URDF with robot.to_urdf() instead)"
         )
     ang, lin = ANGLE_UNITS[angle_unit], LENGTH_UNITS[length_unit]

@@ -46,6 +46,7 @@ from typing import Any
 
 import numpy as np
 
+from serialkin._checks import short_repr
 from serialkin._files import MAX_ITEMS, Field, load_document
 from serialkin.errors import InputError, InputTypeError, SerialkinError
 from serialkin.redundancy.multitask import MultiTaskResolver
@@ -396,7 +397,7 @@ def load_scenario(path_or_name: str | os.PathLike[str]) -> Scenario:
                 if res.is_file():
                     with resources.as_file(res) as real:
                         return load_scenario(real)
-        raise InputError(f"no scenario file {str(path_or_name)!r}; shipped scenarios: "
+        raise InputError(f"no scenario file {short_repr(str(path_or_name))}; shipped scenarios: "
                          f"{', '.join(names)}")
     data = load_document(p, what="scenario", error=ScenarioError)
     return scenario_from_dict(data, source=p.name, base_dir=p.parent)
