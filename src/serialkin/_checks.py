@@ -223,13 +223,75 @@ def check_positive(value: object, name: str, *, allow_zero: bool = False) -> flo
     return v
 
 
-def check_int(value: object, name: str, *, minimum: int = 0) -> int:
-    """Check that ``value`` is an integer >= ``minimum``."""
+#: Largest magnitude of a length [m] in a robot description (DH a and d, the translations
+#: of joint, base and tool transforms): far beyond any robot, far below float overflow in
+#: FK over thousands of links.
+MAX_LENGTH = 1e6
+
+#: Largest magnitude of an angle, joint offset or finite joint limit [rad or m].
+MAX_JOINT_VALUE = 1e9
+
+
+#: Largest integer any option accepts unless it has a tighter bound: exactly representable
+#: in float64 and far inside int64, so nothing that reaches a compiled kernel overflows.
+MAX_INT = 2**53
+
+#: Largest number of joints of a robot: a chain this long already takes seconds to build
+#: and its IK is O(n³) per iteration.
+MAX_JOINTS = 10_000
+
+#: Largest iteration budget (``max_iter``) of any iterative solver, per attempt / point.
+MAX_ITERATIONS = 1_000_000
+
+
+def check_int(value: object, name: str, *, minimum: int = 0, maximum: int | None = MAX_INT,
+              hint: str = "") -> int:
+    """Check that ``value`` is an integer with ``minimum <= value <= maximum``.
+
+    Args:
+        value: the value (bool is refused; Python and numpy integers are accepted).
+        name: the argument's name, used in error messages.
+        minimum: smallest accepted value.
+        maximum: largest accepted value (default :data:`MAX_INT`), or None for no bound.
+        hint: a sentence appended to the "too large" message (e.g. how to raise a bound).
+    """
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise InputTypeError(f"{name} must be an integer, got {_describe(value)}")
     if value < minimum:
         raise InputError(f"{name} must be >= {minimum}, got {short_repr(value)}")
+    if maximum is not None and value > maximum:
+        tail = f" {hint}" if hint else ""
+        raise InputError(f"{name} must be <= {maximum}, got {short_repr(value)}.{tail}")
     return int(value)
+
+
+def check_real(value: object, name: str, *, max_abs: float | None = None,
+               unit: str = "") -> float:
+    """Check that ``value`` is a finite real number with ``|value| <= max_abs``.
+
+    Args:
+        value: the value (bool and strings are refused; Python/numpy ints and floats pass).
+        name: the argument's name, used in error messages.
+        max_abs: largest accepted magnitude, or None for any finite value.
+        unit: unit shown in the message (e.g. 'm').
+
+    Raises:
+        InputTypeError: not a real number.
+        InputError: NaN, infinite, or larger than ``max_abs`` in magnitude.
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InputTypeError(f"{name} must be a number, got {_describe(value)}")
+    u = f" {unit}" if unit else ""
+    try:
+        v = float(value)
+    except OverflowError:  # an integer beyond the float range
+        bound = f"at most {max_abs:g}{u} in magnitude" if max_abs is not None else "finite"
+        raise InputError(f"{name} must be {bound}, got {short_repr(value)}") from None
+    if not np.isfinite(v):
+        raise InputError(f"{name} must be finite, got {short_repr(value)}")
+    if max_abs is not None and abs(v) > max_abs:
+        raise InputError(f"{name} must be at most {max_abs:g}{u} in magnitude, got {v:g}{u}")
+    return v
 
 
 def as_generator(seed: None | int | np.random.Generator) -> np.random.Generator:

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from serialkin._checks import check_choice, check_int, check_positive
+from serialkin._checks import MAX_ITERATIONS, check_choice, check_int, check_positive
 from serialkin.errors import InputError, InputTypeError
 from serialkin.kinematics import _kernels as K
 from serialkin.redundancy.multitask import MultiTaskResolver
@@ -185,7 +185,7 @@ def track(
     accept = check_positive(tolerance, "tolerance")
     conv = check_positive(tol, "tol")
     lam = check_positive(damping, "damping")
-    budget = check_int(max_iter, "max_iter", minimum=1)
+    budget = check_int(max_iter, "max_iter", minimum=1, maximum=MAX_ITERATIONS)
     cap = check_positive(max_step, "max_step")
     check_positive(link_radius, "link_radius", allow_zero=True)
     q_start = (np.zeros(robot.n) if q0 is None
