@@ -8,7 +8,14 @@ from typing import Any
 import click
 import numpy as np
 
-from serialkin.cli.commands import _angle_factor, handle_errors, json_option, quiet_long_option
+from serialkin._checks import short_repr
+from serialkin.cli.commands import (
+    _angle_factor,
+    handle_errors,
+    json_option,
+    memory_budget_option,
+    quiet_long_option,
+)
 from serialkin.cli.io import CLIError, command_help, dumps_json, ensure_dir, parse_numbers
 from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot
 
@@ -38,7 +45,7 @@ def _load_trajectory(path: str, robot: Any) -> tuple[np.ndarray, np.ndarray | No
         traj = Trajectory.load(p)
         if traj.q.shape[1] != robot.n:
             raise CLIError(f"{path}: trajectory has {traj.q.shape[1]} joints but robot "
-                           f"{robot.name!r} has {robot.n}")
+                           f"{short_repr(robot.name)} has {robot.n}")
         return traj.q, traj.targets[:, :3, 3]
     return read_csv_rows(p, "q", robot.n), None
 
@@ -69,6 +76,7 @@ def _is_serialkin_csv(p: Path) -> bool:
 @param_option
 @json_option
 @quiet_long_option
+@memory_budget_option
 @handle_errors
 def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
              scenario: str | None, title: str | None, out: str, open_browser: bool,
