@@ -263,7 +263,11 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
 
 def _names(names: list[str]) -> str:
     """At most ten names, each shown bounded (messages stay short for any file)."""
-    shown = ", ".join(short_repr(n, 40) for n in names[:10])
+    def bare(name: str) -> str:  # the repr without its quotes (escapes kept)
+        r = short_repr(name, 40)
+        return r[1:-1] if len(r) > 1 and r[0] == r[-1] and r[0] in "'\"" else r[1:]
+
+    shown = ", ".join(bare(n) for n in names[:10])
     return shown + (f" ... ({len(names)} in all)" if len(names) > 10 else "")
 
 
