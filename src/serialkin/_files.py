@@ -477,8 +477,9 @@ class Field:
     @staticmethod
     def _number_text(lo: float, hi: float, lo_open: bool, unit: str) -> str:
         u = f" [{unit}]" if unit else ""
-        if lo == 0 and hi == MAX_NUMBER:
-            return f"a number {'>' if lo_open else '>='} 0{u} (at most {_fmt_bound(hi)})"
+        if lo == 0:
+            most = f" (at most {_fmt_bound(hi)})" if hi < math.inf else ""
+            return f"a number {'>' if lo_open else '>='} 0{u}{most}"
         if lo == -MAX_NUMBER and hi == MAX_NUMBER:
             return f"a finite number with |x| <= {_fmt_bound(hi)}{u}"
         return f"a number in {'(' if lo_open else '['}{_fmt_bound(lo)}, {_fmt_bound(hi)}]{u}"

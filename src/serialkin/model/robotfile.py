@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import short_repr
+from serialkin._checks import MAX_JOINT_VALUE, MAX_JOINTS, MAX_LENGTH, short_repr
 from serialkin._files import Field, load_document
 from serialkin.errors import RobotDefinitionError
 from serialkin.model.dh import CONVENTIONS, DHLink
@@ -48,7 +48,7 @@ LENGTH_UNITS: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 #: Suffixes read as robot files (``.urdf`` is read by :mod:`serialkin.model.urdf`).
 ROBOT_FILE_SUFFIXES = (".yaml", ".yml", ".json")
 #: Most rows of a DH table in a robot file or a scenario.
-MAX_DH_ROWS = 10_000
+MAX_DH_ROWS = MAX_JOINTS
 
 _TOP_FIELDS = ("name", "convention", "units", "source", "dh", "base", "tool")
 _ROW_FIELDS = ("a", "alpha", "d", "theta", "type", "qlim", "name")
@@ -59,8 +59,8 @@ def _transform(f: Field, ang: float, lin: float, angle_unit: str, length_unit: s
     """Parse ``{xyz, rpy}`` (either optional) or a 4x4 nested list into a rigid transform."""
     if isinstance(f.value, dict):
         f.mapping({"xyz", "rpy"})
-        xyz = f["xyz"].vector(3, unit=length_unit) * lin if f["xyz"].present else np.zeros(3)
-        rpy = f["rpy"].vector(3, unit=angle_unit) * ang if f["rpy"].present else np.zeros(3)
+        xyz = (_lengths(f["xyz"], 3, length_unit) if f["xyz"].present else np.zeros(3))
+        rpy = (_angles(f["rpy"], 3, angle_unit) if f["rpy"].present else np.zeros(3))
         return make_transform(rpy_to_matrix(rpy), xyz)
     if isinstance(f.value, list) and len(f.value) == 4:
         T = np.array([r.vector(4, unit="matrix row") for r in f.items()])
@@ -77,13 +77,31 @@ def _transform(f: Field, ang: float, lin: float, angle_unit: str, length_unit: s
     raise f.expected("{xyz: [x, y, z], rpy: [roll, pitch, yaw]} or a 4x4 matrix")
 
 
+def _bound(limit: float, factor: float) -> float:
+    """A bound in SI units (``limit``) expressed in the file's units (``factor`` to SI)."""
+    return limit / factor
+
+
+def _lengths(f: Field, size: int, unit: str) -> np.ndarray:
+    """``size`` lengths in ``unit`` as metres, each within ±:data:`MAX_LENGTH` m."""
+    b = _bound(MAX_LENGTH, LENGTH_UNITS[unit])
+    return f.vector(size, lo=-b, hi=b, unit=unit) * LENGTH_UNITS[unit]
+
+
+def _angles(f: Field, size: int, unit: str) -> np.ndarray:
+    """``size`` angles in ``unit`` as radians, each within ±:data:`MAX_JOINT_VALUE` rad."""
+    b = _bound(MAX_JOINT_VALUE, ANGLE_UNITS[unit])
+    return f.vector(size, lo=-b, hi=b, unit=unit) * ANGLE_UNITS[unit]
+
+
 def _limits(f: Field, factor: float, unit: str) -> tuple[float, float]:
     """A joint range ``[lower, upper]`` (null or ±.inf for an open side), times ``factor``."""
     if not isinstance(f.value, list) or len(f.value) != 2:
         raise f.expected(f"a pair [lower, upper] [{unit}] (null or .inf for an open side)")
     lo_f, hi_f = f.items()
-    lo = lo_f.number(unit=unit, allow_inf=True, default=-math.inf)
-    hi = hi_f.number(unit=unit, allow_inf=True, default=math.inf)
+    b = _bound(MAX_JOINT_VALUE, factor)
+    lo = lo_f.number(lo=-b, hi=b, unit=unit, allow_inf=True, default=-math.inf)
+    hi = hi_f.number(lo=-b, hi=b, unit=unit, allow_inf=True, default=math.inf)
     if lo == math.inf:
         raise lo_f.fail("must be a number or null (an open lower side), got +inf")
     if hi == -math.inf:
@@ -118,10 +136,11 @@ def dh_rows_from_field(f: Field, *, angle_unit: str = "rad", length_unit: str = 
             jtype = normalize_joint_type(tf.value if tf.present else "R", tf.path)
         except RobotDefinitionError:
             raise tf.expected("'R' (revolute) or 'P' (prismatic)") from None
-        a = row["a"].number(unit=length_unit) * lin
-        d = row["d"].number(unit=length_unit) * lin
-        alpha = row["alpha"].number(unit=angle_unit) * ang
-        theta = row["theta"].number(unit=angle_unit) * ang
+        bl, ba = _bound(MAX_LENGTH, lin), _bound(MAX_JOINT_VALUE, ang)
+        a = row["a"].number(lo=-bl, hi=bl, unit=length_unit) * lin
+        d = row["d"].number(lo=-bl, hi=bl, unit=length_unit) * lin
+        alpha = row["alpha"].number(lo=-ba, hi=ba, unit=angle_unit) * ang
+        theta = row["theta"].number(lo=-ba, hi=ba, unit=angle_unit) * ang
         qunit, qfac = (angle_unit, ang) if jtype == "R" else (length_unit, lin)
         qlim = (_limits(row["qlim"], qfac, qunit) if row["qlim"].present
                 else (-math.inf, math.inf))

@@ -46,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import short_repr
+from serialkin._checks import MAX_ITERATIONS, MAX_JOINTS, MAX_LENGTH, short_repr
 from serialkin._files import MAX_ITEMS, Field, load_document
 from serialkin.errors import InputError, InputTypeError, SerialkinError
 from serialkin.redundancy.multitask import MultiTaskResolver
@@ -65,11 +65,9 @@ __all__ = [
 ]
 
 #: Most joints of a scenario's robot (planar links or DH rows).
-MAX_LINKS = 10_000
+MAX_LINKS = MAX_JOINTS
 #: Most points of a scenario's path.
 MAX_PATH_POINTS = MAX_ITEMS
-#: Largest iteration budget per path point a scenario may ask for.
-MAX_ITERATIONS = 1_000_000
 
 
 class ScenarioError(InputError):
@@ -169,7 +167,7 @@ def _robot(f: Field, base_dir: FsPath | None):
     if kind == "planar":
         p = sub.mapping({"links", "length"}, ("links", "length"))
         n = p["links"].integer(lo=1, hi=MAX_LINKS)
-        L = p["length"].number(lo=0.0, lo_open=True, unit="m")
+        L = p["length"].number(lo=0.0, lo_open=True, hi=MAX_LENGTH, unit="m")
         robot = planar_arm(n, L, name=name)
     elif kind == "dh":
         rows = dh_rows_from_field(sub, angle_unit="rad", length_unit="m")
@@ -210,7 +208,7 @@ def _count_points(f: Field, length: float, step: float) -> None:
 
 
 def _point(f: Field, what: str = "[x, y]") -> np.ndarray:
-    a = f.require().array(what=what, ndim=1)
+    a = f.require().array(what=what, ndim=1, lo=-MAX_LENGTH, hi=MAX_LENGTH)
     if a.shape != (2,):
         raise f.fail(f"must be {what}, got shape {a.shape}")
     return a
@@ -224,7 +222,7 @@ def _path(f: Field, robot, q0: np.ndarray) -> Path:
     try:
         if kind == "circle":
             c = _point(p["center"])
-            radius = p["radius"].number(lo=0.0, lo_open=True, unit="m")
+            radius = p["radius"].number(lo=0.0, lo_open=True, hi=MAX_LENGTH, unit="m")
             start = p["start"].number(default=0.0, unit="rad")
             stop = p["stop"].number(default=2 * math.pi, unit="rad")
             step = p["step"].number(lo=0.0, lo_open=True, default=0.2, unit="rad")
@@ -233,19 +231,20 @@ def _path(f: Field, robot, q0: np.ndarray) -> Path:
         if kind == "points":
             pts = p["points"].require().array(
                 what="a list of [x, y] or [x, y, z] points", ndim=2, cols=(2, 3),
-                max_items=3 * MAX_PATH_POINTS)
+                max_items=3 * MAX_PATH_POINTS, lo=-MAX_LENGTH, hi=MAX_LENGTH)
             return Path.from_points(pts, task=task)
         if kind == "polyline":
             w = p["waypoints"].require().array(
-                what="a list of [x, y] or [x, y, z] points", ndim=2, cols=(2, 3))
-            step = p["step"].number(lo=0.0, lo_open=True, unit="m")
+                what="a list of [x, y] or [x, y, z] points", ndim=2, cols=(2, 3),
+                lo=-MAX_LENGTH, hi=MAX_LENGTH)
+            step = p["step"].number(lo=0.0, lo_open=True, hi=MAX_LENGTH, unit="m")
             _count_points(p["step"], float(np.linalg.norm(np.diff(w, axis=0), axis=1).sum()),
                           step)
             return Path.polyline(w, step, task=task)
         sf = p["start"].require()
         a = robot.fk(q0)[:2, 3] if sf.value == "q0" else _point(sf, "[x, y] or 'q0'")
         b = _point(p["end"])
-        amp = p["amplitude"].number(default=0.0, unit="m")
+        amp = p["amplitude"].number(lo=-MAX_LENGTH, hi=MAX_LENGTH, default=0.0, unit="m")
         periods = p["periods"].number(default=1.0)
         step = p["step"].number(lo=0.0, lo_open=True, hi=1.0, default=0.02)
         _count_points(p["step"], 1.0, step)
