@@ -9,7 +9,7 @@ from typing import Any
 import click
 import numpy as np
 
-from serialkin._checks import short_repr
+from serialkin._checks import check_positive, short_repr
 from serialkin.cli.commands import (
     check_out_folder,
     handle_errors,
@@ -131,6 +131,9 @@ def workspace_cmd(robot: str, kind: str, samples: int | None, seed: int, cell: f
     r = resolve_robot(robot, params)
     planar = bool(r.is_planar)
     # every option is checked before anything is computed or written
+    margin = check_positive(margin, "--margin", allow_zero=True)
+    if max_angle is not None:
+        max_angle = check_positive(max_angle, "--max-angle", allow_zero=True)
     if slices and planar:
         raise CLIError("--slice applies to spatial robots; this robot is planar")
     parsed_slices = [_parse_slice(s) for s in slices]

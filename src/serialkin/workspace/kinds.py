@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from serialkin._budget import check_allocation
 from serialkin._checks import (
     as_float_array,
     as_generator,
@@ -325,6 +326,7 @@ def _orientation_set(orientations: int | Sequence[object], planar: bool, rng: An
                      ) -> list[np.ndarray]:
     if isinstance(orientations, (int, np.integer)) and not isinstance(orientations, bool):
         k = check_int(orientations, "orientations", minimum=1)
+        check_allocation("the orientation set", (k, 3, 3), 8, setting="orientations")
         if planar:
             return [rotz(phi) for phi in -np.pi + 2 * np.pi * np.arange(k) / k]
         return list(random_rotations(k, rng))
@@ -383,6 +385,8 @@ def dexterous_workspace(robot: Any, orientations: int | Sequence[object] | None 
         per = max(100_000, _default_samples(None, pl) // K)
     else:
         per = check_int(samples, "samples", minimum=1)
+    check_allocation("the workspace samples", (K * per, robot.n + 16), 8,
+                     setting="samples × orientations")
     task = manipulability_task(robot, pl)
     parts = []
     for k, R_t in enumerate(Rs):
