@@ -169,6 +169,8 @@ def test_size_limit_and_non_files(tmp_path):
     latin = write(tmp_path, "latin.yaml", "name: caf\xe9\n".encode("latin-1"))
     assert "not UTF-8" in fails(load_robot_file, latin)
     assert "not UTF-8" in fails(load_scenario, write(tmp_path, "s.yaml", b"robot: \xff\n"))
+    assert "got int 5" in fails(load_scenario, 5)
+    assert "got NoneType None" in fails(load_robot_file, None)
 
 
 def test_yaml_tags_never_execute(tmp_path):

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from serialkin._checks import short_repr
-from serialkin.errors import InputError, SerialkinError
+from serialkin.errors import InputError, InputTypeError, SerialkinError
 
 __all__ = [
     "MAX_DEPTH",
@@ -59,7 +59,7 @@ MAX_FILE_BYTES = 16 * 1024 * 1024
 #: Deepest nesting of lists and mappings accepted in a YAML or JSON document.
 MAX_DEPTH = 64
 #: Most nodes (scalars, lists, mappings) in a document once every YAML alias is expanded.
-MAX_NODES = 2_000_000
+MAX_NODES = 4_000_000
 #: Most items in one list of a document (rows, points, obstacles).
 MAX_ITEMS = 1_000_000
 #: Default bound on the magnitude of a number read from a file (in the file's units):
@@ -98,6 +98,9 @@ def read_bytes(path: str | os.PathLike[str], *, what: str = "file",
         error: the file does not exist, is a folder or a device, is larger than
             ``max_bytes``, or cannot be read (the message names the path and the reason).
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputTypeError(f"the {what} path must be a str or os.PathLike, got "
+                             f"{type(path).__name__} {short_repr(path)}")
     p = Path(path)
     try:
         st = p.stat()

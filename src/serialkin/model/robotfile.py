@@ -36,7 +36,7 @@ import numpy as np
 
 from serialkin._checks import MAX_JOINT_VALUE, MAX_JOINTS, MAX_LENGTH, short_repr
 from serialkin._files import Field, load_document
-from serialkin.errors import RobotDefinitionError
+from serialkin.errors import InputTypeError, RobotDefinitionError
 from serialkin.model.dh import CONVENTIONS, DHLink
 from serialkin.model.joint import normalize_joint_type
 from serialkin.spatial import make_transform, rpy_to_matrix
@@ -201,6 +201,9 @@ def read_robot_data(path: str | os.PathLike[str]) -> object:
     :data:`~serialkin._files.MAX_FILE_BYTES`, UTF-8, no duplicate keys, bounded nesting
     and alias expansion.
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputTypeError(f"path must be a str or os.PathLike, got {type(path).__name__} "
+                             f"{short_repr(path)}")
     p = Path(path)
     if p.suffix.lower() not in ROBOT_FILE_SUFFIXES:
         raise RobotDefinitionError(

@@ -387,6 +387,9 @@ def load_scenario(path_or_name: str | os.PathLike[str]) -> Scenario:
         ScenarioError: unreadable or malformed file (the message names the file and field).
         InputError: no such file and no shipped scenario of that name.
     """
+    if not isinstance(path_or_name, (str, os.PathLike)):
+        raise InputTypeError("path_or_name must be a file path or a shipped scenario name, "
+                             f"got {type(path_or_name).__name__} {short_repr(path_or_name)}")
     p = FsPath(path_or_name)
     if not p.exists():
         names = list_scenarios()
