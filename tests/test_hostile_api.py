@@ -312,3 +312,18 @@ def test_budget_configuration(monkeypatch):
         set_memory_budget(None)
     monkeypatch.delenv("SERIALKIN_MEMORY_BUDGET")
     assert 0 < memory_budget() < math.inf
+
+
+def test_eq49_weights_one_sided_limits():
+    """Eq 49 weights: a one-sided joint is weighted near its finite end only, like a 2π range."""
+    from serialkin.redundancy.multitask import joint_limit_repulsion, joint_limit_weights
+
+    lim = np.array([[-np.inf, 1.0], [-1.0, np.inf], [-np.inf, np.inf], [-1.0, -1.0 + 2 * np.pi]])
+    near = np.array([0.99, -0.99, 0.0, -0.99])
+    far = np.array([-3.0, 3.0, 100.0, 2.0])
+    w_near = joint_limit_weights(near, lim)
+    assert w_near[0] > 0 and w_near[1] > 0 and w_near[2] == 0
+    assert w_near[0] == pytest.approx(w_near[3]) and w_near[1] == pytest.approx(w_near[3])
+    np.testing.assert_array_equal(joint_limit_weights(far, lim), 0.0)
+    push = joint_limit_repulsion(near, lim)
+    assert push[0] < 0 < push[1] and push[2] == 0

@@ -216,7 +216,10 @@ def check_positive(value: object, name: str, *, allow_zero: bool = False) -> flo
     """Check that ``value`` is a finite real number > 0 (or >= 0 with ``allow_zero``)."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise InputTypeError(f"{name} must be a real number, got {_describe(value)}")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:  # an integer beyond the float range
+        v = float("inf")
     if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
         want = ">= 0" if allow_zero else "> 0"
         raise InputError(f"{name} must be a finite number {want}, got {short_repr(value)}")
@@ -298,6 +301,10 @@ def as_generator(seed: None | int | np.random.Generator) -> np.random.Generator:
     """Return a numpy Generator for ``seed`` (None: fresh entropy; int: reproducible)."""
     if isinstance(seed, np.random.Generator):
         return seed
-    if seed is None or (isinstance(seed, (int, np.integer)) and not isinstance(seed, bool)):
-        return np.random.default_rng(seed)
+    if seed is None:
+        return np.random.default_rng()
+    if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+        if seed < 0:
+            raise InputError(f"seed must be >= 0, got {short_repr(seed)}")
+        return np.random.default_rng(int(seed))
     raise InputTypeError(f"seed must be None, an int or a numpy Generator, got {_describe(seed)}")

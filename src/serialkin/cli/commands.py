@@ -116,8 +116,8 @@ def check_out_folder(folder: str | os.PathLike[str]) -> Path:
             break
         probe = probe.parent
     if probe.exists() and not probe.is_dir():
-        what = "exists and is not a folder" if probe == d else f"is under the file {probe}"
-        raise CLIError(f"output folder {d} {what}")
+        raise CLIError(f"output folder {d} exists and is not a folder" if probe == d else
+                       f"cannot create output folder {d}: {probe} is a file")
     if probe.exists() and not os.access(probe, os.W_OK | os.X_OK):
         raise CLIError(f"output folder {d} is not writable" if probe == d else
                        f"cannot create output folder {d}: {probe} is not writable")

@@ -7,7 +7,8 @@ from typing import Any
 import click
 import numpy as np
 
-from serialkin._checks import short_repr
+from serialkin._budget import check_allocation
+from serialkin._checks import check_int, short_repr
 from serialkin.cli.commands import (
     _target_rows,
     _target_sizes,
@@ -111,8 +112,8 @@ def compare_cmd(robot: str, count: int, kind: str, target_file: str | None,
         rows = list(read_csv_rows(target_file, "targets", _target_sizes(planar)))
         targets: Any = np.array(_target_rows(r, rows, False, planar))
     else:
-        if count < 1:
-            raise CLIError(f"--targets must be >= 1, got {count}")
+        count = check_int(count, "--targets", minimum=1)
+        check_allocation("the random targets", (count, r.n + 16), 8, setting="--targets")
         if kind == "auto":
             kind = ("planar_pose" if r.n >= 3 else "planar") if planar else "pose"
         if kind.startswith("planar") and not planar:

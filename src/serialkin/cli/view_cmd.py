@@ -11,6 +11,7 @@ import numpy as np
 from serialkin._checks import short_repr
 from serialkin.cli.commands import (
     _angle_factor,
+    check_out_folder,
     handle_errors,
     json_option,
     memory_budget_option,
@@ -93,18 +94,22 @@ def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
         sc = load_scenario(scenario)
         r = resolve_robot(robot, params) if robot is not None else sc.robot
         obstacles = tuple(sc.obstacles)
-        if trajectory is None:
-            traj = sc.run()
-            Q, path_points = traj.q, traj.targets[:, :3, 3]
         title = title or sc.name
     elif robot is None:
         raise CLIError("missing ROBOT (or --scenario): " + ROBOT_HELP)
     else:
         r = resolve_robot(robot, params)
+    # every input is checked before the scenario runs and before the page is written
+    q = parse_numbers(q_text, "--q", r.n) * _angle_factor(r, degrees) if q_text else None
+    if Path(out).is_dir():
+        raise CLIError(f"--out {out}: is a folder; give the page's file name (.html)")
+    check_out_folder(Path(out).parent)
     if trajectory is not None:
         Q, pts = _load_trajectory(trajectory, r)
-        path_points = pts if pts is not None else path_points
-    q = parse_numbers(q_text, "--q", r.n) * _angle_factor(r, degrees) if q_text else None
+        path_points = pts
+    elif scenario is not None:
+        traj = sc.run()
+        Q, path_points = traj.q, traj.targets[:, :3, 3]
     ensure_dir(Path(out).parent)
     path = write_viewer(r, out, q=q, trajectory=Q, path_points=path_points,
                         obstacles=obstacles or None, title=title)
