@@ -212,8 +212,21 @@ def check_choice(value: object, name: str, choices: Iterable[str]) -> str:
     return value
 
 
-def check_positive(value: object, name: str, *, allow_zero: bool = False) -> float:
-    """Check that ``value`` is a finite real number > 0 (or >= 0 with ``allow_zero``)."""
+#: Largest value of any positive real setting (tolerances, dampings, gains, weights, steps,
+#: radii, cell sizes...): beyond it squares and products of settings approach overflow.
+MAX_REAL = 1e9
+
+
+def check_positive(value: object, name: str, *, allow_zero: bool = False,
+                   maximum: float = MAX_REAL) -> float:
+    """Check that ``value`` is a real number > 0 (or >= 0 with ``allow_zero``), <= ``maximum``.
+
+    Args:
+        value: the value (bool is refused; Python/numpy ints and floats are accepted).
+        name: the argument's name, used in error messages.
+        allow_zero: accept 0.
+        maximum: largest accepted value (default :data:`MAX_REAL`, 1e9).
+    """
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise InputTypeError(f"{name} must be a real number, got {_describe(value)}")
     try:
@@ -223,6 +236,8 @@ def check_positive(value: object, name: str, *, allow_zero: bool = False) -> flo
     if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
         want = ">= 0" if allow_zero else "> 0"
         raise InputError(f"{name} must be a finite number {want}, got {short_repr(value)}")
+    if v > maximum:
+        raise InputError(f"{name} must be at most {maximum:g}, got {v:g}")
     return v
 
 

@@ -300,11 +300,19 @@ def run_attempts(spec: MethodSpec, problem: IKProblem, q0: np.ndarray | None, ma
     return q, success, total, pe, oe, reason, used
 
 
+def _same_options(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
+    """True when two option mappings hold the same plain values (arrays never compare)."""
+    plain = (bool, int, float, str)
+    return a.keys() == b.keys() and all(
+        type(a[k]) is type(b[k]) and isinstance(a[k], plain) and a[k] == b[k] for k in a)
+
+
 def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
     """The method-parameter tail ``cfg[P_DAMPING:]`` of the kernel configuration."""
     from serialkin._checks import check_positive
 
-    if opts is spec.options or opts == spec.options:
+    default = opts is spec.options or _same_options(opts, spec.options)
+    if default:
         cached = _PARAMS.get(spec.name)
         if cached is not None and cached[0] is spec:
             return cached[1]
@@ -319,7 +327,7 @@ def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
                                      maximum=MAX_ITERATIONS)
     p[K.P_MAX_STEP - base] = check_positive(opts.get("max_step", 0.5), "max_step")
     p[K.P_RCOND - base] = check_positive(opts.get("rcond", 1e-10), "rcond")
-    if opts == spec.options:
+    if default:
         p.setflags(write=False)
         _PARAMS[spec.name] = (spec, p)
     return p

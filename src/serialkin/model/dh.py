@@ -157,8 +157,8 @@ def row_joint_type(row: Mapping[str, Any], where: str) -> str:
             given[key] = normalize_joint_type(row[key], f"{where}: field {key!r}")
     if "sigma" in row:
         sigma = row["sigma"]
-        if isinstance(sigma, bool) or sigma not in (0, 1) or not isinstance(
-                sigma, (int, float, np.integer, np.floating)):
+        if isinstance(sigma, bool) or not isinstance(
+                sigma, (int, float, np.integer, np.floating)) or sigma not in (0, 1):
             raise RobotDefinitionError(
                 f"{where}: field 'sigma' must be 0 (revolute) or 1 (prismatic), got "
                 f"{short_repr(sigma)}"

@@ -26,6 +26,7 @@ from serialkin._checks import (
     as_generator,
     check_choice,
     check_int,
+    check_positive,
     short_repr,
 )
 from serialkin.errors import InputError, RobotDefinitionError
@@ -349,7 +350,7 @@ class Robot:
             (6, n) or (..., 6, n).
         """
         if type(q) is np.ndarray and q.dtype is _F64 and q.shape == self._qshape \
-                and link is None and point is None and frame == "base" \
+                and link is None and point is None and type(frame) is str and frame == "base" \
                 and q.flags.c_contiguous:
             J = np.empty((6, self.n))
             T = np.empty((4, 4))
@@ -499,6 +500,7 @@ class Robot:
     def within_limits(self, q: object, tol: float = 0.0) -> np.ndarray | bool:
         """True where ``q`` (..., n) lies inside the joint limits (with tolerance ``tol``)."""
         a = self.check_q(q)
+        tol = check_positive(tol, "tol", allow_zero=True)
         ok = np.all(inside_mask(a, self.qlim[:, 0], self.qlim[:, 1], tol), axis=-1)
         return bool(ok) if ok.ndim == 0 else ok
 

@@ -32,7 +32,7 @@ influence zone) and ``x_L,i = k · (distance into the buffer, signed towards mid
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -363,9 +363,15 @@ class MultiTaskResolver:
             object.__setattr__(self, name, _weight(getattr(self, name), name))
         for name in ("damping", "gain", "max_task_step", "max_step", "tol"):
             object.__setattr__(self, name, check_positive(getattr(self, name), name))
-        if not 0.0 < float(self.limit_buffer) <= 0.5:
-            raise InputError(f"limit_buffer must be in (0, 0.5], got {self.limit_buffer!r}")
+        buffer = check_positive(self.limit_buffer, "limit_buffer")
+        if buffer > 0.5:
+            raise InputError(f"limit_buffer must be in (0, 0.5], got {buffer:g}")
+        object.__setattr__(self, "limit_buffer", buffer)
         check_int(self.max_iter, "max_iter", minimum=1, maximum=MAX_ITERATIONS)
+        if isinstance(self.obstacles, (str, bytes, Mapping)) or not isinstance(
+                self.obstacles, Iterable):
+            raise InputError("obstacles must be a list of Circle, Sphere or Capsule, got "
+                             f"{type(self.obstacles).__name__} {short_repr(self.obstacles)}")
         obs = tuple(self.obstacles)
         for i, o in enumerate(obs):
             if not isinstance(o, (Circle, Sphere, Capsule)):

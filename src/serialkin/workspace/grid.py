@@ -209,7 +209,8 @@ def grid_bounds(points: np.ndarray, cell: float) -> tuple[np.ndarray, tuple[int,
     """
     lo = points.min(axis=0) - cell
     hi = points.max(axis=0) + cell
-    ratios = [float(r) for r in (hi - lo) / cell]
+    with np.errstate(over="ignore"):  # an overflowing extent counts as too many cells
+        ratios = [float(r) for r in (hi - lo) / cell]
     shape = tuple(max(math.ceil(r), 1) if math.isfinite(r) and r < MAX_INT else MAX_INT
                   for r in ratios)
     check_grid_size(shape)

@@ -21,7 +21,7 @@ world frame (base transform included, tool point = the robot's tool frame origin
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -34,8 +34,9 @@ from serialkin._checks import (
     check_int,
     check_positive,
     check_rotation,
+    short_repr,
 )
-from serialkin.errors import InputError
+from serialkin.errors import InputError, InputTypeError
 from serialkin.spatial.transforms import rotz
 from serialkin.workspace.grid import (
     MeasureEstimate,
@@ -330,6 +331,9 @@ def _orientation_set(orientations: int | Sequence[object], planar: bool, rng: An
         if planar:
             return [rotz(phi) for phi in -np.pi + 2 * np.pi * np.arange(k) / k]
         return list(random_rotations(k, rng))
+    if isinstance(orientations, (str, bytes)) or not isinstance(orientations, Iterable):
+        raise InputTypeError("orientations must be a count or a list of orientations, got "
+                             f"{type(orientations).__name__} {short_repr(orientations)}")
     out = [_target_rotation(o, planar) for o in orientations]
     if not out:
         raise InputError("orientations is empty; give a count or at least one orientation")
