@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import serialkin as sk
@@ -327,3 +327,68 @@ def test_eq49_weights_one_sided_limits():
     np.testing.assert_array_equal(joint_limit_weights(far, lim), 0.0)
     push = joint_limit_repulsion(near, lim)
     assert push[0] < 0 < push[1] and push[2] == 0
+
+
+# ---------------------------------------------------------------- fuzzing the API
+_WEIRD = st.one_of(
+    st.none(), st.booleans(), st.integers(-(2**70), 2**70), st.floats(), st.text(max_size=8),
+    st.binary(max_size=4), st.lists(st.floats(), max_size=4),
+    st.lists(st.one_of(st.none(), st.floats(), st.text(max_size=2)), min_size=2, max_size=2),
+    st.sampled_from([(np.inf, np.inf), {"a": 1}, np.zeros((2, 2)), np.array([1, 2]), 10**400,
+                     object(), complex(1, 2)]),
+)
+
+
+def _library_error_or_result(call):
+    """Run ``call``: it returns, or raises a SerialkinError (never another exception)."""
+    try:
+        return call()
+    except SerialkinError:
+        return None
+
+
+@settings(max_examples=150, deadline=None)
+@given(field=st.sampled_from(["a", "alpha", "d", "theta", "type", "qlim", "name", "sigma",
+                              "joint"]), value=_WEIRD)
+def test_fuzz_dh_rows(field, value):
+    """Any value in any DH field: a robot whose FK is finite, or a library error."""
+    r = _library_error_or_result(lambda: sk.Robot.from_dh([dict(ROW, **{field: value})]))
+    if r is not None:
+        assert np.isfinite(r.fk(r.random_q(seed=0))).all()
+        assert np.all(r.qlim[:, 0] <= r.qlim[:, 1])
+
+
+@settings(max_examples=150, deadline=None)
+@given(option=st.sampled_from(["max_iter", "restarts", "tol", "seed", "q0", "mask",
+                               "respect_limits", "damping", "stall_window", "max_step",
+                               "polish", "method"]), value=_WEIRD)
+def test_fuzz_ik_options(option, value):
+    """Any value for any IK option: an honest result, or a library error."""
+    r = sk.models.planar(3, qlim=(-2.0, np.inf))
+    kw = {option: value} if option == "max_iter" else {option: value, "max_iter": 50}
+    res = _library_error_or_result(lambda: r.ik([1.0, 1.0], **kw))
+    if res is not None and res.success:
+        tol = float(value) if option == "tol" and value is not None else 1e-6
+        assert np.linalg.norm(r.fk(res.q)[:2, 3] - [1.0, 1.0]) <= tol * (1 + 1e-9) + 1e-12
+        if option != "respect_limits":
+            assert r.within_limits(res.q)
+
+
+@settings(max_examples=100, deadline=None)
+@given(call=st.sampled_from(["random_q", "manipulability", "jacobian_link", "with_limits",
+                             "within_limits", "circle_step", "planar_n"]), value=_WEIRD)
+def test_fuzz_robot_and_path_calls(call, value):
+    """Any argument to sizes, tasks, links, limits, steps: a result or a library error."""
+    from serialkin.tracking.path import Path
+
+    r = sk.models.planar(3)
+    calls = {
+        "random_q": lambda: r.random_q(value, seed=0),
+        "manipulability": lambda: r.manipulability(np.zeros(3), task=value),
+        "jacobian_link": lambda: r.jacobian(np.zeros(3), link=value),
+        "with_limits": lambda: r.with_limits(value),
+        "within_limits": lambda: r.within_limits(np.zeros(3), tol=value),
+        "circle_step": lambda: Path.circle([0, 0], 1.0, step=value),
+        "planar_n": lambda: sk.models.planar(value),
+    }
+    _library_error_or_result(calls[call])
