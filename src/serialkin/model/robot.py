@@ -300,6 +300,7 @@ class Robot:
             K.fk_into(np.ascontiguousarray(a), self._F, self._meta, T)
             return T
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
+        check_allocation("the FK batch", (flat.shape[0], 4, 4), 8, setting="the batch size")
         out = np.empty((flat.shape[0], 4, 4))
         kernel = K.fk_batch if flat.shape[0] >= PARALLEL_MIN_BATCH else K.fk_batch_serial
         kernel(flat, self._F, self._meta, out)
@@ -316,6 +317,8 @@ class Robot:
         """
         a = self.check_q(q)
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
+        check_allocation("the link frames", (flat.shape[0], self.n + 1, 4, 4), 8,
+                         setting="the batch size")
         out = np.empty((flat.shape[0], self.n + 1, 4, 4))
         if flat.shape[0] < PARALLEL_MIN_BATCH:
             for k in range(flat.shape[0]):
@@ -363,6 +366,7 @@ class Robot:
         a = self.check_q(q)
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
         N = flat.shape[0]
+        check_allocation("the Jacobian batch", (N, 6 * self.n + 16), 8, setting="the batch size")
         J = np.empty((N, 6, self.n))
         T = np.empty((N, 4, 4))
         if link is None:
