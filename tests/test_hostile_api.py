@@ -392,3 +392,17 @@ def test_fuzz_robot_and_path_calls(call, value):
         "planar_n": lambda: sk.models.planar(value),
     }
     _library_error_or_result(calls[call])
+
+
+@pytest.mark.parametrize("qlim", [(-np.inf, 0.3), (-0.2, 0.4), (0.1, np.inf)])
+def test_dls_tracking_stays_inside_limits(qlim):
+    """DLS tracking projects every step onto the limits: no recorded q leaves them."""
+    from serialkin.tracking import track
+    from serialkin.tracking.path import Path
+
+    r = sk.models.planar(4, 0.3, qlim=qlim)
+    traj = track(r, Path.circle([0.6, 0.3], 0.3, step=0.3), "dls", q0=np.full(4, 0.2))
+    assert r.within_limits(traj.q).all()
+    assert np.all(traj.min_limit_margin >= 0)
+    for k in np.flatnonzero(traj.reached):
+        assert np.linalg.norm(r.fk(traj.q[k])[:2, 3] - traj.targets[k, :2, 3]) <= 5e-3 + 1e-9
