@@ -406,3 +406,14 @@ def test_dls_tracking_stays_inside_limits(qlim):
     assert np.all(traj.min_limit_margin >= 0)
     for k in np.flatnonzero(traj.reached):
         assert np.linalg.norm(r.fk(traj.q[k])[:2, 3] - traj.targets[k, :2, 3]) <= 5e-3 + 1e-9
+
+
+def test_superlinear_methods_refuse_the_longest_chains():
+    """Methods whose iteration is O(n³) refuse >1000 joints, naming the scalable methods."""
+    r = sk.models.planar(1500, 1.0 / 1500)
+    with pytest.raises(InputError, match="at most 1000 joints.*dls"):
+        r.ik([0.5, 0.5])
+    with pytest.raises(InputError, match="at most 200 joints"):
+        sk.models.planar(300).ik([1.0, 1.0], method="powell")
+    res = r.ik([0.5, 0.5], method="dls", max_iter=5, restarts=0, seed=0)
+    assert res.q.shape == (1500,)

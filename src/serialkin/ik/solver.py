@@ -36,10 +36,10 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import MAX_ITERATIONS, check_int
+from serialkin._checks import MAX_ITERATIONS, check_int, short_repr
 from serialkin.errors import InputError, InputTypeError
 from serialkin.ik import _kernels as K
-from serialkin.ik.registry import MethodSpec, get_method
+from serialkin.ik.registry import MethodSpec, available_methods, get_method
 from serialkin.ik.result import IKResult
 from serialkin.ik.target import (
     DEFAULT_WEIGHTS,
@@ -380,6 +380,14 @@ def solve(
     spec = get_method(method)
     if not isinstance(robot, Robot):
         raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    if spec.max_joints is not None and robot.n > spec.max_joints:
+        scalable = [m for m in available_methods() if get_method(m).max_joints is None
+                    and get_method(m).family != "analytic"]
+        raise InputError(
+            f"method {spec.name!r} takes robots of at most {spec.max_joints} joints (its "
+            f"cost per iteration grows faster than the number of joints); robot "
+            f"{short_repr(robot.name)} has {robot.n}: use one of {', '.join(scalable)}"
+        )
     tgt = parse_target(robot, target, mask)
     if tgt.kind not in spec.targets:
         raise InputError(
