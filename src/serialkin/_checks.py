@@ -10,7 +10,9 @@ validate: they trust what these functions let through.
 from __future__ import annotations
 
 import difflib
-from collections.abc import Iterable, Sequence
+import itertools
+import reprlib
+from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -20,10 +22,94 @@ from serialkin.errors import InputError, InputTypeError
 ROTATION_TOL = 1e-6
 
 
+class _BoundedRepr(reprlib.Repr):
+    """A :class:`reprlib.Repr` that never builds the full repr of a large value.
+
+    Containers are shown to ``maxlevel`` levels and ``maxlist``/``maxdict`` items, so a
+    YAML alias bomb (a list whose items are the same list, nested) costs at most
+    ``maxlist ** maxlevel`` item reprs. Mapping and sequence subclasses go through the same
+    bounded path, huge integers are described by their size, arrays by shape and dtype.
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.maxlevel = 3
+        self.maxlist = self.maxtuple = self.maxset = self.maxfrozenset = 6
+        self.maxdeque = self.maxarray = 6
+        self.maxdict = 4
+        self.maxstring = 40
+        self.maxlong = 40
+        self.maxother = 40
+
+    def repr1(self, x: object, level: int) -> str:
+        if isinstance(x, np.ndarray):
+            return f"<array of shape {x.shape} and dtype {x.dtype}>"
+        if isinstance(x, bool) or x is None:
+            return repr(x)
+        if isinstance(x, int) and x.bit_length() > 128:
+            return f"<integer of about {int(x.bit_length() * 0.30103) + 1} digits>"
+        if isinstance(x, str):
+            return self.repr_str(x, level)
+        if type(x) in (list, tuple, dict, set, frozenset, int, float):
+            return super().repr1(x, level)
+        if isinstance(x, Mapping):  # subclasses too: never their own full repr
+            return self.repr_dict(dict(_first_items(x, self.maxdict + 1)), level)
+        if isinstance(x, (Sequence, set, frozenset)) and not isinstance(x, (bytes, bytearray)):
+            return self.repr_list(list(itertools.islice(x, self.maxlist + 1)), level)
+        return super().repr1(x, level)
+
+    def repr_dict(self, x: dict, level: int) -> str:  # no sort of a huge dict: first items
+        if not x:
+            return "{}"
+        if level <= 0:
+            return "{...}"
+        items = [f"{self.repr1(k, level - 1)}: {self.repr1(v, level - 1)}"
+                 for k, v in _first_items(x, self.maxdict)]
+        more = ", ..." if len(x) > self.maxdict else ""
+        return "{" + ", ".join(items) + more + "}"
+
+
+def _first_items(m: Mapping, count: int) -> list[tuple[object, object]]:
+    out = []
+    for k in m:
+        if len(out) >= count:
+            break
+        out.append((k, m[k]))
+    return out
+
+
+_BOUNDED = _BoundedRepr()
+
+
+def short_repr(value: object, limit: int = 80) -> str:
+    """Return a repr of ``value`` of at most ``limit`` characters, built in bounded time.
+
+    Unlike ``repr(value)[:limit]`` it never builds the full repr: nested containers are
+    cut at 3 levels and 6 items (4 for mappings), strings at 40 characters, integers of
+    more than 128 bits are described by their number of digits, arrays by their shape.
+    Use it for every user-supplied value formatted into an error message.
+
+    Args:
+        value: any object (typically a value read from a user's file or argument).
+        limit: maximum length of the result, in characters (>= 5).
+
+    Returns:
+        A string of at most ``limit`` characters; ``...`` marks a cut.
+    """
+    try:
+        text = _BOUNDED.repr(value)
+    except Exception:  # a user object whose __repr__ fails
+        text = f"<{type(value).__name__} object>"
+    limit = max(int(limit), 5)
+    if len(text) > limit:
+        text = text[: limit - 3] + "..."
+    return text
+
+
 def _describe(x: object) -> str:
     if isinstance(x, np.ndarray):
         return f"an array of shape {x.shape} and dtype {x.dtype}"
-    return f"{type(x).__name__} {x!r}"[:120]
+    return f"{type(x).__name__} {short_repr(x, 100)}"
 
 
 def as_float_array(x: object, name: str, *, ndim: int | None = None) -> np.ndarray:
@@ -116,38 +202,124 @@ def check_choice(value: object, name: str, choices: Iterable[str]) -> str:
     """Check that ``value`` is one of ``choices``; the error lists them and the nearest match."""
     options = list(choices)
     if not isinstance(value, str) or value not in options:
-        near = difflib.get_close_matches(str(value), options, n=1)
+        near = (difflib.get_close_matches(value[:200], options, n=1)
+                if isinstance(value, str) else [])
         hint = f" Did you mean {near[0]!r}?" if near else ""
         raise InputError(
-            f"unknown {name} {value!r}; expected one of: {', '.join(map(repr, options))}.{hint}"
+            f"unknown {name} {short_repr(value)}; expected one of: "
+            f"{', '.join(map(repr, options))}.{hint}"
         )
     return value
 
 
-def check_positive(value: object, name: str, *, allow_zero: bool = False) -> float:
-    """Check that ``value`` is a finite real number > 0 (or >= 0 with ``allow_zero``)."""
+#: Largest value of any positive real setting (tolerances, dampings, gains, weights, steps,
+#: radii, cell sizes...): beyond it squares and products of settings approach overflow.
+MAX_REAL = 1e9
+
+
+def check_positive(value: object, name: str, *, allow_zero: bool = False,
+                   maximum: float = MAX_REAL) -> float:
+    """Check that ``value`` is a real number > 0 (or >= 0 with ``allow_zero``), <= ``maximum``.
+
+    Args:
+        value: the value (bool is refused; Python/numpy ints and floats are accepted).
+        name: the argument's name, used in error messages.
+        allow_zero: accept 0.
+        maximum: largest accepted value (default :data:`MAX_REAL`, 1e9).
+    """
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise InputTypeError(f"{name} must be a real number, got {_describe(value)}")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:  # an integer beyond the float range
+        v = float("inf")
     if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
         want = ">= 0" if allow_zero else "> 0"
-        raise InputError(f"{name} must be a finite number {want}, got {value!r}")
+        raise InputError(f"{name} must be a finite number {want}, got {short_repr(value)}")
+    if v > maximum:
+        raise InputError(f"{name} must be at most {maximum:g}, got {v:g}")
     return v
 
 
-def check_int(value: object, name: str, *, minimum: int = 0) -> int:
-    """Check that ``value`` is an integer >= ``minimum``."""
+#: Largest magnitude of a length [m] in a robot description (DH a and d, the translations
+#: of joint, base and tool transforms): far beyond any robot, far below float overflow in
+#: FK over thousands of links.
+MAX_LENGTH = 1e6
+
+#: Largest magnitude of an angle, joint offset or finite joint limit [rad or m].
+MAX_JOINT_VALUE = 1e9
+
+
+#: Largest integer any option accepts unless it has a tighter bound: exactly representable
+#: in float64 and far inside int64, so nothing that reaches a compiled kernel overflows.
+MAX_INT = 2**53
+
+#: Largest number of joints of a robot: a chain this long already takes seconds to build
+#: and its IK is O(n³) per iteration.
+MAX_JOINTS = 10_000
+
+#: Largest iteration budget (``max_iter``) of any iterative solver, per attempt / point.
+MAX_ITERATIONS = 1_000_000
+
+
+def check_int(value: object, name: str, *, minimum: int = 0, maximum: int | None = MAX_INT,
+              hint: str = "") -> int:
+    """Check that ``value`` is an integer with ``minimum <= value <= maximum``.
+
+    Args:
+        value: the value (bool is refused; Python and numpy integers are accepted).
+        name: the argument's name, used in error messages.
+        minimum: smallest accepted value.
+        maximum: largest accepted value (default :data:`MAX_INT`), or None for no bound.
+        hint: a sentence appended to the "too large" message (e.g. how to raise a bound).
+    """
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise InputTypeError(f"{name} must be an integer, got {_describe(value)}")
     if value < minimum:
-        raise InputError(f"{name} must be >= {minimum}, got {value}")
+        raise InputError(f"{name} must be >= {minimum}, got {short_repr(value)}")
+    if maximum is not None and value > maximum:
+        tail = f" {hint}" if hint else ""
+        raise InputError(f"{name} must be <= {maximum}, got {short_repr(value)}.{tail}")
     return int(value)
+
+
+def check_real(value: object, name: str, *, max_abs: float | None = None,
+               unit: str = "") -> float:
+    """Check that ``value`` is a finite real number with ``|value| <= max_abs``.
+
+    Args:
+        value: the value (bool and strings are refused; Python/numpy ints and floats pass).
+        name: the argument's name, used in error messages.
+        max_abs: largest accepted magnitude, or None for any finite value.
+        unit: unit shown in the message (e.g. 'm').
+
+    Raises:
+        InputTypeError: not a real number.
+        InputError: NaN, infinite, or larger than ``max_abs`` in magnitude.
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InputTypeError(f"{name} must be a number, got {_describe(value)}")
+    u = f" {unit}" if unit else ""
+    try:
+        v = float(value)
+    except OverflowError:  # an integer beyond the float range
+        bound = f"at most {max_abs:g}{u} in magnitude" if max_abs is not None else "finite"
+        raise InputError(f"{name} must be {bound}, got {short_repr(value)}") from None
+    if not np.isfinite(v):
+        raise InputError(f"{name} must be finite, got {short_repr(value)}")
+    if max_abs is not None and abs(v) > max_abs:
+        raise InputError(f"{name} must be at most {max_abs:g}{u} in magnitude, got {v:g}{u}")
+    return v
 
 
 def as_generator(seed: None | int | np.random.Generator) -> np.random.Generator:
     """Return a numpy Generator for ``seed`` (None: fresh entropy; int: reproducible)."""
     if isinstance(seed, np.random.Generator):
         return seed
-    if seed is None or (isinstance(seed, (int, np.integer)) and not isinstance(seed, bool)):
-        return np.random.default_rng(seed)
+    if seed is None:
+        return np.random.default_rng()
+    if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+        if seed < 0:
+            raise InputError(f"seed must be >= 0, got {short_repr(seed)}")
+        return np.random.default_rng(int(seed))
     raise InputTypeError(f"seed must be None, an int or a numpy Generator, got {_describe(seed)}")

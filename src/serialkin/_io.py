@@ -1,19 +1,37 @@
-"""Atomic file output, shared by every writer: write to a temporary file, then rename."""
+"""Atomic file output, shared by every writer: write to a temporary file, then rename.
+
+The temporary file is hidden beside the target, ``.NAME.HOST-PID.XXXXXXXX.tmp``, where
+HOST is a short hash of the machine's name and PID the writer's process id. A writer
+killed between creating it and renaming it (``kill -9``, power loss) leaves it behind;
+the next atomic write of the same target removes such stale files: those of a process
+of this machine that no longer runs, and any (also from other machines or older
+versions, ``.NAME.XXXXXXXX.tmp``) not modified for :data:`STALE_AFTER` seconds. The
+temporary file of a writer that still runs is never touched, so concurrent writers of
+one target do not break each other (the last rename wins).
+"""
 
 from __future__ import annotations
 
+import hashlib
 import os
+import re
+import socket
 import tempfile
+import time
 from pathlib import Path
 
 from serialkin.errors import OutputError
+
+#: Age [s] after which any leftover temporary file of a target is removed.
+STALE_AFTER = 24 * 3600.0
 
 
 def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
     """Write ``data`` to ``path`` through a temporary file in the same folder and a rename.
 
     An interrupted run never leaves a truncated file: readers see the old file or the new
-    one. Parent folders are created.
+    one. Parent folders are created. Stale temporary files of earlier, killed writes of
+    the same target are removed first (see the module docstring).
 
     Raises:
         OutputError: the folder cannot be created or written (the message names the path).
@@ -21,7 +39,9 @@ def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
     out = Path(path)
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
+        remove_stale_temporaries(out)
+        fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{_stem(out)}.{_writer_tag()}.",
+                                   suffix=".tmp")
     except OSError as exc:
         raise OutputError(f"cannot write {str(out)!r}: {exc.strerror or exc}") from exc
     try:
@@ -44,6 +64,87 @@ def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
 def write_text_atomic(path: str | Path, text: str) -> Path:
     """Write UTF-8 ``text`` to ``path`` atomically (see :func:`write_bytes_atomic`)."""
     return write_bytes_atomic(path, text.encode("utf-8"))
+
+
+def remove_stale_temporaries(target: str | Path, *, now: float | None = None) -> list[Path]:
+    """Remove the stale temporary files that killed writes of ``target`` left beside it.
+
+    A temporary file ``.NAME.HOST-PID.XXXXXXXX.tmp`` is stale when HOST is this machine
+    and process PID no longer runs (PID reuse only delays the removal), or when it has
+    not been modified for :data:`STALE_AFTER` seconds; an old-style
+    ``.NAME.XXXXXXXX.tmp`` only by age. Files of running writers are kept. Errors
+    (a file removed meanwhile by another writer, a folder that cannot be listed) are
+    ignored: cleaning up never makes a write fail.
+
+    Args:
+        target: the file whose leftovers are removed.
+        now: the current time [s since the epoch] (default: the clock).
+
+    Returns:
+        The files removed.
+    """
+    out = Path(target)
+    pattern = re.compile(re.escape(f".{_stem(out)}.") +
+                         r"(?:(?P<host>[0-9a-f]{8})-(?P<pid>[0-9]+)\.)?[A-Za-z0-9_]{8}\.tmp\Z")
+    now = time.time() if now is None else now
+    removed: list[Path] = []
+    try:
+        entries = list(os.scandir(out.parent))
+    except OSError:
+        return removed
+    me = _host_tag()
+    for entry in entries:
+        m = pattern.match(entry.name)
+        if m is None:
+            continue
+        try:
+            age = now - entry.stat(follow_symlinks=False).st_mtime
+            pid = int(m["pid"]) if m["pid"] is not None else None
+            dead = (pid is not None and m["host"] == me and pid != os.getpid()
+                    and not _process_runs(pid))
+            if dead or age > STALE_AFTER:
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+        except (OSError, ValueError):
+            continue
+    return removed
+
+
+def _stem(out: Path) -> str:
+    """The target's name as used in its temporary files (cut so they fit in 255 bytes)."""
+    name = out.name
+    while len(name.encode("utf-8", "surrogateescape")) > 200:
+        name = name[: len(name) // 2]
+    return name
+
+
+def _process_runs(pid: int) -> bool:
+    """True when process ``pid`` exists on this machine (whoever owns it)."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, OSError):
+        return True  # exists but belongs to another user, or cannot tell: keep the file
+    return True
+
+
+_HOST_TAG: str | None = None
+
+
+def _host_tag() -> str:
+    """8 hex digits identifying this machine (a hash of its host name)."""
+    global _HOST_TAG
+    if _HOST_TAG is None:
+        _HOST_TAG = hashlib.sha256(socket.gethostname().encode("utf-8", "replace")
+                                   ).hexdigest()[:8]
+    return _HOST_TAG
+
+
+def _writer_tag() -> str:
+    return f"{_host_tag()}-{os.getpid()}"
 
 
 def _umask() -> int:

@@ -29,6 +29,15 @@ class RobotDefinitionError(InputError):
     """
 
 
+class BudgetError(InputError):
+    """A size derived from the input would need more memory than the budget allows.
+
+    Sizes are those of samples, grid cells, path points, links (see
+    :mod:`serialkin._budget`). The message names the setting, the estimated size and
+    the budget, and how to raise it.
+    """
+
+
 class OutputError(SerialkinError, OSError):
     """An output file or folder cannot be written (the message names the path)."""
 

@@ -134,7 +134,7 @@ def test_obstacle_construction_errors():
         Circle([0, 0], 1.0, influence=-0.1)
     with pytest.raises(InputError, match="obstacle.type"):
         obstacle_from_dict({"type": "cube"})
-    with pytest.raises(InputError, match="obstacle.radius is missing"):
+    with pytest.raises(InputError, match="'obstacle.radius' is missing"):
         obstacle_from_dict({"type": "circle", "center": [0, 0]})
     with pytest.raises(InputError, match="unknown field"):
         obstacle_from_dict({"type": "circle", "center": [0, 0], "radius": 1, "colour": "r"})

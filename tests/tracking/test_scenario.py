@@ -56,7 +56,7 @@ def test_yaml_and_json_agree(tmp_path):
      "'solver.obstacle_weight' must be a number >= 0"),
     (lambda d: d.update(solver={"method": "dls", "damping": "big"}), "'solver.damping'"),
     (lambda d: d.update(obstacles=[{"type": "circle", "center": [0.2, 0.0]}]),
-     "obstacles[0].radius is missing"),
+     "'obstacles[0].radius' is missing"),
     (lambda d: d.update(obstacles=[{"type": "circle", "center": [0.0, 0.0], "radius": 0.05}]),
      "overlaps the robot base"),
 ])

@@ -9,7 +9,9 @@ JSON (no NaN/inf). Exit codes: 0 success, 1 an IK target not reached, 2 bad inpu
 from __future__ import annotations
 
 import functools
+import os
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import click
@@ -29,26 +31,117 @@ from serialkin.cli.io import (
 from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot, robot_argument
 from serialkin.errors import SerialkinError
 
+#: Longest error message printed [characters]: a message is one line, cut beyond this.
+MAX_ERROR_CHARS = 2000
+
+
+def one_line(message: str) -> str:
+    """``message`` on one line, at most :data:`MAX_ERROR_CHARS` characters.
+
+    Line breaks, tabs and runs of spaces become one space.
+    """
+    text = " ".join(str(message).split())
+    if len(text) > MAX_ERROR_CHARS:
+        text = text[: MAX_ERROR_CHARS - 3] + "..."
+    return text
+
+
+def cli_error(exc: BaseException) -> CLIError:
+    """The one-line ``Error: ...`` (exit 2) for an exception raised under a subcommand.
+
+    Library errors (:class:`~serialkin.errors.SerialkinError`) keep their message; OS
+    errors name the file and the reason (a full disk, a read-only folder...); running out
+    of memory or recursion depth, and any other exception, are described in one line.
+    """
+    if isinstance(exc, CLIError):
+        return CLIError(one_line(exc.message))
+    if isinstance(exc, SerialkinError):
+        return CLIError(one_line(str(exc)))
+    if isinstance(exc, PermissionError):
+        return CLIError(one_line(f"permission denied: {exc.filename or exc}"))
+    if isinstance(exc, OSError):
+        where = f"{exc.filename}: " if exc.filename else ""
+        return CLIError(one_line(f"{where}{exc.strerror or exc}"))
+    if isinstance(exc, MemoryError):
+        return CLIError("out of memory; reduce the sizes asked for (samples, cells, path "
+                        "points) or the memory budget (--memory-budget, "
+                        "SERIALKIN_MEMORY_BUDGET)")
+    if isinstance(exc, RecursionError):
+        return CLIError("the input is nested too deeply")
+    return CLIError(one_line(f"unexpected {type(exc).__name__}: {exc}"))
+
+
+#: Exceptions that pass through :func:`handle_errors` unchanged: click's own exits and
+#: usage errors, a closed output pipe, Ctrl-C, sys.exit.
+PASS_THROUGH = (click.exceptions.Exit, click.exceptions.Abort, click.UsageError,
+                BrokenPipeError, KeyboardInterrupt, SystemExit, GeneratorExit)
+
 
 def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """Turn library input errors and OS errors into one clear ``Error:`` line (exit 2)."""
+    """Turn every error under a subcommand into one clear ``Error:`` line (exit 2).
+
+    See :func:`cli_error`; click's usage errors, exits and a broken pipe pass through.
+    """
 
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
             return fn(*args, **kwargs)
-        except SerialkinError as exc:
-            raise CLIError(str(exc)) from exc
-        except BrokenPipeError:  # output piped into e.g. head: click exits quietly
+        except PASS_THROUGH:
             raise
-        except PermissionError as exc:
-            raise CLIError(f"permission denied: {exc.filename or exc}") from exc
-        except OSError as exc:
-            where = f"{exc.filename}: " if exc.filename else ""
-            raise CLIError(f"{where}{exc.strerror or exc}") from exc
+        except click.ClickException as exc:
+            if isinstance(exc, CLIError):
+                raise cli_error(exc) from exc
+            raise CLIError(one_line(exc.format_message())) from exc
+        except Exception as exc:
+            raise cli_error(exc) from exc
 
     return wrapper
 
+
+def check_out_folder(folder: str | os.PathLike[str]) -> Path:
+    """Check that ``folder`` is a writable folder or can be created, creating nothing.
+
+    :func:`~serialkin.cli.io.ensure_dir` creates it later, just before the first file is
+    written, so a run refused by a later check leaves nothing behind. Returns ``folder``.
+
+    Raises:
+        CLIError: ``folder`` (or a parent) is a file, or the nearest existing parent is
+            not a writable folder.
+    """
+    d = Path(folder) if str(folder) else Path(".")
+    probe = d
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if probe.exists() and not probe.is_dir():
+        raise CLIError(f"output folder {d} exists and is not a folder" if probe == d else
+                       f"cannot create output folder {d}: {probe} is a file")
+    if probe.exists() and not os.access(probe, os.W_OK | os.X_OK):
+        raise CLIError(f"output folder {d} is not writable" if probe == d else
+                       f"cannot create output folder {d}: {probe} is not writable")
+    return d
+
+
+def set_budget(ctx: click.Context, param: click.Parameter, value: str | None) -> None:
+    """Callback of ``--memory-budget``: set (or, when absent, reset) the process budget."""
+    from serialkin._budget import set_memory_budget
+    from serialkin.errors import InputError
+
+    if value is None and ctx.parent is not None:
+        return  # a subcommand without the option keeps what the group set
+    try:
+        set_memory_budget(value)
+    except InputError as exc:
+        raise CLIError(f"--memory-budget: {exc}") from None
+
+
+#: ``--memory-budget SIZE`` on a subcommand (the group has it too): see :mod:`serialkin._budget`.
+memory_budget_option = click.option(
+    "--memory-budget", metavar="SIZE", expose_value=False, callback=set_budget,
+    help="Largest memory this run may plan to allocate, e.g. 8G, 500M or unlimited "
+         "(default: half the available memory, or $SERIALKIN_MEMORY_BUDGET).")
 
 json_option = click.option("--json", "as_json", is_flag=True,
                            help="Print the results as JSON (SI units) instead of a table.")
@@ -203,6 +296,7 @@ def _show_robot(r: Any) -> None:
               show_default=True, help="Length unit of a saved robot file.")
 @param_option
 @json_option
+@memory_budget_option
 @handle_errors
 def models_cmd(robot: str | None, save: str | None, angle_unit: str, length_unit: str,
                params: tuple[str, ...], as_json: bool) -> None:
@@ -291,6 +385,7 @@ _FK_CMD_HELP = command_help(
 @json_option
 @out_option
 @quiet_long_option
+@memory_budget_option
 @handle_errors
 def fk_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frames: bool,
            degrees: bool, params: tuple[str, ...], as_json: bool, out: str | None,
@@ -369,6 +464,7 @@ _JACOBIAN_CMD_HELP = command_help(
 @json_option
 @out_option
 @quiet_long_option
+@memory_budget_option
 @handle_errors
 def jacobian_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frame: str,
                  link: int | None, point: str | None, planar: bool, task: str, degrees: bool,
@@ -515,6 +611,7 @@ _IK_CMD_HELP = command_help(
 @json_option
 @out_option
 @quiet_option
+@memory_budget_option
 @handle_errors
 def ik_cmd(robot: str | None, targets: tuple[str, ...], target_file: str | None, method: str,
            q0: str | None, mask: str | None, tol: float | None, max_iter: int | None,

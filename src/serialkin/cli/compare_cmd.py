@@ -7,11 +7,14 @@ from typing import Any
 import click
 import numpy as np
 
+from serialkin._budget import check_allocation
+from serialkin._checks import check_int, short_repr
 from serialkin.cli.commands import (
     _target_rows,
     _target_sizes,
     handle_errors,
     json_option,
+    memory_budget_option,
     out_option,
     quiet_option,
 )
@@ -94,6 +97,7 @@ def _write_table(out: str, data: dict[str, Any]) -> Any:
 @json_option
 @out_option
 @quiet_option
+@memory_budget_option
 @handle_errors
 def compare_cmd(robot: str, count: int, kind: str, target_file: str | None,
                 methods: str | None, seed: int, tol: float, max_iter: int | None,
@@ -108,17 +112,18 @@ def compare_cmd(robot: str, count: int, kind: str, target_file: str | None,
         rows = list(read_csv_rows(target_file, "targets", _target_sizes(planar)))
         targets: Any = np.array(_target_rows(r, rows, False, planar))
     else:
-        if count < 1:
-            raise CLIError(f"--targets must be >= 1, got {count}")
+        count = check_int(count, "--targets", minimum=1)
+        check_allocation("the random targets", (count, r.n + 16), 8, setting="--targets")
         if kind == "auto":
             kind = ("planar_pose" if r.n >= 3 else "planar") if planar else "pose"
         if kind.startswith("planar") and not planar:
-            raise CLIError(f"--kind {kind} needs a planar robot; {r.name!r} is spatial")
+            raise CLIError(f"--kind {kind} needs a planar robot; {short_repr(r.name)} is spatial")
         targets = random_targets(r, count, kind, seed)
     per_method: dict[str, dict[str, Any]] = {}
     for o in options:
         if ":" not in o:
-            raise CLIError(f"--option {o!r}: expected METHOD:KEY=VALUE, e.g. dls:damping=0.05")
+            raise CLIError(f"--option {short_repr(o)}: expected METHOD:KEY=VALUE, "
+                           "e.g. dls:damping=0.05")
         m, kv = o.split(":", 1)
         per_method.setdefault(m.strip(), {}).update(parse_params([kv]))
     common: dict[str, Any] = {"respect_limits": not no_limits}

@@ -21,12 +21,16 @@ from typing import Any
 import click
 import numpy as np
 
+from serialkin._checks import short_repr
+
 #: Exit code of a run whose inputs were wrong (bad file, robot, option): also click's
 #: exit code for usage errors.
 EXIT_INPUT = 2
 #: Exit code of a run that completed but did not reach a goal (an IK target out of
 #: reach, a path point not tracked).
 EXIT_NOT_REACHED = 1
+#: Largest CSV file of targets or joint values read [bytes].
+MAX_CSV_BYTES = 512 * 1024 * 1024
 
 
 class CLIError(click.ClickException):
@@ -57,15 +61,17 @@ def parse_numbers(text: str, name: str, size: int | Sequence[int] | None = None)
         try:
             v = float(t)
         except ValueError:
-            raise CLIError(f"{name}: {t!r} is not a number (in {text!r})") from None
+            raise CLIError(f"{name}: {short_repr(t)} is not a number (in {short_repr(text)})"
+                           ) from None
         if not math.isfinite(v):
-            raise CLIError(f"{name}: {t!r} is not a finite number")
+            raise CLIError(f"{name}: {short_repr(t)} is not a finite number")
         values.append(v)
     if size is not None:
         sizes = (size,) if isinstance(size, int) else tuple(size)
         if len(values) not in sizes:
             want = " or ".join(str(s) for s in sizes)
-            raise CLIError(f"{name}: expected {want} numbers, got {len(values)} ({text!r})")
+            raise CLIError(f"{name}: expected {want} numbers, got {len(values)} "
+                           f"({short_repr(text)})")
     return np.array(values, dtype=float)
 
 
@@ -81,17 +87,23 @@ def read_csv_rows(path: str | os.PathLike[str], name: str,
         columns: the accepted number(s) of columns; every row must have the same count.
 
     Raises:
-        CLIError: unreadable file, no rows, a row with a wrong number of columns or a
-            non-numeric cell; the message gives the file and the line number.
+        CLIError: unreadable, non-UTF-8 or too large (:data:`MAX_CSV_BYTES`) file, a
+            folder, no rows, a row with a wrong number of columns or a non-numeric or
+            non-finite cell; the message gives the file and the line number.
     """
+    from serialkin._files import read_text
+
     accepted = (columns,) if isinstance(columns, int) else tuple(columns)
     label = "<stdin>" if str(path) == "-" else str(path)
-    try:
-        text = sys.stdin.read() if str(path) == "-" else Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise CLIError(f"{label}: cannot read the {name} file ({exc.strerror or exc})") from exc
-    except UnicodeDecodeError as exc:
-        raise CLIError(f"{label}: not a text (UTF-8) CSV file") from exc
+    if str(path) == "-":
+        try:
+            text = sys.stdin.read(MAX_CSV_BYTES + 1)
+        except (OSError, UnicodeDecodeError) as exc:
+            raise CLIError(f"{label}: cannot read the {name} rows ({exc})") from exc
+        if len(text) > MAX_CSV_BYTES:
+            raise CLIError(f"{label}: more than {MAX_CSV_BYTES} characters of {name} rows")
+    else:
+        text = read_text(path, what=f"{name} file", error=CLIError, max_bytes=MAX_CSV_BYTES)
     rows: list[list[float]] = []
     width: int | None = None
     first_data = True
@@ -107,10 +119,12 @@ def read_csv_rows(path: str | os.PathLike[str], name: str,
                 first_data = False  # a header line: no cell is a number
                 continue
             bad = next(c for c in cells if not _is_number(c))
-            raise CLIError(f"{label}, line {lineno}: {bad!r} is not a number") from None
+            raise CLIError(f"{label}, line {lineno}: {short_repr(bad)} is not a number"
+                           ) from None
         first_data = False
         if not all(math.isfinite(v) for v in vals):
-            raise CLIError(f"{label}, line {lineno}: values must be finite, got {s!r}")
+            raise CLIError(f"{label}, line {lineno}: values must be finite, got "
+                           f"{short_repr(s)}")
         want = " or ".join(str(c) for c in accepted)
         if len(vals) not in accepted:
             raise CLIError(

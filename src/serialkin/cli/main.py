@@ -10,7 +10,10 @@ import sys
 
 import click
 
-from serialkin.cli.io import command_help
+from serialkin._checks import short_repr
+from serialkin.cli.commands import handle_errors, memory_budget_option, set_budget
+from serialkin.cli.io import EXIT_INPUT, CLIError, command_help, ensure_dir
+from serialkin.errors import SerialkinError
 
 # click keeps example blocks unwrapped only after a real backspace character, which a raw
 # docstring does not contain: the help texts are built by command_help instead.
@@ -26,8 +29,39 @@ _CLI_HELP = command_help(
 )
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]}, help=_CLI_HELP)
+class SerialkinGroup(click.Group):
+    """The ``serialkin`` group: whatever a subcommand raises becomes one ``Error:`` line.
+
+    Every subcommand also wraps itself in :func:`~serialkin.cli.commands.handle_errors`;
+    this is the last guard, for errors raised outside a command body (e.g. while click
+    converts an option value, or in a subcommand added later).
+    """
+
+    def invoke(self, ctx: click.Context) -> object:
+        """Invoke the subcommand, mapping errors as :func:`handle_errors` does."""
+        from serialkin.cli.commands import PASS_THROUGH, cli_error
+
+        try:
+            return super().invoke(ctx)
+        except PASS_THROUGH:
+            raise
+        except click.ClickException as exc:
+            if isinstance(exc, CLIError) or exc.exit_code == EXIT_INPUT:
+                raise cli_error(exc if isinstance(exc, CLIError) else CLIError(
+                    exc.format_message())) from exc
+            raise CLIError(exc.format_message()) from exc
+        except Exception as exc:
+            raise cli_error(exc) from exc
+
+
+@click.group(cls=SerialkinGroup, context_settings={"help_option_names": ["-h", "--help"]},
+             help=_CLI_HELP)
 @click.version_option(package_name="serialkin")
+@click.option("--memory-budget", metavar="SIZE", expose_value=False, is_eager=True,
+              callback=set_budget,
+              help="Largest memory a run may plan to allocate, e.g. 8G or 500M or unlimited "
+                   "(default: half the available memory, or $SERIALKIN_MEMORY_BUDGET). "
+                   "Sizes beyond it are refused before allocation.")
 def cli() -> None:
     r"""serialkin: kinematics of serial robot manipulators.
 
@@ -46,6 +80,8 @@ def cli() -> None:
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
 @click.option("--section", "sections", multiple=True,
               help="Build only this section (repeatable), e.g. --section forward.")
+@memory_budget_option
+@handle_errors
 def chapter(out: str, quiet: bool, sections: tuple[str, ...]) -> None:
     r"""Reproduce the chapter's worked examples into an HTML report.
 
@@ -57,14 +93,16 @@ def chapter(out: str, quiet: bool, sections: tuple[str, ...]) -> None:
 
     unknown = [s for s in sections if s not in SECTION_MODULES]
     if unknown:
-        raise click.BadParameter(
-            f"unknown section(s) {', '.join(unknown)}; expected: {', '.join(SECTION_MODULES)}",
-            param_hint="--section",
+        raise CLIError(
+            f"--section: unknown section(s) {', '.join(short_repr(u, 40) for u in unknown)}; "
+            f"expected: {', '.join(SECTION_MODULES)}"
         )
+    ensure_dir(out)  # a file, a read-only or uncreatable folder: refused before any work
     try:
         path = build_report(out, quiet=quiet, sections=sections or None)
-    except OSError as exc:
-        raise click.ClickException(f"cannot write the report to {out!r}: {exc}") from exc
+    except (OSError, SerialkinError) as exc:
+        raise CLIError(f"cannot write the report to {short_repr(str(out))}: "
+                       f"{getattr(exc, 'strerror', None) or exc}") from exc
     click.echo(f"wrote {path}")
 
 

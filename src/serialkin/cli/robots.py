@@ -21,6 +21,7 @@ from typing import Any
 
 import click
 
+from serialkin._checks import short_repr
 from serialkin.cli.io import CLIError
 from serialkin.errors import SerialkinError
 
@@ -43,7 +44,7 @@ def parse_params(params: Sequence[str]) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for p in params:
         if "=" not in p:
-            raise CLIError(f"--param {p!r}: expected key=value, e.g. --param l1=0.4")
+            raise CLIError(f"--param {short_repr(p)}: expected key=value, e.g. --param l1=0.4")
         k, v = p.split("=", 1)
         try:
             out[k.strip()] = yaml.safe_load(v)
@@ -95,16 +96,19 @@ def resolve_robot(spec: str, params: Sequence[str] = ()) -> Any:
     try:
         return models.get(spec, **kwargs)
     except TypeError as exc:  # unknown keyword for the model function
-        raise CLIError(f"model {spec!r} does not accept these --param options: {exc}") from exc
+        raise CLIError(f"model {short_repr(spec)} does not accept these --param options: "
+                       f"{exc}") from exc
     except SerialkinError as exc:
         msg = str(exc)
-        if "did you mean" not in msg.lower():
-            near = difflib.get_close_matches(spec.lower(), list(models.names()), n=3, cutoff=0.4)
+        unknown = msg.startswith("unknown robot model")
+        if unknown and "did you mean" not in msg.lower():
+            near = difflib.get_close_matches(spec.lower()[:200], list(models.names()), n=3,
+                                             cutoff=0.4)
             if near:
                 msg += f" Nearest: {', '.join(near)}."
-        if Path(spec).suffix:
-            msg += (f" (A file {spec!r}? Robot files end in .yaml, .yml or .json; URDF in "
-                    ".urdf.)")
+        if unknown and Path(spec[:4096]).suffix:
+            msg += (f" (A file {short_repr(spec)}? Robot files end in .yaml, .yml or .json; "
+                    "URDF in .urdf.)")
         raise CLIError(msg) from exc
 
 

@@ -9,7 +9,14 @@ from typing import Any
 import click
 import numpy as np
 
-from serialkin.cli.commands import handle_errors, json_option, quiet_option
+from serialkin._checks import check_int, check_positive
+from serialkin.cli.commands import (
+    check_out_folder,
+    handle_errors,
+    json_option,
+    memory_budget_option,
+    quiet_option,
+)
 from serialkin.cli.io import (
     EXIT_NOT_REACHED,
     CLIError,
@@ -19,6 +26,9 @@ from serialkin.cli.io import (
     write_bytes_atomic,
     write_text_atomic,
 )
+
+#: Largest --max-frames: an animation longer than this is not a sensible GIF.
+MAX_FRAMES = 100_000
 
 _TRACK_HELP = command_help(
     "Track the path of a scenario file and write the trajectory, figures and animation.\n\n"
@@ -54,6 +64,7 @@ _TRACK_HELP = command_help(
 @click.option("--list", "list_only", is_flag=True, help="List the shipped scenarios.")
 @json_option
 @quiet_option
+@memory_budget_option
 @handle_errors
 def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_animation: bool,
               mp4: bool, fps: float, max_frames: int, viewer: bool, list_only: bool,
@@ -71,14 +82,18 @@ def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_ani
         return
     if scenario is None:
         raise CLIError("missing SCENARIO: a scenario file or a shipped name (see --list)")
+    # every option is checked before anything is computed or written
+    fps = check_positive(fps, "--fps")
+    max_frames = check_int(max_frames, "--max-frames", minimum=1, maximum=MAX_FRAMES)
+    check_out_folder(out)
     sc = load_scenario(scenario)
-    folder = ensure_dir(out)
     stem = Path(scenario).stem if Path(scenario).suffix else scenario
     show = not quiet and not as_json and sys.stderr.isatty()
     if show:
         click.echo(f"tracking {sc.name}: {len(sc.path)} path points, robot {sc.robot.name} "
                    f"({sc.robot.n} joints) ...", err=True)
     traj = sc.run()
+    folder = ensure_dir(out)
     files: dict[str, str] = {}
     for ext in (("csv", "npz") if fmt == "both" else (fmt,)):
         p = folder / f"{stem}.{ext}"

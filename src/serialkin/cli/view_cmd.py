@@ -8,7 +8,15 @@ from typing import Any
 import click
 import numpy as np
 
-from serialkin.cli.commands import _angle_factor, handle_errors, json_option, quiet_long_option
+from serialkin._checks import short_repr
+from serialkin.cli.commands import (
+    _angle_factor,
+    check_out_folder,
+    handle_errors,
+    json_option,
+    memory_budget_option,
+    quiet_long_option,
+)
 from serialkin.cli.io import CLIError, command_help, dumps_json, ensure_dir, parse_numbers
 from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot
 
@@ -38,7 +46,7 @@ def _load_trajectory(path: str, robot: Any) -> tuple[np.ndarray, np.ndarray | No
         traj = Trajectory.load(p)
         if traj.q.shape[1] != robot.n:
             raise CLIError(f"{path}: trajectory has {traj.q.shape[1]} joints but robot "
-                           f"{robot.name!r} has {robot.n}")
+                           f"{short_repr(robot.name)} has {robot.n}")
         return traj.q, traj.targets[:, :3, 3]
     return read_csv_rows(p, "q", robot.n), None
 
@@ -69,6 +77,7 @@ def _is_serialkin_csv(p: Path) -> bool:
 @param_option
 @json_option
 @quiet_long_option
+@memory_budget_option
 @handle_errors
 def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
              scenario: str | None, title: str | None, out: str, open_browser: bool,
@@ -85,18 +94,22 @@ def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
         sc = load_scenario(scenario)
         r = resolve_robot(robot, params) if robot is not None else sc.robot
         obstacles = tuple(sc.obstacles)
-        if trajectory is None:
-            traj = sc.run()
-            Q, path_points = traj.q, traj.targets[:, :3, 3]
         title = title or sc.name
     elif robot is None:
         raise CLIError("missing ROBOT (or --scenario): " + ROBOT_HELP)
     else:
         r = resolve_robot(robot, params)
+    # every input is checked before the scenario runs and before the page is written
+    q = parse_numbers(q_text, "--q", r.n) * _angle_factor(r, degrees) if q_text else None
+    if Path(out).is_dir():
+        raise CLIError(f"--out {out}: is a folder; give the page's file name (.html)")
+    check_out_folder(Path(out).parent)
     if trajectory is not None:
         Q, pts = _load_trajectory(trajectory, r)
-        path_points = pts if pts is not None else path_points
-    q = parse_numbers(q_text, "--q", r.n) * _angle_factor(r, degrees) if q_text else None
+        path_points = pts
+    elif scenario is not None:
+        traj = sc.run()
+        Q, path_points = traj.q, traj.targets[:, :3, 3]
     ensure_dir(Path(out).parent)
     path = write_viewer(r, out, q=q, trajectory=Q, path_points=path_points,
                         obstacles=obstacles or None, title=title)

@@ -9,7 +9,14 @@ from typing import Any
 import click
 import numpy as np
 
-from serialkin.cli.commands import handle_errors, json_option, quiet_option
+from serialkin._checks import check_positive, short_repr
+from serialkin.cli.commands import (
+    check_out_folder,
+    handle_errors,
+    json_option,
+    memory_budget_option,
+    quiet_option,
+)
 from serialkin.cli.io import (
     CLIError,
     command_help,
@@ -51,11 +58,12 @@ def _orientation(text: str | None, planar: bool, degrees: bool) -> Any:
 
 def _parse_slice(text: str) -> tuple[str, float]:
     if "=" not in text:
-        raise CLIError(f"--slice {text!r}: expected AXIS=VALUE, e.g. --slice z=0.4")
+        raise CLIError(f"--slice {short_repr(text)}: expected AXIS=VALUE, e.g. --slice z=0.4")
     axis, val = text.split("=", 1)
     axis = axis.strip().lower()
     if axis not in ("x", "y", "z"):
-        raise CLIError(f"--slice {text!r}: axis must be x, y or z, got {axis!r}")
+        raise CLIError(f"--slice {short_repr(text)}: axis must be x, y or z, got "
+                       f"{short_repr(axis)}")
     return axis, float(parse_numbers(val, "--slice", 1)[0])
 
 
@@ -109,6 +117,7 @@ _WORKSPACE_CMD_HELP = command_help(
 @param_option
 @json_option
 @quiet_option
+@memory_budget_option
 @handle_errors
 def workspace_cmd(robot: str, kind: str, samples: int | None, seed: int, cell: float | None,
                   resolution: int | None, orientation: str | None, max_angle: float | None,
@@ -120,8 +129,14 @@ def workspace_cmd(robot: str, kind: str, samples: int | None, seed: int, cell: f
     from serialkin.workspace import compute_workspace
 
     r = resolve_robot(robot, params)
-    folder = ensure_dir(out)
     planar = bool(r.is_planar)
+    # every option is checked before anything is computed or written
+    margin = check_positive(margin, "--margin", allow_zero=True)
+    if max_angle is not None:
+        max_angle = check_positive(max_angle, "--max-angle", allow_zero=True)
+    if slices and planar:
+        raise CLIError("--slice applies to spatial robots; this robot is planar")
+    parsed_slices = [_parse_slice(s) for s in slices]
     progress = False if quiet or as_json else None
     opts: dict[str, Any] = {"seed": seed, "cell": cell, "resolution": resolution,
                             "progress": progress}
@@ -145,7 +160,9 @@ def workspace_cmd(robot: str, kind: str, samples: int | None, seed: int, cell: f
         opts["manipulability"] = manipulability
     if samples is not None:
         opts["samples"] = samples
+    check_out_folder(out)
     ws = compute_workspace(r, kind, **opts)
+    folder = ensure_dir(out)
     files: dict[str, str] = {}
 
     if points or save_q:
@@ -175,10 +192,7 @@ def workspace_cmd(robot: str, kind: str, samples: int | None, seed: int, cell: f
             files["manipulability"] = str(save_figure(ax.figure,
                                                       folder / f"manipulability_{kind}.png"))
         plt.close("all")
-    for s in slices:
-        if planar:
-            raise CLIError("--slice applies to spatial robots; this robot is planar")
-        axis, value = _parse_slice(s)
+    for axis, value in parsed_slices:
         from serialkin.workspace import workspace_slice
 
         sl = workspace_slice(ws, axis, value)

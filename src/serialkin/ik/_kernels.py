@@ -44,11 +44,13 @@ Method codes and steps:
   then backtracking (halving) until the cost decreases.
 * ``GAUSS_NEWTON`` — ``Δq = (JwᵀJw)⁺ Jwᵀ r`` from the normal equations, full step.
 
-Joint limits (``respect`` true): after every step each joint is projected onto its
+Joint limits (``respect`` true) are intervals whose ends may be infinite
+(:mod:`serialkin.model.limits`): after every step each joint is projected onto its
 range — a revolute joint is first shifted by a multiple of 2π if that brings it inside
 (same pose), else set to the nearer limit on the circle; a prismatic joint is clamped.
 A step that leaves the range is therefore replaced by its projection (projected
-iteration). Unlimited revolute joints are wrapped into [-π, π) at the end.
+iteration). At the end, unlimited revolute joints are wrapped into [-π, π) and joints
+open on one side are tidied without leaving their range (:func:`limits.normalize`).
 
 Stagnation: an attempt ends when the cost has not halved within ``window``
 iterations (or becomes non-finite); the solver then restarts from a configuration drawn
@@ -67,6 +69,10 @@ import numpy as np
 from numba import njit
 
 from serialkin.kinematics._kernels import fk_into, jacobian_into
+from serialkin.model.limits import inside as interval_inside
+from serialkin.model.limits import normalize as interval_normalize
+from serialkin.model.limits import project as interval_project
+from serialkin.model.limits import wrap_angle as interval_wrap
 from serialkin.spatial._kernels import pose_error_into
 
 TRANSPOSE = 0
@@ -139,54 +145,35 @@ def random_q_into(state, slo, shi, q):
         q[i] = slo[i] + (shi[i] - slo[i]) * u
 
 
-# ---------------------------------------------------------------- fast input checks
+# ---------------------------------------------------------------- joint limits
+# The interval logic (open ends included) lives in serialkin.model.limits; these loops
+# apply it joint by joint.
 @njit(cache=True)
 def inside_limits(q, lo, hi, tol):
-    """True when every q_i (finite) lies in [lo_i − tol, hi_i + tol]."""
+    """True when every q_i (finite) lies in [lo_i − tol, hi_i + tol] (ends may be infinite)."""
     for i in range(q.shape[0]):
-        if not math.isfinite(q[i]) or q[i] < lo[i] - tol or q[i] > hi[i] + tol:
+        if not interval_inside(q[i], lo[i], hi[i], tol):
             return False
     return True
 
 
-# ---------------------------------------------------------------- joint limits
 @njit(cache=True)
 def project_into(q, lo, hi, revolute):
-    """Project ``q`` (n,) onto the joint ranges [lo, hi], in place (see module docstring)."""
+    """Project ``q`` (n,) onto the joint ranges [lo, hi], in place (:func:`limits.project`)."""
     for i in range(q.shape[0]):
-        x = q[i]
-        if x >= lo[i] and x <= hi[i]:
-            continue
-        if revolute[i] != 0 and math.isfinite(lo[i]):
-            y = lo[i] + (x - lo[i]) % TWO_PI  # same angle, in [lo, lo + 2π)
-            if y <= hi[i]:
-                q[i] = y
-            elif y - hi[i] <= lo[i] + TWO_PI - y:
-                q[i] = hi[i]
-            else:
-                q[i] = lo[i]
-        elif x < lo[i]:
-            q[i] = lo[i]
-        else:
-            q[i] = hi[i]
+        q[i] = interval_project(q[i], lo[i], hi[i], revolute[i] != 0)
 
 
 @njit(cache=True)
 def normalize_into(q, lo, hi, revolute):
-    """Tidy a final q in place without changing the pose.
+    """Tidy a final q in place without changing the pose (:func:`limits.normalize`).
 
-    Revolute joints without limits are wrapped into [-π, π); a revolute joint outside
-    its range is shifted by a multiple of 2π when that brings it inside.
+    Unlimited revolute joints are wrapped into [-π, π); a revolute joint outside its
+    range is shifted by a multiple of 2π when that brings it inside; a joint open on one
+    side stays inside its range.
     """
     for i in range(q.shape[0]):
-        if revolute[i] == 0:
-            continue
-        if not math.isfinite(lo[i]) or not math.isfinite(hi[i]):
-            q[i] = (q[i] + math.pi) % TWO_PI - math.pi
-        elif q[i] < lo[i] or q[i] > hi[i]:
-            y = lo[i] + (q[i] - lo[i]) % TWO_PI
-            if y <= hi[i]:
-                q[i] = y
+        q[i] = interval_normalize(q[i], lo[i], hi[i], revolute[i] != 0)
 
 
 # ---------------------------------------------------------------- small dense algebra
@@ -506,8 +493,7 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol,
                     x = q[i] + dq[i]
                     if free[i] == 0.0 or (x >= lo[i] and x <= hi[i]):
                         continue
-                    if revolute[i] != 0 and math.isfinite(lo[i]) \
-                            and lo[i] + (x - lo[i]) % TWO_PI <= hi[i]:
+                    if revolute[i] != 0 and not math.isnan(interval_wrap(x, lo[i], hi[i])):
                         continue  # a 2π shift brings it inside: not blocked
                     if (x < lo[i] and q[i] <= lo[i] + 1e-12) \
                             or (x > hi[i] and q[i] >= hi[i] - 1e-12):

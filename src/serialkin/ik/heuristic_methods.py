@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import check_int, check_positive
+from serialkin._checks import MAX_ITERATIONS, check_int, check_positive
 from serialkin.ik import ccd as _ccd
 from serialkin.ik import fabrik as _fabrik
 from serialkin.ik.registry import MethodSpec, register_method
@@ -58,7 +58,8 @@ def characteristic_length(robot: Any) -> float:
 
 
 def _stall(options: Mapping[str, Any]) -> tuple[int, float]:
-    window = check_int(options["stall_window"], "stall_window", minimum=1)
+    window = check_int(options["stall_window"], "stall_window", minimum=1,
+                       maximum=MAX_ITERATIONS)
     progress = check_positive(options["min_progress"], "min_progress")
     return window, progress
 

@@ -81,6 +81,14 @@ _TABLE = (
 
 
 
+#: Largest robot of the methods whose iteration costs O(n³) (an n×n system, or an SVD
+#: over the n columns of J): about a minute for a failing solve at 1000 joints.
+MAX_JOINTS_CUBIC = 1000
+
+#: Methods whose iteration cost grows linearly with the number of joints.
+_LINEAR = (K.TRANSPOSE, K.DLS)
+
+
 def _register_all() -> None:
     """Register every method of :data:`_TABLE` (family 'jacobian', compiled kernel)."""
     for name, code, max_iter, restarts, options, summary in _TABLE:
@@ -88,6 +96,7 @@ def _register_all() -> None:
             name=name, family="jacobian", summary=summary,
             limits=_LIMIT_AWARE if code == K.LM else _PROJECTION,
             max_iter=max_iter, restarts=restarts, options=options, kernel_code=code,
+            max_joints=None if code in _LINEAR else MAX_JOINTS_CUBIC,
         ))
 
 

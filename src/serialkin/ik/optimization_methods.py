@@ -56,5 +56,5 @@ register_method(MethodSpec(
     name="powell", family="optimization",
     summary="Powell's derivative-free method on the pose-error cost (scipy)",
     limits=_BOUNDS, max_iter=100, restarts=20, options={"xtol": 1e-6},
-    attempt=_attempt("powell"),
+    attempt=_attempt("powell"), max_joints=200,  # n line searches of O(n) FK per iteration
 ))

@@ -55,6 +55,11 @@ class MethodSpec:
         options: method-specific keyword options and their defaults.
         kernel_code: method code of the compiled kernel, or None for a Python method.
         attempt: the Python attempt function (see :data:`AttemptFn`), or None.
+        max_joints: the largest robot (number of joints) the method accepts, or None for
+            any: methods whose iteration costs O(n³) (an n×n system or an SVD over n
+            columns) or O(n²) function evaluations would run for hours on the longest
+            chains serialkin allows; those robots are refused with the names of the
+            methods that scale.
         solve: a callable that solves one target entirely on its own (the closed-form
             method, which needs neither restarts nor iterations), or None:
             ``solve(robot, problem, q0, options) -> (q, success, iterations, reason)``
@@ -76,6 +81,7 @@ class MethodSpec:
     kernel_code: int | None = None
     attempt: AttemptFn | None = None
     solve: Callable[..., Any] | None = None
+    max_joints: int | None = None
 
     def __post_init__(self) -> None:
         if (self.kernel_code is None) + (self.attempt is None) + (self.solve is None) != 2:

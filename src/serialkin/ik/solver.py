@@ -36,10 +36,10 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import check_int
+from serialkin._checks import MAX_ITERATIONS, check_int, short_repr
 from serialkin.errors import InputError, InputTypeError
 from serialkin.ik import _kernels as K
-from serialkin.ik.registry import MethodSpec, get_method
+from serialkin.ik.registry import MethodSpec, available_methods, get_method
 from serialkin.ik.result import IKResult
 from serialkin.ik.target import (
     DEFAULT_WEIGHTS,
@@ -55,6 +55,10 @@ from serialkin.spatial import _kernels as SK
 
 #: Default tolerance on the position [m] and orientation [rad] errors.
 DEFAULT_TOL = 1e-9
+
+#: Largest number of restarts a solve accepts (``max_iter`` is bounded by
+#: :data:`serialkin._checks.MAX_ITERATIONS`).
+MAX_RESTARTS = 100_000
 
 _MASK64 = (1 << 64) - 1
 
@@ -288,6 +292,7 @@ def run_attempts(spec: MethodSpec, problem: IKProblem, q0: np.ndarray | None, ma
             break
     q = np.array(best_q, dtype=np.float64)
     K.normalize_into(q, arrays.lo, arrays.hi, arrays.revolute)
+    success = honest_success(robot, q, success, problem.respect_limits)
     pe, oe = problem.errors(q)
     reason = "" if success else failure_reason(
         pe, oe, problem.tol, used + 1, total, problem.kind,
@@ -295,11 +300,19 @@ def run_attempts(spec: MethodSpec, problem: IKProblem, q0: np.ndarray | None, ma
     return q, success, total, pe, oe, reason, used
 
 
+def _same_options(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
+    """True when two option mappings hold the same plain values (arrays never compare)."""
+    plain = (bool, int, float, str)
+    return a.keys() == b.keys() and all(
+        type(a[k]) is type(b[k]) and isinstance(a[k], plain) and a[k] == b[k] for k in a)
+
+
 def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
     """The method-parameter tail ``cfg[P_DAMPING:]`` of the kernel configuration."""
     from serialkin._checks import check_positive
 
-    if opts is spec.options or opts == spec.options:
+    default = opts is spec.options or _same_options(opts, spec.options)
+    if default:
         cached = _PARAMS.get(spec.name)
         if cached is not None and cached[0] is spec:
             return cached[1]
@@ -310,10 +323,11 @@ def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
         raise InputTypeError(f"polish must be True or False, got {polish!r}")
     p[K.C_POLISH - base] = 1.0 if polish else 0.0
     p[K.P_DAMPING - base] = check_positive(opts.get("damping", 1e-3), "damping", allow_zero=True)
-    p[K.P_WINDOW - base] = check_int(opts.get("stall_window", 20), "stall_window", minimum=1)
+    p[K.P_WINDOW - base] = check_int(opts.get("stall_window", 20), "stall_window", minimum=1,
+                                     maximum=MAX_ITERATIONS)
     p[K.P_MAX_STEP - base] = check_positive(opts.get("max_step", 0.5), "max_step")
     p[K.P_RCOND - base] = check_positive(opts.get("rcond", 1e-10), "rcond")
-    if opts == spec.options:
+    if default:
         p.setflags(write=False)
         _PARAMS[spec.name] = (spec, p)
     return p
@@ -347,8 +361,10 @@ def solve(
             target defines).
         tol: tolerance on position [m] and orientation [rad] errors, > 0
             (default :data:`DEFAULT_TOL`).
-        max_iter: iterations per attempt (default per method).
-        restarts: restarts from random configurations allowed (default per method).
+        max_iter: iterations per attempt (default per method), 1 to
+            :data:`~serialkin._checks.MAX_ITERATIONS` (10⁶).
+        restarts: restarts from random configurations allowed (default per method), 0 to
+            :data:`MAX_RESTARTS` (10⁵).
         seed: None, int or numpy Generator for the random starts.
         respect_limits: keep q inside the joint limits (each method documents how).
         **options: method-specific options (see ``METHODS[name].options``).
@@ -364,6 +380,14 @@ def solve(
     spec = get_method(method)
     if not isinstance(robot, Robot):
         raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    if spec.max_joints is not None and robot.n > spec.max_joints:
+        scalable = [m for m in available_methods() if get_method(m).max_joints is None
+                    and get_method(m).family != "analytic"]
+        raise InputError(
+            f"method {spec.name!r} takes robots of at most {spec.max_joints} joints (its "
+            f"cost per iteration grows faster than the number of joints); robot "
+            f"{short_repr(robot.name)} has {robot.n}: use one of {', '.join(scalable)}"
+        )
     tgt = parse_target(robot, target, mask)
     if tgt.kind not in spec.targets:
         raise InputError(
@@ -371,8 +395,10 @@ def solve(
             f"{', '.join(spec.targets)}"
         )
     tol_v = DEFAULT_TOL if tol is None else check_tol(tol)
-    iters = spec.max_iter if max_iter is None else check_int(max_iter, "max_iter", minimum=1)
-    nrest = spec.restarts if restarts is None else check_int(restarts, "restarts", minimum=0)
+    iters = spec.max_iter if max_iter is None else check_int(
+        max_iter, "max_iter", minimum=1, maximum=MAX_ITERATIONS)
+    nrest = spec.restarts if restarts is None else check_int(
+        restarts, "restarts", minimum=0, maximum=MAX_RESTARTS)
     if not isinstance(respect_limits, (bool, np.bool_)):
         raise InputTypeError(f"respect_limits must be True or False, got {respect_limits!r}")
     opts = _options(spec, options)
@@ -470,9 +496,28 @@ def _kernel_config(spec: MethodSpec, tgt: Target, tol: float, max_iter: int, res
     return cfg
 
 
+#: Tolerance of the final "q inside the joint limits" test of a success [rad or m].
+LIMIT_TOL = 1e-12
+
+_OUTSIDE = ("the configuration found lies outside the joint limits; the target may be "
+            "reachable only outside them")
+
+
+def honest_success(robot: Robot, q: np.ndarray, ok: bool, respect: bool) -> bool:
+    """The final guard of every method: a success with ``respect`` has q inside the limits.
+
+    Limits are intervals with possibly infinite ends (:mod:`serialkin.model.limits`).
+    """
+    if not ok or not respect:
+        return ok
+    a = robot_arrays(robot)
+    return bool(K.inside_limits(np.ascontiguousarray(q, dtype=np.float64), a.lo, a.hi,
+                                LIMIT_TOL))
+
+
 def _result_single(robot: Robot, tgt: Target, spec: MethodSpec, q: np.ndarray,
                    info: np.ndarray, tol: float, respect: bool) -> IKResult:
-    ok = bool(info[K.I_SUCCESS])
+    ok = honest_success(robot, q, bool(info[K.I_SUCCESS]), respect)
     pe, oe = float(info[K.I_POS_ERR]), float(info[K.I_ORI_ERR])
     its, used = int(info[K.I_ITERATIONS]), int(info[K.I_RESTARTS])
     reason = "" if ok else failure_reason(
@@ -485,6 +530,8 @@ def _result_single(robot: Robot, tgt: Target, spec: MethodSpec, q: np.ndarray,
 def _result_batch(robot: Robot, tgt: Target, spec: MethodSpec, Q: np.ndarray,
                   info: np.ndarray, tol: float, respect: bool) -> IKResult:
     ok = info[:, K.I_SUCCESS] > 0.5
+    if respect and ok.any():
+        ok &= robot.within_limits(Q, LIMIT_TOL)
     its = info[:, K.I_ITERATIONS].astype(np.int64)
     used = info[:, K.I_RESTARTS].astype(np.int64)
     pe, oe = info[:, K.I_POS_ERR].copy(), info[:, K.I_ORI_ERR].copy()
@@ -523,6 +570,8 @@ def _solve_python(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | 
             q, ok, its, reason = spec.solve(robot, problem, qk, opts)
             q = np.asarray(q, dtype=np.float64)
             pe, oe = problem.errors(q)
+            if ok and not honest_success(robot, q, True, respect):
+                ok, reason = False, _OUTSIDE
             rows.append((q, bool(ok), int(its), pe, oe, "" if ok else str(reason), 0))
     if not tgt.batch:
         q, ok, its, pe, oe, reason, used = rows[0]

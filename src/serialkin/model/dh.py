@@ -16,11 +16,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from serialkin._checks import MAX_JOINT_VALUE, MAX_JOINTS, MAX_LENGTH, short_repr
 from serialkin.errors import RobotDefinitionError
-from serialkin.model.joint import Joint, check_limits, normalize_joint_type
+from serialkin.model.joint import Joint, definition_real, normalize_joint_type
+from serialkin.model.limits import check_interval
 from serialkin.spatial.transforms import make_transform, rotx, rotz
 
 CONVENTIONS = ("standard", "modified")
@@ -50,16 +53,18 @@ class DHLink:
     name: str = ""
 
     def __post_init__(self) -> None:
-        where = f"DH row {self.name!r}" if self.name else "DH row"
+        if not isinstance(self.name, str):
+            raise RobotDefinitionError(
+                f"DH row name must be a string, got {type(self.name).__name__} "
+                f"{short_repr(self.name)}"
+            )
+        where = f"DH row {short_repr(self.name)}" if self.name else "DH row"
         for f in _FIELDS:
-            v = getattr(self, f)
-            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-                raise RobotDefinitionError(f"{where}: field {f!r} must be a number, got {v!r}")
-            if not np.isfinite(v):
-                raise RobotDefinitionError(f"{where}: field {f!r} must be finite, got {v!r}")
-            object.__setattr__(self, f, float(v))
+            bound, unit = (MAX_LENGTH, "m") if f in ("a", "d") else (MAX_JOINT_VALUE, "rad")
+            object.__setattr__(self, f, definition_real(getattr(self, f), where, f"field {f!r}",
+                                                        bound, unit))
         object.__setattr__(self, "type", normalize_joint_type(self.type, where))
-        object.__setattr__(self, "qlim", check_limits(self.qlim, where))
+        object.__setattr__(self, "qlim", check_interval(self.qlim, where))
 
 
 def link_transform(link: DHLink, q: float, convention: str = "standard") -> np.ndarray:
@@ -84,42 +89,86 @@ def parse_dh_rows(links: Sequence[object], where: str = "links") -> list[DHLink]
         RobotDefinitionError: a row is not a mapping, misses a field or has an unknown one.
     """
     if isinstance(links, (str, bytes)) or not isinstance(links, Sequence):
-        raise RobotDefinitionError(f"{where} must be a list of DH rows, got {type(links).__name__}")
+        raise RobotDefinitionError(
+            f"{where} must be a list of DH rows, got {type(links).__name__} {short_repr(links)}")
     if len(links) == 0:
         raise RobotDefinitionError(f"{where} is empty; a robot needs at least one joint")
+    if len(links) > MAX_JOINTS:
+        raise RobotDefinitionError(
+            f"{where} has {len(links)} rows; a robot has at most {MAX_JOINTS} joints")
     rows: list[DHLink] = []
-    allowed = set(_FIELDS) | {"type", "qlim", "name", "sigma", "joint"}
     for i, row in enumerate(links):
         if isinstance(row, DHLink):
             rows.append(row)
             continue
         if not isinstance(row, Mapping):
             raise RobotDefinitionError(
-                f"{where}[{i}] must be a mapping with fields a, alpha, d, theta, got {row!r}"
+                f"{where}[{i}] must be a mapping with fields a, alpha, d, theta, got "
+                f"{type(row).__name__} {short_repr(row)}"
+            )
+        unknown = sorted((k for k in row if k not in ROW_KEYS), key=_key_text)
+        if unknown:
+            raise RobotDefinitionError(
+                f"{where}[{i}] has unknown field(s) "
+                f"{', '.join(_key_text(k) for k in unknown[:5])}"
+                f"; allowed: {', '.join(ROW_KEYS)}"
             )
         missing = [f for f in _FIELDS if f not in row]
         if missing:
             raise RobotDefinitionError(f"{where}[{i}] is missing field(s) {', '.join(missing)}")
-        unknown = sorted(set(row) - allowed)
-        if unknown:
-            raise RobotDefinitionError(
-                f"{where}[{i}] has unknown field(s) {', '.join(unknown)}; allowed: "
-                f"{', '.join(sorted(allowed))}"
-            )
-        jt = row.get("type", row.get("joint", "R"))
-        name = str(row.get("name", f"joint{i + 1}"))
+        name = row.get("name", f"joint{i + 1}")
         rows.append(
             DHLink(
                 a=row["a"],
                 alpha=row["alpha"],
                 d=row["d"],
                 theta=row["theta"],
-                type=jt,
-                qlim=tuple(row.get("qlim", (-np.inf, np.inf))),
+                type=row_joint_type(row, f"{where}[{i}]"),
+                qlim=row.get("qlim", (-np.inf, np.inf)),
                 name=name,
             )
         )
     return rows
+
+
+def _key_text(key: object) -> str:
+    """A mapping key for an error message: identifiers as they are, anything else quoted."""
+    return key if isinstance(key, str) and key.isidentifier() else short_repr(key, 40)
+
+
+#: Keys a DH row mapping may have. ``joint`` is an alias of ``type``; ``sigma`` is the
+#: Robotics Toolbox's joint flag (0 revolute, 1 prismatic) and is honoured.
+ROW_KEYS = ("a", "alpha", "d", "joint", "name", "qlim", "sigma", "theta", "type")
+
+
+def row_joint_type(row: Mapping[str, Any], where: str) -> str:
+    """The joint type of a DH row mapping from ``type``, ``joint`` and/or ``sigma``.
+
+    ``type`` and ``joint`` take 'R'/'P' (or 'revolute'/'prismatic'...), ``sigma`` takes
+    0 (revolute) or 1 (prismatic) as in the Robotics Toolbox. Absent: 'R'.
+
+    Raises:
+        RobotDefinitionError: an unknown value, or keys that contradict each other
+            (e.g. ``type='R', joint='P'``).
+    """
+    given: dict[str, str] = {}
+    for key in ("type", "joint"):
+        if key in row:
+            given[key] = normalize_joint_type(row[key], f"{where}: field {key!r}")
+    if "sigma" in row:
+        sigma = row["sigma"]
+        if isinstance(sigma, bool) or not isinstance(
+                sigma, (int, float, np.integer, np.floating)) or sigma not in (0, 1):
+            raise RobotDefinitionError(
+                f"{where}: field 'sigma' must be 0 (revolute) or 1 (prismatic), got "
+                f"{short_repr(sigma)}"
+            )
+        given["sigma"] = "P" if sigma == 1 else "R"
+    kinds = set(given.values())
+    if len(kinds) > 1:
+        said = ", ".join(f"{k}={short_repr(row[k], 20)}" for k in given)
+        raise RobotDefinitionError(f"{where}: contradictory joint type ({said}); give one")
+    return kinds.pop() if kinds else "R"
 
 
 def dh_to_joints(rows: Sequence[DHLink], convention: str) -> list[Joint]:

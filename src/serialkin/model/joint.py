@@ -13,8 +13,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from serialkin._checks import as_vector, check_transform
-from serialkin.errors import RobotDefinitionError
+from serialkin._checks import (
+    MAX_JOINT_VALUE,
+    MAX_LENGTH,
+    as_vector,
+    check_real,
+    check_transform,
+    short_repr,
+)
+from serialkin.errors import InputError, InputTypeError, RobotDefinitionError
+from serialkin.model.limits import check_interval
 
 JOINT_TYPES = {"R": 0, "P": 1}
 _TYPE_ALIASES = {
@@ -34,26 +42,38 @@ def normalize_joint_type(value: object, where: str) -> str:
     key = str(value).strip().lower() if isinstance(value, str) else None
     if key not in _TYPE_ALIASES:
         raise RobotDefinitionError(
-            f"{where}: unknown joint type {value!r}; expected 'R' (revolute) or 'P' (prismatic)"
+            f"{where}: unknown joint type {short_repr(value)}; expected 'R' (revolute) or 'P' "
+            "(prismatic)"
         )
     return _TYPE_ALIASES[key]
 
 
-def check_limits(qlim: object, where: str) -> tuple[float, float]:
-    """Validate a (lower, upper) joint limit pair; infinities allowed, lower <= upper."""
+def definition_real(value: object, where: str, field: str, max_abs: float, unit: str) -> float:
+    """A finite real number of a robot description with ``|value| <= max_abs``.
+
+    Raises:
+        RobotDefinitionError: not a real number, NaN/inf, or too large (naming ``where``
+            and ``field``).
+    """
     try:
-        lo, hi = (float(v) for v in qlim)  # type: ignore[union-attr]
-    except (TypeError, ValueError) as exc:
+        return check_real(value, f"{where}: {field}", max_abs=max_abs, unit=unit)
+    except (InputError, InputTypeError) as exc:
+        raise RobotDefinitionError(str(exc)) from None
+
+
+def check_fixed_transform(T: object, where: str) -> np.ndarray:
+    """A copy of the rigid transform ``T`` (4, 4) of a robot description.
+
+    Its translation must be at most :data:`~serialkin._checks.MAX_LENGTH` metres long.
+    """
+    a = check_transform(T, where).copy()
+    length = float(np.linalg.norm(a[:3, 3]))
+    if length > MAX_LENGTH:
         raise RobotDefinitionError(
-            f"{where}: joint limits must be a pair (lower, upper), got {qlim!r}"
-        ) from exc
-    if np.isnan(lo) or np.isnan(hi):
-        raise RobotDefinitionError(f"{where}: joint limits must not be NaN, got {qlim!r}")
-    if lo > hi:
-        raise RobotDefinitionError(
-            f"{where}: joint limit lower {lo:g} is greater than upper {hi:g}"
+            f"{where}: translation of {length:g} m exceeds the {MAX_LENGTH:g} m bound on "
+            "lengths in a robot description"
         )
-    return lo, hi
+    return a
 
 
 @dataclass(frozen=True)
@@ -79,9 +99,21 @@ class Joint:
     name: str = ""
 
     def __post_init__(self) -> None:
-        where = f"joint {self.name!r}" if self.name else "joint"
+        if not isinstance(self.name, str):
+            raise RobotDefinitionError(
+                f"joint name must be a string, got {type(self.name).__name__} "
+                f"{short_repr(self.name)}"
+            )
+        where = f"joint {short_repr(self.name)}" if self.name else "joint"
         jt = normalize_joint_type(self.type, where)
-        axis = as_vector(self.axis, f"{where} axis", 3)
+        try:
+            axis = as_vector(self.axis, f"{where} axis", 3)
+            origin = check_fixed_transform(self.origin, f"{where} origin")
+            post = check_fixed_transform(self.post, f"{where} post")
+        except (InputError, InputTypeError) as exc:
+            if isinstance(exc, RobotDefinitionError):
+                raise
+            raise RobotDefinitionError(str(exc)) from None
         norm = float(np.linalg.norm(axis))
         if norm < 1e-12:
             raise RobotDefinitionError(
@@ -89,12 +121,11 @@ class Joint:
             )
         object.__setattr__(self, "type", jt)
         object.__setattr__(self, "axis", axis / norm)
-        object.__setattr__(self, "origin", check_transform(self.origin, f"{where} origin").copy())
-        object.__setattr__(self, "post", check_transform(self.post, f"{where} post").copy())
-        if not np.isfinite(self.offset):
-            raise RobotDefinitionError(f"{where}: offset must be finite, got {self.offset!r}")
-        object.__setattr__(self, "offset", float(self.offset))
-        object.__setattr__(self, "qlim", check_limits(self.qlim, where))
+        object.__setattr__(self, "origin", origin)
+        object.__setattr__(self, "post", post)
+        object.__setattr__(self, "offset", definition_real(
+            self.offset, where, "offset", MAX_JOINT_VALUE, "rad or m"))
+        object.__setattr__(self, "qlim", check_interval(self.qlim, where))
 
     @property
     def is_revolute(self) -> bool:

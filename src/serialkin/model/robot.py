@@ -19,18 +19,22 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from serialkin._budget import check_allocation
 from serialkin._checks import (
+    MAX_JOINTS,
     as_float_array,
     as_generator,
     check_choice,
     check_int,
-    check_transform,
+    check_positive,
+    short_repr,
 )
 from serialkin.errors import InputError, RobotDefinitionError
 from serialkin.kinematics import _kernels as K
 from serialkin.model.chain import compile_chain
 from serialkin.model.dh import CONVENTIONS, DHLink, dh_to_joints, parse_dh_rows
-from serialkin.model.joint import Joint
+from serialkin.model.joint import Joint, check_fixed_transform
+from serialkin.model.limits import DEFAULT_HALF_RANGE, check_interval, inside_mask, sampling_box
 
 if TYPE_CHECKING:
     from serialkin.ik.result import IKResult
@@ -115,16 +119,26 @@ class Robot:
         convention: str | None = None,
         source: str = "",
     ) -> None:
+        if isinstance(joints, (str, bytes, Mapping)) or not isinstance(joints, Sequence):
+            raise RobotDefinitionError(
+                f"joints must be a list of Joint, got {type(joints).__name__} "
+                f"{short_repr(joints)}")
         if len(joints) == 0:
             raise RobotDefinitionError("a robot needs at least one joint")
+        if len(joints) > MAX_JOINTS:
+            raise RobotDefinitionError(
+                f"a robot has at most {MAX_JOINTS} joints, got {len(joints)}")
         for i, j in enumerate(joints):
             if not isinstance(j, Joint):
                 raise RobotDefinitionError(f"joints[{i}] must be a Joint, got {type(j).__name__}")
-        self.name = str(name)
+        if not isinstance(name, str):
+            raise RobotDefinitionError(
+                f"robot name must be a string, got {type(name).__name__} {short_repr(name)}")
+        self.name = name
         self.joints = tuple(joints)
         self.n = len(joints)
-        self.base = np.eye(4) if base is None else check_transform(base, "base").copy()
-        self.tool = np.eye(4) if tool is None else check_transform(tool, "tool").copy()
+        self.base = np.eye(4) if base is None else check_fixed_transform(base, "base")
+        self.tool = np.eye(4) if tool is None else check_fixed_transform(tool, "tool")
         self.dh = tuple(dh) if dh is not None else None
         self.convention = convention
         self.source = source
@@ -222,16 +236,20 @@ class Robot:
 
     def with_limits(self, qlim: object) -> Robot:
         """A copy of this robot with other joint limits, shape (n, 2) [rad or m], ±inf allowed."""
+        if isinstance(qlim, (str, bytes)):
+            raise InputError(f"qlim must be an ({self.n}, 2) array of numbers, got "
+                             f"{short_repr(qlim)}")
         try:
             lim = np.asarray(qlim, dtype=float)
-        except (TypeError, ValueError) as exc:
-            raise InputError(f"qlim must be an ({self.n}, 2) array of numbers, got {qlim!r}") \
-                from exc
+        except (TypeError, ValueError, OverflowError) as exc:
+            raise InputError(f"qlim must be an ({self.n}, 2) array of numbers, got "
+                             f"{short_repr(qlim)}") from exc
         if lim.shape != (self.n, 2):
             raise InputError(f"qlim must have shape ({self.n}, 2), got {lim.shape}")
-        joints = [dataclasses.replace(j, qlim=tuple(lim[i])) for i, j in enumerate(self.joints)]
+        rows = [check_interval(lim[i], f"qlim[{i}]") for i in range(self.n)]
+        joints = [dataclasses.replace(j, qlim=rows[i]) for i, j in enumerate(self.joints)]
         dh = None if self.dh is None else [
-            dataclasses.replace(r, qlim=tuple(lim[i])) for i, r in enumerate(self.dh)]
+            dataclasses.replace(r, qlim=rows[i]) for i, r in enumerate(self.dh)]
         return self._copy(joints=joints, dh=dh)
 
     # ------------------------------------------------------------------ validation
@@ -247,7 +265,7 @@ class Robot:
         return a
 
     def _nonfinite(self, q: np.ndarray, name: str = "q") -> InputError:
-        return InputError(f"{name} must be finite, got {q}")
+        return InputError(f"{name} must be finite, got {short_repr(q.tolist())}")
 
     @functools.cached_property
     def is_planar(self) -> bool:
@@ -282,6 +300,7 @@ class Robot:
             K.fk_into(np.ascontiguousarray(a), self._F, self._meta, T)
             return T
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
+        check_allocation("the FK batch", (flat.shape[0], 4, 4), 8, setting="the batch size")
         out = np.empty((flat.shape[0], 4, 4))
         kernel = K.fk_batch if flat.shape[0] >= PARALLEL_MIN_BATCH else K.fk_batch_serial
         kernel(flat, self._F, self._meta, out)
@@ -298,6 +317,8 @@ class Robot:
         """
         a = self.check_q(q)
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
+        check_allocation("the link frames", (flat.shape[0], self.n + 1, 4, 4), 8,
+                         setting="the batch size")
         out = np.empty((flat.shape[0], self.n + 1, 4, 4))
         if flat.shape[0] < PARALLEL_MIN_BATCH:
             for k in range(flat.shape[0]):
@@ -332,7 +353,7 @@ class Robot:
             (6, n) or (..., 6, n).
         """
         if type(q) is np.ndarray and q.dtype is _F64 and q.shape == self._qshape \
-                and link is None and point is None and frame == "base" \
+                and link is None and point is None and type(frame) is str and frame == "base" \
                 and q.flags.c_contiguous:
             J = np.empty((6, self.n))
             T = np.empty((4, 4))
@@ -345,6 +366,7 @@ class Robot:
         a = self.check_q(q)
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
         N = flat.shape[0]
+        check_allocation("the Jacobian batch", (N, 6 * self.n + 16), 8, setting="the batch size")
         J = np.empty((N, 6, self.n))
         T = np.empty((N, 4, 4))
         if link is None:
@@ -403,9 +425,13 @@ class Robot:
         if isinstance(task, str):
             rows = TASK_ROWS[check_choice(task, "task", TASK_ROWS)]
         else:
-            rows = tuple(check_int(r, "task row") for r in task)
-            if not rows or max(rows) > 5:
-                raise InputError(f"task rows must be a nonempty subset of 0..5, got {task!r}")
+            if not isinstance(task, (Sequence, np.ndarray)) or len(task) > 6:
+                raise InputError("task must be a name or a list of distinct row indices in "
+                                 f"0..5, got {short_repr(task)}")
+            rows = tuple(check_int(r, "task row", maximum=5) for r in task)
+            if not rows or len(set(rows)) != len(rows):
+                raise InputError("task rows must be a nonempty list of distinct indices in "
+                                 f"0..5, got {short_repr(task)}")
         return self.jacobian(q)[..., list(rows), :]
 
     def manipulability(self, q: object, task: str | Sequence[int] = "full") -> np.ndarray | float:
@@ -442,25 +468,44 @@ class Robot:
                  seed: None | int | np.random.Generator = None) -> np.ndarray:
         """Uniform random configurations inside the joint limits, shape (n,) or (*size, n).
 
-        Unlimited revolute joints sample [-π, π], unlimited prismatic joints [-1, 1] m.
+        Draws from :meth:`sampling_limits` (the limits; an open side is replaced as
+        :func:`serialkin.model.limits.sampling_box` documents: unlimited revolute joints
+        sample [-π, π], unlimited prismatic joints [-1, 1] m).
+
+        Args:
+            size: None for one configuration, an int or a tuple of ints (each >= 0).
+            seed: None, int or numpy Generator.
+
+        Raises:
+            InputError / InputTypeError: a negative or non-integer size; a size beyond
+                the memory budget (:mod:`serialkin._budget`).
         """
         rng = as_generator(seed)
         lo, hi = self.sampling_limits().T
-        shape = (() if size is None else (size,) if isinstance(size, int) else tuple(size))
+        if size is None:
+            shape: tuple[int, ...] = ()
+        elif isinstance(size, (tuple, list)):
+            shape = tuple(check_int(s, "size") for s in size)
+        else:
+            shape = (check_int(size, "size"),)
+        check_allocation("random_q size", (*shape, self.n), 8, setting="size")
         return lo + (hi - lo) * rng.random(shape + (self.n,))
 
     def sampling_limits(self) -> np.ndarray:
-        """Joint limits, (n, 2), infinite bounds replaced by ±π (revolute) or ±1 m (prismatic)."""
-        lim = self.qlim.copy()
-        default = np.array([np.pi if t == "R" else 1.0 for t in self.joint_types])
-        lim[:, 0] = np.where(np.isfinite(lim[:, 0]), lim[:, 0], -default)
-        lim[:, 1] = np.where(np.isfinite(lim[:, 1]), lim[:, 1], default)
-        return lim
+        """The finite box random configurations are drawn from, (n, 2) [rad or m].
+
+        The joint limits, each open side replaced as
+        :func:`serialkin.model.limits.sampling_box` documents (default half-range π for
+        revolute joints, 1 m for prismatic ones).
+        """
+        d = np.array([DEFAULT_HALF_RANGE[t] for t in self.joint_types])
+        return sampling_box(self.qlim[:, 0], self.qlim[:, 1], d)
 
     def within_limits(self, q: object, tol: float = 0.0) -> np.ndarray | bool:
         """True where ``q`` (..., n) lies inside the joint limits (with tolerance ``tol``)."""
         a = self.check_q(q)
-        ok = np.all((a >= self.qlim[:, 0] - tol) & (a <= self.qlim[:, 1] + tol), axis=-1)
+        tol = check_positive(tol, "tol", allow_zero=True)
+        ok = np.all(inside_mask(a, self.qlim[:, 0], self.qlim[:, 1], tol), axis=-1)
         return bool(ok) if ok.ndim == 0 else ok
 
     # ------------------------------------------------------------------ inverse kinematics

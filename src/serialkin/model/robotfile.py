@@ -29,13 +29,14 @@ from __future__ import annotations
 import json
 import math
 import os
-from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from serialkin.errors import RobotDefinitionError
+from serialkin._checks import MAX_JOINT_VALUE, MAX_JOINTS, MAX_LENGTH, short_repr
+from serialkin._files import Field, load_document
+from serialkin.errors import InputTypeError, RobotDefinitionError
 from serialkin.model.dh import CONVENTIONS, DHLink
 from serialkin.model.joint import normalize_joint_type
 from serialkin.spatial import make_transform, rpy_to_matrix
@@ -46,83 +47,111 @@ ANGLE_UNITS: dict[str, float] = {"rad": 1.0, "deg": math.pi / 180.0}
 LENGTH_UNITS: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 #: Suffixes read as robot files (``.urdf`` is read by :mod:`serialkin.model.urdf`).
 ROBOT_FILE_SUFFIXES = (".yaml", ".yml", ".json")
+#: Most rows of a DH table in a robot file or a scenario.
+MAX_DH_ROWS = MAX_JOINTS
 
 _TOP_FIELDS = ("name", "convention", "units", "source", "dh", "base", "tool")
 _ROW_FIELDS = ("a", "alpha", "d", "theta", "type", "qlim", "name")
 
 
-class _Where:
-    """Formats error messages that name the file and the field."""
-
-    def __init__(self, origin: str) -> None:
-        self.origin = origin
-
-    def error(self, field: str, expected: str, got: object = None, *, show_got: bool = True
-              ) -> RobotDefinitionError:
-        tail = f", got {got!r}" if show_got else ""
-        return RobotDefinitionError(f"{self.origin}: field '{field}': expected {expected}{tail}")
-
-
-def _number(value: object, field: str, where: _Where, unit: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise where.error(field, f"a number [{unit}]", value)
-    v = float(value)
-    if not math.isfinite(v):
-        raise where.error(field, f"a finite number [{unit}]", value)
-    return v
-
-
-def _vector(value: object, field: str, where: _Where, size: int, unit: str) -> np.ndarray:
-    if not isinstance(value, (list, tuple)) or len(value) != size:
-        raise where.error(field, f"a list of {size} numbers [{unit}]", value)
-    return np.array([_number(v, f"{field}[{i}]", where, unit) for i, v in enumerate(value)])
-
-
-def _transform(value: object, field: str, where: _Where, ang: float, lin: float,
-               angle_unit: str, length_unit: str) -> np.ndarray:
+def _transform(f: Field, ang: float, lin: float, angle_unit: str, length_unit: str
+               ) -> np.ndarray:
     """Parse ``{xyz, rpy}`` (either optional) or a 4x4 nested list into a rigid transform."""
-    if isinstance(value, Mapping):
-        unknown = sorted(set(value) - {"xyz", "rpy"})
-        if unknown:
-            raise where.error(field, "a mapping with keys 'xyz' and/or 'rpy', or a 4x4 matrix",
-                              f"unknown key(s) {', '.join(map(str, unknown))}", show_got=True)
-        xyz = (_vector(value["xyz"], f"{field}.xyz", where, 3, length_unit) * lin
-               if "xyz" in value else np.zeros(3))
-        rpy = (_vector(value["rpy"], f"{field}.rpy", where, 3, angle_unit) * ang
-               if "rpy" in value else np.zeros(3))
+    if isinstance(f.value, dict):
+        f.mapping({"xyz", "rpy"})
+        xyz = (_lengths(f["xyz"], 3, length_unit) if f["xyz"].present else np.zeros(3))
+        rpy = (_angles(f["rpy"], 3, angle_unit) if f["rpy"].present else np.zeros(3))
         return make_transform(rpy_to_matrix(rpy), xyz)
-    if isinstance(value, (list, tuple)) and len(value) == 4:
-        rows = [_vector(r, f"{field}[{i}]", where, 4, "matrix row") for i, r in enumerate(value)]
-        T = np.array(rows)
+    if isinstance(f.value, list) and len(f.value) == 4:
+        T = np.array([r.vector(4, unit="matrix row") for r in f.items()])
         T[:3, 3] *= lin
         if np.abs(T[3] - [0, 0, 0, 1]).max() > 1e-9:
-            raise where.error(field, "a homogeneous transform whose last row is [0, 0, 0, 1]",
-                              T[3].tolist())
+            raise f.fail(f"must be a homogeneous transform whose last row is [0, 0, 0, 1], "
+                         f"got {T[3].tolist()}")
         R = T[:3, :3]
         err = float(np.abs(R.T @ R - np.eye(3)).max())
         if err > 1e-6 or np.linalg.det(R) < 0:
-            raise where.error(field, "a rotation block that is orthonormal with det +1 "
-                              f"(max |RᵀR − I| = {err:.3g}, det = {np.linalg.det(R):.4g})",
-                              show_got=False)
+            raise f.fail("must have a rotation block that is orthonormal with det +1 "
+                         f"(max |RᵀR − I| = {err:.3g}, det = {np.linalg.det(R):.4g})")
         return T
-    raise where.error(field, "{xyz: [x, y, z], rpy: [roll, pitch, yaw]} or a 4x4 matrix", value)
+    raise f.expected("{xyz: [x, y, z], rpy: [roll, pitch, yaw]} or a 4x4 matrix")
 
 
-def _limits(value: object, field: str, where: _Where, factor: float, unit: str
-            ) -> tuple[float, float]:
-    if not isinstance(value, (list, tuple)) or len(value) != 2:
-        raise where.error(field, f"a pair [lower, upper] [{unit}] (null or .inf for none)", value)
-    out = []
-    for i, (v, default) in enumerate(zip(value, (-math.inf, math.inf))):
-        if v is None:
-            out.append(default)
-            continue
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v):
-            raise where.error(f"{field}[{i}]", f"a number [{unit}] or null", v)
-        out.append(float(v) * factor if math.isfinite(v) else float(v))
-    if out[0] > out[1]:
-        raise where.error(field, "lower <= upper", list(value))
-    return out[0], out[1]
+def _bound(limit: float, factor: float) -> float:
+    """A bound in SI units (``limit``) expressed in the file's units (``factor`` to SI)."""
+    return limit / factor
+
+
+def _lengths(f: Field, size: int, unit: str) -> np.ndarray:
+    """``size`` lengths in ``unit`` as metres, each within ±:data:`MAX_LENGTH` m."""
+    b = _bound(MAX_LENGTH, LENGTH_UNITS[unit])
+    return f.vector(size, lo=-b, hi=b, unit=unit) * LENGTH_UNITS[unit]
+
+
+def _angles(f: Field, size: int, unit: str) -> np.ndarray:
+    """``size`` angles in ``unit`` as radians, each within ±:data:`MAX_JOINT_VALUE` rad."""
+    b = _bound(MAX_JOINT_VALUE, ANGLE_UNITS[unit])
+    return f.vector(size, lo=-b, hi=b, unit=unit) * ANGLE_UNITS[unit]
+
+
+def _limits(f: Field, factor: float, unit: str) -> tuple[float, float]:
+    """A joint range ``[lower, upper]`` (null or ±.inf for an open side), times ``factor``."""
+    if not isinstance(f.value, list) or len(f.value) != 2:
+        raise f.expected(f"a pair [lower, upper] [{unit}] (null or .inf for an open side)")
+    lo_f, hi_f = f.items()
+    b = _bound(MAX_JOINT_VALUE, factor)
+    lo = lo_f.number(lo=-b, hi=b, unit=unit, allow_inf=True, default=-math.inf)
+    hi = hi_f.number(lo=-b, hi=b, unit=unit, allow_inf=True, default=math.inf)
+    if lo == math.inf:
+        raise lo_f.fail("must be a number or null (an open lower side), got +inf")
+    if hi == -math.inf:
+        raise hi_f.fail("must be a number or null (an open upper side), got -inf")
+    if lo > hi:
+        raise f.fail(f"must have lower <= upper, got [{lo:g}, {hi:g}]")
+    return (lo * factor if math.isfinite(lo) else lo, hi * factor if math.isfinite(hi) else hi)
+
+
+def dh_rows_from_field(f: Field, *, angle_unit: str = "rad", length_unit: str = "m",
+                       allow_names: bool = True) -> list[DHLink]:
+    """Read a DH table (a list of ``{a, alpha, d, theta, type, qlim, name}`` rows).
+
+    Shared by robot files and scenarios. ``a``, ``d`` and the limits of prismatic
+    joints are lengths in ``length_unit``; ``alpha``, ``theta`` and the limits of
+    revolute joints are angles in ``angle_unit``; the result is in metres and radians.
+
+    Raises:
+        f.error: a malformed table; the message names the file and the field
+            (``dh[2].alpha``).
+    """
+    ang, lin = ANGLE_UNITS[angle_unit], LENGTH_UNITS[length_unit]
+    allowed = _ROW_FIELDS if allow_names else tuple(x for x in _ROW_FIELDS if x != "name")
+    rows: list[DHLink] = []
+    items = f.items(min_len=1, max_len=MAX_DH_ROWS,
+                    what="a non-empty list of rows {a, alpha, d, theta, type, qlim}")
+    for i, row in enumerate(items):
+        row.mapping(allowed, ("a", "alpha", "d", "theta"),
+                    what="a mapping {a, alpha, d, theta, type, qlim}")
+        tf = row["type"]
+        try:
+            jtype = normalize_joint_type(tf.value if tf.present else "R", tf.path)
+        except RobotDefinitionError:
+            raise tf.expected("'R' (revolute) or 'P' (prismatic)") from None
+        bl, ba = _bound(MAX_LENGTH, lin), _bound(MAX_JOINT_VALUE, ang)
+        a = row["a"].number(lo=-bl, hi=bl, unit=length_unit) * lin
+        d = row["d"].number(lo=-bl, hi=bl, unit=length_unit) * lin
+        alpha = row["alpha"].number(lo=-ba, hi=ba, unit=angle_unit) * ang
+        theta = row["theta"].number(lo=-ba, hi=ba, unit=angle_unit) * ang
+        qunit, qfac = (angle_unit, ang) if jtype == "R" else (length_unit, lin)
+        qlim = (_limits(row["qlim"], qfac, qunit) if row["qlim"].present
+                else (-math.inf, math.inf))
+        jname = row["name"].string(default=f"joint{i + 1}", max_len=1000)
+        rows.append(DHLink(a=a, alpha=alpha, d=d, theta=theta, type=jtype, qlim=qlim,
+                           name=jname))
+    names = [r.name for r in rows]
+    if len(set(names)) != len(names):
+        dup = sorted({x for x in names if names.count(x) > 1})
+        raise f.fail(f"must have unique joint names, got duplicates {dup[:5]}")
+    return rows
 
 
 def robot_from_dict(data: object, origin: str = "<robot description>") -> Any:
@@ -141,132 +170,47 @@ def robot_from_dict(data: object, origin: str = "<robot description>") -> Any:
     """
     from serialkin.model.robot import Robot
 
-    where = _Where(origin)
-    if not isinstance(data, Mapping):
-        raise RobotDefinitionError(
-            f"{origin}: expected a mapping with fields {', '.join(_TOP_FIELDS)}, "
-            f"got {type(data).__name__}"
-        )
-    unknown = sorted(set(map(str, data)) - set(_TOP_FIELDS))
-    if unknown:
-        raise RobotDefinitionError(
-            f"{origin}: unknown field(s) {', '.join(repr(u) for u in unknown)}; "
-            f"allowed: {', '.join(_TOP_FIELDS)}"
-        )
-    for req in ("name", "units", "dh"):
-        if req not in data:
-            hint = {"units": " (e.g. units: {angle: deg, length: m})",
-                    "dh": " (a list of rows {a, alpha, d, theta, type, qlim})",
-                    "name": " (a string)"}[req]
-            raise RobotDefinitionError(f"{origin}: missing required field '{req}'{hint}")
-    name = data["name"]
-    if not isinstance(name, str) or not name.strip():
-        raise where.error("name", "a non-empty string", name)
-    convention = data.get("convention", "standard")
-    if convention not in CONVENTIONS:
-        raise where.error("convention", " or ".join(repr(c) for c in CONVENTIONS), convention)
-    source = data.get("source", "")
-    if not isinstance(source, str):
-        raise where.error("source", "a string", source)
-
-    units = data["units"]
-    if not isinstance(units, Mapping):
-        raise where.error("units", "a mapping {angle: rad|deg, length: m|cm|mm}", units)
-    bad = sorted(set(map(str, units)) - {"angle", "length"})
-    if bad:
-        raise where.error("units", "only the keys 'angle' and 'length'", f"key(s) {bad}")
-    if "angle" not in units:
-        raise where.error("units.angle", "'rad' or 'deg' (the angle unit must be stated)",
-                          show_got=False)
-    angle_unit = units["angle"]
-    if angle_unit not in ANGLE_UNITS:
-        raise where.error("units.angle", "'rad' or 'deg'", angle_unit)
-    length_unit = units.get("length", "m")
-    if length_unit not in LENGTH_UNITS:
-        raise where.error("units.length", "'m', 'cm' or 'mm'", length_unit)
+    doc = Field(data, "", origin, RobotDefinitionError)
+    doc.mapping(_TOP_FIELDS, ("name", "units", "dh"),
+                what=f"a mapping with fields {', '.join(_TOP_FIELDS)}")
+    name = doc["name"].string(max_len=1000)
+    convention = doc["convention"].string(choices=CONVENTIONS, default="standard")
+    source = doc["source"].string(default="", nonempty=False)
+    units = doc["units"].mapping({"angle", "length"}, ("angle",),
+                                 what="a mapping {angle: rad|deg, length: m|cm|mm}")
+    angle_unit = units["angle"].string(choices=ANGLE_UNITS)
+    length_unit = units["length"].string(choices=LENGTH_UNITS, default="m")
     ang, lin = ANGLE_UNITS[angle_unit], LENGTH_UNITS[length_unit]
-
-    rows_in = data["dh"]
-    if not isinstance(rows_in, list) or not rows_in:
-        raise where.error("dh", "a non-empty list of rows {a, alpha, d, theta, type, qlim}",
-                          rows_in)
-    rows: list[DHLink] = []
-    for i, row in enumerate(rows_in):
-        f = f"dh[{i}]"
-        if not isinstance(row, Mapping):
-            raise where.error(f, "a mapping {a, alpha, d, theta, type, qlim}", row)
-        extra = sorted(set(map(str, row)) - set(_ROW_FIELDS))
-        if extra:
-            raise where.error(f, f"only the fields {', '.join(_ROW_FIELDS)}",
-                              f"unknown field(s) {', '.join(extra)}")
-        for req in ("a", "alpha", "d", "theta"):
-            if req not in row:
-                raise where.error(f"{f}.{req}", "a number (a, alpha, d and theta are required)",
-                                  show_got=False)
-        try:
-            jtype = normalize_joint_type(row.get("type", "R"), f"{origin}: field '{f}.type'")
-        except RobotDefinitionError as exc:
-            raise where.error(f"{f}.type", "'R' (revolute) or 'P' (prismatic)",
-                              row.get("type")) from exc
-        a = _number(row["a"], f"{f}.a", where, length_unit) * lin
-        d = _number(row["d"], f"{f}.d", where, length_unit) * lin
-        alpha = _number(row["alpha"], f"{f}.alpha", where, angle_unit) * ang
-        theta = _number(row["theta"], f"{f}.theta", where, angle_unit) * ang
-        qunit, qfac = (angle_unit, ang) if jtype == "R" else (length_unit, lin)
-        qlim = (_limits(row["qlim"], f"{f}.qlim", where, qfac, qunit)
-                if row.get("qlim") is not None else (-math.inf, math.inf))
-        jname = row.get("name", f"joint{i + 1}")
-        if not isinstance(jname, str) or not jname:
-            raise where.error(f"{f}.name", "a non-empty string", jname)
-        rows.append(DHLink(a=a, alpha=alpha, d=d, theta=theta, type=jtype, qlim=qlim,
-                           name=jname))
-    names = [r.name for r in rows]
-    dup = sorted({x for x in names if names.count(x) > 1})
-    if dup:
-        raise where.error("dh[*].name", "unique joint names", f"duplicates {dup}")
-
+    rows = dh_rows_from_field(doc["dh"], angle_unit=angle_unit, length_unit=length_unit)
     base = tool = None
-    if data.get("base") is not None:
-        base = _transform(data["base"], "base", where, ang, lin, angle_unit, length_unit)
-    if data.get("tool") is not None:
-        tool = _transform(data["tool"], "tool", where, ang, lin, angle_unit, length_unit)
+    if doc["base"].present:
+        base = _transform(doc["base"], ang, lin, angle_unit, length_unit)
+    if doc["tool"].present:
+        tool = _transform(doc["tool"], ang, lin, angle_unit, length_unit)
     try:
-        return Robot.from_dh(rows, convention, base=base, tool=tool, name=name.strip(),
+        return Robot.from_dh(rows, convention, base=base, tool=tool, name=name,
                              source=source)
     except RobotDefinitionError as exc:  # pragma: no cover - fields are validated above
         raise RobotDefinitionError(f"{origin}: {exc}") from exc
 
 
 def read_robot_data(path: str | os.PathLike[str]) -> object:
-    """Parse a robot file (YAML or JSON by suffix) into Python data, naming the file on error."""
+    """Parse a robot file (YAML or JSON by suffix) into Python data, naming the file on error.
+
+    The file is read by :func:`serialkin._files.load_document`: at most
+    :data:`~serialkin._files.MAX_FILE_BYTES`, UTF-8, no duplicate keys, bounded nesting
+    and alias expansion.
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputTypeError(f"path must be a str or os.PathLike, got {type(path).__name__} "
+                             f"{short_repr(path)}")
     p = Path(path)
     if p.suffix.lower() not in ROBOT_FILE_SUFFIXES:
         raise RobotDefinitionError(
             f"{p}: unknown robot file type {p.suffix!r}; expected one of "
             f"{', '.join(ROBOT_FILE_SUFFIXES)} (or .urdf)"
         )
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError as exc:
-        raise RobotDefinitionError(f"{p}: robot file not found") from exc
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RobotDefinitionError(f"{p}: cannot read the robot file ({exc})") from exc
-    if p.suffix.lower() == ".json":
-        try:
-            return json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise RobotDefinitionError(
-                f"{p}: invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}"
-            ) from exc
-    import yaml
-
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        problem = getattr(exc, "problem", None) or str(exc)
-        raise RobotDefinitionError(f"{p}: invalid YAML{at}: {problem}") from exc
+    return load_document(p, what="robot file", error=RobotDefinitionError)
 
 
 def load_robot_file(path: str | os.PathLike[str]) -> Any:
@@ -302,7 +246,7 @@ def robot_to_dict(robot: Any, angle_unit: str = "deg", length_unit: str = "m") -
     check_choice(length_unit, "length_unit", LENGTH_UNITS)
     if robot.dh is None:
         raise RobotDefinitionError(
-            f"robot {robot.name!r} has no DH table; a robot file needs one "
+            f"robot {short_repr(robot.name)} has no DH table; a robot file needs one "
             "(save a URDF with robot.to_urdf() instead)"
         )
     ang, lin = ANGLE_UNITS[angle_unit], LENGTH_UNITS[length_unit]
@@ -359,7 +303,10 @@ def save_robot_file(robot: Any, path: str | os.PathLike[str], *, angle_unit: str
     else:
         import yaml
 
-        text = f"# serialkin robot file: {robot.name}\n" + yaml.safe_dump(
+        # The dumper quotes and escapes every name and free text: nothing a name holds
+        # (newlines, ':', '#', quotes) can add a line or a key to the file. Non-ASCII is
+        # escaped too (allow_unicode would write U+0085 raw, which reads back as a space).
+        text = "# serialkin robot file\n" + yaml.safe_dump(
             data, sort_keys=False, default_flow_style=None)
     write_text_atomic(p, text)
     return p

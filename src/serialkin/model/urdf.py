@@ -14,13 +14,17 @@ after the motion. That is exactly :class:`~serialkin.model.joint.Joint` with
 
 from __future__ import annotations
 
+import math
 import os
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from serialkin._checks import short_repr
+from serialkin._files import MAX_NUMBER
 from serialkin.errors import NotSupportedError, RobotDefinitionError
 from serialkin.model.joint import Joint
 from serialkin.spatial.transforms import make_transform, rotx, roty, rotz
@@ -42,16 +46,19 @@ class _UJoint:
     unsupported: str = ""
 
 
-def _floats(text: str | None, count: int, default: tuple[float, ...], where: str) -> np.ndarray:
+def _floats(text: str | None, count: int, default: tuple[float, ...], where: str,
+            bound: float = math.inf) -> np.ndarray:
+    """``count`` finite numbers from an attribute, each with magnitude at most ``bound``."""
     if text is None:
         return np.array(default, dtype=float)
     parts = text.split()
+    want = f"{count} finite numbers" + (f" with |x| <= {bound:g}" if bound < math.inf else "")
     try:
-        vals = np.array([float(p) for p in parts])
-    except ValueError as exc:
-        raise RobotDefinitionError(f"{where}: expected {count} numbers, got {text!r}") from exc
-    if vals.shape != (count,) or not np.isfinite(vals).all():
-        raise RobotDefinitionError(f"{where}: expected {count} finite numbers, got {text!r}")
+        vals = np.array([float(p) for p in parts[: count + 1]])
+    except ValueError:
+        raise RobotDefinitionError(f"{where}: expected {want}, got {short_repr(text)}") from None
+    if len(parts) != count or not np.isfinite(vals).all() or np.abs(vals).max() > bound:
+        raise RobotDefinitionError(f"{where}: expected {want}, got {short_repr(text)}")
     return vals
 
 
@@ -63,20 +70,29 @@ def rpy_to_matrix(rpy: np.ndarray) -> np.ndarray:
 def _origin(el: ET.Element | None, where: str) -> np.ndarray:
     if el is None:
         return np.eye(4)
-    xyz = _floats(el.get("xyz"), 3, (0.0, 0.0, 0.0), f"{where} <origin xyz>")
-    rpy = _floats(el.get("rpy"), 3, (0.0, 0.0, 0.0), f"{where} <origin rpy>")
+    xyz = _floats(el.get("xyz"), 3, (0.0, 0.0, 0.0), f"{where} <origin xyz>", MAX_NUMBER)
+    rpy = _floats(el.get("rpy"), 3, (0.0, 0.0, 0.0), f"{where} <origin rpy>", MAX_NUMBER)
     return make_transform(rpy_to_matrix(rpy), xyz)
 
 
 def _read_xml(path_or_string: str | os.PathLike[str]) -> tuple[ET.Element, str]:
+    """Parse a URDF file or string; the XML parser honours the declared encoding.
+
+    A file is read as bytes (at most :data:`serialkin._files.MAX_FILE_BYTES`) so that
+    ``<?xml ... encoding="ISO-8859-1"?>`` is decoded as declared (UTF-8 by default).
+    """
+    from serialkin._files import read_bytes
+
     text = str(path_or_string)
+    data: str | bytes
     if text.lstrip().startswith("<"):
         source, data = "<string>", text
     else:
         path = Path(text)
-        if not path.is_file():
-            raise RobotDefinitionError(f"URDF file {text!r} does not exist")
-        source, data = str(path), path.read_text(encoding="utf-8")
+        if not path.exists():
+            raise RobotDefinitionError(f"URDF file {short_repr(text)} does not exist")
+        source = str(path)
+        data = read_bytes(path, what="URDF file", error=RobotDefinitionError)
     try:
         root = ET.fromstring(data)
     except ET.ParseError as exc:
@@ -84,6 +100,8 @@ def _read_xml(path_or_string: str | os.PathLike[str]) -> tuple[ET.Element, str]:
         raise RobotDefinitionError(
             f"{source}: malformed XML at line {line}, column {col}: {exc}"
         ) from exc
+    except (ValueError, LookupError) as exc:  # e.g. an encoding Python does not know
+        raise RobotDefinitionError(f"{source}: cannot read the XML ({exc})") from exc
     if root.tag != "robot":
         raise RobotDefinitionError(f"{source}: the root element must be <robot>, got <{root.tag}>")
     return root, source
@@ -93,19 +111,20 @@ def _parse_joint(el: ET.Element, source: str) -> _UJoint:
     name = el.get("name")
     if not name:
         raise RobotDefinitionError(f"{source}: a <joint> has no name attribute")
-    where = f"{source}: joint {name!r}"
+    where = f"{source}: joint {short_repr(name)}"
     jtype = el.get("type")
     if jtype is None:
         raise RobotDefinitionError(f"{where} has no type attribute")
     unsupported = ""
     if jtype in _UNSUPPORTED:
-        unsupported = (f"{where} is of type {jtype!r}, which is not supported (serial chains "
-                       "of revolute, continuous, prismatic and fixed joints)")
+        unsupported = (f"{where} is of type {short_repr(jtype)}, which is not supported "
+                       "(serial chains of revolute, continuous, prismatic and fixed joints)")
     elif el.find("mimic") is not None:
         unsupported = f"{where} has a <mimic> element; mimic joints are not supported"
     if jtype not in _MOVING and jtype != "fixed" and not unsupported:
         raise RobotDefinitionError(
-            f"{where} has unknown type {jtype!r}; expected revolute, continuous, prismatic or fixed"
+            f"{where} has unknown type {short_repr(jtype)}; expected revolute, continuous, "
+            "prismatic or fixed"
         )
     parent, child = el.find("parent"), el.find("child")
     if parent is None or parent.get("link") is None:
@@ -113,7 +132,7 @@ def _parse_joint(el: ET.Element, source: str) -> _UJoint:
     if child is None or child.get("link") is None:
         raise RobotDefinitionError(f"{where} has no <child link=...>")
     axis = _floats(el.find("axis").get("xyz") if el.find("axis") is not None else None, 3,
-                   (1.0, 0.0, 0.0), f"{where} <axis xyz>")
+                   (1.0, 0.0, 0.0), f"{where} <axis xyz>", MAX_NUMBER)
     if jtype in _MOVING and np.linalg.norm(axis) < 1e-12:
         raise RobotDefinitionError(f"{where} has a zero <axis xyz>; expected a nonzero 3-vector")
     lower, upper = -np.inf, np.inf
@@ -165,13 +184,15 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
         for role, link in (("parent", j.parent), ("child", j.child)):
             if link not in link_set:
                 raise RobotDefinitionError(
-                    f"{source}: joint {j.name!r} refers to {role} link {link!r}, "
+                    f"{source}: joint {short_repr(j.name)} refers to {role} link "
+                    f"{short_repr(link)}, "
                     "which does not exist"
                 )
         if j.child in by_child:
             raise RobotDefinitionError(
-                f"{source}: link {j.child!r} is the child of two joints "
-                f"({by_child[j.child].name!r} and {j.name!r}); the description has a loop"
+                f"{source}: link {short_repr(j.child)} is the child of two joints "
+                f"({short_repr(by_child[j.child].name)} and {short_repr(j.name)}); the "
+                "description has a loop"
             )
         by_child[j.child] = j
         children[j.parent].append(j.child)
@@ -179,37 +200,41 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
     if len(roots) != 1:
         raise RobotDefinitionError(
             f"{source}: expected one root link, found {len(roots)}"
-            + (f" ({', '.join(roots)})" if roots else "; the joints form a loop")
+            + (f" ({_names(roots)})" if roots else "; the joints form a loop")
         )
+    _check_tree(roots[0], children, source)
     base = base_link or roots[0]
     if base not in link_set:
-        raise RobotDefinitionError(f"{source}: base_link {base!r} is not a link of the robot")
+        raise RobotDefinitionError(
+            f"{source}: base_link {short_repr(base)} is not a link of the robot")
     if tip_link is None:
         leaves = [n for n in links if not children[n] and n != base]
         below = [n for n in leaves if _is_below(n, base, by_child)]
         if len(below) != 1:
             raise RobotDefinitionError(
-                f"{source}: the tree below {base!r} branches into {len(below)} leaves "
-                f"({', '.join(below)}); pass tip_link= one of them"
+                f"{source}: the tree below {short_repr(base)} branches into {len(below)} leaves "
+                f"({_names(below)}); pass tip_link= one of them"
             )
         tip = below[0]
     else:
         tip = tip_link
         if tip not in link_set:
-            raise RobotDefinitionError(f"{source}: tip_link {tip!r} is not a link of the robot")
+            raise RobotDefinitionError(
+                f"{source}: tip_link {short_repr(tip)} is not a link of the robot")
     chain: list[_UJoint] = []
     link = tip
     seen = {tip}
     while link != base:
         if link not in by_child:
             raise RobotDefinitionError(
-                f"{source}: tip_link {tip!r} is not below base_link {base!r}"
+                f"{source}: tip_link {short_repr(tip)} is not below base_link {short_repr(base)}"
             )
         j = by_child[link]
         chain.append(j)
         link = j.parent
         if link in seen:
-            raise RobotDefinitionError(f"{source}: the joints form a loop at link {link!r}")
+            raise RobotDefinitionError(
+                f"{source}: the joints form a loop at link {short_repr(link)}")
         seen.add(link)
     chain.reverse()
     for j in chain:
@@ -228,12 +253,41 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
         fixed = np.eye(4)
     if not out:
         raise RobotDefinitionError(
-            f"{source}: no moving joint between {base!r} and {tip!r}"
+            f"{source}: no moving joint between {short_repr(base)} and {short_repr(tip)}"
         )
     robot = Robot(out, tool=fixed, name=root.get("name") or "urdf_robot",
                   source=f"URDF {source} ({base} -> {tip})")
     robot.link_names = tuple(link_names) + ((tip,) if link_names[-1] != tip else ())
     return robot
+
+
+def _names(names: list[str]) -> str:
+    """At most ten names, each shown bounded (messages stay short for any file)."""
+    def bare(name: str) -> str:  # the repr without its quotes (escapes kept)
+        r = short_repr(name, 40)
+        return r[1:-1] if len(r) > 1 and r[0] == r[-1] and r[0] in "'\"" else r[1:]
+
+    shown = ", ".join(bare(n) for n in names[:10])
+    return shown + (f" ... ({len(names)} in all)" if len(names) > 10 else "")
+
+
+def _check_tree(root: str, children: dict[str, list[str]], source: str) -> None:
+    """Refuse links not reachable from the root: with one parent per link, they form a loop.
+
+    A loop anywhere in the description is refused, on the chain or off it.
+    """
+    reached = {root}
+    todo = [root]
+    while todo:
+        for c in children[todo.pop()]:
+            if c not in reached:
+                reached.add(c)
+                todo.append(c)
+    if len(reached) != len(children):
+        loop = sorted(set(children) - reached)
+        raise RobotDefinitionError(
+            f"{source}: the joints form a loop through link(s) {_names(loop)} (not reachable from "
+            f"the root link {short_repr(root)}); a URDF must be a tree")
 
 
 def _is_below(link: str, base: str, by_child: dict[str, _UJoint]) -> bool:
@@ -250,7 +304,21 @@ def _fmt(v: float) -> str:
     return repr(float(v))
 
 
-def _origin_xml(T: np.ndarray) -> str:
+#: Characters XML 1.0 cannot hold at all (even escaped): most C0 controls, surrogates.
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+
+
+def _xml_name(text: str, what: str) -> str:
+    """A name for an XML attribute; refuse characters no XML document can contain."""
+    m = _NOT_XML.search(text)
+    if m is not None:
+        raise RobotDefinitionError(
+            f"{what} {short_repr(text, 60)} contains the character U+{ord(m.group()):04X}, "
+            "which XML (and so URDF) cannot hold; rename it")
+    return text
+
+
+def _origin_el(parent: ET.Element, T: np.ndarray) -> None:
     import warnings
 
     from scipy.spatial.transform import Rotation
@@ -258,8 +326,8 @@ def _origin_xml(T: np.ndarray) -> str:
     with warnings.catch_warnings():  # at gimbal lock scipy picks roll = 0: still exact
         warnings.simplefilter("ignore", UserWarning)
         rpy = Rotation.from_matrix(T[:3, :3]).as_euler("xyz")  # extrinsic xyz = Rz·Ry·Rx
-    xyz = " ".join(_fmt(v) for v in T[:3, 3])
-    return f'<origin xyz="{xyz}" rpy="{" ".join(_fmt(v) for v in rpy)}"/>'
+    ET.SubElement(parent, "origin", xyz=" ".join(_fmt(v) for v in T[:3, 3]),
+                  rpy=" ".join(_fmt(v) for v in rpy))
 
 
 def robot_to_urdf(robot) -> str:
@@ -269,7 +337,12 @@ def robot_to_urdf(robot) -> str:
     base included for the first joint) composed with the joint offset, so that
     :func:`robot_from_urdf` reproduces the same forward kinematics; the tool becomes a
     fixed joint to a link named ``tool``. Infinite revolute limits export as
-    ``continuous`` joints.
+    ``continuous`` joints. The document is built with :mod:`xml.etree.ElementTree`,
+    which escapes every name (``&``, ``<``, quotes, newlines): no name can add markup.
+
+    Raises:
+        RobotDefinitionError: a robot, joint or link name holds a character XML cannot
+            represent (a control character other than tab, newline and carriage return).
     """
     from scipy.spatial.transform import Rotation
 
@@ -277,33 +350,39 @@ def robot_to_urdf(robot) -> str:
     names = getattr(robot, "link_names", None)
     if names is None or len(names) < robot.n + 1:
         names = ["base_link"] + [f"link{i + 1}" for i in range(robot.n)]
-    lines = ['<?xml version="1.0"?>', f'<robot name="{robot.name}">']
-    lines += [f'  <link name="{n}"/>' for n in names[: robot.n + 1]]
-    lines.append('  <link name="tool"/>')
+    names = [_xml_name(str(n), "link name") for n in names[: robot.n + 1]]
+    tool_link = "tool"
+    while tool_link in names:  # a robot whose own links include 'tool'
+        tool_link = "_" + tool_link
+    joint_names = [_xml_name(str(n), "joint name") for n in robot.joint_names]
+    tool_joint = "tool_fixed"
+    while tool_joint in joint_names:
+        tool_joint = "_" + tool_joint
+    root = ET.Element("robot", name=_xml_name(str(robot.name), "robot name"))
+    for n in [*names, tool_link]:
+        ET.SubElement(root, "link", name=n)
     for i, j in enumerate(robot.joints):
         M = np.eye(4)
         if j.type == "R":
             M[:3, :3] = Rotation.from_rotvec(meta[i, :3] * j.offset).as_matrix()
         else:
             M[:3, 3] = meta[i, :3] * j.offset
-        origin = F[i] @ M
         lo, hi = j.qlim
-        if j.type == "R" and not (np.isfinite(lo) or np.isfinite(hi)):
-            jtype, limit = "continuous", ""
-        else:
-            jtype = "revolute" if j.type == "R" else "prismatic"
-            lo_s = _fmt(lo if np.isfinite(lo) else -1e9)
-            hi_s = _fmt(hi if np.isfinite(hi) else 1e9)
-            limit = f'<limit lower="{lo_s}" upper="{hi_s}" effort="0" velocity="0"/>'
-        axis = " ".join(_fmt(v) for v in meta[i, :3])
-        lines.append(
-            f'  <joint name="{robot.joint_names[i]}" type="{jtype}">'
-            f'<parent link="{names[i]}"/><child link="{names[i + 1]}"/>'
-            f'{_origin_xml(origin)}<axis xyz="{axis}"/>{limit}</joint>'
-        )
-    lines.append(
-        f'  <joint name="tool_fixed" type="fixed"><parent link="{names[robot.n]}"/>'
-        f'<child link="tool"/>{_origin_xml(F[robot.n])}</joint>'
-    )
-    lines.append("</robot>")
-    return "\n".join(lines) + "\n"
+        continuous = j.type == "R" and not (np.isfinite(lo) or np.isfinite(hi))
+        jtype = "continuous" if continuous else ("revolute" if j.type == "R" else "prismatic")
+        el = ET.SubElement(root, "joint", name=joint_names[i], type=jtype)
+        ET.SubElement(el, "parent", link=names[i])
+        ET.SubElement(el, "child", link=names[i + 1])
+        _origin_el(el, F[i] @ M)
+        ET.SubElement(el, "axis", xyz=" ".join(_fmt(v) for v in meta[i, :3]))
+        if not continuous:
+            ET.SubElement(el, "limit", lower=_fmt(lo if np.isfinite(lo) else -1e9),
+                          upper=_fmt(hi if np.isfinite(hi) else 1e9), effort="0",
+                          velocity="0")
+    el = ET.SubElement(root, "joint", name=tool_joint, type="fixed")
+    ET.SubElement(el, "parent", link=names[robot.n])
+    ET.SubElement(el, "child", link=tool_link)
+    _origin_el(el, F[robot.n])
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") \
+        + "\n"

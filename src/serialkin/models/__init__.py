@@ -20,6 +20,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from serialkin._checks import MAX_JOINTS, short_repr
 from serialkin.errors import InputError
 from serialkin.model.robot import Robot
 from serialkin.models.chapter import scara, three_link, two_link
@@ -96,7 +97,11 @@ def get(name: str, **kwargs: Any) -> Robot:
     key = _ALIASES.get(key, key)
     m = _PLANAR_N.match(key)
     if m and key not in names():
-        return planar(int(m.group(1)), **kwargs)
+        digits = m.group(1)  # no int() of a 10,000-digit string: bounded first
+        if len(digits) > 12:
+            raise InputError(f"robot model planar<N> with a {len(digits)}-digit N; a robot "
+                             f"has at most {MAX_JOINTS} joints")
+        return planar(int(digits), **kwargs)
     for info in _CATALOG:
         if info.name == key:
             return info.build(**kwargs)
@@ -107,7 +112,7 @@ def get(name: str, **kwargs: Any) -> Robot:
     hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close \
         else ""
     raise InputError(
-        f"unknown robot model {name!r}{hint} Available: {', '.join(names())} "
+        f"unknown robot model {short_repr(name)}{hint} Available: {', '.join(names())} "
         f"(and planar<N>, e.g. planar6)"
     )
 

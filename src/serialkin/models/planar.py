@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from serialkin._checks import as_float_array, check_int
+from serialkin._checks import MAX_JOINTS, as_float_array, check_int, short_repr
 from serialkin.errors import InputError
 from serialkin.model.dh import DHLink
 from serialkin.model.robot import Robot
@@ -33,7 +33,14 @@ def _lengths(n: int, lengths: float | Sequence[float]) -> np.ndarray:
 def _limits(n: int, qlim: object) -> np.ndarray:
     if qlim is None:
         return np.tile([-np.inf, np.inf], (n, 1))
-    lim = np.asarray(qlim, dtype=float)
+    if isinstance(qlim, (str, bytes)):
+        raise InputError(f"qlim must be a pair (lower, upper) or ({n}, 2) numbers [rad], got "
+                         f"{short_repr(qlim)}")
+    try:
+        lim = np.asarray(qlim, dtype=float)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise InputError(f"qlim must be a pair (lower, upper) or ({n}, 2) numbers [rad], got "
+                         f"{short_repr(qlim)}") from exc
     if lim.shape == (2,):
         lim = np.tile(lim, (n, 1))
     if lim.shape != (n, 2):
@@ -53,7 +60,7 @@ def planar(
     """Build a planar arm of ``n`` revolute joints (any n, any link lengths).
 
     Args:
-        n: number of links/joints (>= 1).
+        n: number of links/joints, 1 to :data:`~serialkin._checks.MAX_JOINTS` (10 000).
         lengths: one link length for all links, or ``n`` lengths [m].
         qlim: None (unlimited), one (lower, upper) pair for every joint, or (n, 2) [rad].
         name: robot name (default ``planar<n>``).
@@ -63,7 +70,8 @@ def planar(
         link ``n``.
 
     Raises:
-        InputError: n < 1, wrong number of lengths, negative lengths, bad ``qlim`` shape.
+        InputError: n < 1 or above MAX_JOINTS, wrong number of lengths, negative or
+            too large lengths, bad ``qlim`` shape.
         RobotDefinitionError: a joint limit with lower > upper.
 
     Example:
@@ -71,7 +79,9 @@ def planar(
         >>> robot.fk([0.0, 0.0, 0.0])[:3, 3].tolist()
         [2.3, 0.0, 0.0]
     """
-    n = check_int(n, "n", minimum=1)
+    n = check_int(n, "n", minimum=1, maximum=None)
+    if n > MAX_JOINTS:
+        raise InputError(f"n = {short_repr(n)}: a robot has at most {MAX_JOINTS} joints")
     L = _lengths(n, lengths)
     lim = _limits(n, qlim)
     rows = [

@@ -32,15 +32,23 @@ influence zone) and ``x_L,i = k · (distance into the buffer, signed towards mid
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numba import njit
 
-from serialkin._checks import as_float_array, check_int, check_positive
+from serialkin._checks import (
+    MAX_ITERATIONS,
+    as_float_array,
+    check_int,
+    check_positive,
+    check_transform,
+    short_repr,
+)
 from serialkin.errors import InputError
 from serialkin.kinematics import _kernels as K
+from serialkin.model.limits import check_interval
 from serialkin.redundancy.objectives import task_rows
 from serialkin.redundancy.obstacles import (
     Capsule,
@@ -70,19 +78,35 @@ def smoothstep(s: np.ndarray | float) -> np.ndarray:
     return x * x * (3.0 - 2.0 * x)
 
 
+#: Range [rad or m] whose buffer a joint open on one side gets at its finite end (eq 49).
+ONE_SIDED_RANGE = 2.0 * math.pi
+
+
 @njit(cache=True)
 def _limit_weight_and_push(q, lo, hi, buffer, max_weight):
     """Eq 49 weight of one joint and its signed depth into the buffer (towards mid-range).
 
-    Returns (0, 0) for a joint with an infinite limit.
+    Limits are intervals whose ends may be infinite (:mod:`serialkin.model.limits`):
+    an unlimited joint gets (0, 0); a joint open on one side gets, at its finite end, the
+    buffer of a range :data:`ONE_SIDED_RANGE` wide.
     """
-    if not (math.isfinite(lo) and math.isfinite(hi)):
+    lo_f = math.isfinite(lo)
+    hi_f = math.isfinite(hi)
+    if not (lo_f or hi_f):
         return 0.0, 0.0
-    width = buffer * (hi - lo)
-    s = max((lo + width - q) / width, (q - (hi - width)) / width)
+    width = buffer * ((hi - lo) if lo_f and hi_f else ONE_SIDED_RANGE)
+    if width <= 0.0:  # a fixed joint (lo == hi): always at its limit, nothing to push
+        return max_weight, 0.0
+    s = 0.0
+    push = 0.0
+    if lo_f:
+        s = max(s, (lo + width - q) / width)
+        push += max(lo + width - q, 0.0)
+    if hi_f:
+        s = max(s, (q - (hi - width)) / width)
+        push -= max(q - (hi - width), 0.0)
     s = 1.0 if q <= lo or q >= hi else min(max(s, 0.0), 1.0)  # exactly the max at the limit
     w = max_weight * s * s * (3.0 - 2.0 * s)
-    push = max(lo + width - q, 0.0) - max(q - (hi - width), 0.0)
     return w, push
 
 
@@ -105,7 +129,8 @@ def joint_limit_weights(q: object, qlim: object, *, buffer: float = 0.1,
       growing towards the limit,
     * ``W_Li = max_weight`` at and beyond the limit.
 
-    Joints with an infinite limit get 0.
+    Unlimited joints get 0; a joint open on one side gets the buffer of a 2π-wide range
+    at its finite end.
 
     Args:
         q: joint values (n,).
@@ -338,9 +363,15 @@ class MultiTaskResolver:
             object.__setattr__(self, name, _weight(getattr(self, name), name))
         for name in ("damping", "gain", "max_task_step", "max_step", "tol"):
             object.__setattr__(self, name, check_positive(getattr(self, name), name))
-        if not 0.0 < float(self.limit_buffer) <= 0.5:
-            raise InputError(f"limit_buffer must be in (0, 0.5], got {self.limit_buffer!r}")
-        check_int(self.max_iter, "max_iter", minimum=1)
+        buffer = check_positive(self.limit_buffer, "limit_buffer")
+        if buffer > 0.5:
+            raise InputError(f"limit_buffer must be in (0, 0.5], got {buffer:g}")
+        object.__setattr__(self, "limit_buffer", buffer)
+        check_int(self.max_iter, "max_iter", minimum=1, maximum=MAX_ITERATIONS)
+        if isinstance(self.obstacles, (str, bytes, Mapping)) or not isinstance(
+                self.obstacles, Iterable):
+            raise InputError("obstacles must be a list of Circle, Sphere or Capsule, got "
+                             f"{type(self.obstacles).__name__} {short_repr(self.obstacles)}")
         obs = tuple(self.obstacles)
         for i, o in enumerate(obs):
             if not isinstance(o, (Circle, Sphere, Capsule)):
@@ -356,10 +387,17 @@ class MultiTaskResolver:
     def _limits(self, robot) -> np.ndarray:
         if self.joint_limits is None:
             return np.asarray(robot.qlim, dtype=float)
-        lim = np.asarray(self.joint_limits, dtype=float)
+        if isinstance(self.joint_limits, (str, bytes)):
+            raise InputError(f"joint_limits must be ({robot.n}, 2) numbers, got "
+                             f"{short_repr(self.joint_limits)}")
+        try:
+            lim = np.asarray(self.joint_limits, dtype=float)
+        except (TypeError, ValueError, OverflowError) as exc:
+            raise InputError(f"joint_limits must be ({robot.n}, 2) numbers, got "
+                             f"{short_repr(self.joint_limits)}") from exc
         if lim.shape != (robot.n, 2):
             raise InputError(f"joint_limits must have shape ({robot.n}, 2), got {lim.shape}")
-        return lim
+        return np.array([check_interval(row, f"joint_limits[{i}]") for i, row in enumerate(lim)])
 
     def prepare(self, robot) -> _State:
         """Buffers and checks for one robot (obstacles overlapping the base raise)."""
@@ -382,10 +420,20 @@ class MultiTaskResolver:
         Each iteration: ẋ = gain·(x_d − x) (norm capped), q ← q + q̇ (dt = 1). Stops when the
         task error is below ``tol``, after ``max_iter`` iterations, or when the step
         becomes negligible (a compromise between the tasks).
+
+        Raises:
+            InputError: ``target`` not a finite (4, 4) rigid transform, ``q0`` not (n,)
+                finite values.
         """
+        T = check_transform(target, "target")
+        if T.shape != (4, 4):
+            raise InputError(f"target must be one (4, 4) pose, got shape {T.shape}")
+        q = robot.check_q(q0, "q0")
+        if q.ndim != 1:
+            raise InputError(f"q0 must have shape ({robot.n},), got {q.shape}")
         st = state if state is not None else self.prepare(robot)
-        return st.solve(np.ascontiguousarray(target, dtype=float),
-                        np.ascontiguousarray(q0, dtype=float).copy())
+        return st.solve(np.ascontiguousarray(T, dtype=float),
+                        np.array(q, dtype=float, order="C"))
 
 
 class _State:

@@ -18,6 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from serialkin._budget import check_allocation
 from serialkin._checks import as_float_array, check_choice, check_int, check_positive
 from serialkin.errors import InputError
 from serialkin.redundancy.objectives import Objective, task_rows
@@ -172,6 +173,7 @@ def self_motion(robot, q0: object, objective: Objective, *, steps: int = 50,
     """
     q = robot.check_q(q0, "q0").astype(float).copy()
     s = check_int(steps, "steps", minimum=1)
+    check_allocation("the self-motion path", (s + 1, robot.n), 8, setting="steps")
     k = check_positive(gain, "gain", allow_zero=True)
     cap = check_positive(max_step, "max_step")
     rows = task_rows(task)

@@ -52,6 +52,7 @@ __all__ = [
     "clearances",
     "closest_pairs",
     "obstacle_from_dict",
+    "obstacle_from_field",
     "obstacle_jacobian",
     "robot_segments",
 ]
@@ -160,36 +161,41 @@ class Capsule:
 Obstacle = Circle | Sphere | Capsule
 
 
+def obstacle_from_field(f: Any) -> Obstacle:
+    """Build an obstacle from a file field ``{type: circle|cylinder|sphere|capsule, ...}``.
+
+    ``f`` is a :class:`serialkin._files.Field` (the reader every file format shares):
+    the type, the fields of that type and their values are checked before use.
+
+    Raises:
+        f.error: unknown type or a missing/invalid field; the message names the field.
+    """
+    kinds = {"circle": Circle, "cylinder": Circle, "sphere": Sphere, "capsule": Capsule}
+    f.mapping(what="a mapping {type: circle|cylinder|sphere|capsule, ...}")
+    t = f["type"].string(choices=kinds)
+    points = {"circle": {"center": 2}, "cylinder": {"center": 2}, "sphere": {"center": 3},
+              "capsule": {"a": 3, "b": 3}}[t]
+    f.mapping({*points, "radius", "type", "influence", "name"}, (*points, "radius"))
+    kwargs: dict[str, Any] = {k: f[k].vector(size, unit="m") for k, size in points.items()}
+    kwargs["radius"] = f["radius"].number(lo=0.0, lo_open=True, unit="m")
+    if f["influence"].present:
+        kwargs["influence"] = f["influence"].number(lo=0.0, unit="m")
+    kwargs["name"] = f["name"].string(default="", nonempty=False, max_len=1000)
+    try:
+        return kinds[t](**kwargs)
+    except (InputError, InputTypeError) as exc:  # pragma: no cover - fields checked above
+        raise f.fail(f"is invalid: {exc}") from exc
+
+
 def obstacle_from_dict(d: dict, where: str = "obstacle") -> Obstacle:
     """Build an obstacle from a mapping ``{type: circle|cylinder|sphere|capsule, ...}``.
 
     Raises:
-        InputError: unknown type or missing/invalid field; the message starts with ``where``.
+        InputError: unknown type or missing/invalid field; the message names ``where``.
     """
-    if not isinstance(d, dict):
-        raise InputTypeError(f"{where} must be a mapping, got {type(d).__name__}")
-    kinds = {"circle": Circle, "cylinder": Circle, "sphere": Sphere, "capsule": Capsule}
-    t = d.get("type")
-    if t not in kinds:
-        raise InputError(f"{where}.type must be one of {', '.join(kinds)}, got {t!r}")
-    cls = kinds[t]
-    fields = {"circle": ("center", "radius"), "cylinder": ("center", "radius"),
-              "sphere": ("center", "radius"), "capsule": ("a", "b", "radius")}[t]
-    extra = set(d) - set(fields) - {"type", "influence", "name"}
-    if extra:
-        raise InputError(f"{where}: unknown field(s) {sorted(extra)} for a {t}")
-    kwargs = {}
-    for f in fields:
-        if f not in d:
-            raise InputError(f"{where}.{f} is missing (a {t} needs {', '.join(fields)})")
-        kwargs[f] = d[f]
-    if "influence" in d:
-        kwargs["influence"] = d["influence"]
-    kwargs["name"] = str(d.get("name", ""))
-    try:
-        return cls(**kwargs)
-    except (InputError, InputTypeError) as exc:
-        raise type(exc)(f"{where}: {exc}") from exc
+    from serialkin._files import Field
+
+    return obstacle_from_field(Field(d, where, "", InputError))
 
 
 def encode_obstacles(obstacles: Sequence[Obstacle]) -> np.ndarray:

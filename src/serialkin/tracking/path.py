@@ -19,7 +19,16 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from serialkin._checks import as_float_array, check_last_dims, check_positive, check_transform
+from serialkin._budget import check_allocation
+from serialkin._checks import (
+    MAX_INT,
+    as_float_array,
+    check_last_dims,
+    check_positive,
+    check_real,
+    check_transform,
+    short_repr,
+)
 from serialkin.errors import InputError
 
 __all__ = ["TASKS", "Path", "sample_parameter"]
@@ -33,15 +42,29 @@ def sample_parameter(start: float, stop: float, step: float) -> np.ndarray:
 
     The chapter's "φ ∈ {0, ..., 2π} with step 0.2" gives 0, 0.2, ..., 6.2 (32 values).
     """
-    s0 = float(start)
-    s1 = float(stop)
+    s0 = check_real(start, "start")
+    s1 = check_real(stop, "stop")
     h = check_positive(step, "step")
-    if not (np.isfinite(s0) and np.isfinite(s1)):
-        raise InputError(f"start and stop must be finite, got {start!r}, {stop!r}")
     if s1 < s0:
         raise InputError(f"stop ({s1}) must not be below start ({s0})")
-    count = int(np.floor((s1 - s0) / h + 1e-9)) + 1
+    ratio = (s1 - s0) / h
+    count = int(np.floor(ratio + 1e-9)) + 1 if ratio < MAX_INT else MAX_INT
+    check_path_size(count, "step")
     return s0 + h * np.arange(count)
+
+
+#: Estimated memory per path point [bytes]: its 4x4 target, up to 6 task coordinates
+#: and the parameter (float64), before any tracking result.
+PATH_POINT_BYTES = 8 * (16 + 6 + 1)
+
+
+def check_path_size(count: int, setting: str) -> None:
+    """Refuse a path of ``count`` points beyond the memory budget (:mod:`serialkin._budget`).
+
+    Raises:
+        BudgetError: naming ``setting`` (e.g. 'step') and the estimated size.
+    """
+    check_allocation(f"a path of {count} points", count, PATH_POINT_BYTES, setting=setting)
 
 
 class Path:
@@ -59,7 +82,8 @@ class Path:
     def __init__(self, targets: np.ndarray, task: str, points: np.ndarray,
                  parameter: np.ndarray | None = None) -> None:
         if task not in TASKS:
-            raise InputError(f"unknown path task {task!r}; expected one of: {', '.join(TASKS)}")
+            raise InputError(f"unknown path task {short_repr(task)}; expected one of: "
+                             f"{', '.join(TASKS)}")
         if targets.shape[0] == 0:
             raise InputError("a path needs at least one point")
         self.task = task
@@ -104,7 +128,7 @@ class Path:
                 raise InputError(f"path points must have 2 or 3 columns, got shape {P.shape}")
         if task not in TASKS or task == "pose":
             raise InputError(f"task for points must be 'planar', 'planar_pose' or 'position', "
-                             f"got {task!r}")
+                             f"got {short_repr(task)}")
         if cols != TASKS[task]:
             raise InputError(f"task {task!r} needs {TASKS[task]} columns, got shape {P.shape}")
         p = P.shape[0]
@@ -177,9 +201,11 @@ class Path:
         if W.shape[0] < 2:
             raise InputError(f"a polyline needs at least 2 waypoints, got {W.shape[0]}")
         h = check_positive(step, "step")
-        pts = [W[0]]
-        for a, b in zip(W[:-1], W[1:]):
-            k = max(1, int(np.ceil(np.linalg.norm(b[:3] - a[:3]) / h - 1e-9)))
-            for i in range(1, k + 1):
-                pts.append(a + (b - a) * i / k)
-        return cls.from_points(np.array(pts), task=task)
+        seg = np.linalg.norm(W[1:, :3] - W[:-1, :3], axis=1) / h
+        seg = np.where(np.isfinite(seg), seg, float(MAX_INT))
+        ks = [max(1, int(np.ceil(x - 1e-9))) if x < MAX_INT else MAX_INT for x in seg]
+        check_path_size(1 + sum(ks), "step")
+        pts = [W[:1]]
+        for a, b, k in zip(W[:-1], W[1:], ks):
+            pts.append(a + (b - a) * (np.arange(1, k + 1)[:, None] / k))
+        return cls.from_points(np.concatenate(pts), task=task)

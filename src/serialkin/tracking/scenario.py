@@ -37,10 +37,8 @@ Schema (fields marked * are required)::
 
 from __future__ import annotations
 
-import json
 import math
 import os
-from collections.abc import Iterable
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path as FsPath
@@ -48,9 +46,11 @@ from typing import Any
 
 import numpy as np
 
+from serialkin._checks import MAX_ITERATIONS, MAX_JOINTS, MAX_LENGTH, short_repr
+from serialkin._files import MAX_ITEMS, Field, load_document
 from serialkin.errors import InputError, InputTypeError, SerialkinError
 from serialkin.redundancy.multitask import MultiTaskResolver
-from serialkin.redundancy.obstacles import check_obstacles, obstacle_from_dict
+from serialkin.redundancy.obstacles import check_obstacles, obstacle_from_field
 from serialkin.tracking.path import Path
 from serialkin.tracking.tracker import ON_UNREACHABLE, track
 from serialkin.tracking.trajectory import Trajectory
@@ -63,6 +63,11 @@ __all__ = [
     "planar_arm",
     "scenario_from_dict",
 ]
+
+#: Most joints of a scenario's robot (planar links or DH rows).
+MAX_LINKS = MAX_JOINTS
+#: Most points of a scenario's path.
+MAX_PATH_POINTS = MAX_ITEMS
 
 
 class ScenarioError(InputError):
@@ -98,95 +103,12 @@ _DLS_FIELDS = {"damping", "tol", "max_iter", "max_step"}
 _MT_FIELDS = {"weight", "obstacle_weight", "joint_limit_weight", "limit_buffer", "damping",
               "singularity_damping", "manipulability_threshold", "repulsive_gain", "gain",
               "max_task_step", "max_step", "tol", "max_iter", "link_radius"}
-
-
-class _Reader:
-    """Field access with messages that name the file and the field."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, where: str, msg: str) -> ScenarioError:
-        return ScenarioError(f"scenario {self.source!r}: field {where!r} {msg}")
-
-    def mapping(self, d: object, where: str) -> dict:
-        if not isinstance(d, dict):
-            raise self.fail(where, f"must be a mapping, got {type(d).__name__} {d!r}"[:200])
-        return d
-
-    def get(self, d: dict, key: str, where: str, required: bool = False) -> Any:
-        full = f"{where}.{key}" if where else key
-        if key not in d or d[key] is None:
-            if required:
-                raise self.fail(full, "is missing")
-            return None
-        return d[key]
-
-    def number(self, d: dict, key: str, where: str, *, default: float | None = None,
-               positive: bool = False, nonneg: bool = False, required: bool = False) -> float:
-        v = self.get(d, key, where, required)
-        full = f"{where}.{key}" if where else key
-        if v is None:
-            return default  # type: ignore[return-value]
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise self.fail(full, f"must be a finite number, got {v!r}")
-        if positive and v <= 0:
-            raise self.fail(full, f"must be a number > 0, got {v!r}")
-        if nonneg and v < 0:
-            raise self.fail(full, f"must be a number >= 0, got {v!r}")
-        return float(v)
-
-    def integer(self, d: dict, key: str, where: str, *, minimum: int = 1,
-                default: int | None = None, required: bool = False) -> int:
-        v = self.get(d, key, where, required)
-        full = f"{where}.{key}" if where else key
-        if v is None:
-            return default  # type: ignore[return-value]
-        if isinstance(v, bool) or not isinstance(v, int) or v < minimum:
-            raise self.fail(full, f"must be an integer >= {minimum}, got {v!r}")
-        return int(v)
-
-    def present(self, d: dict, where: str, numbers: Iterable[str], integers: Iterable[str],
-                *, positive: bool = False, nonneg: bool = False) -> dict[str, Any]:
-        """The given fields of ``d``: ``numbers`` (see :meth:`number`), then ``integers``.
-
-        Integers must be >= 1; absent or null fields are left out of the result.
-        """
-        out: dict[str, Any] = {}
-        for k in numbers:
-            v = self.number(d, k, where, positive=positive, nonneg=nonneg)
-            if v is not None:
-                out[k] = v
-        for k in integers:
-            i = self.integer(d, k, where)
-            if i is not None:
-                out[k] = i
-        return out
-
-    def array(self, v: object, where: str, shape_desc: str, ndim: int | None = None,
-              cols: tuple[int, ...] | None = None) -> np.ndarray:
-        try:
-            a = np.asarray(v, dtype=float)
-        except (TypeError, ValueError):
-            raise self.fail(where, f"must be {shape_desc} of numbers, got {v!r}"[:300]) from None
-        if ndim is not None and a.ndim != ndim or cols is not None and a.shape[-1] not in cols:
-            raise self.fail(where, f"must be {shape_desc}, got shape {a.shape}")
-        if not np.isfinite(a).all():
-            bad = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
-            raise self.fail(where, f"must be finite; entry {bad} is {a[bad]}")
-        return a
-
-    def unknown(self, d: dict, allowed: set[str], where: str) -> None:
-        extra = sorted(set(d) - allowed)
-        if extra:
-            import difflib
-
-            hints = [f"{e!r} (did you mean {m[0]!r}?)" if (m := difflib.get_close_matches(
-                e, sorted(allowed), n=1)) else repr(e) for e in extra]
-            label = f"{where}." if where else ""
-            raise ScenarioError(f"scenario {self.source!r}: unknown field(s) "
-                                f"{', '.join(label + h for h in hints)}; allowed: "
-                                f"{', '.join(sorted(allowed))}")
+_ROBOT_KINDS = ("planar", "dh", "model", "urdf")
+_PATH_FIELDS = {"circle": {"center", "radius", "start", "stop", "step"},
+                "points": {"points"},
+                "polyline": {"waypoints", "step"},
+                "wave": {"start", "end", "amplitude", "periods", "step"}}
+_TASKS = ("planar", "position", "planar_pose")
 
 
 @dataclass
@@ -230,111 +152,178 @@ class Scenario:
                      on_unreachable=self.on_unreachable, **self.options)
 
 
-def _robot(rd: _Reader, d: dict, base_dir: FsPath | None):
+def _robot(f: Field, base_dir: FsPath | None):
     from serialkin.model.robot import Robot
+    from serialkin.model.robotfile import dh_rows_from_field
 
-    r = rd.mapping(d, "robot")
-    kinds = [k for k in ("planar", "dh", "model", "urdf") if k in r]
-    rd.unknown(r, {"planar", "dh", "model", "urdf", "joint_limits_deg", "name"}, "robot")
+    r = f.mapping({*_ROBOT_KINDS, "joint_limits_deg", "name"})
+    kinds = [k for k in _ROBOT_KINDS if k in r]
     if len(kinds) != 1:
-        raise rd.fail("robot", "must have exactly one of 'planar', 'dh', 'model', 'urdf', "
-                      f"got {kinds or 'none'}")
+        raise r.fail("must have exactly one of 'planar', 'dh', 'model', 'urdf', "
+                     f"got {kinds or 'none'}")
     kind = kinds[0]
-    name = r.get("name")
-    try:
-        if kind == "planar":
-            p = rd.mapping(r["planar"], "robot.planar")
-            rd.unknown(p, {"links", "length"}, "robot.planar")
-            n = rd.integer(p, "links", "robot.planar", required=True)
-            L = rd.number(p, "length", "robot.planar", positive=True, required=True)
-            robot = planar_arm(n, L, name=name)
-        elif kind == "dh":
-            rows = r["dh"]
-            if not isinstance(rows, list) or not rows:
-                raise rd.fail("robot.dh", "must be a non-empty list of rows")
-            robot = Robot.from_dh(rows, name=name or "robot")
-        elif kind == "model":
-            import serialkin.models as models
+    name = r["name"].string(default=None, max_len=1000)
+    sub = r[kind]
+    if kind == "planar":
+        p = sub.mapping({"links", "length"}, ("links", "length"))
+        n = p["links"].integer(lo=1, hi=MAX_LINKS)
+        L = p["length"].number(lo=0.0, lo_open=True, hi=MAX_LENGTH, unit="m")
+        robot = planar_arm(n, L, name=name)
+    elif kind == "dh":
+        rows = dh_rows_from_field(sub, angle_unit="rad", length_unit="m")
+        robot = Robot.from_dh(rows, name=name or "robot")
+    else:
+        text = sub.string(max_len=4096)
+        try:
+            if kind == "model":
+                from serialkin import models
 
-            fn = getattr(models, str(r["model"]), None)
-            if not callable(fn):
-                raise rd.fail("robot.model", f"names no model of serialkin.models: {r['model']!r}")
-            robot = fn()
-        else:
-            p = FsPath(str(r["urdf"]))
-            if not p.is_absolute() and base_dir is not None:
-                p = base_dir / p
-            robot = Robot.from_urdf(str(p))
-    except ScenarioError:
-        raise
-    except (SerialkinError, ValueError, TypeError) as exc:
-        raise rd.fail(f"robot.{kind}", f"is invalid: {exc}") from exc
-    lim = r.get("joint_limits_deg")
-    if lim is not None:
-        a = rd.array(lim, "robot.joint_limits_deg", "[lo, hi] or (n, 2) degrees")
+                robot = models.get(text)
+            else:
+                p = FsPath(text)
+                if not p.is_absolute() and base_dir is not None:
+                    p = base_dir / p
+                robot = Robot.from_urdf(str(p))
+        except SerialkinError as exc:
+            raise sub.fail(f"is invalid: {exc}") from exc
+        if robot.n > MAX_LINKS:
+            raise sub.fail(f"gives a robot of {robot.n} joints, more than {MAX_LINKS}")
+    lim_f = r["joint_limits_deg"]
+    if lim_f.present:
+        a = lim_f.array(what="[lo, hi] or (n, 2) degrees", lo=-1e6, hi=1e6)
         if a.shape == (2,):
             a = np.tile(a, (robot.n, 1))
         if a.shape != (robot.n, 2) or np.any(a[:, 0] >= a[:, 1]):
-            raise rd.fail("robot.joint_limits_deg",
-                          f"must be [lo, hi] or ({robot.n}, 2) with lo < hi, got {lim!r}")
+            raise lim_f.expected(f"[lo, hi] or ({robot.n}, 2) with lo < hi")
         robot = robot.with_limits(np.radians(a))
     return robot
 
 
-def _path(rd: _Reader, d: object, robot, q0: np.ndarray) -> Path:
-    p = rd.mapping(d, "path")
-    kind = rd.get(p, "type", "path", required=True)
-    allowed = {"circle": {"center", "radius", "start", "stop", "step"},
-               "points": {"points"},
-               "polyline": {"waypoints", "step"},
-               "wave": {"start", "end", "amplitude", "periods", "step"}}
-    if kind not in allowed:
-        raise rd.fail("path.type", f"must be one of {', '.join(allowed)}, got {kind!r}")
-    rd.unknown(p, allowed[kind] | {"type", "task"}, "path")
-    task = p.get("task")
-    if task is not None and task not in ("planar", "position", "planar_pose"):
-        raise rd.fail("path.task", f"must be planar, position or planar_pose, got {task!r}")
+def _count_points(f: Field, length: float, step: float) -> None:
+    """Refuse a path whose ``length / step`` exceeds :data:`MAX_PATH_POINTS`."""
+    count = length / step
+    if not count <= MAX_PATH_POINTS:
+        raise f.fail(f"gives about {count:.3g} path points, more than the limit of "
+                     f"{MAX_PATH_POINTS}; use a larger step")
+
+
+def _point(f: Field, what: str = "[x, y]") -> np.ndarray:
+    a = f.require().array(what=what, ndim=1, lo=-MAX_LENGTH, hi=MAX_LENGTH)
+    if a.shape != (2,):
+        raise f.fail(f"must be {what}, got shape {a.shape}")
+    return a
+
+
+def _path(f: Field, robot, q0: np.ndarray) -> Path:
+    p = f.mapping()
+    kind = p["type"].string(choices=_PATH_FIELDS)
+    p.mapping(_PATH_FIELDS[kind] | {"type", "task"})
+    task = p["task"].string(choices=_TASKS, default=None)
     try:
         if kind == "circle":
-            c = rd.array(rd.get(p, "center", "path", True), "path.center", "[x, y]", 1, (2,))
-            return Path.circle(c, rd.number(p, "radius", "path", positive=True, required=True),
-                               start=rd.number(p, "start", "path", default=0.0),
-                               stop=rd.number(p, "stop", "path", default=2 * math.pi),
-                               step=rd.number(p, "step", "path", default=0.2, positive=True))
+            c = _point(p["center"])
+            radius = p["radius"].number(lo=0.0, lo_open=True, hi=MAX_LENGTH, unit="m")
+            start = p["start"].number(default=0.0, unit="rad")
+            stop = p["stop"].number(default=2 * math.pi, unit="rad")
+            step = p["step"].number(lo=0.0, lo_open=True, default=0.2, unit="rad")
+            _count_points(p["step"], abs(stop - start), step)
+            return Path.circle(c, radius, start=start, stop=stop, step=step)
         if kind == "points":
-            pts = rd.array(rd.get(p, "points", "path", True), "path.points",
-                           "a list of [x, y] or [x, y, z] points", 2, (2, 3))
+            pts = p["points"].require().array(
+                what="a list of [x, y] or [x, y, z] points", ndim=2, cols=(2, 3),
+                max_items=3 * MAX_PATH_POINTS, lo=-MAX_LENGTH, hi=MAX_LENGTH)
             return Path.from_points(pts, task=task)
         if kind == "polyline":
-            w = rd.array(rd.get(p, "waypoints", "path", True), "path.waypoints",
-                         "a list of [x, y] or [x, y, z] points", 2, (2, 3))
-            return Path.polyline(w, rd.number(p, "step", "path", positive=True, required=True),
-                                 task=task)
-        start = rd.get(p, "start", "path", True)
-        if start == "q0":
-            a = robot.fk(q0)[:2, 3]
-        else:
-            a = rd.array(start, "path.start", "[x, y] or 'q0'", 1, (2,))
-        b = rd.array(rd.get(p, "end", "path", True), "path.end", "[x, y]", 1, (2,))
-        amp = rd.number(p, "amplitude", "path", default=0.0)
-        periods = rd.number(p, "periods", "path", default=1.0)
-        step = rd.number(p, "step", "path", default=0.02, positive=True)
-        if step > 1:
-            raise rd.fail("path.step", f"must be in (0, 1] for a wave, got {step!r}")
+            w = p["waypoints"].require().array(
+                what="a list of [x, y] or [x, y, z] points", ndim=2, cols=(2, 3),
+                lo=-MAX_LENGTH, hi=MAX_LENGTH)
+            step = p["step"].number(lo=0.0, lo_open=True, hi=MAX_LENGTH, unit="m")
+            _count_points(p["step"], float(np.linalg.norm(np.diff(w, axis=0), axis=1).sum()),
+                          step)
+            return Path.polyline(w, step, task=task)
+        sf = p["start"].require()
+        a = robot.fk(q0)[:2, 3] if sf.value == "q0" else _point(sf, "[x, y] or 'q0'")
+        b = _point(p["end"])
+        amp = p["amplitude"].number(lo=-MAX_LENGTH, hi=MAX_LENGTH, default=0.0, unit="m")
+        periods = p["periods"].number(default=1.0)
+        step = p["step"].number(lo=0.0, lo_open=True, hi=1.0, default=0.02)
+        _count_points(p["step"], 1.0, step)
         dvec = b - a
         nrm = np.array([-dvec[1], dvec[0]]) / max(np.linalg.norm(dvec), 1e-12)
         return Path.from_function(
             lambda s: a + dvec * s + amp * math.sin(2 * math.pi * periods * s) * nrm,
             0.0, 1.0, step, task="planar")
-    except ScenarioError:
-        raise
     except (InputError, InputTypeError) as exc:
-        raise rd.fail("path", f"is invalid: {exc}") from exc
+        if isinstance(exc, ScenarioError):
+            raise
+        raise f.fail(f"is invalid: {exc}") from exc
+
+
+def _ik_options(f: Field, method: str) -> dict[str, Any]:
+    """The ``solver.options`` of an IK method: known names, plain values of the right type."""
+    from serialkin.ik.registry import get_method
+
+    spec = get_method(method)
+    defaults: dict[str, Any] = {"restarts": 0, "seed": 0, "respect_limits": True}
+    defaults.update(spec.options)
+    f.mapping(set(defaults), what="a mapping of option names to values")
+    out: dict[str, Any] = {}
+    for key in f.keys():
+        v, default = f[key], defaults[key]
+        if isinstance(default, bool):
+            if not isinstance(v.value, bool):
+                raise v.expected("true or false")
+            out[key] = v.value
+        elif key == "seed":
+            out[key] = v.integer(lo=0, hi=2**63 - 1)
+        elif isinstance(default, int):
+            out[key] = v.integer(lo=0, hi=MAX_ITERATIONS)
+        elif isinstance(default, str):
+            out[key] = v.string(max_len=100)
+        else:
+            out[key] = v.number()
+    return out
+
+
+def _solver(f: Field, path: Path, obstacles: tuple) -> tuple[Any, dict[str, Any], float]:
+    """The solver (name or resolver), the tracker's options and the link radius."""
+    from serialkin.ik.registry import available_methods
+
+    s = f.mapping() if f.present else Field({}, f.path, f.origin, f.error)
+    others = [m for m in available_methods() if m not in ("dls", "multitask")]
+    method = s["method"].string(choices=("dls", "multitask", *others),
+                                default="dls")
+    if method == "multitask":
+        s.mapping(_MT_FIELDS | {"method"})
+        kw: dict[str, Any] = {k: s[k].number(lo=0.0) for k in sorted(_MT_FIELDS - {"max_iter"})
+                              if s[k].present}
+        if s["max_iter"].present:
+            kw["max_iter"] = s["max_iter"].integer(lo=1, hi=MAX_ITERATIONS)
+        try:
+            resolver = MultiTaskResolver(task=path.task, obstacles=obstacles, **kw)
+        except (InputError, InputTypeError) as exc:
+            raise s.fail(f"is invalid: {exc}") from exc
+        return resolver, {}, kw.get("link_radius", 0.0)
+    s.mapping(_DLS_FIELDS | {"method", "options"})
+    options: dict[str, Any] = {k: s[k].number(lo=0.0, lo_open=True)
+                               for k in ("damping", "tol", "max_step") if s[k].present}
+    if s["max_iter"].present:
+        options["max_iter"] = s["max_iter"].integer(lo=1, hi=MAX_ITERATIONS)
+    if method != "dls":
+        options["ik_options"] = _ik_options(s["options"], method) if s["options"].present \
+            else {}
+    elif s["options"].present:
+        raise s["options"].fail("is for IK methods; the 'dls' tracker has no options")
+    return method, options, 0.0
 
 
 def scenario_from_dict(data: object, source: str = "<dict>",
                        base_dir: str | os.PathLike[str] | None = None) -> Scenario:
     """Validate a scenario mapping and build a :class:`Scenario`.
+
+    Every field is read with :class:`serialkin._files.Field` (type and range checked
+    before use; the robot has at most :data:`MAX_LINKS` joints, the path at most
+    :data:`MAX_PATH_POINTS` points, iteration budgets at most :data:`MAX_ITERATIONS`).
 
     Args:
         data: the mapping (as read from YAML/JSON).
@@ -345,71 +334,40 @@ def scenario_from_dict(data: object, source: str = "<dict>",
         ScenarioError: a missing, unknown or mistyped field (the message names the file
             and the field), negative weights, obstacles overlapping the base.
     """
-    rd = _Reader(source)
-    d = rd.mapping(data, "(root)")
-    rd.unknown(d, _ROOT_FIELDS, "")
-    robot = _robot(rd, rd.get(d, "robot", "", required=True),
-                   FsPath(base_dir) if base_dir is not None else None)
+    doc = Field(data, "", f"scenario {source!r}", ScenarioError)
+    doc.mapping(_ROOT_FIELDS, ("robot", "path"))
+    robot = _robot(doc["robot"], FsPath(base_dir) if base_dir is not None else None)
     n = robot.n
-    if "q0" in d and "q0_deg" in d:
-        raise rd.fail("q0", "and 'q0_deg' are both given; use one")
+    if doc["q0"].present and doc["q0_deg"].present:
+        raise doc["q0"].fail("and 'q0_deg' are both given; use one")
     q0 = np.zeros(n)
     for key, scale in (("q0", 1.0), ("q0_deg", math.pi / 180)):
-        if d.get(key) is not None:
-            a = rd.array(d[key], key, f"one number or a list of {n} numbers")
+        qf = doc[key]
+        if qf.present:
+            a = qf.array(what=f"one number or a list of {n} numbers", scalar_ok=True,
+                         lo=-1e6, hi=1e6)
             if a.ndim == 0:
                 a = np.full(n, float(a))
             if a.shape != (n,):
-                raise rd.fail(key, f"must have {n} values (one per joint), got shape {a.shape}")
+                raise qf.fail(f"must have {n} values (one per joint), got shape {a.shape}")
             q0 = a * scale
-    path = _path(rd, rd.get(d, "path", "", required=True), robot, q0)
-    obs_list = d.get("obstacles") or []
-    if not isinstance(obs_list, list):
-        raise rd.fail("obstacles", f"must be a list, got {type(obs_list).__name__}")
-    obstacles = []
-    for i, o in enumerate(obs_list):
-        try:
-            obstacles.append(obstacle_from_dict(o, where=f"obstacles[{i}]"))
-        except (InputError, InputTypeError) as exc:
-            raise ScenarioError(f"scenario {source!r}: {exc}") from exc
-    obstacles = tuple(obstacles)
-    solver_d = rd.mapping(d.get("solver") or {}, "solver")
-    method = solver_d.get("method", "dls")
-    if not isinstance(method, str):
-        raise rd.fail("solver.method", f"must be a string, got {method!r}")
-    tolerance = rd.number(d, "tolerance", "", default=5e-3, positive=True)
-    on_unreach = d.get("on_unreachable", "continue")
-    if on_unreach not in ON_UNREACHABLE:
-        raise rd.fail("on_unreachable", f"must be one of {', '.join(ON_UNREACHABLE)}, "
-                      f"got {on_unreach!r}")
-    options: dict[str, Any] = {}
-    link_radius = 0.0
-    if method == "multitask":
-        rd.unknown(solver_d, _MT_FIELDS | {"method"}, "solver")
-        kw = rd.present(solver_d, "solver", sorted(_MT_FIELDS - {"max_iter"}), ["max_iter"],
-                        nonneg=True)
-        link_radius = kw.get("link_radius", 0.0)
-        try:
-            solver: Any = MultiTaskResolver(task=path.task, obstacles=obstacles, **kw)
-        except (InputError, InputTypeError) as exc:
-            raise rd.fail("solver", f"is invalid: {exc}") from exc
-    else:
-        rd.unknown(solver_d, _DLS_FIELDS | {"method", "options"}, "solver")
-        options.update(rd.present(solver_d, "solver", ("damping", "tol", "max_step"),
-                                  ["max_iter"], positive=True))
-        if method != "dls":
-            extra = solver_d.get("options") or {}
-            options["ik_options"] = rd.mapping(extra, "solver.options")
-        solver = method
+    path = _path(doc["path"], robot, q0)
+    obs_f = doc["obstacles"]
+    obstacles = tuple(obstacle_from_field(o) for o in obs_f.items(max_len=10_000)) \
+        if obs_f.present else ()
+    solver, options, link_radius = _solver(doc["solver"], path, obstacles)
+    tolerance = doc["tolerance"].number(lo=0.0, lo_open=True, default=5e-3, unit="m")
+    on_unreach = doc["on_unreachable"].string(choices=ON_UNREACHABLE, default="continue")
     try:
         check_obstacles(robot, obstacles, link_radius=link_radius)
     except InputError as exc:
         raise ScenarioError(f"scenario {source!r}: field 'obstacles': {exc}") from exc
-    name = d.get("name", FsPath(source).stem)
-    return Scenario(name=str(name), description=str(d.get("description", "")), robot=robot,
+    name = doc["name"].string(default=FsPath(source).stem or "scenario", max_len=1000)
+    description = doc["description"].string(default="", nonempty=False)
+    return Scenario(name=name, description=description, robot=robot,
                     path=path, q0=q0, obstacles=obstacles, solver=solver, options=options,
                     tolerance=tolerance, on_unreachable=on_unreach, link_radius=link_radius,
-                    source=source, data=dict(d))
+                    source=source, data=dict(doc.value))
 
 
 def _shipped_dir():
@@ -429,8 +387,9 @@ def load_scenario(path_or_name: str | os.PathLike[str]) -> Scenario:
         ScenarioError: unreadable or malformed file (the message names the file and field).
         InputError: no such file and no shipped scenario of that name.
     """
-    import yaml
-
+    if not isinstance(path_or_name, (str, os.PathLike)):
+        raise InputTypeError("path_or_name must be a file path or a shipped scenario name, "
+                             f"got {type(path_or_name).__name__} {short_repr(path_or_name)}")
     p = FsPath(path_or_name)
     if not p.exists():
         names = list_scenarios()
@@ -440,14 +399,7 @@ def load_scenario(path_or_name: str | os.PathLike[str]) -> Scenario:
                 if res.is_file():
                     with resources.as_file(res) as real:
                         return load_scenario(real)
-        raise InputError(f"no scenario file {str(path_or_name)!r}; shipped scenarios: "
+        raise InputError(f"no scenario file {short_repr(str(path_or_name))}; shipped scenarios: "
                          f"{', '.join(names)}")
-    text = p.read_text(encoding="utf-8")
-    try:
-        if p.suffix.lower() == ".json":
-            data = json.loads(text)
-        else:
-            data = yaml.safe_load(text)
-    except (json.JSONDecodeError, yaml.YAMLError) as exc:
-        raise ScenarioError(f"scenario {p.name!r}: cannot be parsed: {exc}") from exc
+    data = load_document(p, what="scenario", error=ScenarioError)
     return scenario_from_dict(data, source=p.name, base_dir=p.parent)

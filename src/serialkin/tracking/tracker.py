@@ -26,9 +26,10 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from serialkin._checks import check_choice, check_int, check_positive
+from serialkin._checks import MAX_ITERATIONS, check_choice, check_int, check_positive
 from serialkin.errors import InputError, InputTypeError
 from serialkin.kinematics import _kernels as K
+from serialkin.model.limits import project as interval_project
 from serialkin.redundancy.multitask import MultiTaskResolver
 from serialkin.redundancy.objectives import task_rows
 from serialkin.redundancy.obstacles import _Geometry, check_obstacles, encode_obstacles
@@ -43,8 +44,13 @@ ON_UNREACHABLE = ("continue", "stop")
 
 @njit(cache=True)
 def dls_track(q0, targets, rows, F, meta, lam, tol, max_iter, max_step, accept, stop_on_fail,
-              kick, Q, ITER, ERR):
+              kick, lo, hi, revolute, Q, ITER, ERR):
     """Compiled DLS path tracking (eq 46 corrected, the 6-link algorithm).
+
+    After every step each joint is projected onto its limits
+    (:func:`serialkin.model.limits.project`: whole turns first for revolute joints, then
+    the nearer limit), so every recorded q is inside the limits; unlimited joints are
+    untouched (the chapter's 6-link arm).
 
     Args:
         q0: (n,) start configuration.
@@ -60,6 +66,9 @@ def dls_track(q0, targets, rows, F, meta, lam, tol, max_iter, max_step, accept, 
         stop_on_fail: stop after the first point not reached.
         kick: joint offset [rad] added to every joint when the step vanishes while the
             error does not (an exact singularity), to leave it.
+        lo: (n,) lower joint limits (-inf allowed).
+        hi: (n,) upper joint limits (+inf allowed).
+        revolute: (n,) 1.0 for revolute joints, 0.0 for prismatic ones.
         Q: out (p, n) joint values per point.
         ITER: out (p,) iterations per point.
         ERR: out (p,) final error norm per point [m].
@@ -71,6 +80,8 @@ def dls_track(q0, targets, rows, F, meta, lam, tol, max_iter, max_step, accept, 
     m = rows.shape[0]
     p = targets.shape[0]
     q = q0.copy()
+    for j in range(n):
+        q[j] = interval_project(q[j], lo[j], hi[j], revolute[j] != 0.0)
     J = np.empty((6, n))
     T = np.empty((4, 4))
     e6 = np.empty(6)
@@ -112,6 +123,8 @@ def dls_track(q0, targets, rows, F, meta, lam, tol, max_iter, max_step, accept, 
                 # vanishes; bend every joint by a small fixed angle to leave the singularity
                 for j in range(n):
                     q[j] += kick
+            for j in range(n):
+                q[j] = interval_project(q[j], lo[j], hi[j], revolute[j] != 0.0)
         for j in range(n):
             Q[k, j] = q[j]
         ITER[k] = it
@@ -155,7 +168,8 @@ def track(
     Args:
         robot: the robot.
         path: a :class:`~serialkin.tracking.path.Path`.
-        solver: 'dls' (eq 46 corrected, compiled), 'multitask' (eq 48 with default
+        solver: 'dls' (eq 46 corrected, compiled; joints projected onto their limits
+            after every step), 'multitask' (eq 48 with default
             weights and the given obstacles), a ``MultiTaskResolver``, or an IK method
             name of :func:`serialkin.ik.solve`.
         q0: start configuration (n,); default zeros (the chapter's q0 = 0).
@@ -185,7 +199,7 @@ def track(
     accept = check_positive(tolerance, "tolerance")
     conv = check_positive(tol, "tol")
     lam = check_positive(damping, "damping")
-    budget = check_int(max_iter, "max_iter", minimum=1)
+    budget = check_int(max_iter, "max_iter", minimum=1, maximum=MAX_ITERATIONS)
     cap = check_positive(max_step, "max_step")
     check_positive(link_radius, "link_radius", allow_zero=True)
     q_start = (np.zeros(robot.n) if q0 is None
@@ -210,8 +224,10 @@ def track(
     if isinstance(solver, str) and solver == "dls":
         label = f"DLS (eq 46), λ = {lam:g} m"
         t0 = time.perf_counter()
+        revolute = np.array([t == "R" for t in robot.joint_types], dtype=float)
         count = dls_track(q_start, targets, rows, robot._F, robot._meta, lam, conv, budget, cap,
-                          accept, stop, 1e-3, Q, ITER, ERR)
+                          accept, stop, 1e-3, np.ascontiguousarray(robot.qlim[:, 0]),
+                          np.ascontiguousarray(robot.qlim[:, 1]), revolute, Q, ITER, ERR)
         elapsed = time.perf_counter() - t0
         # per-point time: shared in proportion to the iterations used
         its = ITER[:count].astype(float) + 1.0

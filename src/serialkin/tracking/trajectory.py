@@ -189,63 +189,175 @@ class Trajectory:
     def load(cls, path: str | os.PathLike[str]) -> Trajectory:
         """Read a trajectory written by :meth:`save` (``.csv`` or ``.npz``).
 
+        The file is read through :mod:`serialkin._files` (at most
+        :data:`MAX_TRAJECTORY_BYTES`, regular file, UTF-8 for CSV; ``.npz`` arrays are
+        loaded without pickle and their unpacked size is bounded too); the header is
+        checked field by field and the arrays for type and consistent shapes.
+
         Raises:
-            InputError: unknown extension or a file that is not a serialkin trajectory.
+            InputError: unknown extension, a missing or unreadable file, or a file that is
+                not a valid serialkin trajectory (the message names the file and what is
+                wrong).
         """
+        from serialkin._files import read_bytes
+
         p = FsPath(path)
         suffix = p.suffix.lower()
+        if suffix not in (".npz", ".csv"):
+            raise InputError(f"trajectory file must end in .csv or .npz, got {p.name!r}")
+        data = read_bytes(p, what="trajectory file", max_bytes=MAX_TRAJECTORY_BYTES)
         if suffix == ".npz":
-            with np.load(p, allow_pickle=False) as z:
-                try:
-                    meta = json.loads(str(z["meta"]))
-                    arrays = {k: z[k] for k in ("q", "poses", "targets", "errors", "iterations",
-                                                "reached", "clearance", "limit_margin", "times")}
-                except KeyError as exc:
-                    raise InputError(f"{p}: not a serialkin trajectory (missing {exc})") from exc
-            return cls._from(arrays, meta)
-        if suffix == ".csv":
-            return cls._read_csv(p)
-        raise InputError(f"trajectory file must end in .csv or .npz, got {p.name!r}")
+            arrays, meta = _read_npz(p, data)
+        else:
+            arrays, meta = _read_csv(p, data)
+        return cls._from(p, arrays, meta)
 
     @classmethod
-    def _from(cls, a: dict, meta: dict) -> Trajectory:
+    def _from(cls, p: FsPath, a: dict, meta_data: object) -> Trajectory:
+        from serialkin._files import Field
+
+        meta = Field(meta_data, "", f"{p}: trajectory header", InputError)
+        meta.mapping(None, ("task", "tolerance", "joint_names", "obstacle_names", "failures",
+                            "stopped", "path_length", "solver"))
+        arrays = _check_arrays(p, a)
+        n, k = arrays["q"].shape[1], arrays["clearance"].shape[1]
+        joint_names = tuple(f.string(nonempty=False, max_len=1000)
+                            for f in meta["joint_names"].items(max_len=n))
+        obstacle_names = tuple(f.string(nonempty=False, max_len=1000)
+                               for f in meta["obstacle_names"].items(max_len=k))
+        failures = []
+        for f in meta["failures"].items(max_len=arrays["q"].shape[0]):
+            idx, err, tgt = f.items(min_len=3, max_len=3, what="[index, error, target]")
+            failures.append(PathFailure(idx.integer(hi=2**62), err.number(allow_inf=True),
+                                        tuple(tgt.array(what="a list of numbers", ndim=1,
+                                                        max_items=16))))
+        stopped = meta["stopped"].value
+        if not isinstance(stopped, bool):
+            raise meta["stopped"].expected("true or false")
         return cls(
-            q=a["q"], poses=a["poses"], targets=a["targets"], errors=a["errors"],
-            iterations=a["iterations"].astype(int), reached=a["reached"].astype(bool),
-            clearance=a["clearance"], limit_margin=a["limit_margin"], times=a["times"],
-            task=meta["task"], tolerance=float(meta["tolerance"]),
-            joint_names=tuple(meta["joint_names"]), obstacle_names=tuple(meta["obstacle_names"]),
-            failures=[PathFailure(int(i), float(e), tuple(t)) for i, e, t in meta["failures"]],
-            stopped=bool(meta["stopped"]), path_length=int(meta["path_length"]),
-            solver=str(meta["solver"]))
+            q=arrays["q"], poses=arrays["poses"], targets=arrays["targets"],
+            errors=arrays["errors"], iterations=arrays["iterations"].astype(int),
+            reached=arrays["reached"].astype(bool), clearance=arrays["clearance"],
+            limit_margin=arrays["limit_margin"], times=arrays["times"],
+            task=meta["task"].string(max_len=100),
+            tolerance=meta["tolerance"].number(lo=0.0, lo_open=True),
+            joint_names=joint_names, obstacle_names=obstacle_names, failures=failures,
+            stopped=stopped, path_length=meta["path_length"].integer(hi=2**62),
+            solver=meta["solver"].string(nonempty=False, max_len=10_000))
 
-    @classmethod
-    def _read_csv(cls, p: FsPath) -> Trajectory:
-        text = p.read_text(encoding="utf-8")
-        first, _, rest = text.partition("\n")
-        prefix = "# serialkin trajectory "
-        if not first.startswith(prefix):
-            raise InputError(f"{p}: not a serialkin trajectory (first line must start with "
-                             f"{prefix.strip()!r})")
-        meta = json.loads(first[len(prefix):])
+
+#: Largest trajectory file read, and largest total size of the arrays it unpacks to [bytes].
+MAX_TRAJECTORY_BYTES = 1024 * 1024 * 1024
+_ARRAYS = ("q", "poses", "targets", "errors", "iterations", "reached", "clearance",
+           "limit_margin", "times")
+
+
+def _bad(p: FsPath, why: str) -> InputError:
+    return InputError(f"{p}: not a serialkin trajectory: {why}")
+
+
+def _read_npz(p: FsPath, data: bytes) -> tuple[dict, object]:
+    """Arrays and header of a ``.npz`` trajectory (no pickle, bounded unpacked size)."""
+    import zipfile
+
+    from serialkin._files import parse_json
+
+    try:
+        with zipfile.ZipFile(io.BytesIO(data)) as zf:
+            unpacked = sum(info.file_size for info in zf.infolist())
+        if unpacked > MAX_TRAJECTORY_BYTES:
+            raise _bad(p, f"its arrays unpack to {unpacked} bytes, more than the limit "
+                          f"of {MAX_TRAJECTORY_BYTES}")
+        with np.load(io.BytesIO(data), allow_pickle=False) as z:
+            missing = [k for k in (*_ARRAYS, "meta") if k not in z.files]
+            if missing:
+                raise _bad(p, f"missing array(s) {', '.join(missing)}")
+            arrays = {k: z[k] for k in _ARRAYS}
+            meta = z["meta"]
+    except InputError:
+        raise
+    except zipfile.BadZipFile:
+        raise _bad(p, "not an .npz (zip) archive") from None
+    except (ValueError, OSError, EOFError, KeyError, RuntimeError, NotImplementedError,
+            zipfile.LargeZipFile) as exc:  # pickled arrays, corrupt members, bad headers
+        raise _bad(p, f"cannot read its arrays ({str(exc)[:120]})") from None
+    if meta.dtype.kind != "U" or meta.shape != ():
+        raise _bad(p, "its 'meta' entry is not a text header")
+    return arrays, parse_json(str(meta), f"{p}: header")
+
+
+def _read_csv(p: FsPath, data: bytes) -> tuple[dict, object]:
+    """Arrays and header of a ``.csv`` trajectory (header line, column names, numbers)."""
+    from serialkin._files import decode_text, parse_json
+
+    text = decode_text(data, str(p), what="trajectory file")
+    first, _, rest = text.partition("\n")
+    prefix = "# serialkin trajectory "
+    if not first.startswith(prefix):
+        raise _bad(p, f"the first line must start with {prefix.strip()!r}")
+    meta = parse_json(first[len(prefix):], f"{p}: header line")
+    try:
         rows = list(csv.reader(io.StringIO(rest)))
-        header, body = rows[0], [r for r in rows[1:] if r]
-        data = np.array([[float(v) for v in r] for r in body]).reshape(len(body), len(header))
-        col = {h: i for i, h in enumerate(header)}
+    except csv.Error as exc:
+        raise _bad(p, f"malformed CSV ({exc})") from None
+    if not rows:
+        raise _bad(p, "no column names after the header line")
+    header, body = rows[0], [r for r in rows[1:] if r]
+    col = {h: i for i, h in enumerate(header)}
+    needed = ("step", "reached", "iterations", "error", "time")
+    missing = [h for h in needed if h not in col]
+    if missing or len(col) != len(header):
+        raise _bad(p, f"missing column(s) {', '.join(missing)}" if missing
+                   else "duplicate column names")
+    values = np.empty((len(body), len(header)))
+    for i, r in enumerate(body):
+        if len(r) != len(header):
+            raise _bad(p, f"line {i + 3} has {len(r)} values, the header names {len(header)}")
+        for j, v in enumerate(r):
+            try:
+                values[i, j] = float(v)
+            except ValueError:
+                raise _bad(p, f"line {i + 3}, column {header[j][:40]!r}: "
+                              f"{v[:40]!r} is not a number") from None
+    steps = len(body)
 
-        def block(prefix: str) -> np.ndarray:
-            idx = [i for h, i in col.items() if h.startswith(prefix)]
-            return data[:, idx]
+    def block(prefix: str) -> np.ndarray:
+        return values[:, [i for h, i in col.items() if h.startswith(prefix)]]
 
-        p_ = data.shape[0]
+    def poses(prefix: str) -> np.ndarray:
+        b = block(prefix)
+        if b.shape[1] != 12:
+            raise _bad(p, f"expected 12 columns {prefix}RC, got {b.shape[1]}")
+        T = np.tile(np.eye(4), (steps, 1, 1))
+        T[:, :3, :] = b.reshape(steps, 3, 4)
+        return T
 
-        def poses(prefix: str) -> np.ndarray:
-            T = np.tile(np.eye(4), (p_, 1, 1))
-            T[:, :3, :] = block(prefix).reshape(p_, 3, 4)
-            return T
+    arrays = {"q": block("q:"), "poses": poses("pose_T"), "targets": poses("target_T"),
+              "errors": values[:, col["error"]], "iterations": values[:, col["iterations"]],
+              "reached": values[:, col["reached"]], "clearance": block("clearance:"),
+              "limit_margin": block("margin:"), "times": values[:, col["time"]]}
+    return arrays, meta
 
-        a = {"q": block("q:"), "poses": poses("pose_T"), "targets": poses("target_T"),
-             "errors": data[:, col["error"]], "iterations": data[:, col["iterations"]],
-             "reached": data[:, col["reached"]], "clearance": block("clearance:"),
-             "limit_margin": block("margin:"), "times": data[:, col["time"]]}
-        return cls._from(a, meta)
+
+def _check_arrays(p: FsPath, a: dict) -> dict:
+    """Check dtypes and shapes: q (s, n), poses/targets (s, 4, 4), clearance (s, k) ..."""
+    for k in _ARRAYS:
+        if a[k].dtype.kind not in "biuf":
+            raise _bad(p, f"array {k!r} holds {a[k].dtype} values, not numbers")
+    q = a["q"]
+    if q.ndim != 2 or q.shape[1] < 1:
+        raise _bad(p, f"array 'q' must have shape (steps, joints), got {q.shape}")
+    s, n = q.shape
+    shapes = {"poses": (s, 4, 4), "targets": (s, 4, 4), "errors": (s,), "iterations": (s,),
+              "reached": (s,), "limit_margin": (s, n), "times": (s,)}
+    for k, shape in shapes.items():
+        if a[k].shape != shape:
+            raise _bad(p, f"array {k!r} must have shape {shape}, got {a[k].shape}")
+    if a["clearance"].ndim != 2 or a["clearance"].shape[0] != s:
+        raise _bad(p, f"array 'clearance' must have shape ({s}, obstacles), got "
+                      f"{a['clearance'].shape}")
+    for k in ("q", "poses", "targets"):
+        if not np.isfinite(a[k]).all():
+            raise _bad(p, f"array {k!r} has NaN or infinite values")
+    return {k: a[k] if k in ("iterations", "reached") else np.asarray(a[k], dtype=float)
+            for k in _ARRAYS}

@@ -21,12 +21,14 @@ the workspace (true for uniform joint-space sampling of a robot with finite limi
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from itertools import product
 
 import numpy as np
 
-from serialkin._checks import as_float_array, check_positive
+from serialkin._budget import check_allocation
+from serialkin._checks import MAX_INT, as_float_array, check_int, check_positive, short_repr
 from serialkin.errors import InputError
 
 
@@ -228,11 +230,34 @@ def sampling_gaps(counts: np.ndarray, p_min: float = GAP_PROBABILITY) -> np.ndar
     return gap[labels]
 
 
+#: Estimated memory per grid cell [bytes]: the int64 count plus the boolean and float
+#: arrays derived from it (occupancy, interior, boundary, per-cell maps).
+GRID_CELL_BYTES = 32
+
+
+def check_grid_size(shape: tuple[int, ...], setting: str = "the cell size (--cell / --resolution)"
+                    ) -> None:
+    """Refuse a grid of ``shape`` cells beyond the memory budget (:mod:`serialkin._budget`).
+
+    Raises:
+        BudgetError: naming ``setting`` and the estimated size.
+    """
+    check_allocation("the workspace grid", shape, GRID_CELL_BYTES, setting=setting)
+
+
 def grid_bounds(points: np.ndarray, cell: float) -> tuple[np.ndarray, tuple[int, ...]]:
-    """Lower corner and shape of a grid of edge ``cell`` covering ``points`` with one free cell."""
+    """Lower corner and shape of a grid of edge ``cell`` covering ``points`` with one free cell.
+
+    Raises:
+        BudgetError: the grid would exceed the memory budget (checked before allocating).
+    """
     lo = points.min(axis=0) - cell
     hi = points.max(axis=0) + cell
-    shape = tuple(int(s) for s in np.maximum(np.ceil((hi - lo) / cell), 1).astype(int))
+    with np.errstate(over="ignore"):  # an overflowing extent counts as too many cells
+        ratios = [float(r) for r in (hi - lo) / cell]
+    shape = tuple(max(math.ceil(r), 1) if math.isfinite(r) and r < MAX_INT else MAX_INT
+                  for r in ratios)
+    check_grid_size(shape)
     return lo, shape
 
 
@@ -260,7 +285,13 @@ def occupancy_grid(points: object, cell: float, *, lower: object = None,
     else:
         if shape is None:
             raise InputError("shape must be given together with lower")
-        lo, shp = as_float_array(lower, "lower", ndim=1), tuple(int(s) for s in shape)
+        lo = as_float_array(lower, "lower", ndim=1)
+        if isinstance(shape, (str, bytes)) or not hasattr(shape, "__len__") \
+                or len(shape) != lo.shape[0]:
+            raise InputError(f"shape must have {lo.shape[0]} cell counts, got "
+                             f"{short_repr(shape)}")
+        shp = tuple(check_int(s, "shape", minimum=1) for s in shape)
+        check_grid_size(shp, "shape")
     grid = OccupancyGrid(lower=lo, cell=h, counts=np.zeros(shp, dtype=np.int64))
     if P.shape[0]:
         idx, inside = grid.index(P)

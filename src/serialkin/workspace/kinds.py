@@ -21,20 +21,22 @@ world frame (base transform included, tool point = the robot's tool frame origin
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from serialkin._budget import check_allocation
 from serialkin._checks import (
     as_float_array,
     as_generator,
     check_int,
     check_positive,
     check_rotation,
+    short_repr,
 )
-from serialkin.errors import InputError
+from serialkin.errors import InputError, InputTypeError
 from serialkin.spatial.transforms import rotz
 from serialkin.workspace.grid import (
     MeasureEstimate,
@@ -330,9 +332,13 @@ def _orientation_set(orientations: int | Sequence[object], planar: bool, rng: An
                      ) -> list[np.ndarray]:
     if isinstance(orientations, (int, np.integer)) and not isinstance(orientations, bool):
         k = check_int(orientations, "orientations", minimum=1)
+        check_allocation("the orientation set", (k, 3, 3), 8, setting="orientations")
         if planar:
             return [rotz(phi) for phi in -np.pi + 2 * np.pi * np.arange(k) / k]
         return list(random_rotations(k, rng))
+    if isinstance(orientations, (str, bytes)) or not isinstance(orientations, Iterable):
+        raise InputTypeError("orientations must be a count or a list of orientations, got "
+                             f"{type(orientations).__name__} {short_repr(orientations)}")
     out = [_target_rotation(o, planar) for o in orientations]
     if not out:
         raise InputError("orientations is empty; give a count or at least one orientation")
@@ -403,6 +409,8 @@ def _orientation_samples(robot: Any, orientations: int | Sequence[object] | None
         per = max(100_000, _default_samples(None, pl) // K)
     else:
         per = check_int(samples, "samples", minimum=1)
+    check_allocation("the workspace samples", (K * per, robot.n + 16), 8,
+                     setting="samples × orientations")
     task = manipulability_task(robot, pl)
     parts = []
     for k, R_t in enumerate(Rs):

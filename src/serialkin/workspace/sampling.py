@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from serialkin._budget import check_allocation
 from serialkin._checks import as_generator, check_int
 from serialkin.spatial import so3_log, wrap_angle
 
@@ -86,8 +87,15 @@ def evaluate(robot: object, Q: np.ndarray, *, manipulability: str | None = None,
 
 def sample_configurations(robot: object, samples: int, seed: None | int | np.random.Generator
                           ) -> np.ndarray:
-    """Configurations (samples, n) uniform in the joint limits (±π / ±1 m where unlimited)."""
+    """Configurations (samples, n) uniform in the joint limits (see :meth:`Robot.random_q`).
+
+    Raises:
+        BudgetError: the samples and their FK results (about ``8·(n + 16)`` bytes each)
+            would exceed the memory budget (checked before allocating).
+    """
     N = check_int(samples, "samples", minimum=1)
+    check_allocation("the workspace samples", (N, robot.n + 16), 8,  # type: ignore[attr-defined]
+                     setting="samples (--samples)")
     return robot.random_q(N, seed=as_generator(seed))  # type: ignore[attr-defined]
 
 
