@@ -75,23 +75,46 @@ def _row_times(t0, t1, t2, t3, A):
 
 
 @njit(cache=True, inline="always")
-def _chain_walk(q, F, kind, off, J, record):
+def _chain_walk(q, F, kind, off, J, record, SC):
     """Walk the chain holding the pose's 12 entries in registers; return them as a tuple.
 
     ``F`` (n+1, 4, 4) fixed transforms (only their top three rows are read), ``kind`` and
     ``off`` (n,) each joint's type and offset (``meta[:, 3]``, ``meta[:, 4]``, or the same
-    entries of the packed chain). Each joint's sin/cos is computed at the top of its step:
-    it does not depend on the pose, so the processor overlaps it with the previous joint's
-    products. With ``record``, each joint's world axis z_i and origin o_i (its frame just
-    before its motion) are stored in ``J[3:, i]`` and ``J[:3, i]`` (J (6, n)) on the way.
+    entries of the packed chain). ``SC`` is scratch of at least 2n entries (the caller's
+    output array, overwritten later) for all joints' sin/cos, computed first in one
+    vectorised loop; with fewer entries each joint's sin/cos is computed on its step.
+    With ``record``, each joint's world axis z_i and origin o_i (its frame just before
+    its motion) are stored in ``J[3:, i]`` and ``J[:3, i]`` (J (6, n)) on the way; SC
+    may then be J itself (joint i's sin/cos are read before column i is written).
     """
     n = kind.shape[0]
+    pre = SC.shape[0] >= 2 * n
+    if pre:
+        big = False
+        for i in range(n):
+            x = q[i] + off[i]
+            SC[i] = x
+            big |= abs(x) > 1e5
+        if big:
+            for i in range(n):
+                x = SC[i]
+                SC[n + i] = math.cos(x)
+                SC[i] = math.sin(x)
+        else:
+            for i in range(n):
+                SC[i], SC[n + i] = _sincos(SC[i])
     A = F[0]
     a0, a1, a2, a3 = A[0, 0], A[0, 1], A[0, 2], A[0, 3]
     b0, b1, b2, b3 = A[1, 0], A[1, 1], A[1, 2], A[1, 3]
     c0, c1, c2, c3 = A[2, 0], A[2, 1], A[2, 2], A[2, 3]
     for i in range(n):
         x = q[i] + off[i]
+        if kind[i] != PRISMATIC:
+            if pre:
+                s = SC[i]
+                c = SC[n + i]
+            else:
+                s, c = _sincos_scalar(x)
         if record:
             J[0, i], J[1, i], J[2, i] = a3, b3, c3
             J[3, i], J[4, i], J[5, i] = a2, b2, c2
@@ -100,7 +123,6 @@ def _chain_walk(q, F, kind, off, J, record):
             b3 += x * b2
             c3 += x * c2
         else:
-            s, c = _sincos_scalar(x)
             a0, a1 = a0 * c + a1 * s, a1 * c - a0 * s
             b0, b1 = b0 * c + b1 * s, b1 * c - b0 * s
             c0, c1 = c0 * c + c1 * s, c1 * c - c0 * s
@@ -124,7 +146,7 @@ def _store_pose(t, T):
 @njit(cache=True)
 def fk_into(q, F, meta, T):
     """End-effector pose (eq 11) into ``T`` (4, 4) for one configuration ``q`` (n,)."""
-    _store_pose(_chain_walk(q, F, meta[:, 3], meta[:, 4], T, False), T)
+    _store_pose(_chain_walk(q, F, meta[:, 3], meta[:, 4], T, False, T.reshape(16)), T)
 
 
 # --- single calls from Python: the packed chain -------------------------------------------
@@ -143,7 +165,7 @@ def fk_one(q, P, T):
     for i in range(n):
         if not math.isfinite(q[i]):
             return False
-    _store_pose(_chain_walk(q, P, P[:n, 3, 0], P[:n, 3, 1], T, False), T)
+    _store_pose(_chain_walk(q, P, P[:n, 3, 0], P[:n, 3, 1], T, False, T.reshape(16)), T)
     return True
 
 
@@ -155,7 +177,7 @@ def jacobian_one(q, P, J):
         if not math.isfinite(q[i]):
             return False
     kind = P[:n, 3, 0]
-    t = _chain_walk(q, P, kind, P[:n, 3, 1], J, True)
+    t = _chain_walk(q, P, kind, P[:n, 3, 1], J, True, J.reshape(J.size))
     _finish_columns(J, kind, n, t[3], t[7], t[11])
     return True
 
@@ -353,7 +375,7 @@ def jacobian_into(q, F, meta, J, T):
     (4, 4). Joint *i*'s axis and origin are those of its frame just before its motion
     (for standard DH, frame i-1: the chapter's z_{i-1}, p_{i-1}).
     """
-    t = _chain_walk(q, F, meta[:, 3], meta[:, 4], J, True)
+    t = _chain_walk(q, F, meta[:, 3], meta[:, 4], J, True, J.reshape(J.size))
     _store_pose(t, T)
     _finish_columns(J, meta[:, 3], meta.shape[0], t[3], t[7], t[11])
 

@@ -37,28 +37,33 @@ if TYPE_CHECKING:
     from serialkin.ik.result import IKResult
 
 _F64 = np.dtype(np.float64)
-_ENTRY: dict[str, Any] = {}
+_NDARRAY = np.ndarray
+_EMPTY = np.empty
+#: Entry points of the single-call kernels, resolved on first use by :func:`_fast`.
+_FK1: Any = None
+_JAC1: Any = None
 
 
-def _entry(name: str) -> Any:
-    """Compiled entry point of the single-call kernel ``name`` (``fk_one``, ``jacobian_one``).
+def _fast() -> tuple[Any, Any]:
+    """Resolve (once) the compiled entry points of ``fk_one`` and ``jacobian_one``.
 
-    Calling it skips numba's per-call type dispatch (about 0.2 µs). It is compiled for
-    ``(q, P, out)`` with ``q`` a 1-D float64 array of any layout, ``P`` the read-only
-    packed chain and ``out`` a C-contiguous 2-D float64 array; the fast paths check
-    exactly that before calling.
+    Calling an entry point skips numba's per-call type dispatch (about 0.2 µs). They are
+    compiled for ``(q, P, out)`` with ``q`` a 1-D float64 array of any layout, ``P`` the
+    read-only packed chain and ``out`` a C-contiguous 2-D float64 array; the fast paths
+    check exactly that before calling.
     """
-    fn = _ENTRY.get(name)
-    if fn is None:
-        import numba
+    global _FK1, _JAC1
+    import numba
 
-        f64 = numba.float64
-        sig = (numba.types.Array(f64, 1, "A"), numba.types.Array(f64, 3, "C", readonly=True),
-               numba.types.Array(f64, 2, "C"))
-        dispatcher = getattr(K, name)
+    f64 = numba.float64
+    sig = (numba.types.Array(f64, 1, "A"), numba.types.Array(f64, 3, "C", readonly=True),
+           numba.types.Array(f64, 2, "C"))
+    found = []
+    for dispatcher in (K.fk_one, K.jacobian_one):
         dispatcher.compile(sig)  # loads from numba's cache when it can
-        fn = _ENTRY[name] = dispatcher.overloads[sig].entry_point
-    return fn
+        found.append(dispatcher.overloads[sig].entry_point)
+    _FK1, _JAC1 = found
+    return _FK1, _JAC1
 
 
 def _out_array(out: object, shape: tuple[int, ...]) -> np.ndarray:
@@ -274,9 +279,9 @@ class Robot:
         Raises:
             InputError: q of the wrong shape or not finite; out of the wrong kind.
         """
-        if type(q) is np.ndarray and q.dtype is _F64 and q.shape == self._qshape:
-            T = np.empty((4, 4)) if out is None else _out_array(out, (4, 4))
-            if (_ENTRY.get("fk_one") or _entry("fk_one"))(q, self._P, T):
+        if type(q) is _NDARRAY and q.dtype is _F64 and q.shape == self._qshape:
+            T = _EMPTY((4, 4)) if out is None else _out_array(out, (4, 4))
+            if (_FK1 or _fast()[0])(q, self._P, T):
                 return T
             raise self._nonfinite(q)
         a = self.check_q(q)
@@ -338,10 +343,10 @@ class Robot:
             InputError: q of the wrong shape or not finite, unknown frame, link outside
                 0..n, point without link, out of the wrong kind.
         """
-        if type(q) is np.ndarray and q.dtype is _F64 and q.shape == self._qshape \
+        if type(q) is _NDARRAY and q.dtype is _F64 and q.shape == self._qshape \
                 and link is None and point is None and frame == "base":
-            J = np.empty(self._jshape) if out is None else _out_array(out, self._jshape)
-            if (_ENTRY.get("jacobian_one") or _entry("jacobian_one"))(q, self._P, J):
+            J = _EMPTY(self._jshape) if out is None else _out_array(out, self._jshape)
+            if (_JAC1 or _fast()[1])(q, self._P, J):
                 return J
             raise self._nonfinite(q)
         a, J, T = self._jacobians(q, frame, link, point)
