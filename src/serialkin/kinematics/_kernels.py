@@ -539,6 +539,35 @@ def jacobian_dot_into(J, qd, R, ee, Jd):
                     Jd[r + c, j] = R[0, c] * hx + R[1, c] * hy + R[2, c] * hz
 
 
+@njit(cache=True, inline="always")
+def _tool_jacobian(q, P):
+    """Tool Jacobian (6, n) and rotation (3, 3) over the packed chain (single calls)."""
+    n = P.shape[0] - 1
+    kind = P[:n, 3, 0]
+    J = np.empty((6, n))
+    t = _chain_walk(q, P, kind, P[:n, 3, 1], J, True, J.reshape(J.size))
+    _finish_columns(J, kind, n, t[3], t[7], t[11])
+    R = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            R[r, c] = t[4 * r + c]
+    return J, R
+
+
+@njit(cache=True)
+def hessian_one(q, P, ee, H):
+    """:func:`hessian_into` of the tool Jacobian at one ``q`` over the packed chain."""
+    J, R = _tool_jacobian(q, P)
+    hessian_into(J, R, ee, H)
+
+
+@njit(cache=True)
+def jacobian_dot_one(q, P, qd, ee, Jd):
+    """:func:`jacobian_dot_into` of the tool Jacobian at one ``q`` over the packed chain."""
+    J, R = _tool_jacobian(q, P)
+    jacobian_dot_into(J, qd, R, ee, Jd)
+
+
 @njit(cache=True, nogil=True)
 def hessian_range(J, R, ee, H, start, stop):
     """:func:`hessian_into` for items ``start..stop-1`` of J (N, 6, n), R (N, 3, 3) into H."""

@@ -104,8 +104,11 @@ def run(kernel: Callable[..., Any], args: tuple, N: int, grain: int) -> None:
     run on the calling thread. Exceptions raised by the kernel are re-raised here.
     """
     grain = max(1, int(grain))
+    if N < 2 * grain:
+        kernel(*args, 0, N)
+        return
     nthreads = threads()
-    if nthreads == 1 or N < 2 * grain:
+    if nthreads == 1:
         kernel(*args, 0, N)
         return
     job = _Job(kernel, args, N, grain)

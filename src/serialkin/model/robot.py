@@ -419,6 +419,12 @@ class Robot:
             InputError: as :meth:`jacobian`.
         """
         check_choice(frame, "frame", ("base", "ee"))
+        if link is None and point is None:
+            a = self.check_q(q)
+            if a.ndim == 1:
+                H = np.empty((6, self.n, self.n))
+                K.hessian_one(a, self._P, frame == "ee", H)
+                return H
         a, J, T = self._jacobians(q, "base", link, point)
         N = J.shape[0]
         H = np.empty((N, 6, self.n, self.n))
@@ -456,6 +462,13 @@ class Robot:
             InputError: as :meth:`jacobian`; qd not finite or not broadcastable to q.
         """
         check_choice(frame, "frame", ("base", "ee"))
+        if link is None and point is None:
+            a = self.check_q(q)
+            v = self.check_q(qd, "qd")
+            if a.ndim == 1 and v.ndim == 1:
+                Jd = np.empty((6, self.n))
+                K.jacobian_dot_one(a, self._P, v, frame == "ee", Jd)
+                return Jd
         a, J, T = self._jacobians(q, "base", link, point)
         v = self.check_q(qd, "qd")
         try:
