@@ -5,7 +5,8 @@ the registry and runs it:
 
 * compiled methods (the Jacobian family) run entirely in
   :func:`serialkin.ik._kernels.solve_one`; a batch runs
-  :func:`~serialkin.ik._kernels.solve_chunk` on one thread per core (GIL released);
+  :func:`~serialkin.ik._kernels.solve_chunk` on every core (GIL released, chunks
+  handed out by :func:`serialkin.kinematics.parallel.run`);
 * Python methods supply one attempt and :func:`run_attempts` owns the rest.
 
 Both follow the same semantics:
@@ -416,11 +417,11 @@ def _run_chunks(F: np.ndarray, meta: np.ndarray, Tt: np.ndarray, box: np.ndarray
                 info: np.ndarray) -> None:
     """Solve a batch with :func:`~serialkin.ik._kernels.solve_chunk` on every core.
 
-    Scheduled by :func:`serialkin.kinematics.parallel.run` (chunks of 4 targets claimed
+    Scheduled by :func:`serialkin.kinematics.parallel.run` (chunks of 8 targets claimed
     dynamically, so a few slow targets or a busy core do not leave the batch waiting).
     """
     parallel.run(K.solve_chunk, (F, meta, Tt, box, Q0, cfg, seed64, Q, info), Tt.shape[0],
-                 grain=4)
+                 grain=8)
 
 
 def _kernel_config(spec: MethodSpec, tgt: Target, tol: float, max_iter: int, restarts: int,

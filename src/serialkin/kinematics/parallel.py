@@ -26,6 +26,7 @@ The number of threads is ``numba.get_num_threads()`` (``NUMBA_NUM_THREADS``,
 from __future__ import annotations
 
 import itertools
+import os
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -34,6 +35,8 @@ from typing import Any
 #: Worker pools by number of workers, created on first use (never at import).
 _POOLS: dict[int, ThreadPoolExecutor] = {}
 _POOL_LOCK = threading.Lock()
+if hasattr(os, "register_at_fork"):  # a forked child starts without the parent's threads
+    os.register_at_fork(after_in_child=_POOLS.clear)
 
 
 def threads() -> int:
@@ -89,6 +92,21 @@ class _Job:
                     self.idle.set()
 
 
+def _entry_point(kernel: Callable[..., Any], args: tuple) -> Callable[..., Any]:
+    """The compiled entry point of a numba ``kernel`` for ``(*args, start, stop)``.
+
+    Resolved once per batch, so that every chunk skips numba's type dispatch (a few µs
+    with many arguments). Anything else is returned unchanged.
+    """
+    typeof = getattr(kernel, "typeof_pyval", None)
+    if typeof is None:
+        return kernel
+    sig = tuple(typeof(a) for a in args) + (typeof(0), typeof(0))
+    if sig not in kernel.overloads:
+        kernel.compile(sig)  # loads from numba's cache when it can
+    return kernel.overloads[sig].entry_point
+
+
 def run(kernel: Callable[..., Any], args: tuple, N: int, grain: int) -> None:
     """Run ``kernel(*args, start, stop)`` over items 0..N-1 on every thread, chunk by chunk.
 
@@ -111,7 +129,7 @@ def run(kernel: Callable[..., Any], args: tuple, N: int, grain: int) -> None:
     if nthreads == 1:
         kernel(*args, 0, N)
         return
-    job = _Job(kernel, args, N, grain)
+    job = _Job(_entry_point(kernel, args), args, N, grain)
     pool = _pool(nthreads - 1)
     for _ in range(min(nthreads, job.chunks) - 1):
         pool.submit(job.work)
