@@ -279,7 +279,7 @@ class Robot:
         Raises:
             InputError: q of the wrong shape or not finite; out of the wrong kind.
         """
-        if type(q) is _NDARRAY and q.dtype is _F64 and q.shape == self._qshape:
+        if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 and len(q) == self.n:
             T = _EMPTY((4, 4)) if out is None else _out_array(out, (4, 4))
             if (_FK1 or _fast()[0])(q, self._P, T):
                 return T
@@ -343,7 +343,7 @@ class Robot:
             InputError: q of the wrong shape or not finite, unknown frame, link outside
                 0..n, point without link, out of the wrong kind.
         """
-        if type(q) is _NDARRAY and q.dtype is _F64 and q.shape == self._qshape \
+        if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 and len(q) == self.n \
                 and link is None and point is None and frame == "base":
             J = _EMPTY(self._jshape) if out is None else _out_array(out, self._jshape)
             if (_JAC1 or _fast()[1])(q, self._P, J):
