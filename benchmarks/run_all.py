@@ -44,6 +44,10 @@ def summary(path: Path) -> str:
                  "met" if all(r["met"] for r in mine) else
                  f"NOT met ({sum(not r['met'] for r in mine)} of {len(mine)} rows)")
         out.append(f"goal {goal} ({text}): {state}")
+    if hasattr(os, "getloadavg"):
+        load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
+        out.append(f"load average at the end (1, 5, 15 min): {load} on {os.cpu_count()} CPUs "
+                   "(other processes' load makes the parallel rows meaningless)")
     return "\n".join(out)
 
 

@@ -75,46 +75,81 @@ def _row_times(t0, t1, t2, t3, A):
 
 
 @njit(cache=True, inline="always")
+def _sincos_banks(q, off, SC, n):
+    """All joints' (sin, cos) of ``q + off`` into the scratch ``SC`` (2-D); False if too small.
+
+    Joint ``i = b·w + c`` (w = ``SC.shape[1]``) goes to ``SC[2b, c]`` (sin) and
+    ``SC[2b+1, c]`` (cos): for a (6, n) Jacobian rows 0 and 1, for a (4, 4) pose rows 0-1
+    then 2-3. Each bank's loop is contiguous and branch-free, so LLVM vectorises it.
+    """
+    w = SC.shape[1]
+    if (SC.shape[0] // 2) * w < n:
+        return False
+    big = False
+    i0 = 0
+    b = 0
+    while i0 < n:
+        m = min(w, n - i0)
+        S = SC[2 * b]
+        for c in range(m):
+            x = q[i0 + c] + off[i0 + c]
+            S[c] = x
+            big |= abs(x) > 1e5
+        i0 += m
+        b += 1
+    i0 = 0
+    b = 0
+    while i0 < n:
+        m = min(w, n - i0)
+        S = SC[2 * b]
+        C = SC[2 * b + 1]
+        if big:
+            for c in range(m):
+                C[c] = math.cos(S[c])
+                S[c] = math.sin(S[c])
+        else:
+            for c in range(m):
+                S[c], C[c] = _sincos(S[c])
+        i0 += m
+        b += 1
+    return True
+
+
+@njit(cache=True, inline="always")
 def _chain_walk(q, F, kind, off, J, record, SC):
     """Walk the chain holding the pose's 12 entries in registers; return them as a tuple.
 
     ``F`` (n+1, 4, 4) fixed transforms (only their top three rows are read), ``kind`` and
     ``off`` (n,) each joint's type and offset (``meta[:, 3]``, ``meta[:, 4]``, or the same
-    entries of the packed chain). ``SC`` is scratch of at least 2n entries (the caller's
-    output array, overwritten later) for all joints' sin/cos, computed first in one
-    vectorised loop; with fewer entries each joint's sin/cos is computed on its step.
-    With ``record``, each joint's world axis z_i and origin o_i (its frame just before
-    its motion) are stored in ``J[3:, i]`` and ``J[:3, i]`` (J (6, n)) on the way; SC
-    may then be J itself (joint i's sin/cos are read before column i is written).
+    entries of the packed chain). ``SC`` is 2-D scratch (the caller's output array,
+    overwritten later) for all joints' sin/cos, computed first (:func:`_sincos_banks`);
+    when it is too small each joint's sin/cos is computed on its step. With ``record``,
+    each joint's world axis z_i and origin o_i (its frame just before its motion) are
+    stored in ``J[3:, i]`` and ``J[:3, i]`` (J (6, n)) on the way; SC may then be J
+    itself (joint i's sin/cos are read before column i is written).
     """
     n = kind.shape[0]
-    pre = SC.shape[0] >= 2 * n
-    if pre:
-        big = False
-        for i in range(n):
-            x = q[i] + off[i]
-            SC[i] = x
-            big |= abs(x) > 1e5
-        if big:
-            for i in range(n):
-                x = SC[i]
-                SC[n + i] = math.cos(x)
-                SC[i] = math.sin(x)
-        else:
-            for i in range(n):
-                SC[i], SC[n + i] = _sincos(SC[i])
+    pre = _sincos_banks(q, off, SC, n)
+    w = SC.shape[1]
+    bank = 0
+    col = 0
     A = F[0]
     a0, a1, a2, a3 = A[0, 0], A[0, 1], A[0, 2], A[0, 3]
     b0, b1, b2, b3 = A[1, 0], A[1, 1], A[1, 2], A[1, 3]
     c0, c1, c2, c3 = A[2, 0], A[2, 1], A[2, 2], A[2, 3]
     for i in range(n):
         x = q[i] + off[i]
-        if kind[i] != PRISMATIC:
-            if pre:
-                s = SC[i]
-                c = SC[n + i]
-            else:
-                s, c = _sincos_scalar(x)
+        if pre:
+            s = SC[bank, col]
+            c = SC[bank + 1, col]
+            col += 1
+            if col == w:
+                col = 0
+                bank += 2
+        elif kind[i] != PRISMATIC:
+            s, c = _sincos_scalar(x)
+        else:
+            s, c = 0.0, 1.0
         if record:
             J[0, i], J[1, i], J[2, i] = a3, b3, c3
             J[3, i], J[4, i], J[5, i] = a2, b2, c2
@@ -146,7 +181,7 @@ def _store_pose(t, T):
 @njit(cache=True)
 def fk_into(q, F, meta, T):
     """End-effector pose (eq 11) into ``T`` (4, 4) for one configuration ``q`` (n,)."""
-    _store_pose(_chain_walk(q, F, meta[:, 3], meta[:, 4], T, False, T.reshape(16)), T)
+    _store_pose(_chain_walk(q, F, meta[:, 3], meta[:, 4], T, False, T), T)
 
 
 # --- single calls from Python: the packed chain -------------------------------------------
@@ -165,7 +200,7 @@ def fk_one(q, P, T):
     for i in range(n):
         if not math.isfinite(q[i]):
             return False
-    _store_pose(_chain_walk(q, P, P[:n, 3, 0], P[:n, 3, 1], T, False, T.reshape(16)), T)
+    _store_pose(_chain_walk(q, P, P[:n, 3, 0], P[:n, 3, 1], T, False, T), T)
     return True
 
 
@@ -177,7 +212,7 @@ def jacobian_one(q, P, J):
         if not math.isfinite(q[i]):
             return False
     kind = P[:n, 3, 0]
-    t = _chain_walk(q, P, kind, P[:n, 3, 1], J, True, J.reshape(J.size))
+    t = _chain_walk(q, P, kind, P[:n, 3, 1], J, True, J)
     _finish_columns(J, kind, n, t[3], t[7], t[11])
     return True
 
@@ -375,7 +410,7 @@ def jacobian_into(q, F, meta, J, T):
     (4, 4). Joint *i*'s axis and origin are those of its frame just before its motion
     (for standard DH, frame i-1: the chapter's z_{i-1}, p_{i-1}).
     """
-    t = _chain_walk(q, F, meta[:, 3], meta[:, 4], J, True, J.reshape(J.size))
+    t = _chain_walk(q, F, meta[:, 3], meta[:, 4], J, True, J)
     _store_pose(t, T)
     _finish_columns(J, meta[:, 3], meta.shape[0], t[3], t[7], t[11])
 
@@ -545,7 +580,7 @@ def _tool_jacobian(q, P):
     n = P.shape[0] - 1
     kind = P[:n, 3, 0]
     J = np.empty((6, n))
-    t = _chain_walk(q, P, kind, P[:n, 3, 1], J, True, J.reshape(J.size))
+    t = _chain_walk(q, P, kind, P[:n, 3, 1], J, True, J)
     _finish_columns(J, kind, n, t[3], t[7], t[11])
     R = np.empty((3, 3))
     for r in range(3):
