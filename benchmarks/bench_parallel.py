@@ -3,7 +3,7 @@
 Run by hand: ``.venv/bin/python benchmarks/bench_parallel.py [--runs 20] [--quick]``.
 
 For every batch kernel — FK (UR5 and Panda, 100,000 configurations), Jacobians (UR5,
-100,000), IK (``lm``, UR5, 400 targets) and workspace sampling (UR5, 200,000 samples with
+100,000), IK (``lm``, UR5, 400 targets) and workspace sampling (UR5, 20,000 samples with
 manipulability, i.e. FK and Jacobian batches) — it times the same call with all numba
 threads and with one (``numba.set_num_threads``), interleaved, ``--runs`` times each,
 first on the machine as it is and then while a busy-loop subprocess keeps one core busy.
@@ -39,7 +39,7 @@ def cases(quick: bool) -> dict[str, tuple[int, object]]:
     Tp = np.empty((len(Qp), 4, 4))
     targets = ur5.fk(ur5.random_q(400 // k, seed=1))
     q0 = ur5.random_q(len(targets), seed=2)
-    Qw = ur5.random_q(200_000 // k, seed=3)
+    Qw = ur5.random_q(20_000 // k, seed=3)
     return {
         "FK UR5 [M q/s]": (len(Qu), lambda: ur5.fk(Qu, out=Tu)),
         "FK Panda [M q/s]": (len(Qp), lambda: panda.fk(Qp, out=Tp)),

@@ -124,6 +124,14 @@ def test_bad_input_is_named():
         robot.jacobian_dot(q, [0, 0, np.nan, 0, 0, 0])
     with pytest.raises(InputError, match="qd"):
         robot.jacobian_dot(q, np.zeros((3, 6)))
+    with pytest.raises(InputError, match="qd"):
+        robot.jacobian_dot(q, np.array([0, 0, np.inf, 0, 0, 0.0]))
+    bad = q.copy()
+    bad[1] = np.nan
+    with pytest.raises(InputError, match="q must be finite"):
+        robot.jacobian_dot(bad, np.zeros(6))
+    with pytest.raises(InputError, match="q must be finite"):
+        robot.hessian(bad)
     with pytest.raises(InputError, match="frame"):
         robot.hessian(q, "tool")
     with pytest.raises(InputError, match="frame"):

@@ -591,16 +591,24 @@ def _tool_jacobian(q, P):
 
 @njit(cache=True)
 def hessian_one(q, P, ee, H):
-    """:func:`hessian_into` of the tool Jacobian at one ``q`` over the packed chain."""
+    """:func:`hessian_into` of the tool Jacobian at one ``q`` (packed chain); False on NaN q."""
+    for i in range(q.shape[0]):
+        if not math.isfinite(q[i]):
+            return False
     J, R = _tool_jacobian(q, P)
     hessian_into(J, R, ee, H)
+    return True
 
 
 @njit(cache=True)
 def jacobian_dot_one(q, P, qd, ee, Jd):
-    """:func:`jacobian_dot_into` of the tool Jacobian at one ``q`` over the packed chain."""
+    """:func:`jacobian_dot_into` of the tool Jacobian at one ``q`` (packed chain); False on NaN."""
+    for i in range(q.shape[0]):
+        if not (math.isfinite(q[i]) and math.isfinite(qd[i])):
+            return False
     J, R = _tool_jacobian(q, P)
     jacobian_dot_into(J, qd, R, ee, Jd)
+    return True
 
 
 @njit(cache=True, nogil=True)

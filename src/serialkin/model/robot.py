@@ -42,28 +42,34 @@ _EMPTY = np.empty
 #: Entry points of the single-call kernels, resolved on first use by :func:`_fast`.
 _FK1: Any = None
 _JAC1: Any = None
+_HESS1: Any = None
+_JDOT1: Any = None
 
 
-def _fast() -> tuple[Any, Any]:
-    """Resolve (once) the compiled entry points of ``fk_one`` and ``jacobian_one``.
+def _fast() -> tuple[Any, Any, Any, Any]:
+    """Resolve (once) the compiled entry points of the single-call kernels.
 
-    Calling an entry point skips numba's per-call type dispatch (about 0.2 µs). They are
-    compiled for ``(q, P, out)`` with ``q`` a 1-D float64 array of any layout, ``P`` the
-    read-only packed chain and ``out`` a C-contiguous 2-D float64 array; the fast paths
-    check exactly that before calling.
+    ``fk_one``, ``jacobian_one``, ``hessian_one``, ``jacobian_dot_one``. Calling an entry
+    point skips numba's per-call type dispatch (0.2-2 µs). They are compiled for ``q``
+    (and ``qd``) 1-D float64 arrays of any layout, ``P`` the read-only packed chain, a
+    bool frame flag and a C-contiguous float64 output; the fast paths check exactly that
+    before calling.
     """
-    global _FK1, _JAC1
+    global _FK1, _JAC1, _HESS1, _JDOT1
     import numba
 
-    f64 = numba.float64
-    sig = (numba.types.Array(f64, 1, "A"), numba.types.Array(f64, 3, "C", readonly=True),
-           numba.types.Array(f64, 2, "C"))
+    f64, Array = numba.float64, numba.types.Array
+    vec, P = Array(f64, 1, "A"), Array(f64, 3, "C", readonly=True)
+    flag = numba.types.boolean
     found = []
-    for dispatcher in (K.fk_one, K.jacobian_one):
+    for dispatcher, sig in ((K.fk_one, (vec, P, Array(f64, 2, "C"))),
+                            (K.jacobian_one, (vec, P, Array(f64, 2, "C"))),
+                            (K.hessian_one, (vec, P, flag, Array(f64, 3, "C"))),
+                            (K.jacobian_dot_one, (vec, P, vec, flag, Array(f64, 2, "C")))):
         dispatcher.compile(sig)  # loads from numba's cache when it can
         found.append(dispatcher.overloads[sig].entry_point)
-    _FK1, _JAC1 = found
-    return _FK1, _JAC1
+    _FK1, _JAC1, _HESS1, _JDOT1 = found
+    return _FK1, _JAC1, _HESS1, _JDOT1
 
 
 def _out_array(out: object, shape: tuple[int, ...]) -> np.ndarray:
@@ -418,13 +424,13 @@ class Robot:
         Raises:
             InputError: as :meth:`jacobian`.
         """
-        check_choice(frame, "frame", ("base", "ee"))
-        if link is None and point is None:
-            a = self.check_q(q)
-            if a.ndim == 1:
-                H = np.empty((6, self.n, self.n))
-                K.hessian_one(a, self._P, frame == "ee", H)
+        if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 and len(q) == self.n \
+                and link is None and point is None and (frame == "base" or frame == "ee"):
+            H = _EMPTY((6, self.n, self.n))
+            if (_HESS1 or _fast()[2])(q, self._P, frame == "ee", H):
                 return H
+            raise self._nonfinite(q)
+        check_choice(frame, "frame", ("base", "ee"))
         a, J, T = self._jacobians(q, "base", link, point)
         N = J.shape[0]
         H = np.empty((N, 6, self.n, self.n))
@@ -461,14 +467,17 @@ class Robot:
         Raises:
             InputError: as :meth:`jacobian`; qd not finite or not broadcastable to q.
         """
-        check_choice(frame, "frame", ("base", "ee"))
-        if link is None and point is None:
-            a = self.check_q(q)
-            v = self.check_q(qd, "qd")
-            if a.ndim == 1 and v.ndim == 1:
-                Jd = np.empty((6, self.n))
-                K.jacobian_dot_one(a, self._P, v, frame == "ee", Jd)
+        n = self.n
+        if type(q) is _NDARRAY and type(qd) is _NDARRAY and q.dtype is _F64 \
+                and qd.dtype is _F64 and q.ndim == 1 and qd.ndim == 1 and len(q) == n \
+                and len(qd) == n and link is None and point is None \
+                and (frame == "base" or frame == "ee"):
+            Jd = _EMPTY((6, n))
+            if (_JDOT1 or _fast()[3])(q, self._P, qd, frame == "ee", Jd):
                 return Jd
+            self.check_q(qd, "qd")  # names the non-finite argument
+            raise self._nonfinite(q)
+        check_choice(frame, "frame", ("base", "ee"))
         a, J, T = self._jacobians(q, "base", link, point)
         v = self.check_q(qd, "qd")
         try:
