@@ -181,7 +181,9 @@ def _store_pose(t, T):
 @njit(cache=True)
 def fk_into(q, F, meta, T):
     """End-effector pose (eq 11) into ``T`` (4, 4) for one configuration ``q`` (n,)."""
-    _store_pose(_chain_walk(q, F, meta[:, 3], meta[:, 4], T, False, T), T)
+    n = meta.shape[0]
+    SC = T if n <= 8 else np.empty((2, n))  # T holds the sin/cos of up to 8 joints
+    _store_pose(_chain_walk(q, F, meta[:, 3], meta[:, 4], T, False, SC), T)
 
 
 # --- single calls from Python: the packed chain -------------------------------------------
@@ -200,7 +202,8 @@ def fk_one(q, P, T):
     for i in range(n):
         if not math.isfinite(q[i]):
             return False
-    _store_pose(_chain_walk(q, P, P[:n, 3, 0], P[:n, 3, 1], T, False, T), T)
+    SC = T if n <= 8 else np.empty((2, n))  # T holds the sin/cos of up to 8 joints
+    _store_pose(_chain_walk(q, P, P[:n, 3, 0], P[:n, 3, 1], T, False, SC), T)
     return True
 
 
