@@ -18,6 +18,29 @@ def _count_range(hits, start, stop):
         hits[k] += 1
 
 
+_FREE_CORES = parallel.free_cores  # the real one (the fixture below replaces it)
+
+
+@pytest.fixture(autouse=True)
+def _all_cores_free(monkeypatch):
+    """Exercise the threaded path whatever else runs on the machine."""
+    monkeypatch.setattr(parallel, "free_cores", lambda: 64)
+
+
+def test_free_cores_is_a_positive_count():
+    """free_cores() (the /proc/loadavg reading, cached 20 ms) is at least 1."""
+    n = _FREE_CORES()
+    assert isinstance(n, int) and 1 <= n <= 1 << 30
+
+
+def test_no_free_core_runs_on_the_calling_thread(monkeypatch):
+    """With no core free, a batch runs as one call on the calling thread."""
+    monkeypatch.setattr(parallel, "free_cores", lambda: 1)
+    calls = []
+    parallel.run(lambda start, stop: calls.append((start, stop)), (), 10_000, 10)
+    assert calls == [(0, 10_000)]
+
+
 @pytest.mark.parametrize(("N", "grain"), [(0, 4), (1, 4), (7, 4), (8, 4), (1001, 16),
                                           (4096, 1)])
 def test_every_item_is_processed_exactly_once(N, grain):
