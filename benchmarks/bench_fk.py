@@ -4,7 +4,9 @@ Run by hand: ``.venv/bin/python benchmarks/bench_fk.py [--batch 100000] [--quick
 
 For the Panda, the UR5 and a planar 20-link arm it measures, in one run:
 
-* single-call latency of ``robot.fk(q)`` and ``robot.jacobian(q)`` (one float64 q),
+* single-call latency of ``robot.fk(q)``, ``robot.jacobian(q)`` (one float64 q, a new
+  array returned), the same with ``out=`` buffers, ``robot.jacobian_dot(q, qd)`` and
+  ``robot.hessian(q)``;
 * batch FK throughput over 100,000 random configurations (``robot.fk(Q)``),
 
 and the same for the peers when the ``bench`` extra is installed:
@@ -12,43 +14,30 @@ and the same for the peers when the ``bench`` extra is installed:
 * Pinocchio (``pin``): a model built from the *same* DH table (one revolute/prismatic
   z joint per row, the fixed transforms as joint placements, the tool as a frame), so
   both libraries compute exactly the same kinematics (checked before timing).
-  FK = ``forwardKinematics`` + ``updateFramePlacement``; Jacobian =
-  ``computeFrameJacobian(..., LOCAL_WORLD_ALIGNED)``; batch = a Python loop of FK calls.
+  FK = ``forwardKinematics`` + ``updateFramePlacement`` (Pinocchio's update alone: no
+  array is returned); Jacobian = ``computeFrameJacobian(..., LOCAL_WORLD_ALIGNED)``;
+  J̇ = ``computeJointJacobiansTimeVariation`` + ``getFrameJacobianTimeVariation``;
+  Hessian = ``computeJointJacobians`` + ``computeJointKinematicHessians`` +
+  ``getJointKinematicHessian``; batch = a Python loop of FK calls.
 * Robotics Toolbox for Python: a ``DHRobot`` built from the same table, timed through its
-  ETS (``ets.eval(q)``, ``ets.jacob0(q)``; batch ``ets.eval(Q)`` with Q (k, n)).
+  ETS (``ets.eval(q)``, ``ets.jacob0(q)``, ``ets.hessian0(q)``; batch ``ets.eval(Q)``).
 
-Ratios are serialkin / peer: below 1 is faster for latencies, above 1 is faster for
-throughput. Latencies are the best of 5 repeats (microseconds per call).
+Each latency is the **median over 15 runs** of ``number`` calls, serialkin's and the
+peers' runs interleaved (so that they see the same machine load), with the 10–90 %
+spread of the runs; throughputs are the median of 7 runs. Ratios are serialkin / peer
+medians: below 1 is faster for latencies, above 1 is faster for throughput.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import sys
-import time
-import timeit
 
 import numpy as np
+from _common import Stat, header, interleaved_us, record, wall_s
 
 import serialkin as sk
 from serialkin import models
-
-
-def best_us(fn, number: int, repeat: int = 5) -> float:
-    """Best-of-``repeat`` time per call [µs]."""
-    return min(timeit.repeat(fn, number=number, repeat=repeat)) / number * 1e6
-
-
-def best_rate(fn, count: int, repeat: int = 3) -> float:
-    """Best-of-``repeat`` throughput [configurations per second] of ``fn()`` over ``count``."""
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return count / best
 
 
 # ---------------------------------------------------------------------------- peers
@@ -102,36 +91,68 @@ def rtb_ets(robot: sk.Robot):
 
 # ---------------------------------------------------------------------------- run
 def bench_robot(robot: sk.Robot, batch: int, number: int) -> list[tuple]:
-    """Measure one robot; return table rows (measure, serialkin, pin, rtb, unit)."""
+    """Measure one robot; return rows (measure, serialkin Stat, pin Stat|None, rtb Stat|None)."""
     rng = np.random.default_rng(0)
     q = robot.random_q(seed=rng)
+    qd = rng.normal(size=robot.n)
     Q = robot.random_q(batch, seed=rng)
-    robot.fk(q), robot.jacobian(q), robot.fk(Q[:10])  # compile / warm up
-
-    sk_fk = best_us(lambda: robot.fk(q), number)
-    sk_jac = best_us(lambda: robot.jacobian(q), number)
-    sk_batch = best_rate(lambda: robot.fk(Q), batch)
-
-    pin_fk = pin_jac = pin_batch = np.nan
+    T, J = np.empty((4, 4)), np.empty((6, robot.n))
+    sk_calls = {
+        "fk": lambda: robot.fk(q),
+        "fk_out": lambda: robot.fk(q, out=T),
+        "jac": lambda: robot.jacobian(q),
+        "jac_out": lambda: robot.jacobian(q, out=J),
+        "jdot": lambda: robot.jacobian_dot(q, qd),
+        "hess": lambda: robot.hessian(q),
+    }
+    peer_calls: dict[str, object] = {}
     peer = pin_model(robot)
     if peer is not None:
         pin, model, data, fid = peer
         pin.forwardKinematics(model, data, q)
         pin.updateFramePlacement(model, data, fid)
         err = np.abs(data.oMf[fid].homogeneous - robot.fk(q)).max()
-        J = pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL_WORLD_ALIGNED)
-        err = max(err, np.abs(J - robot.jacobian(q)).max())
+        Jp = pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL_WORLD_ALIGNED)
+        err = max(err, np.abs(Jp - robot.jacobian(q)).max())
+        pin.computeJointJacobiansTimeVariation(model, data, q, qd)
+        dJ = pin.getFrameJacobianTimeVariation(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+        err = max(err, np.abs(dJ - robot.jacobian_dot(q, qd)).max())
         if err > 1e-9:
             print(f"  ! pinocchio disagrees with serialkin on {robot.name}: {err:.2e}")
 
-        def pin_fk_call():
+        def pin_fk():
             pin.forwardKinematics(model, data, q)
             pin.updateFramePlacement(model, data, fid)
 
-        pin_fk = best_us(pin_fk_call, number)
-        pin_jac = best_us(
-            lambda: pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL_WORLD_ALIGNED),
-            number)
+        def pin_jdot():
+            pin.computeJointJacobiansTimeVariation(model, data, q, qd)
+            return pin.getFrameJacobianTimeVariation(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+
+        def pin_hess():
+            pin.computeJointJacobians(model, data, q)
+            pin.computeJointKinematicHessians(model, data, q)
+            return pin.getJointKinematicHessian(model, data, robot.n, pin.LOCAL_WORLD_ALIGNED)
+
+        peer_calls.update({
+            "pin_fk": pin_fk,
+            "pin_jac": lambda: pin.computeFrameJacobian(model, data, q, fid,
+                                                        pin.LOCAL_WORLD_ALIGNED),
+            "pin_jdot": pin_jdot,
+            "pin_hess": pin_hess,
+        })
+    ets = rtb_ets(robot)
+    if ets is not None:
+        err = max(np.abs(ets.eval(q) - robot.fk(q)).max(),
+                  np.abs(ets.jacob0(q) - robot.jacobian(q)).max())
+        if err > 1e-9:
+            print(f"  ! robotics toolbox disagrees with serialkin on {robot.name}: {err:.2e}")
+        peer_calls.update({"rtb_fk": lambda: ets.eval(q), "rtb_jac": lambda: ets.jacob0(q),
+                           "rtb_hess": lambda: ets.hessian0(q)})
+    t = interleaved_us({**sk_calls, **peer_calls}, number)
+    robot.fk(Q[:10])
+    sk_batch = Stat(batch / wall_s(lambda: robot.fk(Q), repeat=7).values / 1e6)
+    pin_batch = rtb_batch = None
+    if peer is not None:
         k = min(batch, 20000)
 
         def pin_loop():
@@ -139,31 +160,29 @@ def bench_robot(robot: sk.Robot, batch: int, number: int) -> list[tuple]:
                 pin.forwardKinematics(model, data, qi)
                 pin.updateFramePlacement(model, data, fid)
 
-        pin_batch = best_rate(pin_loop, k)
-
-    rtb_fk = rtb_jac = rtb_batch = np.nan
-    ets = rtb_ets(robot)
+        pin_batch = Stat(k / wall_s(pin_loop, repeat=3).values / 1e6)
     if ets is not None:
-        err = max(np.abs(ets.eval(q) - robot.fk(q)).max(),
-                  np.abs(ets.jacob0(q) - robot.jacobian(q)).max())
-        if err > 1e-9:
-            print(f"  ! robotics toolbox disagrees with serialkin on {robot.name}: {err:.2e}")
-        n_rtb = max(number // 20, 200)
-        rtb_fk = best_us(lambda: ets.eval(q), n_rtb)
-        rtb_jac = best_us(lambda: ets.jacob0(q), n_rtb)
-        rtb_batch = best_rate(lambda: ets.eval(Q), batch, repeat=2)
-
+        rtb_batch = Stat(batch / wall_s(lambda: ets.eval(Q), repeat=3).values / 1e6)
+    g = t.get
     return [
-        ("fk(q) latency [µs]", sk_fk, pin_fk, rtb_fk, "lat"),
-        ("jacobian(q) latency [µs]", sk_jac, pin_jac, rtb_jac, "lat"),
-        (f"batch fk, {batch:,} q [M q/s]", sk_batch / 1e6, pin_batch / 1e6, rtb_batch / 1e6,
-         "rate"),
+        ("fk(q) [µs]", t["fk"], g("pin_fk"), g("rtb_fk")),
+        ("fk(q, out=T) [µs]", t["fk_out"], g("pin_fk"), g("rtb_fk")),
+        ("jacobian(q) [µs]", t["jac"], g("pin_jac"), g("rtb_jac")),
+        ("jacobian(q, out=J) [µs]", t["jac_out"], g("pin_jac"), g("rtb_jac")),
+        ("jacobian_dot(q, qd) [µs]", t["jdot"], g("pin_jdot"), None),
+        ("hessian(q) [µs]", t["hess"], g("pin_hess"), g("rtb_hess")),
+        (f"batch fk, {batch:,} q [M q/s]", sk_batch, pin_batch, rtb_batch),
     ]
 
 
-def ratio(a: float, b: float) -> str:
-    """Format a/b, or '-' when the peer is missing."""
-    return "-" if not np.isfinite(b) or b == 0 else f"{a / b:.2f}"
+def ratio(a: Stat, b: Stat | None) -> str:
+    """Format a/b of the medians, or '-' when the peer is missing."""
+    return "-" if b is None or b.median == 0 else f"{a / b:.2f}"
+
+
+def cell(s: Stat | None) -> str:
+    """'median [10-90 %]' or '-'."""
+    return "-" if s is None else s.fmt(3 if s.median < 10 else 1)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -171,27 +190,26 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--batch", type=int, default=100_000, help="batch size (default 100000)")
     ap.add_argument("--quick", action="store_true", help="fewer repetitions")
     args = ap.parse_args(argv)
-    number = 2000 if args.quick else 20000
+    number = 1000 if args.quick else 10000
     robots = [models.panda(), models.ur5(), models.planar(20, 0.01675, name="planar20")]
-
-    try:
-        import numba
-
-        threads = numba.get_num_threads()
-    except Exception:  # pragma: no cover
-        threads = "?"
-    print(f"serialkin {sk.__version__}, numpy {np.__version__}, Python "
-          f"{platform.python_version()}, {os.cpu_count()} CPUs, numba threads {threads}")
+    print(header())
     print("pin: same-DH Pinocchio model; rtb: Robotics Toolbox ETS of the same DH table.")
-    print("Ratios serialkin/peer: < 1 faster for latency rows, > 1 faster for throughput.\n")
-    head = (f"{'robot':9s} {'measure':28s} {'serialkin':>10s} {'pin':>10s} {'rtb':>10s} "
+    print("median [10-90 %] of 15 interleaved runs; ratios serialkin/peer medians: < 1 faster "
+          "for latency rows, > 1 faster for throughput.\n")
+    head = (f"{'robot':9s} {'measure':28s} {'serialkin':>22s} {'pin':>22s} {'rtb':>22s} "
             f"{'sk/pin':>7s} {'sk/rtb':>7s}")
     print(head)
     print("-" * len(head))
     for robot in robots:
-        for name, a, b, c, _ in bench_robot(robot, args.batch, number):
-            print(f"{robot.name:9s} {name:28s} {a:10.3f} {b:10.3f} {c:10.3f} "
+        for name, a, b, c in bench_robot(robot, args.batch, number):
+            print(f"{robot.name:9s} {name:28s} {cell(a):>22s} {cell(b):>22s} {cell(c):>22s} "
                   f"{ratio(a, b):>7s} {ratio(a, c):>7s}", flush=True)
+            if robot.name in ("UR5", "Panda", "ur5", "panda") and b is not None and (
+                    name.startswith("fk(q) ") or name.startswith("jacobian(q) ")):
+                r = a / b
+                record("1", f"{robot.name} {name.split(' [')[0]} / Pinocchio "
+                       f"{'FK update' if name.startswith('fk') else 'computeFrameJacobian'}",
+                       r, "x (median ratio)", "<= 1", r <= 1.0)
     return 0
 
 

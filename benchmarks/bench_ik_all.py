@@ -58,7 +58,9 @@ def bench_serialkin(robot: Robot, n_targets: int, seed: int = 0) -> dict:
         if len(S):
             found += np.abs(_wrap(S - q)).max(axis=1).min() < 1e-6
             worst = max(worst, float(np.abs(robot.fk(S) - T).max()))
-    return {"median": np.median(times), "mean": times.mean(), "solutions": np.mean(counts),
+    return {"median": np.median(times), "mean": times.mean(),
+            "p10": np.percentile(times, 10), "p90": np.percentile(times, 90),
+            "solutions": np.mean(counts),
             "found": found / n_targets, "worst": worst}
 
 
@@ -108,12 +110,13 @@ def main() -> None:
     args = parser.parse_args()
 
     print(f"serialkin ik_all, {args.targets} reachable targets per arm (limits on)")
-    print(f"{'robot':10s} {'class':6s} {'median us':>10s} {'mean us':>9s} {'mean #sol':>10s} "
-          f"{'q found':>8s} {'worst err':>10s}")
+    print(f"{'robot':10s} {'class':6s} {'median us':>10s} {'p10-p90 us':>12s} {'mean us':>9s} "
+          f"{'mean #sol':>10s} {'q found':>8s} {'worst err':>10s}")
     for robot in (models.ur5(), models.puma560()):
         r = bench_serialkin(robot, args.targets)
-        print(f"{robot.name:10s} {classify(robot):6s} {r['median']:10.1f} {r['mean']:9.1f} "
-              f"{r['solutions']:10.2f} {r['found']:8.1%} {r['worst']:10.1e}")
+        spread = f"{r['p10']:.1f}-{r['p90']:.1f}"
+        print(f"{robot.name:10s} {classify(robot):6s} {r['median']:10.1f} {spread:>12s} "
+              f"{r['mean']:9.1f} {r['solutions']:10.2f} {r['found']:8.1%} {r['worst']:10.1e}")
     if args.no_peers:
         return
     try:

@@ -25,13 +25,25 @@ REPEATS = 7
 
 
 def median_time(fn, repeats: int = REPEATS) -> float:
+    """Median wall time [s] of ``repeats`` runs after a warm-up; the spread is kept in SPREAD."""
     fn()
     ts = []
     for _ in range(repeats):
         t0 = time.perf_counter()
         fn()
         ts.append(time.perf_counter() - t0)
+    SPREAD[fn] = (min(ts), max(ts))
     return statistics.median(ts)
+
+
+#: (min, max) run time [s] of the last median_time() of each function.
+SPREAD: dict = {}
+
+
+def spread_us(fn, per: int = 1) -> str:
+    """'[min-max] µs' of fn's runs (divided by ``per``)."""
+    lo, hi = SPREAD[fn]
+    return f"[{lo / per * 1e6:.1f}-{hi / per * 1e6:.1f}]"
 
 
 def dls_loop_python(jac_pos, targets, q0, lam, tol, max_iter, max_step, kick=1e-3):
@@ -97,13 +109,15 @@ def main() -> None:
                       ("c", "twenty_link_obstacles")):
         s = load_scenario(name)
         tr = s.run()
-        t = median_time(s.run)
+        run = s.run
+        t = median_time(run)
         rows.append((f"({key}) {name}", len(tr), int(tr.iterations.sum()), t * 1e3,
-                     t / len(tr) * 1e6, tr.max_error * 1e3))
+                     t / len(tr) * 1e6, spread_us(run, len(tr)), tr.max_error * 1e3))
+    print(f"median of {REPEATS} runs [min-max]")
     print(f"{'scenario':<28}{'points':>7}{'iters':>7}{'total [ms]':>12}{'per point [µs]':>16}"
-          f"{'max err [mm]':>14}")
+          f"{'spread [µs]':>16}{'max err [mm]':>14}")
     for r in rows:
-        print(f"{r[0]:<28}{r[1]:>7}{r[2]:>7}{r[3]:>12.3f}{r[4]:>16.1f}{r[5]:>14.3g}")
+        print(f"{r[0]:<28}{r[1]:>7}{r[2]:>7}{r[3]:>12.3f}{r[4]:>16.1f}{r[5]:>16}{r[6]:>14.3g}")
 
     # ---------------------------------------------------------------- (a) vs peers
     s = load_scenario("six_link_circle")
@@ -122,7 +136,8 @@ def main() -> None:
 
     t_kernel = median_time(kernel, 21)
     t_track = median_time(s.run)
-    print(f"\n(a) serialkin compiled DLS loop only: {t_kernel * 1e6:.1f} µs total, "
+    print(f"\n(a) serialkin compiled DLS loop only: {t_kernel * 1e6:.1f} µs total "
+          f"{spread_us(kernel)} (median of 21 [min-max]), "
           f"{t_kernel / p * 1e6:.2f} µs per point ({int(IT.sum())} iterations); "
           f"track() with recording: {t_track * 1e6:.0f} µs")
     xy = s.path.points

@@ -1,24 +1,72 @@
-"""Run every benchmark script in this folder, one after the other (``make bench``).
+"""Run every benchmark script in this folder, then print one summary table (``make bench``).
 
-Each script prints its own table; peers are measured in the same run when the ``bench``
-extra is installed. Benchmarks are run by hand, never as timed assertions in tests.
+Each script prints its own table (medians and spread of repeated runs, peers measured in
+the same run when the ``bench`` extra is installed). The figures on which the goals of
+issue 11 are judged are collected from the scripts (``SERIALKIN_BENCH_RESULTS``, see
+``_common.record``) into the closing table: goal, measured figure, target, met or not.
+Benchmarks are run by hand, never as timed assertions in tests.
+
+``--only fk,parallel`` runs a subset of the scripts (by name without ``bench_``).
 """
 
 from __future__ import annotations
 
+import argparse
+import json
+import os
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 
+GOALS = {
+    "1": "single calls no slower than Pinocchio (UR5, Panda)",
+    "2": "parallel batches never slower than serial; 6-DOF batch FK >= 40 M/s",
+    "3": "IK lm single <= 8 us at 100 % success; batch <= 4 us per target",
+}
 
-def main() -> int:
+
+def summary(path: Path) -> str:
+    """The closing table from the recorded JSON lines."""
+    rows = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()
+            if line.strip()] if path.exists() else []
+    out = ["", "=== summary: goals of issue 11 ===", ""]
+    head = f"{'goal':4s} {'measure':72s} {'measured':>12s} {'target':>14s} {'met':>4s}"
+    out += [head, "-" * len(head)]
+    for r in rows:
+        out.append(f"{r['goal']:4s} {r['measure'][:72]:72s} {r['value']:12.3f} "
+                   f"{r['target']:>14s} {'yes' if r['met'] else 'NO':>4s}")
+    for goal, text in GOALS.items():
+        mine = [r for r in rows if r["goal"] == goal]
+        state = ("not measured" if not mine else
+                 "met" if all(r["met"] for r in mine) else
+                 f"NOT met ({sum(not r['met'] for r in mine)} of {len(mine)} rows)")
+        out.append(f"goal {goal} ({text}): {state}")
+    if hasattr(os, "getloadavg"):
+        load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
+        out.append(f"load average at the end (1, 5, 15 min): {load} on {os.cpu_count()} CPUs "
+                   "(other processes' load makes the parallel rows meaningless)")
+    return "\n".join(out)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", default="", help="comma-separated script names (fk, parallel...)")
+    args = ap.parse_args(argv)
+    wanted = {w.strip() for w in args.only.split(",") if w.strip()}
     status = 0
-    for script in sorted(HERE.glob("bench_*.py")):
-        print(f"\n=== {script.name} ===", flush=True)
-        rc = subprocess.call([sys.executable, str(script)], cwd=HERE.parent)
-        status = status or rc
+    with tempfile.TemporaryDirectory() as tmp:
+        results = Path(tmp) / "results.jsonl"
+        env = dict(os.environ, SERIALKIN_BENCH_RESULTS=str(results))
+        for script in sorted(HERE.glob("bench_*.py")):
+            if wanted and script.stem.removeprefix("bench_") not in wanted:
+                continue
+            print(f"\n=== {script.name} ===", flush=True)
+            rc = subprocess.call([sys.executable, str(script)], cwd=HERE.parent, env=env)
+            status = status or rc
+        print(summary(results), flush=True)
     return status
 
 

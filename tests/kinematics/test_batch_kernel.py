@@ -11,6 +11,8 @@ from numba import njit
 import serialkin as sk
 from serialkin.kinematics import _kernels as K
 from serialkin.model.chain import z_alignment
+from serialkin.model.dh import link_transform, parse_dh_rows
+from tests.kinematics._fd import dh_rows, random_transform
 
 
 @njit(cache=True)
@@ -86,3 +88,24 @@ def test_general_axes_compile_to_z():
         frames.append(T)
     np.testing.assert_allclose(robot.fk_all(q), np.stack(frames), atol=1e-12)
     np.testing.assert_allclose(robot.fk(q), frames[-1], atol=1e-12)
+
+
+@settings(max_examples=25, deadline=None)
+@given(rows=dh_rows(min_joints=1, max_joints=14), seed=st.integers(0, 2**32 - 1),
+       huge=st.booleans())
+def test_single_calls_match_link_products_on_long_chains(rows, seed, huge):
+    """Single-call fk/jacobian on 1-14 joints (huge angles too) equal link products and batches."""
+    rng = np.random.default_rng(seed)
+    robot = sk.Robot.from_dh(rows, "standard", base=random_transform(rng),
+                             tool=random_transform(rng))
+    q = robot.random_q(seed=rng)
+    if huge:
+        q[int(rng.integers(robot.n))] = 3e6 * rng.choice([-1.0, 1.0])
+    T = robot.base.copy()
+    for i, row in enumerate(parse_dh_rows(rows)):
+        T = T @ link_transform(row, q[i], "standard")
+    T = T @ robot.tool
+    np.testing.assert_allclose(robot.fk(q), T, atol=1e-9)
+    Q = np.stack([q, q])
+    np.testing.assert_allclose(robot.fk(q), robot.fk(Q)[1], atol=1e-12)
+    np.testing.assert_allclose(robot.jacobian(q), robot.jacobian(Q)[1], atol=1e-12)

@@ -773,8 +773,8 @@ def solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
 
     ``Q0`` (N, n) start configurations (read when ``cfg[C_USE_Q0]`` is 1), ``Q_out``
     (N, n) and ``info`` (N, N_INFO) outputs. The batch driver
-    (:func:`serialkin.ik.solver.solve`) runs one chunk per thread, one thread per core:
-    the same parallelism as a ``prange`` loop at a fraction of its compile time. Every
+    (:func:`serialkin.ik.solver.solve`) hands chunks to every core through
+    :func:`serialkin.kinematics.parallel.run`, the scheduler of every batch kernel. Every
     target uses the same random stream ``seed``, so a batch solve returns exactly what
     the single solves with that seed return, whatever the chunking.
     """

@@ -5,7 +5,8 @@ the registry and runs it:
 
 * compiled methods (the Jacobian family) run entirely in
   :func:`serialkin.ik._kernels.solve_one`; a batch runs
-  :func:`~serialkin.ik._kernels.solve_chunk` on one thread per core (GIL released);
+  :func:`~serialkin.ik._kernels.solve_chunk` on every core (GIL released, chunks
+  handed out by :func:`serialkin.kinematics.parallel.run`);
 * Python methods supply one attempt and :func:`run_attempts` owns the rest.
 
 Both follow the same semantics:
@@ -30,7 +31,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -50,6 +50,7 @@ from serialkin.ik.target import (
     robot_arrays,
 )
 from serialkin.kinematics import _kernels as FK
+from serialkin.kinematics import parallel
 from serialkin.model.robot import Robot
 from serialkin.spatial import _kernels as SK
 
@@ -437,35 +438,16 @@ def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray 
     return _result_batch(robot, tgt, spec, Q, info, tol, respect)
 
 
-#: Worker pools by thread count, created on first use (never at import).
-_POOLS: dict[int, ThreadPoolExecutor] = {}
-
-
 def _run_chunks(F: np.ndarray, meta: np.ndarray, Tt: np.ndarray, box: np.ndarray,
                 Q0: np.ndarray, cfg: np.ndarray, seed64: np.uint64, Q: np.ndarray,
                 info: np.ndarray) -> None:
-    """Solve a batch with :func:`~serialkin.ik._kernels.solve_chunk`, one thread per core.
+    """Solve a batch with :func:`~serialkin.ik._kernels.solve_chunk` on every core.
 
-    The targets are cut into 4 chunks per thread (so that a few slow targets do not
-    leave a core idle); the kernel releases the GIL. The number of threads is
-    ``numba.get_num_threads()`` (``NUMBA_NUM_THREADS``).
+    Scheduled by :func:`serialkin.kinematics.parallel.run` (chunks of 8 targets claimed
+    dynamically, so a few slow targets or a busy core do not leave the batch waiting).
     """
-    import numba
-
-    N = Tt.shape[0]
-    threads = max(1, min(numba.get_num_threads(), N // 4))
-    if threads == 1:
-        K.solve_chunk(F, meta, Tt, box, Q0, cfg, seed64, Q, info, 0, N)
-        return
-    pool = _POOLS.get(threads)
-    if pool is None:
-        pool = _POOLS[threads] = ThreadPoolExecutor(max_workers=threads,
-                                                    thread_name_prefix="serialkin-ik")
-    bounds = np.linspace(0, N, 4 * threads + 1).astype(int)
-    futures = [pool.submit(K.solve_chunk, F, meta, Tt, box, Q0, cfg, seed64, Q, info,
-                               int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
-    for f in futures:
-        f.result()
+    parallel.run(K.solve_chunk, (F, meta, Tt, box, Q0, cfg, seed64, Q, info), Tt.shape[0],
+                 grain=8)
 
 
 def _kernel_config(spec: MethodSpec, tgt: Target, tol: float, max_iter: int, restarts: int,

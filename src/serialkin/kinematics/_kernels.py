@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 REVOLUTE = 0
 PRISMATIC = 1
@@ -75,33 +75,89 @@ def _row_times(t0, t1, t2, t3, A):
 
 
 @njit(cache=True, inline="always")
-def _chain_walk(q, F, meta, J, record):
+def _sincos_banks(q, off, SC, n):
+    """All joints' (sin, cos) of ``q + off`` into the scratch ``SC`` (2-D); False if too small.
+
+    Joint ``i = b·w + c`` (w = ``SC.shape[1]``) goes to ``SC[2b, c]`` (sin) and
+    ``SC[2b+1, c]`` (cos): for a (6, n) Jacobian rows 0 and 1, for a (4, 4) pose rows 0-1
+    then 2-3. Each bank's loop is contiguous and branch-free, so LLVM vectorises it.
+    """
+    w = SC.shape[1]
+    if (SC.shape[0] // 2) * w < n:
+        return False
+    big = False
+    i0 = 0
+    b = 0
+    while i0 < n:
+        m = min(w, n - i0)
+        S = SC[2 * b]
+        for c in range(m):
+            x = q[i0 + c] + off[i0 + c]
+            S[c] = x
+            big |= abs(x) > 1e5
+        i0 += m
+        b += 1
+    i0 = 0
+    b = 0
+    while i0 < n:
+        m = min(w, n - i0)
+        S = SC[2 * b]
+        C = SC[2 * b + 1]
+        if big:
+            for c in range(m):
+                C[c] = math.cos(S[c])
+                S[c] = math.sin(S[c])
+        else:
+            for c in range(m):
+                S[c], C[c] = _sincos(S[c])
+        i0 += m
+        b += 1
+    return True
+
+
+@njit(cache=True, inline="always")
+def _chain_walk(q, F, kind, off, J, record, SC):
     """Walk the chain holding the pose's 12 entries in registers; return them as a tuple.
 
-    The joints' sin/cos are computed first (independent of the pose, so they pipeline).
-    With ``record``, each joint's world axis z_i and origin o_i (its frame just before its
-    motion) are stored in ``J[3:, i]`` and ``J[:3, i]`` (J (6, n)) on the way.
+    ``F`` (n+1, 4, 4) fixed transforms (only their top three rows are read), ``kind`` and
+    ``off`` (n,) each joint's type and offset (``meta[:, 3]``, ``meta[:, 4]``, or the same
+    entries of the packed chain). ``SC`` is 2-D scratch (the caller's output array,
+    overwritten later) for all joints' sin/cos, computed first (:func:`_sincos_banks`);
+    when it is too small each joint's sin/cos is computed on its step. With ``record``,
+    each joint's world axis z_i and origin o_i (its frame just before its motion) are
+    stored in ``J[3:, i]`` and ``J[:3, i]`` (J (6, n)) on the way; SC may then be J
+    itself (joint i's sin/cos are read before column i is written).
     """
-    n = meta.shape[0]
-    sc = np.empty((2, n))
-    for i in range(n):
-        sc[0, i], sc[1, i] = _sincos_scalar(q[i] + meta[i, 4])
+    n = kind.shape[0]
+    pre = _sincos_banks(q, off, SC, n)
+    w = SC.shape[1]
+    bank = 0
+    col = 0
     A = F[0]
     a0, a1, a2, a3 = A[0, 0], A[0, 1], A[0, 2], A[0, 3]
     b0, b1, b2, b3 = A[1, 0], A[1, 1], A[1, 2], A[1, 3]
     c0, c1, c2, c3 = A[2, 0], A[2, 1], A[2, 2], A[2, 3]
     for i in range(n):
+        x = q[i] + off[i]
+        if pre:
+            s = SC[bank, col]
+            c = SC[bank + 1, col]
+            col += 1
+            if col == w:
+                col = 0
+                bank += 2
+        elif kind[i] != PRISMATIC:
+            s, c = _sincos_scalar(x)
+        else:
+            s, c = 0.0, 1.0
         if record:
             J[0, i], J[1, i], J[2, i] = a3, b3, c3
             J[3, i], J[4, i], J[5, i] = a2, b2, c2
-        if meta[i, 3] == PRISMATIC:
-            x = q[i] + meta[i, 4]
+        if kind[i] == PRISMATIC:
             a3 += x * a2
             b3 += x * b2
             c3 += x * c2
         else:
-            s = sc[0, i]
-            c = sc[1, i]
             a0, a1 = a0 * c + a1 * s, a1 * c - a0 * s
             b0, b1 = b0 * c + b1 * s, b1 * c - b0 * s
             c0, c1 = c0 * c + c1 * s, c1 * c - c0 * s
@@ -125,7 +181,43 @@ def _store_pose(t, T):
 @njit(cache=True)
 def fk_into(q, F, meta, T):
     """End-effector pose (eq 11) into ``T`` (4, 4) for one configuration ``q`` (n,)."""
-    _store_pose(_chain_walk(q, F, meta, T, False), T)
+    n = meta.shape[0]
+    SC = T if n <= 8 else np.empty((2, n))  # T holds the sin/cos of up to 8 joints
+    _store_pose(_chain_walk(q, F, meta[:, 3], meta[:, 4], T, False, SC), T)
+
+
+# --- single calls from Python: the packed chain -------------------------------------------
+#
+# A call from Python pays for every array argument it passes (numba unboxes each one) and
+# for every array a kernel allocates. The single-call entries therefore take the packed
+# chain ``P`` (n+1, 4, 4) of :attr:`serialkin.model.chain.Chain.packed` — the fixed
+# transforms ``F`` whose constant last rows carry each joint's type and offset
+# (``P[i, 3, 0]``, ``P[i, 3, 1]``) — and allocate nothing.
+
+
+@njit(cache=True)
+def fk_one(q, P, T):
+    """End-effector pose into ``T`` (4, 4) over the packed chain; False (T untouched) on NaN q."""
+    n = P.shape[0] - 1
+    for i in range(n):
+        if not math.isfinite(q[i]):
+            return False
+    SC = T if n <= 8 else np.empty((2, n))  # T holds the sin/cos of up to 8 joints
+    _store_pose(_chain_walk(q, P, P[:n, 3, 0], P[:n, 3, 1], T, False, SC), T)
+    return True
+
+
+@njit(cache=True)
+def jacobian_one(q, P, J):
+    """Geometric Jacobian (eqs 33-36) into ``J`` (6, n) over the packed chain; False on NaN q."""
+    n = P.shape[0] - 1
+    for i in range(n):
+        if not math.isfinite(q[i]):
+            return False
+    kind = P[:n, 3, 0]
+    t = _chain_walk(q, P, kind, P[:n, 3, 1], J, True, J)
+    _finish_columns(J, kind, n, t[3], t[7], t[11])
+    return True
 
 
 # --- sin/cos, and batches: blocks of configurations in structure-of-arrays form -----------
@@ -234,34 +326,29 @@ def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
         o[3, 3] = 1.0
 
 
-@njit(cache=True, parallel=True)
-def fk_batch(Q, F, meta, out):
-    """End-effector poses for a batch ``Q`` (N, n) into ``out`` (N, 4, 4), across cores.
+# --- batches: range kernels ----------------------------------------------------------------
+#
+# Every batch kernel processes items ``start..stop-1`` with the GIL released; the
+# scheduler in :mod:`serialkin.kinematics.parallel` hands chunks of the range to the
+# cores (dynamic scheduling: see there why not ``prange``).
 
-    Each thread takes a contiguous chunk and walks it in blocks of ``_BLOCK``
-    configurations (structure of arrays, see :func:`_sincos`).
+
+@njit(cache=True, nogil=True)
+def fk_range(Q, F, meta, out, start, stop):
+    """End-effector poses of ``Q[start:stop]`` (Q (N, n)) into ``out`` (N, 4, 4).
+
+    Walks the range in blocks of ``_BLOCK`` configurations (structure of arrays, see
+    :func:`_sincos`).
     """
-    N = Q.shape[0]
-    chunks = 32  # enough to balance any thread count numba uses here
-    per = (N + chunks - 1) // chunks
-    for ch in prange(chunks):
-        T = np.empty((12, _BLOCK))
-        X = np.empty((meta.shape[0], _BLOCK))
-        c = np.empty(_BLOCK)
-        s = np.empty(_BLOCK)
-        k0 = ch * per
-        end = min(N, k0 + per)
-        while k0 < end:
-            B = min(_BLOCK, end - k0)
-            _fk_block(Q, F, meta, out, k0, B, T, X, c, s)
-            k0 += B
-
-
-@njit(cache=True)
-def fk_batch_serial(Q, F, meta, out):
-    """:func:`fk_batch` on one core: small batches, where starting threads costs more."""
-    for k in range(Q.shape[0]):
-        fk_into(Q[k], F, meta, out[k])
+    T = np.empty((12, _BLOCK))
+    X = np.empty((meta.shape[0], _BLOCK))
+    c = np.empty(_BLOCK)
+    s = np.empty(_BLOCK)
+    k0 = start
+    while k0 < stop:
+        B = min(_BLOCK, stop - k0)
+        _fk_block(Q, F, meta, out, k0, B, T, X, c, s)
+        k0 += B
 
 
 @njit(cache=True)
@@ -277,10 +364,10 @@ def fk_all_into(q, F, L, meta, out):
         _post_multiply(T, F[i + 1])
 
 
-@njit(cache=True, parallel=True)
-def fk_all_batch(Q, F, L, meta, out):
-    """Link frames for a batch ``Q`` (N, n) into ``out`` (N, n+1, 4, 4), across cores."""
-    for k in prange(Q.shape[0]):
+@njit(cache=True, nogil=True)
+def fk_all_range(Q, F, L, meta, out, start, stop):
+    """Link frames of ``Q[start:stop]`` (Q (N, n)) into ``out`` (N, n+1, 4, 4)."""
+    for k in range(start, stop):
         fk_all_into(Q[k], F, L, meta, out[k])
 
 
@@ -293,7 +380,7 @@ def _record_joint(J, j, T, meta_j):
 
 
 @njit(cache=True, inline="always")
-def _finish_columns(J, meta, m, px, py, pz):
+def _finish_columns(J, kind, m, px, py, pz):
     """Turn the recorded (o_j, z_j) of the first m joints into Jacobian columns (eqs 35-36).
 
     Revolute: ``[z × (p − o); z]``; prismatic: ``[z; 0]``.
@@ -302,7 +389,7 @@ def _finish_columns(J, meta, m, px, py, pz):
         zx = J[3, j]
         zy = J[4, j]
         zz = J[5, j]
-        if meta[j, 3] == PRISMATIC:
+        if kind[j] == PRISMATIC:
             J[0, j] = zx
             J[1, j] = zy
             J[2, j] = zz
@@ -326,9 +413,9 @@ def jacobian_into(q, F, meta, J, T):
     (4, 4). Joint *i*'s axis and origin are those of its frame just before its motion
     (for standard DH, frame i-1: the chapter's z_{i-1}, p_{i-1}).
     """
-    t = _chain_walk(q, F, meta, J, True)
+    t = _chain_walk(q, F, meta[:, 3], meta[:, 4], J, True, J)
     _store_pose(t, T)
-    _finish_columns(J, meta, meta.shape[0], t[3], t[7], t[11])
+    _finish_columns(J, meta[:, 3], meta.shape[0], t[3], t[7], t[11])
 
 
 @njit(cache=True)
@@ -347,17 +434,10 @@ def joint_axes_into(q, F, meta, P, W):
         _post_multiply(T, F[i + 1])
 
 
-@njit(cache=True, parallel=True)
-def jacobian_batch(Q, F, meta, J, T):
-    """Geometric Jacobians (N, 6, n) and poses (N, 4, 4) for a batch ``Q`` (N, n)."""
-    for k in prange(Q.shape[0]):
-        jacobian_into(Q[k], F, meta, J[k], T[k])
-
-
-@njit(cache=True)
-def jacobian_batch_serial(Q, F, meta, J, T):
-    """:func:`jacobian_batch` on one core, for small batches."""
-    for k in range(Q.shape[0]):
+@njit(cache=True, nogil=True)
+def jacobian_range(Q, F, meta, J, T, start, stop):
+    """Geometric Jacobians (N, 6, n) and poses (N, 4, 4) of ``Q[start:stop]`` (Q (N, n))."""
+    for k in range(start, stop):
         jacobian_into(Q[k], F, meta, J[k], T[k])
 
 
@@ -382,38 +462,167 @@ def point_jacobian_into(q, F, L, meta, link, point, J, p_out):
         _post_multiply(T, F[i + 1])
     for r in range(3):
         p_out[r] = W[r, 0] * point[0] + W[r, 1] * point[1] + W[r, 2] * point[2] + W[r, 3]
-    _finish_columns(J, meta, link, p_out[0], p_out[1], p_out[2])
+    _finish_columns(J, meta[:, 3], link, p_out[0], p_out[1], p_out[2])
 
 
-@njit(cache=True, parallel=True)
-def point_jacobian_batch(Q, F, L, meta, link, point, J, P):
-    """Point Jacobians (N, 6, n) and point positions (N, 3) for a batch ``Q`` (N, n)."""
-    for k in prange(Q.shape[0]):
+@njit(cache=True, nogil=True)
+def point_jacobian_range(Q, F, L, meta, link, point, J, P, start, stop):
+    """Point Jacobians (N, 6, n) and point positions (N, 3) of ``Q[start:stop]``."""
+    for k in range(start, stop):
         point_jacobian_into(Q[k], F, L, meta, link, point, J[k], P[k])
 
 
+# --- second order: Hessian and time derivative of the geometric Jacobian ------------------
+#
+# With J's columns J_j = [v_j; w_j] (w_j = z_j for a revolute joint, 0 for a prismatic one),
+# a joint k before j turns column j rigidly and a joint k at or after j moves only the
+# reference point, so (Haviland & Corke 2022, "Manipulator differential kinematics II",
+# in the [v; ω] row order):
+#
+#     ∂J_j/∂q_k = [w_k × v_j; w_k × w_j]   for k < j,
+#     ∂J_j/∂q_k = [w_j × v_k; 0]           for k ≥ j,
+#
+# and J̇ = Σ_k (∂J/∂q_k) q̇_k, i.e. column j of J̇ is
+#
+#     J̇_j = [ω_{<j} × v_j + w_j × v_{≥j};  ω_{<j} × w_j],
+#
+# with ω_{<j} = Σ_{k<j} w_k q̇_k and v_{≥j} = Σ_{k≥j} v_k q̇_k: O(n) once J is known.
+# Both hold for any point Jacobian (columns beyond the link are zero). In the tool frame
+# (J_ee = blockdiag(Rᵀ, Rᵀ) J, Ṙ = [ω]× R) each block gains a term: ∂J_ee/∂q_k =
+# blockdiag(Rᵀ, Rᵀ)(∂J/∂q_k − [w_k]× J) and J̇_ee = blockdiag(Rᵀ, Rᵀ)(J̇ − [ω]× J) with
+# ω = Σ_k w_k q̇_k.
+
+
+@njit(cache=True, inline="always")
+def _cross_into(ax, ay, az, bx, by, bz, out, r, j, k, sign):
+    """out[r:r+3, j, k] = sign · (a × b)."""
+    out[r, j, k] = sign * (ay * bz - az * by)
+    out[r + 1, j, k] = sign * (az * bx - ax * bz)
+    out[r + 2, j, k] = sign * (ax * by - ay * bx)
+
+
 @njit(cache=True)
-def all_finite(x):
-    """True when every entry of the 1-D array ``x`` is finite (cheap check for the fast path)."""
-    for i in range(x.shape[0]):
-        if not math.isfinite(x[i]):
+def hessian_into(J, R, ee, H):
+    """Hessian ``H`` (6, n, n), ``H[:, j, k] = ∂J[:, j]/∂q_k``, of a base-frame Jacobian J (6, n).
+
+    With ``ee`` the Hessian of ``blockdiag(Rᵀ, Rᵀ) J`` (R (3, 3) the frame's rotation) is
+    written instead. Formulas in the section comment above.
+    """
+    n = J.shape[1]
+    for j in range(n):
+        for k in range(n):
+            if k < j:
+                wx, wy, wz = J[3, k], J[4, k], J[5, k]
+                _cross_into(wx, wy, wz, J[0, j], J[1, j], J[2, j], H, 0, j, k, 1.0)
+                _cross_into(wx, wy, wz, J[3, j], J[4, j], J[5, j], H, 3, j, k, 1.0)
+            else:
+                _cross_into(J[3, j], J[4, j], J[5, j], J[0, k], J[1, k], J[2, k], H, 0, j, k,
+                            1.0)
+                H[3, j, k] = 0.0
+                H[4, j, k] = 0.0
+                H[5, j, k] = 0.0
+    if ee:
+        for j in range(n):
+            for k in range(n):
+                wx, wy, wz = J[3, k], J[4, k], J[5, k]
+                for r in (0, 3):
+                    vx, vy, vz = J[r, j], J[r + 1, j], J[r + 2, j]
+                    hx = H[r, j, k] - (wy * vz - wz * vy)
+                    hy = H[r + 1, j, k] - (wz * vx - wx * vz)
+                    hz = H[r + 2, j, k] - (wx * vy - wy * vx)
+                    for c in range(3):
+                        H[r + c, j, k] = R[0, c] * hx + R[1, c] * hy + R[2, c] * hz
+
+
+@njit(cache=True)
+def jacobian_dot_into(J, qd, R, ee, Jd):
+    """Time derivative ``Jd`` (6, n) of a base-frame Jacobian J (6, n) at joint rates qd (n,).
+
+    ``J̇ = Σ_k (∂J/∂q_k) q̇_k`` in O(n) (see the section comment); with ``ee`` that of
+    ``blockdiag(Rᵀ, Rᵀ) J`` (R (3, 3) the frame's rotation).
+    """
+    n = J.shape[1]
+    vx = vy = vz = 0.0  # v_{≥j}, accumulated from the last column backwards
+    for j in range(n - 1, -1, -1):
+        vx += J[0, j] * qd[j]
+        vy += J[1, j] * qd[j]
+        vz += J[2, j] * qd[j]
+        Jd[0, j] = J[4, j] * vz - J[5, j] * vy
+        Jd[1, j] = J[5, j] * vx - J[3, j] * vz
+        Jd[2, j] = J[3, j] * vy - J[4, j] * vx
+    ox = oy = oz = 0.0  # ω_{<j}
+    for j in range(n):
+        for r in (0, 3):
+            ax, ay, az = J[r, j], J[r + 1, j], J[r + 2, j]
+            cx, cy, cz = oy * az - oz * ay, oz * ax - ox * az, ox * ay - oy * ax
+            if r == 0:
+                Jd[0, j] += cx
+                Jd[1, j] += cy
+                Jd[2, j] += cz
+            else:
+                Jd[3, j] = cx
+                Jd[4, j] = cy
+                Jd[5, j] = cz
+        ox += J[3, j] * qd[j]
+        oy += J[4, j] * qd[j]
+        oz += J[5, j] * qd[j]
+    if ee:  # ω is now the frame's angular velocity
+        for j in range(n):
+            for r in (0, 3):
+                ax, ay, az = J[r, j], J[r + 1, j], J[r + 2, j]
+                hx = Jd[r, j] - (oy * az - oz * ay)
+                hy = Jd[r + 1, j] - (oz * ax - ox * az)
+                hz = Jd[r + 2, j] - (ox * ay - oy * ax)
+                for c in range(3):
+                    Jd[r + c, j] = R[0, c] * hx + R[1, c] * hy + R[2, c] * hz
+
+
+@njit(cache=True, inline="always")
+def _tool_jacobian(q, P):
+    """Tool Jacobian (6, n) and rotation (3, 3) over the packed chain (single calls)."""
+    n = P.shape[0] - 1
+    kind = P[:n, 3, 0]
+    J = np.empty((6, n))
+    t = _chain_walk(q, P, kind, P[:n, 3, 1], J, True, J)
+    _finish_columns(J, kind, n, t[3], t[7], t[11])
+    R = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            R[r, c] = t[4 * r + c]
+    return J, R
+
+
+@njit(cache=True)
+def hessian_one(q, P, ee, H):
+    """:func:`hessian_into` of the tool Jacobian at one ``q`` (packed chain); False on NaN q."""
+    for i in range(q.shape[0]):
+        if not math.isfinite(q[i]):
             return False
+    J, R = _tool_jacobian(q, P)
+    hessian_into(J, R, ee, H)
     return True
 
 
 @njit(cache=True)
-def fk_checked(q, F, meta, T):
-    """Run :func:`fk_into` after a finiteness check of q; False (T untouched) on NaN/inf."""
-    if not all_finite(q):
-        return False
-    fk_into(q, F, meta, T)
+def jacobian_dot_one(q, P, qd, ee, Jd):
+    """:func:`jacobian_dot_into` of the tool Jacobian at one ``q`` (packed chain); False on NaN."""
+    for i in range(q.shape[0]):
+        if not (math.isfinite(q[i]) and math.isfinite(qd[i])):
+            return False
+    J, R = _tool_jacobian(q, P)
+    jacobian_dot_into(J, qd, R, ee, Jd)
     return True
 
 
-@njit(cache=True)
-def jacobian_checked(q, F, meta, J, T):
-    """:func:`jacobian_into` preceded by a finiteness check of q; returns False on NaN/inf."""
-    if not all_finite(q):
-        return False
-    jacobian_into(q, F, meta, J, T)
-    return True
+@njit(cache=True, nogil=True)
+def hessian_range(J, R, ee, H, start, stop):
+    """:func:`hessian_into` for items ``start..stop-1`` of J (N, 6, n), R (N, 3, 3) into H."""
+    for k in range(start, stop):
+        hessian_into(J[k], R[k], ee, H[k])
+
+
+@njit(cache=True, nogil=True)
+def jacobian_dot_range(J, Qd, R, ee, Jd, start, stop):
+    """:func:`jacobian_dot_into` for items ``start..stop-1`` of J (N, 6, n), Qd (N, n)."""
+    for k in range(start, stop):
+        jacobian_dot_into(J[k], Qd[k], R[k], ee, Jd[k])

@@ -25,11 +25,15 @@ class Chain:
         L: (n+1, 4, 4) link-frame offsets (L[0] is the base).
         meta: (n, 5) axis x, y, z (always 0, 0, 1 after compilation), type (0 R, 1 P),
             offset.
+        packed: (n+1, 4, 4) ``F`` with each joint's type and offset in the last row,
+            ``packed[i, 3, :2] = (type_i, offset_i)`` (zeros for i = n): the one array the
+            single-call kernels take.
     """
 
     F: np.ndarray
     L: np.ndarray
     meta: np.ndarray
+    packed: np.ndarray
 
     @property
     def n(self) -> int:
@@ -84,6 +88,10 @@ def compile_chain(joints: Sequence[Joint], base: np.ndarray, tool: np.ndarray) -
         F[i + 1] = R.T @ F[i + 1]
         L[i + 1] = R.T @ L[i + 1]
         meta[i, :3] = (0.0, 0.0, 1.0)
-    for a in (F, L, meta):
+    packed = F.copy()
+    packed[:, 3, :] = 0.0
+    packed[:n, 3, 0] = meta[:, 3]
+    packed[:n, 3, 1] = meta[:, 4]
+    for a in (F, L, meta, packed):
         a.setflags(write=False)
-    return Chain(F=np.ascontiguousarray(F), L=np.ascontiguousarray(L), meta=meta)
+    return Chain(F=F, L=L, meta=meta, packed=packed)

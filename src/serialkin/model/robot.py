@@ -31,6 +31,7 @@ from serialkin._checks import (
 )
 from serialkin.errors import InputError, RobotDefinitionError
 from serialkin.kinematics import _kernels as K
+from serialkin.kinematics import parallel
 from serialkin.model.chain import compile_chain
 from serialkin.model.dh import CONVENTIONS, DHLink, dh_to_joints, parse_dh_rows
 from serialkin.model.joint import Joint, check_fixed_transform
@@ -40,45 +41,52 @@ if TYPE_CHECKING:
     from serialkin.ik.result import IKResult
 
 _F64 = np.dtype(np.float64)
-#: Batches smaller than this run on one core (thread start-up would cost more).
-PARALLEL_MIN_BATCH = 256
-_ENTRY: dict[str, Any] = {}
+_NDARRAY = np.ndarray
+_EMPTY = np.empty
+#: Entry points of the single-call kernels, resolved on first use by :func:`_fast`.
+_FK1: Any = None
+_JAC1: Any = None
+_HESS1: Any = None
+_JDOT1: Any = None
 
 
-def _entry(name: str, *example: object) -> Any:
-    """Compiled entry point of kernel ``name`` for exactly the numba types of ``example``.
+def _fast() -> tuple[Any, Any, Any, Any]:
+    """Resolve (once) the compiled entry points of the single-call kernels.
 
-    Calling it skips numba's per-call type dispatch (about 0.2 µs). The single-call fast
-    paths compile it with ``q`` typed as a 1-D float64 array of any layout ('A'), so any
-    1-D float64 array may be passed; they check dtype, shape and type before calling.
+    ``fk_one``, ``jacobian_one``, ``hessian_one``, ``jacobian_dot_one``. Calling an entry
+    point skips numba's per-call type dispatch (0.2-2 µs). They are compiled for ``q``
+    (and ``qd``) 1-D float64 arrays of any layout, ``P`` the read-only packed chain, a
+    bool frame flag and a C-contiguous float64 output; the fast paths check exactly that
+    before calling.
     """
-    fn = _ENTRY.get(name)
-    if fn is None:
-        import numba
+    global _FK1, _JAC1, _HESS1, _JDOT1
+    import numba
 
-        dispatcher = getattr(K, name)
-        sig = tuple(numba.typeof(a) for a in example)
-        sig = (numba.types.Array(numba.float64, 1, "A"),) + sig[1:]
+    f64, Array = numba.float64, numba.types.Array
+    vec, P = Array(f64, 1, "A"), Array(f64, 3, "C", readonly=True)
+    flag = numba.types.boolean
+    found = []
+    for dispatcher, sig in ((K.fk_one, (vec, P, Array(f64, 2, "C"))),
+                            (K.jacobian_one, (vec, P, Array(f64, 2, "C"))),
+                            (K.hessian_one, (vec, P, flag, Array(f64, 3, "C"))),
+                            (K.jacobian_dot_one, (vec, P, vec, flag, Array(f64, 2, "C")))):
         dispatcher.compile(sig)  # loads from numba's cache when it can
-        fn = _ENTRY[name] = dispatcher.overloads[sig].entry_point
-    return fn
+        found.append(dispatcher.overloads[sig].entry_point)
+    _FK1, _JAC1, _HESS1, _JDOT1 = found
+    return _FK1, _JAC1, _HESS1, _JDOT1
 
 
-_FK = None
-_JAC = None
-
-
-def _fast_kernels() -> tuple[Any, Any]:
-    """Resolve (once) the entry points of the checked FK and Jacobian kernels."""
-    global _FK, _JAC
-    F = np.zeros((2, 4, 4))
-    meta = np.zeros((1, 5))
-    for a in (F, meta):
-        a.setflags(write=False)
-    q, T, J = np.zeros(1), np.empty((4, 4)), np.empty((6, 1))
-    _FK = _entry("fk_checked", q, F, meta, T)
-    _JAC = _entry("jacobian_checked", q, F, meta, J, T)
-    return _FK, _JAC
+def _out_array(out: object, shape: tuple[int, ...]) -> np.ndarray:
+    """``out`` when it is a writeable C-contiguous float64 array of ``shape``, else raise."""
+    if not (type(out) is np.ndarray and out.dtype is _F64 and out.shape == shape
+            and out.flags.c_contiguous and out.flags.writeable):
+        got = (f"{type(out).__name__}" if not isinstance(out, np.ndarray) else
+               f"{out.dtype} array of shape {out.shape}"
+               f"{'' if out.flags.c_contiguous else ', not C-contiguous'}"
+               f"{'' if out.flags.writeable else ', read-only'}")
+        raise InputError(f"out must be a writeable C-contiguous float64 array of shape "
+                         f"{shape}, got {got}")
+    return out
 
 
 #: Named task-row selections for manipulability and condition number.
@@ -153,7 +161,9 @@ class Robot:
             a.setflags(write=False)
         self.chain = compile_chain(self.joints, self.base, self.tool)
         self._F, self._L, self._meta = self.chain.F, self.chain.L, self.chain.meta
+        self._P = self.chain.packed
         self._qshape = (self.n,)
+        self._jshape = (6, self.n)
 
     # ------------------------------------------------------------------ constructors
     @classmethod
@@ -277,34 +287,38 @@ class Robot:
         return bool(np.allclose(J[:, [2, 3, 4]], 0.0, atol=1e-9))
 
     # ------------------------------------------------------------------ kinematics
-    def fk(self, q: object) -> np.ndarray:
+    def fk(self, q: object, *, out: np.ndarray | None = None) -> np.ndarray:
         """Forward kinematics: the tool pose in the world frame (eqs 10-11).
 
         ``T = base · A_1(q_1) ··· A_n(q_n) · tool``.
 
         Args:
             q: joint values, shape (n,) or (..., n) [rad / m].
+            out: optional writeable C-contiguous float64 array of shape (..., 4, 4) to
+                write the result into (and return), for callers that reuse buffers.
 
         Returns:
             (4, 4) or (..., 4, 4) homogeneous transforms.
+
+        Raises:
+            InputError: q of the wrong shape or not finite; out of the wrong kind.
         """
-        if type(q) is np.ndarray and q.dtype is _F64 and q.shape == self._qshape:
-            T = np.empty((4, 4))
-            fk = _FK or _fast_kernels()[0]
-            if fk(q, self._F, self._meta, T):
+        if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 and len(q) == self.n:
+            T = _EMPTY((4, 4)) if out is None else _out_array(out, (4, 4))
+            if (_FK1 or _fast()[0])(q, self._P, T):
                 return T
             raise self._nonfinite(q)
         a = self.check_q(q)
+        shape = a.shape[:-1] + (4, 4)
+        check_allocation("the FK batch", shape, 8, setting="the batch size")
+        T = np.empty(shape) if out is None else _out_array(out, shape)
         if a.ndim == 1:
-            T = np.empty((4, 4))
             K.fk_into(np.ascontiguousarray(a), self._F, self._meta, T)
             return T
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
-        check_allocation("the FK batch", (flat.shape[0], 4, 4), 8, setting="the batch size")
-        out = np.empty((flat.shape[0], 4, 4))
-        kernel = K.fk_batch if flat.shape[0] >= PARALLEL_MIN_BATCH else K.fk_batch_serial
-        kernel(flat, self._F, self._meta, out)
-        return out.reshape(a.shape[:-1] + (4, 4))
+        parallel.run(K.fk_range, (flat, self._F, self._meta, T.reshape(-1, 4, 4)),
+                     flat.shape[0], grain=max(256, 12288 // self.n))
+        return T
 
     def fk_all(self, q: object) -> np.ndarray:
         """Every link frame ``world_T_i`` for i = 0..n (frame 0 is the base; no tool), eq 11.
@@ -320,11 +334,8 @@ class Robot:
         check_allocation("the link frames", (flat.shape[0], self.n + 1, 4, 4), 8,
                          setting="the batch size")
         out = np.empty((flat.shape[0], self.n + 1, 4, 4))
-        if flat.shape[0] < PARALLEL_MIN_BATCH:
-            for k in range(flat.shape[0]):
-                K.fk_all_into(flat[k], self._F, self._L, self._meta, out[k])
-        else:
-            K.fk_all_batch(flat, self._F, self._L, self._meta, out)
+        parallel.run(K.fk_all_range, (flat, self._F, self._L, self._meta, out), flat.shape[0],
+                     grain=max(32, 1536 // self.n))
         return out.reshape(a.shape[:-1] + (self.n + 1, 4, 4))
 
     def jacobian(
@@ -334,6 +345,7 @@ class Robot:
         *,
         link: int | None = None,
         point: object = None,
+        out: np.ndarray | None = None,
     ) -> np.ndarray:
         """Geometric Jacobian (eqs 33-36), rows (vx, vy, vz, wx, wy, wz).
 
@@ -348,32 +360,47 @@ class Robot:
             link: None for the tool point; else a link frame index 0..n, and the Jacobian
                 is that of ``point`` fixed on that link (joints beyond it give zero columns).
             point: (3,) point in the link frame's coordinates [m] (default its origin).
+            out: optional writeable C-contiguous float64 array of shape (..., 6, n) to
+                write the result into (and return), for callers that reuse buffers.
 
         Returns:
             (6, n) or (..., 6, n).
+
+        Raises:
+            InputError: q of the wrong shape or not finite, unknown frame, link outside
+                0..n, point without link, out of the wrong kind.
         """
-        if type(q) is np.ndarray and q.dtype is _F64 and q.shape == self._qshape \
-                and link is None and point is None and type(frame) is str and frame == "base" \
-                and q.flags.c_contiguous:
-            J = np.empty((6, self.n))
-            T = np.empty((4, 4))
-            jac = _ENTRY.get("jacobian_checked") or _entry(
-                "jacobian_checked", q, self._F, self._meta, J, T)
-            if jac(q, self._F, self._meta, J, T):
+        if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 and len(q) == self.n \
+                and link is None and point is None and type(frame) is str and frame == "base":
+            J = _EMPTY(self._jshape) if out is None else _out_array(out, self._jshape)
+            if (_JAC1 or _fast()[1])(q, self._P, J):
                 return J
             raise self._nonfinite(q)
+        a, J, T = self._jacobians(q, frame, link, point)
+        shape = a.shape[:-1] + (6, self.n)
+        if out is None:
+            return J.reshape(shape)
+        _out_array(out, shape)[...] = J.reshape(shape)
+        return out
+
+    def _jacobians(self, q: object, frame: str, link: int | None,
+                   point: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Validated q (..., n), Jacobians (N, 6, n) in ``frame`` and the frames' poses (N, 4, 4).
+
+        The poses are the tool's (``link`` None) or link ``link``'s frame (not the point's).
+        """
         check_choice(frame, "frame", ("base", "ee"))
         a = self.check_q(q)
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
         N = flat.shape[0]
         check_allocation("the Jacobian batch", (N, 6 * self.n + 16), 8, setting="the batch size")
         J = np.empty((N, 6, self.n))
-        T = np.empty((N, 4, 4))
+        grain = max(16, 3072 // self.n)
         if link is None:
             if point is not None:
                 raise InputError("point is given without link; pass link=k (0..n) as well")
-            kernel = K.jacobian_batch if N >= PARALLEL_MIN_BATCH else K.jacobian_batch_serial
-            kernel(flat, self._F, self._meta, J, T)
+            T = np.empty((N, 4, 4))
+            parallel.run(K.jacobian_range, (flat, self._F, self._meta, J, T), N, grain)
         else:
             k = check_int(link, "link")
             if k > self.n:
@@ -382,17 +409,111 @@ class Robot:
             if p.shape != (3,):
                 raise InputError(f"point must have 3 values, got shape {p.shape}")
             P = np.empty((N, 3))
-            if N < PARALLEL_MIN_BATCH:
-                for i in range(N):
-                    K.point_jacobian_into(flat[i], self._F, self._L, self._meta, k, p, J[i], P[i])
-            else:
-                K.point_jacobian_batch(flat, self._F, self._L, self._meta, k, p, J, P)
-            if frame == "ee":
-                T = self.fk_all(flat)[:, k]
+            parallel.run(K.point_jacobian_range,
+                         (flat, self._F, self._L, self._meta, k, np.ascontiguousarray(p), J, P),
+                         N, grain)
+            T = self.fk_all(flat)[:, k]
         if frame == "ee":
             Rt = np.swapaxes(T[:, :3, :3], -1, -2)
             J = np.concatenate([Rt @ J[:, :3], Rt @ J[:, 3:]], axis=1)
-        return J.reshape(a.shape[:-1] + (6, self.n))
+        return a, J, T
+
+    def hessian(self, q: object, frame: str = "base", *, link: int | None = None,
+                point: object = None) -> np.ndarray:
+        """Hessian of the geometric Jacobian, ``H[..., :, j, k] = ∂J[..., :, j]/∂q_k``.
+
+        With J's columns ``J_j = [v_j; w_j]`` (``w_j = z_j`` revolute, 0 prismatic), in the
+        base frame (Haviland & Corke 2022; Pinocchio's kinematic Hessian)::
+
+            ∂J_j/∂q_k = [w_k × v_j;  w_k × w_j]   k < j
+            ∂J_j/∂q_k = [w_j × v_k;  0        ]   k ≥ j
+
+        and in the 'ee' frame ``∂(blockdiag(Rᵀ, Rᵀ) J)/∂q_k = blockdiag(Rᵀ, Rᵀ)(∂J/∂q_k −
+        [w_k]× J)``. The linear block is symmetric in (j, k) (it is the Hessian of the
+        point's position). It gives the task acceleration ``ẍ = J q̈ + Σ_k H[:, :, k] q̇_k q̇``
+        and :meth:`jacobian_dot` ``J̇ = Σ_k H[:, :, k] q̇_k``.
+
+        Args:
+            q: joint values, shape (..., n) [rad / m].
+            frame: 'base' or 'ee', as for :meth:`jacobian`.
+            link: None (tool) or a link frame 0..n, as for :meth:`jacobian`.
+            point: (3,) point on that link [m], as for :meth:`jacobian`.
+
+        Returns:
+            (6, n, n) or (..., 6, n, n): units of J per rad (revolute q_k) or per m
+            (prismatic q_k), i.e. [m/rad²], [1/rad] ... as the columns combine.
+
+        Raises:
+            InputError: as :meth:`jacobian`.
+        """
+        if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 and len(q) == self.n \
+                and link is None and point is None and (frame == "base" or frame == "ee"):
+            H = _EMPTY((6, self.n, self.n))
+            if (_HESS1 or _fast()[2])(q, self._P, frame == "ee", H):
+                return H
+            raise self._nonfinite(q)
+        check_choice(frame, "frame", ("base", "ee"))
+        a, J, T = self._jacobians(q, "base", link, point)
+        N = J.shape[0]
+        H = np.empty((N, 6, self.n, self.n))
+        R = np.ascontiguousarray(T[:, :3, :3])
+        parallel.run(K.hessian_range, (J, R, frame == "ee", H), N,
+                     grain=max(8, 1024 // (self.n * self.n)))
+        return H.reshape(a.shape[:-1] + (6, self.n, self.n))
+
+    def jacobian_dot(self, q: object, qd: object, frame: str = "base", *,
+                     link: int | None = None, point: object = None) -> np.ndarray:
+        """Time derivative J̇ of the geometric Jacobian at joint rates ``qd``.
+
+        The task acceleration is ``ẍ = J q̈ + J̇ q̇`` (ẍ = [a; α], the linear acceleration
+        of the reference point and the angular acceleration, in ``frame``), with
+
+            ``J̇ = Σ_k (∂J/∂q_k) q̇_k``  (see :meth:`hessian`),
+
+        evaluated in O(n) per configuration without forming the Hessian: column j is
+        ``[ω_{<j} × v_j + w_j × v_{≥j};  ω_{<j} × w_j]`` with ``ω_{<j} = Σ_{k<j} w_k q̇_k``
+        and ``v_{≥j} = Σ_{k≥j} v_k q̇_k``; in the 'ee' frame ``blockdiag(Rᵀ, Rᵀ)(J̇ − [ω]× J)``
+        with ω the frame's angular velocity. Pinocchio's ``getFrameJacobianTimeVariation``
+        computes the same matrix (LOCAL_WORLD_ALIGNED for 'base', LOCAL for 'ee').
+
+        Args:
+            q: joint values, shape (..., n) [rad / m].
+            qd: joint rates, shape broadcastable to q's [rad/s / m/s].
+            frame: 'base' or 'ee', as for :meth:`jacobian`.
+            link: None (tool) or a link frame 0..n, as for :meth:`jacobian`.
+            point: (3,) point on that link [m], as for :meth:`jacobian`.
+
+        Returns:
+            (6, n) or (..., 6, n) [J's units per s].
+
+        Raises:
+            InputError: as :meth:`jacobian`; qd not finite or not broadcastable to q.
+        """
+        n = self.n
+        if type(q) is _NDARRAY and type(qd) is _NDARRAY and q.dtype is _F64 \
+                and qd.dtype is _F64 and q.ndim == 1 and qd.ndim == 1 and len(q) == n \
+                and len(qd) == n and link is None and point is None \
+                and (frame == "base" or frame == "ee"):
+            Jd = _EMPTY((6, n))
+            if (_JDOT1 or _fast()[3])(q, self._P, qd, frame == "ee", Jd):
+                return Jd
+            self.check_q(qd, "qd")  # names the non-finite argument
+            raise self._nonfinite(q)
+        check_choice(frame, "frame", ("base", "ee"))
+        a, J, T = self._jacobians(q, "base", link, point)
+        v = self.check_q(qd, "qd")
+        try:
+            v = np.broadcast_to(v, a.shape)
+        except ValueError:
+            raise InputError(f"qd has shape {v.shape}, which does not broadcast to q's "
+                             f"shape {a.shape}") from None
+        N = J.shape[0]
+        Jd = np.empty((N, 6, self.n))
+        R = np.ascontiguousarray(T[:, :3, :3])
+        parallel.run(K.jacobian_dot_range,
+                     (J, np.ascontiguousarray(v.reshape(-1, self.n)), R, frame == "ee", Jd),
+                     N, grain=max(16, 3072 // self.n))
+        return Jd.reshape(a.shape[:-1] + (6, self.n))
 
     def joint_axes(self, q: object = None) -> tuple[np.ndarray, np.ndarray]:
         """Joint lines in the world frame: origins (n, 3) [m] and unit axes (n, 3) at ``q``.
