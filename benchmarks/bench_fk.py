@@ -15,7 +15,8 @@ and the same for the peers when the ``bench`` extra is installed:
   z joint per row, the fixed transforms as joint placements, the tool as a frame), so
   both libraries compute exactly the same kinematics (checked before timing).
   FK = ``forwardKinematics`` + ``updateFramePlacement`` (Pinocchio's update alone: no
-  array is returned); Jacobian = ``computeFrameJacobian(..., LOCAL_WORLD_ALIGNED)``;
+  array is returned; one row adds ``data.oMf[fid].homogeneous``, the 4×4 array that
+  ``robot.fk`` returns); Jacobian = ``computeFrameJacobian(..., LOCAL_WORLD_ALIGNED)``;
   J̇ = ``computeJointJacobiansTimeVariation`` + ``getFrameJacobianTimeVariation``;
   Hessian = ``computeJointJacobians`` + ``computeJointKinematicHessians`` +
   ``getJointKinematicHessian``; batch = a Python loop of FK calls.
@@ -133,8 +134,14 @@ def bench_robot(robot: sk.Robot, batch: int, number: int) -> list[tuple]:
             pin.computeJointKinematicHessians(model, data, q)
             return pin.getJointKinematicHessian(model, data, robot.n, pin.LOCAL_WORLD_ALIGNED)
 
+        def pin_fk_array():
+            pin.forwardKinematics(model, data, q)
+            pin.updateFramePlacement(model, data, fid)
+            return data.oMf[fid].homogeneous
+
         peer_calls.update({
             "pin_fk": pin_fk,
+            "pin_fk_array": pin_fk_array,
             "pin_jac": lambda: pin.computeFrameJacobian(model, data, q, fid,
                                                         pin.LOCAL_WORLD_ALIGNED),
             "pin_jdot": pin_jdot,
@@ -166,6 +173,7 @@ def bench_robot(robot: sk.Robot, batch: int, number: int) -> list[tuple]:
     g = t.get
     return [
         ("fk(q) [µs]", t["fk"], g("pin_fk"), g("rtb_fk")),
+        ("fk(q), pin + 4x4 array [µs]", t["fk"], g("pin_fk_array"), g("rtb_fk")),
         ("fk(q, out=T) [µs]", t["fk_out"], g("pin_fk"), g("rtb_fk")),
         ("jacobian(q) [µs]", t["jac"], g("pin_jac"), g("rtb_jac")),
         ("jacobian(q, out=J) [µs]", t["jac_out"], g("pin_jac"), g("rtb_jac")),

@@ -295,7 +295,8 @@ class Robot:
         Args:
             q: joint values, shape (n,) or (..., n) [rad / m].
             out: optional writeable C-contiguous float64 array of shape (..., 4, 4) to
-                write the result into (and return), for callers that reuse buffers.
+                write the result into (and return), for callers that reuse buffers (it
+                pays off for batches; for one pose checking it costs what allocating does).
 
         Returns:
             (4, 4) or (..., 4, 4) homogeneous transforms.
@@ -361,7 +362,8 @@ class Robot:
                 is that of ``point`` fixed on that link (joints beyond it give zero columns).
             point: (3,) point in the link frame's coordinates [m] (default its origin).
             out: optional writeable C-contiguous float64 array of shape (..., 6, n) to
-                write the result into (and return), for callers that reuse buffers.
+                write the result into (and return), for callers that reuse buffers (it
+                pays off for batches in the base frame, where it is written in place).
 
         Returns:
             (6, n) or (..., 6, n).
