@@ -5,8 +5,7 @@ shown on the chapter's formulas; the numerical families of section 5.3 measured 
 side by :func:`serialkin.ik.compare.compare` on a planar 3-link arm, the Puma 560 and the
 UR5 (every number in those tables is measured when the report is built), the default
 solver's warm timing per robot (median and spread, ``ctx.timing``), a table of the
-trade-offs; the obstacle-distance objective of eq 45 evaluated and checked. The redundancy
-resolution itself (eqs 42-56, the 6- and 20-link examples) follows in
+trade-offs. The redundancy resolution itself (eqs 42-56, the 6- and 20-link examples) follows in
 :mod:`serialkin.chapter.sections.redundancy`.
 """
 
@@ -119,46 +118,6 @@ def _newton_demo(ctx: ReportContext) -> str:
     )
 
 
-def _obstacle_objective(ctx: ReportContext) -> str:
-    """Eq 45 on a planar 3-link arm and a circular obstacle, checked by brute force."""
-    from serialkin.redundancy import Circle, obstacle_distance
-    from serialkin.redundancy.objectives import finite_difference_gradient
-
-    arm = models.three_link(1.0, 0.8, 0.5)
-    obstacle = Circle(center=np.array([1.2, 1.3]), radius=0.25)
-    H = obstacle_distance(arm, [obstacle])
-    rows = []
-    for q in (np.array([0.3, 0.6, -0.4]), np.array([0.0, 0.3, 0.9]),
-              np.array([-0.2, 1.0, 1.0])):
-        pts = arm.fk_all(q)[:, :2, 3]
-        t = np.linspace(0.0, 1.0, 1001)[:, None]
-        a = np.vstack([p0 + t * (p1 - p0) for p0, p1 in zip(pts[:-1], pts[1:])])
-        ang = np.linspace(0.0, 2 * np.pi, 721)
-        b = obstacle.center + obstacle.radius * np.c_[np.cos(ang), np.sin(ang)]
-        d2 = min(float(np.min(np.sum((a[:, None, :] - bj) ** 2, axis=-1))) for bj in b)
-        d_exact = np.min(np.linalg.norm(a - obstacle.center, axis=1)) - obstacle.radius
-        g = H.gradient(q)
-        g_fd = finite_difference_gradient(H.value, q)
-        rows.append((", ".join(f"{v:g}" for v in q), H.value(q), d_exact * abs(d_exact),
-                     d2, float(np.abs(g - g_fd).max())))
-    return (
-        "<h3>Obstacle-avoidance objective (eq 45)</h3>"
-        + ctx.eq(r"H(\mathbf{q}) = \min_{\mathbf{a}\in\text{robot},\ \mathbf{b}\in"
-                 r"\text{obstacle}}\left\|\mathbf{a}(\mathbf{q}) - \mathbf{b}\right\|^2", "45")
-        + "<p>On the planar three-link arm (L = 1.0, 0.8, 0.5 m) and a circle of radius "
-        "0.25 m at (1.2, 1.3) m: <code>redundancy.obstacle_distance(arm, [circle])</code> "
-        "computes H from the closest points of the link segments (eqs 51-56, corrected); "
-        "it is compared with a brute-force minimum over 3,000 points on the links and 720 "
-        "on the circle, and with the point-to-centre distance minus the radius. Its "
-        "gradient (used as " + ctx.imath(r"\dot{\mathbf{q}}_0") + " in eq 42) is checked "
-        "against central finite differences.</p>"
-        + "<p>(serialkin keeps the sign of the clearance, H = c·|c|, so that H still grows "
-        "when a link has entered the obstacle.)</p>"
-        + ctx.table(rows, ["q [rad]", "H(q) [m²]", "(min |a − centre| − r)² [m²]",
-                           "brute force [m²]", "|∇H − finite differences|"], fmt="{:.6g}")
-    )
-
-
 def _compare_html(ctx: ReportContext, table: CompareTable) -> str:
     """A comparison table through ``ctx.table`` (aligned columns), skipped methods below."""
     caption = (f"<caption>IK methods on {html.escape(table.robot)}: {table.n_targets} "
@@ -244,7 +203,6 @@ def build(ctx: ReportContext) -> Section:
         "FABRIK is exact and fast on planar revolute chains and is skipped (with the reason "
         "shown) on spatial arms.</p>"
     )
-    parts.append(_obstacle_objective(ctx))
     parts.append(ctx.reproduce(
         "import serialkin as sk\n"
         "from serialkin.ik.compare import compare\n"
@@ -252,4 +210,4 @@ def build(ctx: ReportContext) -> Section:
         "print(compare(robot, robot.fk(robot.random_q(10, seed=42)), tol=1e-6, seed=0))"))
     return Section(title="5.3 Kinematically redundant manipulators",
                    part="Numerical inverse kinematics, measured",
-                   equations="eqs 39-41, 45", html="".join(parts))
+                   equations="eqs 39-41", html="".join(parts))
