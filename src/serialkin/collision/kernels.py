@@ -240,8 +240,8 @@ def sphere_box(c, r, bc, R, h):
     else:  # the centre lies on the boundary: the outward normal of the face it lies on
         e = np.abs(R.T @ (c - bc)) - h
         k = int(np.argmax(e))
-        sign = 1.0 if np.dot(R[:, k], c - bc) >= 0.0 else -1.0
-        u = sign * R[:, k]
+        axis = np.array([R[0, k], R[1, k], R[2, k]])
+        u = axis if np.dot(axis, c - bc) >= 0.0 else -axis
     return sd - r, c - r * u, q
 
 
