@@ -26,7 +26,7 @@ from serialkin.collision import (
 )
 from serialkin.collision import kernels as K
 from serialkin.errors import InputError, RobotDefinitionError
-from serialkin.redundancy.obstacles import Capsule, Sphere
+from serialkin.redundancy.obstacles import Capsule, Circle, Sphere
 
 _SHARE = (Path(sys.prefix) / "lib" / f"python{sys.version_info.major}.{sys.version_info.minor}"
           / "site-packages" / "cmeel.prefix" / "share" / "example-robot-data" / "robots")
@@ -192,3 +192,33 @@ def test_scene_clearance_table_and_box(panda):
         assert c.distance[k] == pytest.approx(best, abs=1e-12)
     high = HalfSpace([0, 0, 1], 0.05)  # a table top cutting the base
     assert in_collision(robot, model, Q, scene=[high], acm=None).all()
+
+
+def test_scene_z_cylinder_is_planar_distance(panda):
+    """A Circle (infinite z-cylinder) obstacle is measured in the xy plane."""
+    robot, model = panda
+    q = robot.random_q(3, seed=2)
+    post = Circle([0.4, -0.2], 0.05)
+    c = scene_clearance(robot, model, q, [post])
+    for k in range(3):
+        F = robot.fk_all(q[k])
+        best = np.inf
+        for s in range(len(model.radius)):
+            T = F[model.shape_frame[s]]
+            a = (T[:3, :3] @ model.a[s] + T[:3, 3]) * [1, 1, 0]
+            b = (T[:3, :3] @ model.b[s] + T[:3, 3]) * [1, 1, 0]
+            best = min(best, K.capsule_sphere(a, b, model.radius[s], np.array([0.4, -0.2, 0.0]),
+                                              0.05)[0])
+        assert c.distance[k] == pytest.approx(best, abs=1e-12)
+        assert c.pair[k, 1] == 0
+
+
+def test_pairs_follow_the_matrix(panda):
+    """Allowing the reported pair removes it: the next query reports another pair or more room."""
+    robot, model = panda
+    acm = default_acm(model)
+    c = self_clearance(robot, model, FOLDED, acm)
+    i, j = c.pair
+    looser = acm.allow([(model.body_names[i], model.body_names[j])])
+    c2 = self_clearance(robot, model, FOLDED, looser)
+    assert tuple(c2.pair) != (i, j) and c2.distance >= c.distance

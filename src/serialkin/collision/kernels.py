@@ -171,15 +171,15 @@ def box_point(c, R, h, p):
 
 
 @njit(cache=True, nogil=True)
-def _box_sd(c, R, h, x, y, z):
-    """Signed distance of point (x, y, z) to the box, without allocation."""
+def _box_sd(c, Rf, h, x, y, z):
+    """Signed distance of point (x, y, z) to the box; ``Rf[3 r + k] = R[r, k]`` (no allocation)."""
     px = x - c[0]
     py = y - c[1]
     pz = z - c[2]
     out2 = 0.0
     emax = -np.inf
     for k in range(3):
-        u = R[0, k] * px + R[1, k] * py + R[2, k] * pz
+        u = Rf[k] * px + Rf[3 + k] * py + Rf[6 + k] * pz
         e = abs(u) - h[k]
         if e > 0.0:
             out2 += e * e
@@ -191,8 +191,11 @@ def _box_sd(c, R, h, x, y, z):
 
 
 @njit(cache=True, nogil=True)
-def _segment_box_t(a0, a1, c, R, h):
-    """Parameter t ∈ [0, 1] minimising the convex signed distance of a0 + t(a1 − a0) to the box."""
+def _segment_box_t(a0, a1, c, Rf, h):
+    """Parameter t ∈ [0, 1] minimising the convex signed distance of a0 + t(a1 − a0) to the box.
+
+    ``Rf`` is the box rotation flattened row-major (any indexable of 9 numbers).
+    """
     dx = a1[0] - a0[0]
     dy = a1[1] - a0[1]
     dz = a1[2] - a0[2]
@@ -202,28 +205,28 @@ def _segment_box_t(a0, a1, c, R, h):
     hi = 1.0
     m1 = hi - _INVPHI * (hi - lo)
     m2 = lo + _INVPHI * (hi - lo)
-    f1 = _box_sd(c, R, h, a0[0] + m1 * dx, a0[1] + m1 * dy, a0[2] + m1 * dz)
-    f2 = _box_sd(c, R, h, a0[0] + m2 * dx, a0[1] + m2 * dy, a0[2] + m2 * dz)
+    f1 = _box_sd(c, Rf, h, a0[0] + m1 * dx, a0[1] + m1 * dy, a0[2] + m1 * dz)
+    f2 = _box_sd(c, Rf, h, a0[0] + m2 * dx, a0[1] + m2 * dy, a0[2] + m2 * dz)
     for _ in range(GOLDEN_STEPS):
         if f1 <= f2:
             hi = m2
             m2 = m1
             f2 = f1
             m1 = hi - _INVPHI * (hi - lo)
-            f1 = _box_sd(c, R, h, a0[0] + m1 * dx, a0[1] + m1 * dy, a0[2] + m1 * dz)
+            f1 = _box_sd(c, Rf, h, a0[0] + m1 * dx, a0[1] + m1 * dy, a0[2] + m1 * dz)
         else:
             lo = m1
             m1 = m2
             f1 = f2
             m2 = lo + _INVPHI * (hi - lo)
-            f2 = _box_sd(c, R, h, a0[0] + m2 * dx, a0[1] + m2 * dy, a0[2] + m2 * dz)
+            f2 = _box_sd(c, Rf, h, a0[0] + m2 * dx, a0[1] + m2 * dy, a0[2] + m2 * dz)
     best = 0.5 * (lo + hi)
-    fb = _box_sd(c, R, h, a0[0] + best * dx, a0[1] + best * dy, a0[2] + best * dz)
+    fb = _box_sd(c, Rf, h, a0[0] + best * dx, a0[1] + best * dy, a0[2] + best * dz)
     # the minimum of a convex function on [0, 1] may sit at an end
-    f0 = _box_sd(c, R, h, a0[0], a0[1], a0[2])
+    f0 = _box_sd(c, Rf, h, a0[0], a0[1], a0[2])
     if f0 < fb:
         best, fb = 0.0, f0
-    fe = _box_sd(c, R, h, a1[0], a1[1], a1[2])
+    fe = _box_sd(c, Rf, h, a1[0], a1[1], a1[2])
     if fe < fb:
         best = 1.0
     return best
@@ -248,7 +251,7 @@ def sphere_box(c, r, bc, R, h):
 @njit(cache=True, nogil=True)
 def capsule_box(a0, a1, r, bc, R, h):
     """Signed distance ``min_t sd_box(a0 + t(a1 − a0)) − r`` of a capsule to a box, witnesses."""
-    t = _segment_box_t(a0, a1, bc, R, h)
+    t = _segment_box_t(a0, a1, bc, np.ascontiguousarray(R).ravel(), h)
     return sphere_box(a0 + t * (a1 - a0), r, bc, R, h)
 
 

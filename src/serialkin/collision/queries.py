@@ -20,6 +20,7 @@ configurations (the link frames of one chunk are held in memory).
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -119,33 +120,35 @@ def pair_distances_range(frames, shape_frame, A, B, rad, pa, pb, out, start, sto
 
 
 @njit(cache=True, nogil=True)
-def _shape_scene(a0, a1, r, row, tmp0, tmp1):
-    """Signed distance of capsule (a0 a1, r) to one encoded scene shape (shapes.py layout)."""
-    kind = int(row[0])
+def _shape_scene(W0, W1, s, r, scene, o):
+    """Signed distance of robot capsule s (world ends W0[s], W1[s], radius r) to scene shape o.
+
+    Points are passed on as tuples (no array views in the inner loop).
+    """
+    a0 = (W0[s, 0], W0[s, 1], W0[s, 2])
+    a1 = (W1[s, 0], W1[s, 1], W1[s, 2])
+    kind = int(scene[o, 0])
     if kind == 0:
-        return segment_distance(a0, a1, row[1:4], row[1:4]) - r - row[4]
+        c = (scene[o, 1], scene[o, 2], scene[o, 3])
+        return segment_distance(a0, a1, c, c) - r - scene[o, 4]
     if kind == 1:
-        return segment_distance(a0, a1, row[1:4], row[4:7]) - r - row[7]
+        return segment_distance(a0, a1, (scene[o, 1], scene[o, 2], scene[o, 3]),
+                                (scene[o, 4], scene[o, 5], scene[o, 6])) - r - scene[o, 7]
     if kind == 2:
-        c = row[1:4]
-        R = row[4:13].reshape((3, 3))
-        h = row[13:16]
-        t = _segment_box_t(a0, a1, c, R, h)
-        return _box_sd(c, R, h, a0[0] + t * (a1[0] - a0[0]), a0[1] + t * (a1[1] - a0[1]),
+        c = (scene[o, 1], scene[o, 2], scene[o, 3])
+        Rf = (scene[o, 4], scene[o, 5], scene[o, 6], scene[o, 7], scene[o, 8], scene[o, 9],
+              scene[o, 10], scene[o, 11], scene[o, 12])
+        h = (scene[o, 13], scene[o, 14], scene[o, 15])
+        t = _segment_box_t(a0, a1, c, Rf, h)
+        return _box_sd(c, Rf, h, a0[0] + t * (a1[0] - a0[0]), a0[1] + t * (a1[1] - a0[1]),
                        a0[2] + t * (a1[2] - a0[2])) - r
     if kind == 3:
-        h0 = row[1] * a0[0] + row[2] * a0[1] + row[3] * a0[2]
-        h1 = row[1] * a1[0] + row[2] * a1[1] + row[3] * a1[2]
-        return min(h0, h1) - row[4] - r
+        h0 = scene[o, 1] * a0[0] + scene[o, 2] * a0[1] + scene[o, 3] * a0[2]
+        h1 = scene[o, 1] * a1[0] + scene[o, 2] * a1[1] + scene[o, 3] * a1[2]
+        return min(h0, h1) - scene[o, 4] - r
     # kind 4: infinite cylinder along z: distances in the xy plane
-    tmp0[0] = a0[0]
-    tmp0[1] = a0[1]
-    tmp0[2] = 0.0
-    tmp1[0] = a1[0]
-    tmp1[1] = a1[1]
-    tmp1[2] = 0.0
-    c = np.array([row[1], row[2], 0.0])
-    return segment_distance(tmp0, tmp1, c, c) - r - row[3]
+    c = (scene[o, 1], scene[o, 2], 0.0)
+    return segment_distance((a0[0], a0[1], 0.0), (a1[0], a1[1], 0.0), c, c) - r - scene[o, 3]
 
 
 @njit(cache=True, nogil=True)
@@ -155,8 +158,6 @@ def scene_clearance_range(frames, shape_frame, A, B, rad, shape_body, scene, out
     m = A.shape[0]
     W0 = np.empty((m, 3))
     W1 = np.empty((m, 3))
-    tmp0 = np.empty(3)
-    tmp1 = np.empty(3)
     for k in range(start, stop):
         _to_world(frames[k], shape_frame, A, B, W0, W1)
         best = np.inf
@@ -164,7 +165,7 @@ def scene_clearance_range(frames, shape_frame, A, B, rad, shape_body, scene, out
         bo = -1
         for s in range(m):
             for o in range(scene.shape[0]):
-                d = _shape_scene(W0[s], W1[s], rad[s], scene[o], tmp0, tmp1)
+                d = _shape_scene(W0, W1, s, rad[s], scene, o)
                 if d < best:
                     best = d
                     bs = shape_body[s]
@@ -185,21 +186,36 @@ def _check_model(robot, model: CollisionModel) -> None:
                          f"0..{robot.n}")
 
 
+#: (id(model), id(acm) or None) -> (weak refs to both, pa, pb); both objects are immutable.
+_PAIR_CACHE: dict[tuple[int, int | None], tuple] = {}
+
+
 def checked_shape_pairs(model: CollisionModel,
                         acm: AllowedCollisionMatrix | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Shape index pairs (s < t) whose bodies differ and are not allowed by ``acm``.
 
     Returns:
-        Two (P,) int arrays. ``acm`` defaults to :func:`default_acm`.
+        Two (P,) int arrays (read-only; cached per model and matrix, both immutable).
+        ``acm`` defaults to :func:`default_acm`.
     """
-    acm = default_acm(model) if acm is None else acm
-    if not isinstance(acm, AllowedCollisionMatrix) or acm.body_names != model.body_names:
+    key = (id(model), None if acm is None else id(acm))
+    hit = _PAIR_CACHE.get(key)
+    if hit is not None and hit[0]() is model and (acm is None or hit[1]() is acm):
+        return hit[2], hit[3]
+    full = default_acm(model) if acm is None else acm
+    if not isinstance(full, AllowedCollisionMatrix) or full.body_names != model.body_names:
         raise InputError("acm must be an AllowedCollisionMatrix over the model's bodies "
                          f"{model.body_names}")
     sb = model.shape_body
     s, t = np.triu_indices(len(sb), 1)
-    keep = ~acm.allowed[sb[s], sb[t]]
-    return np.ascontiguousarray(s[keep]), np.ascontiguousarray(t[keep])
+    keep = ~full.allowed[sb[s], sb[t]]
+    pa, pb = np.ascontiguousarray(s[keep]), np.ascontiguousarray(t[keep])
+    pa.setflags(write=False)
+    pb.setflags(write=False)
+    if len(_PAIR_CACHE) >= 64:
+        _PAIR_CACHE.clear()
+    _PAIR_CACHE[key] = (weakref.ref(model), weakref.ref(full), pa, pb)
+    return pa, pb
 
 
 def _batches(robot, q: object):
