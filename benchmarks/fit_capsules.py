@@ -15,9 +15,13 @@ For each link with a collision mesh (binary STL, read with numpy):
 2. the mesh vertices, moved into the zoo frame, get a bounding capsule: axis along the
    principal direction of the vertices, centred in the cross-section's bounding square,
    radius = largest distance of a vertex from the axis, ends pulled in as far as every
-   vertex stays inside the capsule;
-3. the fit is reported: mesh volume (divergence theorem on the closed triangle soup),
-   capsule volume and their ratio (≥ 1: the capsule is conservative).
+   vertex stays inside the capsule (a capsule is convex: it then holds the mesh's hull);
+3. two capsules replace it when their summed volume is below 0.8 × its volume: the
+   vertices' convex hull is cut across its principal axis (19 cut positions tried), each
+   half being the hull of its vertices and of the points where hull edges cross the cut,
+   so the two capsules together still contain the whole hull;
+4. the fit is reported: mesh volume (divergence theorem on the closed triangle soup),
+   summed capsule volume and their ratio (≥ 1: the capsules are conservative).
 """
 
 from __future__ import annotations
@@ -133,8 +137,46 @@ def bounding_capsule(P: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     return c + lo * u, c + hi * u, float(r)
 
 
+def capsule_volume(a, b, r) -> float:
+    return math.pi * r * r * (float(np.linalg.norm(b - a)) + 4.0 * r / 3.0)
+
+
+def split_fit(P: np.ndarray, cuts: int = 19):
+    """Best pair of capsules covering the convex hull of P, cut across its principal axis.
+
+    The hull is cut by a plane normal to the principal axis; each half is the hull of its
+    vertices and of the points where hull edges cross the plane, so the two bounding
+    capsules together contain the whole hull. Returns (capsules, summed volume).
+    """
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(P)
+    V = P[hull.vertices]
+    c = V.mean(axis=0)
+    u = np.linalg.svd(V - c)[2][0]
+    edges = {tuple(sorted((int(s[i]), int(s[(i + 1) % 3])))) for s in hull.simplices
+             for i in range(3)}
+    E = np.array(sorted(edges))
+    t = (P - c) @ u
+    best = None
+    for f in np.linspace(0.05, 0.95, cuts):
+        cut = t.min() + f * (t.max() - t.min())
+        t0, t1 = t[E[:, 0]], t[E[:, 1]]
+        crossing = (t0 - cut) * (t1 - cut) < 0
+        w = (cut - t0[crossing]) / (t1[crossing] - t0[crossing])
+        X = P[E[crossing, 0]] + w[:, None] * (P[E[crossing, 1]] - P[E[crossing, 0]])
+        lo = np.vstack([P[hull.vertices][t[hull.vertices] <= cut], X])
+        hi = np.vstack([P[hull.vertices][t[hull.vertices] >= cut], X])
+        caps = [bounding_capsule(lo), bounding_capsule(hi)]
+        vol = sum(capsule_volume(*k) for k in caps)
+        if best is None or vol < best[1]:
+            best = (caps, vol)
+    return best
+
+
 def fit(robot, urdf: Path, joint_names, attach: dict[str, int], extra=None, offsets=None,
-        seed=0):
+        seed=0, gain=0.8):
+    """Capsules per link: one, or two when their summed volume is below ``gain`` × one's."""
     rng = np.random.default_rng(seed)
     meshes = collision_meshes(urdf)
     fixed = {}
@@ -155,9 +197,13 @@ def fit(robot, urdf: Path, joint_names, attach: dict[str, int], extra=None, offs
     for link, f in attach.items():
         X = fixed[link]
         P, vol = meshes[link]
-        a, b, r = bounding_capsule(P @ X[:3, :3].T + X[:3, 3])
-        cap = math.pi * r * r * (np.linalg.norm(b - a) + 4 * r / 3)
-        rows.append((link, f, a, b, r, vol, cap))
+        P = P @ X[:3, :3].T + X[:3, 3]
+        one = bounding_capsule(P)
+        caps, cap = [one], capsule_volume(*one)
+        two = split_fit(P)
+        if two[1] < gain * cap:
+            caps, cap = two
+        rows.append((link, f, caps, vol, cap))
     return rows
 
 
@@ -176,10 +222,11 @@ def main() -> None:
     res["ur5"] = fit(ur5, SHARE / "ur_description/urdf/ur5_robot.urdf", uj,
                      {n: i for i, n in enumerate(names)}, offsets=[math.pi, 0, 0, 0, 0, 0])
     for robot, rows in res.items():
-        print(f"# {robot}: link, frame, a, b, radius, mesh volume [l], capsule volume [l], ratio")
-        for link, f, a, b, r, vol, cap in rows:
-            print(f'    ("{link}", {f}, {np.round(a, 4).tolist()}, {np.round(b, 4).tolist()}, '
-                  f"{r:.4f}),  # mesh {vol * 1e3:.2f} l, capsule {cap * 1e3:.2f} l, "
+        print(f"# {robot}: body, frame, capsules [(a, b, radius)]; mesh volume, capsule volume")
+        for link, f, caps, vol, cap in rows:
+            text = ", ".join(f"({np.round(a, 4).tolist()}, {np.round(b, 4).tolist()}, {r:.4f})"
+                             for a, b, r in caps)
+            print(f'    ("{link}", {f}, [{text}]),  # {vol * 1e3:.2f} l -> {cap * 1e3:.2f} l, '
                   f"x{cap / vol:.2f}")
 
 

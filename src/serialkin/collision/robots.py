@@ -5,10 +5,12 @@ the Panda's fingers), moved into the link frame of :mod:`serialkin.models` (the 
 transform was checked to be the same at several configurations, which proves the frame
 correspondence). Axis along the principal direction of the vertices, radius the largest
 distance of a vertex from the axis, ends pulled in as far as every vertex stays inside:
-every capsule *contains* its mesh. The comments give the mesh volume, the capsule volume
-and their ratio (one capsule per mesh is loose, about ×2.2-2.8 in volume; ×7 for the UR5's
-flat base). Reproduce with ``benchmarks/fit_capsules.py`` (example-robot-data 4.x, the
-``bench`` extra); numbers rounded to 0.1 mm.
+every capsule *contains* its mesh. One capsule per mesh is loose, about ×2.2-2.8 the
+mesh volume (×7 for the UR5's flat base); the fit script also tries two capsules per mesh
+(hull cut across its principal axis) but none saved 20 % of the volume (at best 13 %, on
+panda_link1 and link2), so every body has one. Reproduce with
+``benchmarks/fit_capsules.py`` (example-robot-data 4.x, the ``bench`` extra); numbers
+rounded to 0.1 mm.
 
 Volumes [litre], mesh → capsule: Panda link0 3.00 → 8.46, link1 2.98 → 7.29, link2
 3.00 → 7.11, link3 2.33 → 5.21, link4 2.37 → 5.30, link5 3.42 → 7.76, link6 1.43 → 3.34,
