@@ -1,0 +1,47 @@
+"""Collision: primitive distance kernels, robot capsule models, the allowed-collision matrix.
+
+* :mod:`~serialkin.collision.kernels` — compiled signed distances with witness points
+  (sphere, capsule, box, half-space);
+* :mod:`~serialkin.collision.shapes` — scene shapes (boxes, half-spaces, and the obstacles
+  of :mod:`serialkin.redundancy.obstacles`);
+* :mod:`~serialkin.collision.model` — :class:`CollisionModel`, capsules per body per frame;
+* :mod:`~serialkin.collision.robots` — fitted models of built-in robots;
+* :mod:`~serialkin.collision.acm` — the allowed-collision matrix (default, SRDF, sampled);
+* :mod:`~serialkin.collision.srdf` — reading an SRDF;
+* :mod:`~serialkin.collision.queries` — self/scene clearance and collision checks, batched.
+"""
+
+from serialkin.collision.acm import (
+    AllowedCollisionMatrix,
+    acm_from_srdf,
+    default_acm,
+    sampled_acm,
+)
+from serialkin.collision.model import CollisionModel
+from serialkin.collision.queries import (
+    Clearance,
+    in_collision,
+    scene_clearance,
+    self_clearance,
+)
+from serialkin.collision.robots import panda_collision_model, ur5_collision_model
+from serialkin.collision.shapes import Box, HalfSpace
+from serialkin.collision.srdf import Srdf, read_srdf
+
+__all__ = [
+    "AllowedCollisionMatrix",
+    "Box",
+    "Clearance",
+    "CollisionModel",
+    "HalfSpace",
+    "Srdf",
+    "acm_from_srdf",
+    "default_acm",
+    "in_collision",
+    "panda_collision_model",
+    "read_srdf",
+    "sampled_acm",
+    "scene_clearance",
+    "self_clearance",
+    "ur5_collision_model",
+]

@@ -1,0 +1,125 @@
+"""The allowed-collision matrix: body pairs whose contact is allowed (never checked).
+
+Three sources, combined with :meth:`AllowedCollisionMatrix.allow`:
+
+* :func:`default_acm` — every body with itself, bodies on the same link frame (one rigid
+  part) and bodies on adjacent frames ``i, i+1`` (joined by a joint, usually touching);
+* :func:`acm_from_srdf` — an SRDF's ``<disable_collisions>`` pairs, added to the default;
+* :func:`sampled_acm` — pairs in contact in *every* sampled configuration (as MoveIt's
+  setup assistant finds "always in collision" pairs): ``q`` drawn uniformly within the
+  joint limits (seeded), contact meaning a signed distance ≤ ``margin``.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from serialkin._checks import as_generator, check_int, check_real
+from serialkin.collision.model import CollisionModel
+from serialkin.collision.srdf import Srdf, read_srdf
+from serialkin.errors import InputError, RobotDefinitionError
+
+__all__ = ["AllowedCollisionMatrix", "acm_from_srdf", "default_acm", "sampled_acm"]
+
+
+@dataclass(frozen=True)
+class AllowedCollisionMatrix:
+    """A symmetric boolean (B, B) matrix over a model's bodies: True = never checked.
+
+    Attributes:
+        body_names: (B,) the bodies, in the model's order.
+        allowed: (B, B) bool, symmetric, True on the diagonal.
+    """
+
+    body_names: tuple[str, ...]
+    allowed: np.ndarray
+
+    def __post_init__(self) -> None:
+        m = np.array(self.allowed, dtype=bool)
+        B = len(self.body_names)
+        if m.shape != (B, B):
+            raise InputError(f"allowed must have shape ({B}, {B}), got {m.shape}")
+        m = m | m.T
+        np.fill_diagonal(m, True)
+        m.setflags(write=False)
+        object.__setattr__(self, "body_names", tuple(self.body_names))
+        object.__setattr__(self, "allowed", m)
+
+    def allow(self, pairs: Iterable[tuple[str, str]]) -> AllowedCollisionMatrix:
+        """A copy that also allows the named body pairs (InputError for unknown names)."""
+        m = self.allowed.copy()
+        index = {n: i for i, n in enumerate(self.body_names)}
+        for a, b in pairs:
+            for x in (a, b):
+                if x not in index:
+                    raise InputError(f"unknown body {x!r}; bodies: {', '.join(self.body_names)}")
+            m[index[a], index[b]] = m[index[b], index[a]] = True
+        return AllowedCollisionMatrix(self.body_names, m)
+
+    def is_allowed(self, a: str, b: str) -> bool:
+        """True when the contact of bodies ``a`` and ``b`` is allowed."""
+        return bool(self.allowed[self.body_names.index(a), self.body_names.index(b)])
+
+    def checked_pairs(self) -> list[tuple[str, str]]:
+        """The body pairs (i < j) that are checked."""
+        B = len(self.body_names)
+        return [(self.body_names[i], self.body_names[j]) for i in range(B)
+                for j in range(i + 1, B) if not self.allowed[i, j]]
+
+
+def default_acm(model: CollisionModel) -> AllowedCollisionMatrix:
+    """Allow bodies on the same frame and on adjacent frames (``|frame_i − frame_j| ≤ 1``)."""
+    f = model.body_frames
+    return AllowedCollisionMatrix(model.body_names, np.abs(f[:, None] - f[None, :]) <= 1)
+
+
+def acm_from_srdf(model: CollisionModel, srdf: Srdf | str | os.PathLike[str],
+                  acm: AllowedCollisionMatrix | None = None) -> AllowedCollisionMatrix:
+    """Add an SRDF's ``<disable_collisions>`` pairs to ``acm`` (default: :func:`default_acm`).
+
+    Raises:
+        RobotDefinitionError: the SRDF names a link that is not a body of ``model`` (the
+            message names the SRDF, the link and lists the bodies).
+    """
+    s = srdf if isinstance(srdf, Srdf) else read_srdf(srdf)
+    known = set(model.body_names)
+    for a, b, _ in s.disabled:
+        for x in (a, b):
+            if x not in known:
+                raise RobotDefinitionError(
+                    f"{s.source}: disable_collisions names link {x!r}, which is not a body of "
+                    f"the collision model; bodies: {', '.join(model.body_names)}")
+    base = default_acm(model) if acm is None else acm
+    return base.allow((a, b) for a, b, _ in s.disabled)
+
+
+def sampled_acm(robot, model: CollisionModel, acm: AllowedCollisionMatrix | None = None, *,
+                samples: int = 1000, seed: object = 0,
+                margin: float = 0.0) -> AllowedCollisionMatrix:
+    """Add to ``acm`` (default: :func:`default_acm`) the pairs in contact in every sample.
+
+    ``samples`` configurations are drawn uniformly within ``robot.qlim`` (±π where a joint
+    is unlimited) with the generator made from ``seed``; a body pair is in contact when
+    the smallest signed distance between their shapes is ≤ ``margin`` [m].
+
+    Returns:
+        The matrix with those pairs allowed (pairs without shapes are left as they are).
+    """
+    from serialkin.collision.queries import body_pair_distances
+
+    samples = check_int(samples, "samples", minimum=1, maximum=10**7)
+    margin = check_real(margin, "margin", unit="m")
+    rng = as_generator(seed)
+    lo, hi = robot.qlim[:, 0].copy(), robot.qlim[:, 1].copy()
+    lo[~np.isfinite(lo)] = -np.pi
+    hi[~np.isfinite(hi)] = np.pi
+    q = lo + (hi - lo) * rng.random((samples, robot.n))
+    pairs, d = body_pair_distances(robot, model, q)
+    always = (d <= margin).all(axis=0)
+    base = default_acm(model) if acm is None else acm
+    return base.allow((model.body_names[i], model.body_names[j])
+                      for (i, j), yes in zip(pairs, always, strict=True) if yes)
