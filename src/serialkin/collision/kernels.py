@@ -35,7 +35,7 @@ Every kernel returns ``(d, w1, w2)``: ``d`` the signed distance [m] and the witn
   surface it must reach, so that ``‖w1 − w2‖ = −d`` wherever the depth is exact.
 
 Closest points of two segments come from
-:func:`serialkin.redundancy.obstacles._closest_segment_segment` (Ericson's clamped
+:func:`serialkin.spatial.segments.closest_segment_segment` (Ericson's clamped
 solution, robust for parallel and zero-length segments), the one implementation of that
 idea in the package. The capsule–box distance minimises the convex function
 ``t ↦ sd_box(a + t (b − a))`` over ``t ∈ [0, 1]`` by golden-section search
@@ -52,7 +52,7 @@ import math
 import numpy as np
 from numba import njit
 
-from serialkin.redundancy.obstacles import _closest_segment_segment
+from serialkin.spatial.segments import closest_segment_segment
 
 __all__ = [
     "GOLDEN_STEPS",
@@ -79,7 +79,7 @@ def segment_distance(a0, a1, b0, b1):
     ``min_{s,t ∈ [0,1]} ‖a0 + s (a1 − a0) − b0 − t (b1 − b0)‖``; no allocation (used by the
     batch kernels).
     """
-    s, t = _closest_segment_segment(a0, a1, b0, b1)
+    s, t = closest_segment_segment(a0, a1, b0, b1)
     dx = a0[0] + s * (a1[0] - a0[0]) - b0[0] - t * (b1[0] - b0[0])
     dy = a0[1] + s * (a1[1] - a0[1]) - b0[1] - t * (b1[1] - b0[1])
     dz = a0[2] + s * (a1[2] - a0[2]) - b0[2] - t * (b1[2] - b0[2])
@@ -116,7 +116,7 @@ def capsule_capsule(a0, a1, ra, b0, b1, rb):
     ``w1 = sa − ra u``, ``w2 = sb + rb u``, ``u = (sa − sb)/‖sa − sb‖`` (see the module
     docstring for crossing segments). Points shape (3,), radii [m]; returns (float, (3,), (3,)).
     """
-    s, t = _closest_segment_segment(a0, a1, b0, b1)
+    s, t = closest_segment_segment(a0, a1, b0, b1)
     sa = a0 + s * (a1 - a0)
     sb = b0 + t * (b1 - b0)
     diff = sa - sb

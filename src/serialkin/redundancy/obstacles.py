@@ -40,6 +40,7 @@ from numba import njit
 from serialkin._checks import as_vector, check_positive
 from serialkin.errors import InputError, InputTypeError
 from serialkin.kinematics import _kernels as K
+from serialkin.spatial.segments import closest_segment_segment
 
 __all__ = [
     "Capsule",
@@ -211,42 +212,6 @@ def encode_obstacles(obstacles: Sequence[Obstacle]) -> np.ndarray:
 
 # --------------------------------------------------------------------- compiled geometry
 @njit(cache=True)
-def _closest_segment_segment(p0, p1, a, b):
-    """Parameters (s, t) in [0, 1] of the closest points of segments p0p1 and ab (Ericson)."""
-    d1x = p1[0] - p0[0]
-    d1y = p1[1] - p0[1]
-    d1z = p1[2] - p0[2]
-    d2x = b[0] - a[0]
-    d2y = b[1] - a[1]
-    d2z = b[2] - a[2]
-    rx = p0[0] - a[0]
-    ry = p0[1] - a[1]
-    rz = p0[2] - a[2]
-    aa = d1x * d1x + d1y * d1y + d1z * d1z
-    ee = d2x * d2x + d2y * d2y + d2z * d2z
-    ff = d2x * rx + d2y * ry + d2z * rz
-    eps = 1e-18
-    if aa <= eps and ee <= eps:
-        return 0.0, 0.0
-    if aa <= eps:
-        return 0.0, min(max(ff / ee, 0.0), 1.0)
-    cc = d1x * rx + d1y * ry + d1z * rz
-    if ee <= eps:
-        return min(max(-cc / aa, 0.0), 1.0), 0.0
-    bb = d1x * d2x + d1y * d2y + d1z * d2z
-    den = aa * ee - bb * bb
-    s = min(max((bb * ff - cc * ee) / den, 0.0), 1.0) if den > eps else 0.0
-    t = (bb * s + ff) / ee
-    if t < 0.0:
-        t = 0.0
-        s = min(max(-cc / aa, 0.0), 1.0)
-    elif t > 1.0:
-        t = 1.0
-        s = min(max((bb - cc) / aa, 0.0), 1.0)
-    return s, t
-
-
-@njit(cache=True)
 def segment_obstacle_kernel(P0, P1, obs, link_radius, T, SC, B, D, C):
     """Closest points between every segment and every obstacle (eqs 51-53, corrected).
 
@@ -289,7 +254,7 @@ def segment_obstacle_kernel(P0, P1, obs, link_radius, T, SC, B, D, C):
                     q1[r] = P1[i, r]
                     pa[r] = obs[j, 1 + r]
                     pb[r] = obs[j, 4 + r]
-                s, u = _closest_segment_segment(q0, q1, pa, pb)
+                s, u = closest_segment_segment(q0, q1, pa, pb)
                 t = s
                 for r in range(3):
                     SC[i, j, r] = q0[r] + s * (q1[r] - q0[r])
