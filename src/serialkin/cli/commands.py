@@ -30,6 +30,7 @@ from serialkin.cli.io import (
 )
 from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot, robot_argument
 from serialkin.errors import SerialkinError
+from serialkin.model.tasks import TASK_NAMES, get_task
 
 #: Longest error message printed [characters]: a message is one line, cut beyond this.
 MAX_ERROR_CHARS = 2000
@@ -455,8 +456,8 @@ _JACOBIAN_CMD_HELP = command_help(
               help="The point on --link, in that link frame [m] (default its origin).")
 @click.option("--planar", is_flag=True,
               help="Planar task Jacobian: rows vx, vy, wz (eqs 30-32, 38).")
-@click.option("--task", type=click.Choice(["auto", "full", "position", "orientation", "planar",
-                                           "planar_pose"]), default="auto", show_default=True,
+@click.option("--task", type=click.Choice(["auto", *TASK_NAMES]), default="auto",
+              show_default=True,
               help="Task rows for manipulability and condition number (auto: planar/"
                    "planar_pose for planar robots, full with >= 6 joints, else position).")
 @degrees_option
@@ -475,20 +476,19 @@ def jacobian_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frame
     pt = parse_numbers(point, "--point", 3) if point is not None else None
     if pt is not None and link is None:
         raise CLIError("--point needs --link (the link frame the point is fixed on)")
-    from serialkin.model.robot import TASK_ROWS
     from serialkin.workspace.sampling import manipulability_task
 
     rows_sel = [0, 1, 5] if planar else list(range(6))
     names = ["vx", "vy", "vz", "wx", "wy", "wz"]
     task_name = manipulability_task(r, bool(r.is_planar)) if task == "auto" else task
-    task_rows = list(TASK_ROWS[task_name])
+    task_rows = list(get_task(task_name).rows)
     recs = []
     for q in Q:
         J6 = r.jacobian(q, frame=frame, link=link, point=pt)
         J = J6[rows_sel]
         Jt = J6[task_rows]
         s = np.linalg.svd(Jt, compute_uv=False)
-        w = float(np.sqrt(max(np.linalg.det(Jt @ Jt.T), 0.0)))
+        w = r.manipulability(q, task_name, frame=frame, link=link, point=pt)
         cond = float(s[0] / s[-1]) if s[-1] > 1e-15 * max(s[0], 1e-300) else float("inf")
         rank = int(np.sum(s > 1e-10 * max(s[0], 1e-300)))
         recs.append({"q": q, "J": J, "manipulability": w, "condition_number": cond,

@@ -40,6 +40,8 @@ __all__ = [
     "dls_step_batch",
     "dls_step_into",
     "gram_into",
+    "manipulability_batch",
+    "manipulability_of",
     "spd_solve_into",
     "weigh_rows_into",
 ]
@@ -246,3 +248,29 @@ def weigh_rows_into(J, e, rows, sw, Jw, ew):
         for j in range(n):
             Jw[i, j] = sw[i] * J[r, j]
     return s2
+
+
+@njit(cache=True)
+def manipulability_of(J):
+    """Yoshikawa manipulability ``w = sqrt(det(J Jᵀ))`` (eq 43) of a task Jacobian J (m, n).
+
+    Computed as the product of J's singular values (equal to sqrt(det(J Jᵀ)) and exactly
+    0 at singular configurations); 0 when m > n (J Jᵀ has rank ≤ n < m). The one
+    implementation of eq 43: :meth:`serialkin.Robot.manipulability`, the multi-task
+    resolver and the CLI call it.
+    """
+    m, n = J.shape
+    if m > n:
+        return 0.0
+    s = np.linalg.svd(np.ascontiguousarray(J), full_matrices=False)[1]
+    w = 1.0
+    for i in range(s.shape[0]):
+        w *= s[i]
+    return w
+
+
+@njit(cache=True)
+def manipulability_batch(J, out):
+    """:func:`manipulability_of` of each J[k] (N, m, n) into ``out`` (N,)."""
+    for k in range(J.shape[0]):
+        out[k] = manipulability_of(J[k])

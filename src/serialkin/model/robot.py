@@ -32,10 +32,12 @@ from serialkin._checks import (
 from serialkin.errors import InputError, RobotDefinitionError
 from serialkin.kinematics import _kernels as K
 from serialkin.kinematics import parallel
+from serialkin.kinematics.dls import manipulability_batch
 from serialkin.model.chain import compile_chain
 from serialkin.model.dh import CONVENTIONS, DHLink, dh_to_joints, parse_dh_rows
 from serialkin.model.joint import Joint, check_fixed_transform
 from serialkin.model.limits import DEFAULT_HALF_RANGE, check_interval, inside_mask, sampling_box
+from serialkin.model.tasks import TASKS, task_rows
 
 if TYPE_CHECKING:
     from serialkin.ik.result import IKResult
@@ -89,14 +91,9 @@ def _out_array(out: object, shape: tuple[int, ...]) -> np.ndarray:
     return out
 
 
-#: Named task-row selections for manipulability and condition number.
-TASK_ROWS: dict[str, tuple[int, ...]] = {
-    "full": (0, 1, 2, 3, 4, 5),
-    "position": (0, 1, 2),
-    "orientation": (3, 4, 5),
-    "planar": (0, 1),
-    "planar_pose": (0, 1, 5),
-}
+#: Named task-row selections for manipulability and condition number, by name and alias
+#: (a view of :data:`serialkin.model.tasks.TASKS`, the one task table).
+TASK_ROWS: dict[str, tuple[int, ...]] = {name: t.rows for name, t in TASKS.items()}
 
 
 class Robot:
@@ -545,37 +542,34 @@ class Robot:
         return jacobian_analytic(self, q, rep)
 
     def _task_jacobian(self, q: object, task: str | Sequence[int]) -> np.ndarray:
-        if isinstance(task, str):
-            rows = TASK_ROWS[check_choice(task, "task", TASK_ROWS)]
-        else:
-            if not isinstance(task, (Sequence, np.ndarray)) or len(task) > 6:
-                raise InputError("task must be a name or a list of distinct row indices in "
-                                 f"0..5, got {short_repr(task)}")
-            rows = tuple(check_int(r, "task row", maximum=5) for r in task)
-            if not rows or len(set(rows)) != len(rows):
-                raise InputError("task rows must be a nonempty list of distinct indices in "
-                                 f"0..5, got {short_repr(task)}")
-        return self.jacobian(q)[..., list(rows), :]
+        return self.jacobian(q)[..., task_rows(task), :]
 
-    def manipulability(self, q: object, task: str | Sequence[int] = "full") -> np.ndarray | float:
+    def manipulability(self, q: object, task: str | Sequence[int] = "full", *,
+                       frame: str = "base", link: int | None = None,
+                       point: object = None) -> np.ndarray | float:
         """Yoshikawa manipulability ``w = sqrt(det(J Jᵀ))`` (eq 43) of the task Jacobian.
 
         Args:
             q: joint values, shape (..., n).
-            task: rows of J that form the task: 'full', 'position', 'orientation',
-                'planar' (vx, vy), 'planar_pose' (vx, vy, wz) or a list of row indices.
+            task: rows of J that form the task: a name of :data:`serialkin.model.tasks.TASKS`
+                ('full'/'pose', 'position', 'orientation', 'planar' (vx, vy),
+                'planar_pose' (vx, vy, wz)) or a list of row indices.
+            frame: frame of the Jacobian, as in :meth:`jacobian` ('base' or 'ee').
+            link: Jacobian of a point on this link frame, as in :meth:`jacobian`.
+            point: that point, as in :meth:`jacobian`.
 
         Returns:
             float or (...) array; 0 at singular configurations (and when n < m). Computed
             as the product of J's singular values, which equals sqrt(det(J Jᵀ)) and is
-            exactly representable near singularities.
+            exactly representable near singularities
+            (:func:`serialkin.kinematics.dls.manipulability_of`).
         """
-        J = self._task_jacobian(q, task)
-        m, n = J.shape[-2:]
-        if m > n:  # J Jᵀ (m x m) has rank <= n < m
-            w = np.zeros(J.shape[:-2])
-        else:  # sqrt(det(J Jᵀ)) = product of the singular values: exact 0 at singularities
-            w = np.prod(np.linalg.svd(J, compute_uv=False), axis=-1)
+        rows = task_rows(task)
+        J = np.ascontiguousarray(self.jacobian(q, frame, link=link, point=point)[..., rows, :])
+        flat = J.reshape((-1,) + J.shape[-2:])
+        w = np.empty(flat.shape[0])
+        manipulability_batch(flat, w)
+        w = w.reshape(J.shape[:-2])
         return float(w) if w.ndim == 0 else w
 
     def condition_number(self, q: object, task: str | Sequence[int] = "full") -> np.ndarray | float:

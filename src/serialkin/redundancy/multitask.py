@@ -48,6 +48,7 @@ from serialkin._checks import (
 )
 from serialkin.errors import InputError
 from serialkin.kinematics import _kernels as K
+from serialkin.kinematics.dls import manipulability_of, spd_solve_into
 from serialkin.model.limits import check_interval
 from serialkin.redundancy.objectives import task_rows
 from serialkin.redundancy.obstacles import (
@@ -212,14 +213,11 @@ def eq48_into(q, xdot, J, rows, F, L, meta, cfg, qlim, enc, influence, link, fra
             A[a, b] = w * s
     lam2 = cfg[_DAMP] * cfg[_DAMP]
     if cfg[_SING] > 0.0 and cfg[_W0] > 0.0:
-        M = np.empty((m, m))
+        Jt = np.empty((m, n))
         for r in range(m):
-            for c in range(m):
-                s = 0.0
-                for a in range(n):
-                    s += J[rows[r], a] * J[rows[c], a]
-                M[r, c] = s
-        wm = math.sqrt(max(np.linalg.det(M), 0.0))
+            for a in range(n):
+                Jt[r, a] = J[rows[r], a]
+        wm = manipulability_of(Jt)
         if wm < cfg[_W0]:
             ls = cfg[_SING] * (1.0 - wm / cfg[_W0])
             lam2 += ls * ls
@@ -236,9 +234,8 @@ def eq48_into(q, xdot, J, rows, F, L, meta, cfg, qlim, enc, influence, link, fra
                              P1, Tee, T, SC, B, D, C)
         accumulate_obstacle_task(q, F, L, meta, frames, P0, P1, link, T, SC, B, D, C, influence,
                                  cfg[_WC], cfg[_KREP], A, rhs, Jbuf, pbuf)
-    x = np.linalg.solve(A, rhs)
-    for a in range(n):
-        qdot[a] = x[a]
+    # SPD: damping > 0 is validated by MultiTaskResolver, the other terms are PSD
+    spd_solve_into(A, rhs, qdot, n)
 
 
 @njit(cache=True)

@@ -29,6 +29,7 @@ from numba import njit
 from serialkin._checks import MAX_ITERATIONS, check_choice, check_int, check_positive
 from serialkin.errors import InputError, InputTypeError
 from serialkin.kinematics import _kernels as K
+from serialkin.kinematics.dls import dls_step_into, weigh_rows_into
 from serialkin.model.limits import project as interval_project
 from serialkin.redundancy.multitask import MultiTaskResolver
 from serialkin.redundancy.objectives import task_rows
@@ -88,29 +89,18 @@ def dls_track(q0, targets, rows, F, meta, lam, tol, max_iter, max_step, accept, 
     e = np.empty(m)
     Jt = np.empty((m, n))
     A = np.empty((m, m))
+    y = np.empty(m)
+    dq = np.empty(n)
+    ones = np.ones(m)
     for k in range(p):
         it = 0
         while True:
             K.jacobian_into(q, F, meta, J, T)
             pose_error_into(T, targets[k], e6)
-            err2 = 0.0
-            for r in range(m):
-                e[r] = e6[rows[r]]
-                err2 += e[r] * e[r]
-                for c in range(n):
-                    Jt[r, c] = J[rows[r], c]
-            err = np.sqrt(err2)
+            err = np.sqrt(weigh_rows_into(J, e6, rows, ones, Jt, e))
             if err < tol or it >= max_iter:
                 break
-            for r in range(m):
-                for c in range(m):
-                    s = 0.0
-                    for j in range(n):
-                        s += Jt[r, j] * Jt[c, j]
-                    A[r, c] = s
-                A[r, r] += lam * lam
-            y = np.linalg.solve(A, e)
-            dq = Jt.T @ y
+            dls_step_into(Jt, e, lam * lam, 0.0, A, y, dq)
             nrm = np.sqrt(np.sum(dq * dq))
             if nrm > max_step:
                 dq *= max_step / nrm
