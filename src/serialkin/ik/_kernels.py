@@ -7,8 +7,8 @@ final polish and the result — is this module's one loop. :func:`compile_method
 from a step kernel, the method's :class:`CompiledMethod`: a ``solve_one`` (one target with
 restarts) and a ``solve_chunk`` (targets ``start..stop-1`` with the GIL released, so the
 batch driver solves across all cores). It is built on the only FK/Jacobian implementation
-(``serialkin.kinematics._kernels.jacobian_into`` and ``fk_into``), the only pose-error
-implementation (:func:`serialkin.spatial._kernels.pose_error_into`) and the one
+(``serialkin.kinematics.kernels.jacobian_into`` and ``fk_into``), the only pose-error
+implementation (:func:`serialkin.spatial.kernels.pose_error_into`) and the one
 Cholesky solve (:func:`serialkin.kinematics.dls.spd_solve_into`). The helpers every
 compiled IK method shares live here too: the cost and error norms (:func:`task_cost`,
 :func:`task_errors`), joint-limit projection, the random starts, small dense algebra
@@ -73,12 +73,12 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from serialkin.kinematics._kernels import fk_into, jacobian_into
 from serialkin.kinematics.dls import spd_solve_into
+from serialkin.kinematics.kernels import fk_into, jacobian_into
 from serialkin.model.limits import inside as interval_inside
 from serialkin.model.limits import normalize as interval_normalize
 from serialkin.model.limits import project as interval_project
-from serialkin.spatial._kernels import pose_error_into
+from serialkin.spatial.kernels import pose_error_into
 
 #: Layout of the configuration vector ``cfg`` (float64): the loop's slots, then the
 #: method's parameters ``cfg[N_LOOP:]`` (``CompiledMethod.params``, in order).
@@ -481,7 +481,7 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     """Solve one target with restarts; write the best q into ``q_out`` (n,) and ``info``.
 
     Args:
-        F: (n+1, 4, 4) chain fixed transforms (see :mod:`serialkin.kinematics._kernels`).
+        F: (n+1, 4, 4) chain fixed transforms (see :mod:`serialkin.kinematics.kernels`).
         meta: (n, 5) chain joint data.
         Tt: (4, 4) target pose.
         box: (5, n) joint limits, sampling box and joint types (rows ``B_*``).

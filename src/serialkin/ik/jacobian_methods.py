@@ -69,10 +69,10 @@ from serialkin.ik._kernels import (
     task_cost,
 )
 from serialkin.ik.registry import MethodSpec, register_method
-from serialkin.kinematics._kernels import fk_into
 from serialkin.kinematics.dls import dls_step_into, spd_solve_into
+from serialkin.kinematics.kernels import fk_into
 from serialkin.model.limits import wrap_angle as interval_wrap
-from serialkin.spatial._kernels import pose_error_into
+from serialkin.spatial.kernels import pose_error_into
 
 _PROJECTION = (
     "projection after every step: a revolute joint is shifted by 2π when that brings it "

@@ -49,10 +49,10 @@ from serialkin.ik.target import (
     parse_target,
     robot_arrays,
 )
-from serialkin.kinematics import _kernels as FK
+from serialkin.kinematics import kernels as FK
 from serialkin.kinematics import parallel
 from serialkin.model.robot import Robot
-from serialkin.spatial import _kernels as SK
+from serialkin.spatial import kernels as SK
 
 #: Default tolerance on the position [m] and orientation [rad] errors.
 DEFAULT_TOL = 1e-9

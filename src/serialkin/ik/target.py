@@ -30,7 +30,7 @@ from serialkin.errors import InputError
 from serialkin.ik._kernels import inside_limits
 from serialkin.model.robot import Robot
 from serialkin.model.tasks import TARGET_TASKS, TASK_COORDINATES, task_weights
-from serialkin.spatial._kernels import transforms_valid
+from serialkin.spatial.kernels import transforms_valid
 
 #: Default weights per target kind: 1 on the task's rows (the target kinds of
 #: :data:`serialkin.model.tasks.TASKS`, the one task table).

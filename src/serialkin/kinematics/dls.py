@@ -1,8 +1,8 @@
 """The damped least-squares step: one compiled implementation (numba, ``cache=True``).
 
-Kernel contract: these functions trust their input (float64, C-contiguous arrays of the
-documented shapes, buffers at least as large as stated); validation happens at the
-public boundary (the Python functions that call them).
+Kernel contract: trusts its input; validation happens at the public boundary (the Python
+functions that call these kernels). Arrays are float64, C-contiguous, of the documented
+shapes, buffers at least as large as stated.
 
 The damped least-squares (DLS) step of eq 46, as corrected by the ERRATA, for a task
 Jacobian ``J`` (m, n) and a task error ``e`` (m,)::

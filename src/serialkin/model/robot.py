@@ -30,7 +30,7 @@ from serialkin._checks import (
     short_repr,
 )
 from serialkin.errors import InputError, RobotDefinitionError
-from serialkin.kinematics import _kernels as K
+from serialkin.kinematics import kernels as K
 from serialkin.kinematics import parallel
 from serialkin.kinematics.dls import manipulability_batch
 from serialkin.model.chain import compile_chain

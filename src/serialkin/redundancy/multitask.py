@@ -47,7 +47,7 @@ from serialkin._checks import (
     short_repr,
 )
 from serialkin.errors import InputError
-from serialkin.kinematics import _kernels as K
+from serialkin.kinematics import kernels as K
 from serialkin.kinematics.dls import manipulability_of, spd_solve_into
 from serialkin.model.limits import check_interval
 from serialkin.redundancy.objectives import task_rows
@@ -60,7 +60,7 @@ from serialkin.redundancy.obstacles import (
     check_obstacles,
     update_geometry_into,
 )
-from serialkin.spatial._kernels import pose_error_into
+from serialkin.spatial.kernels import pose_error_into
 
 __all__ = [
     "MultiTaskResolver",

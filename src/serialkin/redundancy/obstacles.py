@@ -39,7 +39,7 @@ from numba import njit
 
 from serialkin._checks import as_vector, check_positive
 from serialkin.errors import InputError, InputTypeError
-from serialkin.kinematics import _kernels as K
+from serialkin.kinematics import kernels as K
 
 __all__ = [
     "Capsule",

@@ -154,7 +154,7 @@ class Path:
         T = check_last_dims(check_transform(poses, "path poses"), "path poses", (4, 4))
         if T.ndim != 3:
             raise InputError(f"path poses must have shape (p, 4, 4), got {T.shape}")
-        from serialkin.spatial._kernels import so3_log_batch
+        from serialkin.spatial.kernels import so3_log_batch
 
         W = np.empty((T.shape[0], 3))
         so3_log_batch(np.ascontiguousarray(T[:, :3, :3]), W)

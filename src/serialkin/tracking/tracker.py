@@ -28,13 +28,13 @@ from numba import njit
 
 from serialkin._checks import MAX_ITERATIONS, check_choice, check_int, check_positive
 from serialkin.errors import InputError, InputTypeError
-from serialkin.kinematics import _kernels as K
+from serialkin.kinematics import kernels as K
 from serialkin.kinematics.dls import dls_step_into, weigh_rows_into
 from serialkin.model.limits import project as interval_project
 from serialkin.redundancy.multitask import MultiTaskResolver
 from serialkin.redundancy.objectives import task_rows
 from serialkin.redundancy.obstacles import _Geometry, check_obstacles, encode_obstacles
-from serialkin.spatial._kernels import pose_error_into
+from serialkin.spatial.kernels import pose_error_into
 from serialkin.tracking.path import Path
 from serialkin.tracking.trajectory import PathFailure, Trajectory
 

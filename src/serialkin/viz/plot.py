@@ -79,7 +79,7 @@ def robot_points(robot: Robot, q: object) -> np.ndarray:
 def joint_positions(robot: Robot, q: object) -> np.ndarray:
     """Points on the joint axes: the origin of the frame right after each joint motion.
 
-    Link frame i is ``(pose after M_i) · L[i]`` (see :mod:`serialkin.kinematics._kernels`),
+    Link frame i is ``(pose after M_i) · L[i]`` (see :mod:`serialkin.kinematics.kernels`),
     so the joint frame is ``world_T_i · L[i]⁻¹``. For a standard-DH robot this is the
     origin of DH frame i-1, where joint i's axis z_{i-1} passes.
 
@@ -167,7 +167,7 @@ def _mechanism_points(robot: Robot, q: np.ndarray) -> np.ndarray:
     then the rest (the DH length a). Returns (k, 3) points [m], consecutive duplicates
     removed, ending at the tool point.
     """
-    from serialkin.kinematics._kernels import PRISMATIC
+    from serialkin.kinematics.kernels import PRISMATIC
 
     F, meta = robot.chain.F, robot.chain.meta
     W = F[0].copy()
