@@ -171,7 +171,7 @@ def _angle_factor(robot: Any, degrees: bool) -> np.ndarray:
     """Per-joint factor from the user's unit to SI: π/180 for revolute joints with --degrees."""
     f = np.ones(robot.n)
     if degrees:
-        f[np.array(robot.joint_types) == "R"] = np.pi / 180.0
+        f[robot.revolute] = np.pi / 180.0
     return f
 
 
@@ -264,20 +264,20 @@ def _show_robot(r: Any) -> None:
     if r.source:
         click.echo(f"source: {r.source}")
 
-    def lim(lo: float, hi: float, t: str) -> str:
+    def lim(lo: float, hi: float, revolute: bool) -> str:
         if not (np.isfinite(lo) and np.isfinite(hi)):
             return "unlimited"
-        return (f"[{np.degrees(lo):.1f}, {np.degrees(hi):.1f}] deg" if t == "R"
+        return (f"[{np.degrees(lo):.1f}, {np.degrees(hi):.1f}] deg" if revolute
                 else f"[{lo:.4g}, {hi:.4g}] m")
 
     if r.dh is not None:
         rows = [(d.name, d.type, d.a, np.degrees(d.alpha), d.d, np.degrees(d.theta),
-                 lim(*d.qlim, d.type)) for d in r.dh]
+                 lim(*d.qlim, rev)) for d, rev in zip(r.dh, r.revolute)]
         click.echo(format_table(rows, ["joint", "type", "a [m]", "alpha [deg]", "d [m]",
                                        "theta [deg]", "limits"]))
     else:
         rows = [(j.name, j.type, fmt_vector(j.axis, 3), fmt_vector(j.origin[:3, 3], 4),
-                 lim(*j.qlim, j.type)) for j in r.joints]
+                 lim(*j.qlim, rev)) for j, rev in zip(r.joints, r.revolute)]
         click.echo(format_table(rows, ["joint", "type", "axis", "origin xyz [m]", "limits"]))
     for key in ("base", "tool"):
         T = getattr(r, key)

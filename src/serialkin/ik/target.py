@@ -74,7 +74,7 @@ def robot_arrays(robot: Robot) -> RobotArrays:
     a = _ARRAYS.get(robot)
     if a is None:
         samp = robot.sampling_limits()
-        revolute = np.array([t == "R" for t in robot.joint_types])
+        revolute = robot.revolute
         box = np.ascontiguousarray(
             np.stack([robot.qlim[:, 0], robot.qlim[:, 1], samp[:, 0], samp[:, 1],
                       revolute.astype(np.float64)]), dtype=np.float64)

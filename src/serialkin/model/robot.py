@@ -111,6 +111,10 @@ class Robot:
         base: (4, 4) world-from-base transform.
         tool: (4, 4) last-link-from-tool transform.
         qlim: (n, 2) joint limits [rad or m], ±inf where unlimited.
+        revolute: (n,) read-only bool array, True for a revolute joint, False for a
+            prismatic one (``joint_types`` holds the same as 'R'/'P').
+        chain: the compiled chain arrays (:class:`~serialkin.model.chain.Chain`: ``F``,
+            ``L``, ``meta``, ``packed``) that compiled kernels of other subpackages take.
     """
 
     def __init__(
@@ -151,10 +155,11 @@ class Robot:
         self.link_names: tuple[str, ...] | None = None
         self.qlim = np.array([j.qlim for j in joints], dtype=float)
         self.joint_types = tuple(j.type for j in joints)
+        self.revolute = np.array([t == "R" for t in self.joint_types], dtype=bool)
         self.joint_names = tuple(j.name or f"joint{i + 1}" for i, j in enumerate(joints))
         if len(set(self.joint_names)) != self.n:
             raise RobotDefinitionError(f"joint names must be unique, got {self.joint_names}")
-        for a in (self.base, self.tool, self.qlim):
+        for a in (self.base, self.tool, self.qlim, self.revolute):
             a.setflags(write=False)
         self.chain = compile_chain(self.joints, self.base, self.tool)
         self._F, self._L, self._meta = self.chain.F, self.chain.L, self.chain.meta

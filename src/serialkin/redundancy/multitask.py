@@ -466,14 +466,14 @@ class _State:
     def _args(self):
         g = self.geom
         rb = self.robot
-        return (rb._F, rb._L, rb._meta, self.cfg, self.lim, g.enc, self.infl, g.link,
+        return (rb.chain.F, rb.chain.L, rb.chain.meta, self.cfg, self.lim, g.enc, self.infl, g.link,
                 g.frames, g.P0, g.P1, g.Tee, g.T, g.SC, g.B, g.D, g.C, g.Jbuf, g.pbuf, self.A,
                 self.rhs, self.qdot_buf)
 
     def qdot(self, q: np.ndarray, xdot: np.ndarray) -> np.ndarray:
         """Eq 48 at q (n,) for the task velocity ẋ (m,)."""
         rb = self.robot
-        K.jacobian_into(q, rb._F, rb._meta, self.J, self.T)
+        K.jacobian_into(q, rb.chain.F, rb.chain.meta, self.J, self.T)
         eq48_into(q, np.ascontiguousarray(xdot, dtype=float), self.J, self.rows, *self._args())
         return self.qdot_buf.copy()
 

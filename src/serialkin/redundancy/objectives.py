@@ -92,7 +92,7 @@ def jacobian_derivative(robot: Robot, q: object) -> np.ndarray:
     if qv.ndim != 1:
         raise InputError(f"q must have shape ({robot.n},), got {qv.shape}")
     J = robot.jacobian(qv)
-    return _jacobian_derivative_from(J, np.array([t == "R" for t in robot.joint_types]))
+    return _jacobian_derivative_from(J, robot.revolute)
 
 
 def _jacobian_derivative_from(J: np.ndarray, revolute: np.ndarray) -> np.ndarray:
@@ -140,7 +140,7 @@ def manipulability_gradient(robot: Robot, q: object, task: str | Sequence[int] =
     w = float(manipulability_of(np.ascontiguousarray(Jt)))
     if w <= 1e-300 or Jt.shape[0] > Jt.shape[1]:
         return w, np.zeros(robot.n)
-    H = _jacobian_derivative_from(J, np.array([t == "R" for t in robot.joint_types]))[:, rows, :]
+    H = _jacobian_derivative_from(J, robot.revolute)[:, rows, :]
     B = np.linalg.solve(A, Jt)  # (m, n)
     grad = w * np.einsum("mn,kmn->k", B, H)
     return w, grad

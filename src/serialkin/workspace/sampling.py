@@ -143,7 +143,7 @@ def project_orientation(robot: object, Q: np.ndarray, R_target: np.ndarray, *,
     lo, hi = robot.sampling_limits().T  # type: ignore[attr-defined]
     phi_t = float(planar_angle(R_target))
     # revolute joints whose range spans a full turn wrap around instead of stopping
-    wrap = (np.array(robot.joint_types) == "R") & (hi - lo >= 2 * np.pi - 1e-12)  # type: ignore[attr-defined]
+    wrap = robot.revolute & (hi - lo >= 2 * np.pi - 1e-12)  # type: ignore[attr-defined]
     lam2 = damping * damping
     for sl in chunks(Q.shape[0]):
         Qc = Q[sl]
