@@ -106,8 +106,8 @@ def robot_scale(robot: Robot) -> float:
     """
     F = robot.chain.F
     total = float(np.linalg.norm(F[1:, :3, 3], axis=-1).sum())
-    for i, t in enumerate(robot.joint_types):
-        if t == "P":
+    for i, revolute in enumerate(robot.revolute):
+        if not revolute:
             lim = np.abs(robot.qlim[i])
             finite = lim[np.isfinite(lim)]
             total += float(finite.max()) if finite.size else 1.0
