@@ -30,7 +30,7 @@ from serialkin.cli.io import (
 )
 from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot, robot_argument
 from serialkin.errors import SerialkinError
-from serialkin.model.tasks import TASK_NAMES, get_task
+from serialkin.model.tasks import TASK_COORDINATES, TASK_NAMES, get_task
 
 #: Longest error message printed [characters]: a message is one line, cut beyond this.
 MAX_ERROR_CHARS = 2000
@@ -478,8 +478,8 @@ def jacobian_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frame
         raise CLIError("--point needs --link (the link frame the point is fixed on)")
     from serialkin.workspace.sampling import manipulability_task
 
-    rows_sel = [0, 1, 5] if planar else list(range(6))
-    names = ["vx", "vy", "vz", "wx", "wy", "wz"]
+    rows_sel = list(get_task("planar_pose" if planar else "pose").rows)
+    names = list(TASK_COORDINATES)
     task_name = manipulability_task(r, bool(r.is_planar)) if task == "auto" else task
     task_rows = list(get_task(task_name).rows)
     recs = []
