@@ -118,7 +118,11 @@ I_POS_ERR = 2
 I_ORI_ERR = 3
 I_RESTARTS = 4
 I_COST = 5
-N_INFO = 6
+I_INSIDE = 6  # 1: the returned q lies inside the joint limits (within LIMIT_TOL)
+N_INFO = 7
+
+#: Tolerance of the final "q inside the joint limits" test of a success [rad or m].
+LIMIT_TOL = 1e-12
 
 #: Status codes of the heuristic attempts (:func:`stopping_test`; CCD and FABRIK).
 RUNNING = -1
@@ -575,6 +579,7 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     info[I_ORI_ERR] = oe
     info[I_RESTARTS] = used
     info[I_COST] = best_cost
+    info[I_INSIDE] = 1.0 if inside_limits(q_out, lo, hi, LIMIT_TOL) else 0.0
 
 
 def _solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):

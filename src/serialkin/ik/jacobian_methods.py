@@ -92,7 +92,7 @@ MAX_JOINTS_CUBIC = 1000
 # the weighted Jacobian and residual at q.
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_transpose(q, J, e, cost, p, ctx, ws, dq):
     """``Δq = α Jwᵀ r`` with ``α = ⟨r, Jw Jwᵀ r⟩ / |Jw Jwᵀ r|²`` (Buss 2004; Wolovich & Elliott).
 
@@ -117,7 +117,7 @@ def step_transpose(q, J, e, cost, p, ctx, ws, dq):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_pinv(q, J, e, cost, p, ctx, ws, dq):
     """``Δq = Jw⁺ r`` (eq 40; σ below ``rcond·σ_max`` dropped), scaled to max |Δq_i| ≤ max_step.
 
@@ -128,7 +128,7 @@ def step_pinv(q, J, e, cost, p, ctx, ws, dq):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_dls(q, J, e, cost, p, ctx, ws, dq):
     """``Δq = Jwᵀ (Jw Jwᵀ + λ² I)⁻¹ r`` (eq 46 as corrected in the errata), fixed λ = ``p[0]``.
 
@@ -137,7 +137,7 @@ def step_dls(q, J, e, cost, p, ctx, ws, dq):
     return dls_step_into(ws[W_JW], ws[W_R], p[0] * p[0], 1e-12, ws[W_M6], ws[W_Y6], dq)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_lm(q, J, e, cost, p, ctx, ws, dq):
     """Error-damped Levenberg-Marquardt with a limit-aware active set, λ = ``p[0]``.
 
@@ -215,19 +215,19 @@ def _damped_normal_step(ws, wn, dq):
     return spd_solve_into(A, g, dq, n)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_lm_wampler(q, J, e, cost, p, ctx, ws, dq):
     """``(JwᵀJw + λI) Δq = Jwᵀ r`` (Wampler 1986), λ = ``p[0]``; every step taken."""
     return _damped_normal_step(ws, p[0], dq)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_lm_chan(q, J, e, cost, p, ctx, ws, dq):
     """``(JwᵀJw + λE I) Δq = Jwᵀ r`` (Chan & Lawrence 1988), λ = ``p[0]``; every step taken."""
     return _damped_normal_step(ws, p[0] * cost, dq)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_lm_sugihara(q, J, e, cost, p, ctx, ws, dq):
     """``(JwᵀJw + (E + λ) I) Δq = Jwᵀ r`` (Sugihara 2011), λ = ``p[0]``; every step taken."""
     return _damped_normal_step(ws, cost + p[0], dq)
@@ -284,7 +284,7 @@ def _sdls_into(Jw, r, dq, gamma_max):
 
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_sdls(q, J, e, cost, p, ctx, ws, dq):
     """Selectively damped least squares (Buss & Kim 2005), γ_max = ``p[0]``.
 
@@ -296,7 +296,7 @@ def step_sdls(q, J, e, cost, p, ctx, ws, dq):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_newton(q, J, e, cost, p, ctx, ws, dq):
     """Newton-Raphson (eq 41 in n dimensions): ``Δq = Jw⁺ r`` (rcond = ``p[0]``), backtracking.
 
@@ -332,7 +332,7 @@ def step_newton(q, J, e, cost, p, ctx, ws, dq):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_gauss_newton(q, J, e, cost, p, ctx, ws, dq):
     """Gauss-Newton on the normal equations, ``Δq = (JwᵀJw)⁺ Jwᵀ r`` (rcond ``p[0]``), full step."""
     A = ws[W_A]

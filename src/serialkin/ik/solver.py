@@ -155,6 +155,8 @@ class IKProblem:
 
 def _stream_seed(seed: object) -> int:
     """A uint64 stream seed from ``seed`` (None: fresh OS entropy; int; Generator)."""
+    if type(seed) is int:
+        return seed & _MASK64
     if seed is None:
         return int.from_bytes(os.urandom(8), "little")
     if isinstance(seed, np.random.Generator):
@@ -483,7 +485,7 @@ def _kernel_config(spec: MethodSpec, tgt: Target, tol: float, max_iter: int, res
 
 
 #: Tolerance of the final "q inside the joint limits" test of a success [rad or m].
-LIMIT_TOL = 1e-12
+LIMIT_TOL = K.LIMIT_TOL
 
 _OUTSIDE = ("the configuration found lies outside the joint limits; the target may be "
             "reachable only outside them")
@@ -503,14 +505,14 @@ def honest_success(robot: Robot, q: np.ndarray, ok: bool, respect: bool) -> bool
 
 def _result_single(robot: Robot, tgt: Target, spec: MethodSpec, q: np.ndarray,
                    info: np.ndarray, tol: float, respect: bool) -> IKResult:
-    ok = honest_success(robot, q, bool(info[K.I_SUCCESS]), respect)
+    # the final guard of honest_success, evaluated by the kernel (info[I_INSIDE])
+    ok = info[K.I_SUCCESS] > 0.5 and (not respect or info[K.I_INSIDE] > 0.5)
     pe, oe = float(info[K.I_POS_ERR]), float(info[K.I_ORI_ERR])
     its, used = int(info[K.I_ITERATIONS]), int(info[K.I_RESTARTS])
     reason = "" if ok else failure_reason(
         pe, oe, tol, used + 1, its, tgt.kind,
         failure_hint(robot, q, tgt.weights, respect, tgt.T))
-    return IKResult(q=q, success=ok, iterations=its, position_error=pe, orientation_error=oe,
-                    reason=reason, restarts=used, method=spec.name)
+    return IKResult.make(q, ok, its, pe, oe, reason, used, spec.name)
 
 
 def _result_batch(robot: Robot, tgt: Target, spec: MethodSpec, Q: np.ndarray,
