@@ -49,3 +49,13 @@ def test_manipulability_is_one_implementation():
     Jl = r.jacobian(q[0], "ee", link=3)[:3]
     np.testing.assert_allclose(r.manipulability(q[0], "position", frame="ee", link=3),
                                np.sqrt(max(np.linalg.det(Jl @ Jl.T), 0.0)), atol=1e-12)
+
+
+def test_revolute_flags_and_chain_are_public():
+    """robot.revolute matches the joint types and the chain's meta column; it is read-only."""
+    r = models.stanford()  # RRPRRR
+    assert r.revolute.dtype == bool and r.revolute.shape == (r.n,)
+    assert r.revolute.tolist() == [t == "R" for t in r.joint_types]
+    assert (r.chain.meta[:, 3] == 0.0).tolist() == r.revolute.tolist()
+    with pytest.raises(ValueError):
+        r.revolute[0] = not r.revolute[0]
