@@ -506,7 +506,7 @@ def honest_success(robot: Robot, q: np.ndarray, ok: bool, respect: bool) -> bool
 def _result_single(robot: Robot, tgt: Target, spec: MethodSpec, q: np.ndarray,
                    info: np.ndarray, tol: float, respect: bool) -> IKResult:
     # the final guard of honest_success, evaluated by the kernel (info[I_INSIDE])
-    ok = info[K.I_SUCCESS] > 0.5 and (not respect or info[K.I_INSIDE] > 0.5)
+    ok = bool(info[K.I_SUCCESS] > 0.5 and (not respect or info[K.I_INSIDE] > 0.5))
     pe, oe = float(info[K.I_POS_ERR]), float(info[K.I_ORI_ERR])
     its, used = int(info[K.I_ITERATIONS]), int(info[K.I_RESTARTS])
     reason = "" if ok else failure_reason(
