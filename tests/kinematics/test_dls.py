@@ -71,3 +71,15 @@ def test_spd_solve_and_weighted_rows():
     np.testing.assert_allclose(Jw, sw[:, None] * J[rows])
     np.testing.assert_allclose(ew, sw * e[rows])
     assert abs(s2 - float(ew @ ew)) < 1e-12
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(1, 6), st.integers(1, 8), st.integers(0, 2**32 - 1))
+def test_manipulability_is_the_product_of_singular_values(m, n, seed):
+    """Manipulability = Π σ_i = sqrt(det(J Jᵀ)) for m ≤ n; 0 for m > n and a repeated row."""
+    J = np.random.default_rng(seed).standard_normal((m, n))
+    want = float(np.prod(np.linalg.svd(J, compute_uv=False))) if m <= n else 0.0
+    assert abs(dls.manipulability_of(J) - want) <= 1e-12 * max(1.0, want)
+    if m >= 2 and m <= n:
+        J[1] = J[0]
+        assert dls.manipulability_of(J) <= 1e-12 * np.linalg.norm(J) ** m

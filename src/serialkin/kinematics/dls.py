@@ -254,18 +254,40 @@ def weigh_rows_into(J, e, rows, sw, Jw, ew):
 def manipulability_of(J):
     """Yoshikawa manipulability ``w = sqrt(det(J Jᵀ))`` (eq 43) of a task Jacobian J (m, n).
 
-    Computed as the product of J's singular values (equal to sqrt(det(J Jᵀ)) and exactly
-    0 at singular configurations); 0 when m > n (J Jᵀ has rank ≤ n < m). The one
-    implementation of eq 43: :meth:`serialkin.Robot.manipulability`, the multi-task
-    resolver and the CLI call it.
+    Computed without forming ``J Jᵀ``: with the Householder QR factorisation
+    ``Jᵀ = Q R`` (R upper triangular, m × m), ``J Jᵀ = Rᵀ R`` and ``w = Π |R_kk|`` (the
+    product of J's singular values), so w keeps full relative accuracy near
+    singularities and is 0 when a column of the reduction vanishes; 0 when m > n (J Jᵀ has
+    rank ≤ n < m). The one implementation of eq 43: :meth:`serialkin.Robot.manipulability`,
+    the manipulability objective, the multi-task resolver and the CLI call it.
     """
     m, n = J.shape
     if m > n:
         return 0.0
-    s = np.linalg.svd(np.ascontiguousarray(J), full_matrices=False)[1]
+    A = np.empty((n, m))
+    for i in range(m):
+        for j in range(n):
+            A[j, i] = J[i, j]
     w = 1.0
-    for i in range(s.shape[0]):
-        w *= s[i]
+    for k in range(m):
+        s = 0.0
+        for j in range(k, n):
+            s += A[j, k] * A[j, k]
+        nrm = math.sqrt(s)
+        if nrm == 0.0:
+            return 0.0
+        w *= nrm  # |R_kk|
+        alpha = -nrm if A[k, k] >= 0.0 else nrm
+        # Householder vector v = a - alpha e_k (in place), vᵀv = 2 nrm (nrm + |a_k|)
+        A[k, k] -= alpha
+        vv = 2.0 * nrm * (nrm + abs(A[k, k] + alpha))
+        for c in range(k + 1, m):
+            d = 0.0
+            for j in range(k, n):
+                d += A[j, k] * A[j, c]
+            f = 2.0 * d / vv
+            for j in range(k, n):
+                A[j, c] -= f * A[j, k]
     return w
 
 
