@@ -343,12 +343,12 @@ def step_gauss_newton(q, J, e, cost, p, ctx, ws, dq):
 
 
 def _register(name, step, params, max_iter, restarts, options, summary, *, limits=_PROJECTION,
-              linear=False):
+              linear=False, allocates=False):
     """Register ``name`` as the step kernel ``step`` in the shared compiled loop."""
     register_method(MethodSpec(
         name=name, family="jacobian", summary=summary, limits=limits,
         max_iter=max_iter, restarts=restarts, options=options,
-        kernel=compile_method(name, step, params),
+        kernel=compile_method(name, step, params, allocates=allocates),
         max_joints=None if linear else MAX_JOINTS_CUBIC,
     ))
 
@@ -358,7 +358,8 @@ _register("transpose", step_transpose, (), 5000, 5, {"stall_window": 1000},
           linear=True)
 _register("pinv", step_pinv, (("max_step", False), ("rcond", False)), 100, 50,
           {"max_step": 0.5, "rcond": 1e-10, "stall_window": 20},
-          "Moore-Penrose pseudoinverse step J⁺e (eq 40), steps capped at max_step")
+          "Moore-Penrose pseudoinverse step J⁺e (eq 40), steps capped at max_step",
+          allocates=True)
 _register("dls", step_dls, (("damping", True),), 200, 50, {"damping": 0.01, "stall_window": 30},
           "damped least squares Jᵀ(JJᵀ+λ²I)⁻¹e with fixed damping λ (eq 46)", linear=True)
 _register("lm", step_lm, (("damping", True),), 100, 100,
@@ -376,9 +377,10 @@ _register("lm_sugihara", step_lm_sugihara, (("damping", True),), 200, 50,
           "Levenberg-Marquardt with damping E + λ (Sugihara)")
 _register("sdls", step_sdls, (("max_step", False),), 500, 30,
           {"max_step": math.pi / 4, "stall_window": 60},
-          "selectively damped least squares by SVD (Buss & Kim)")
+          "selectively damped least squares by SVD (Buss & Kim)", allocates=True)
 _register("newton", step_newton, (("rcond", False),), 100, 50, {"rcond": 1e-10, "stall_window": 20},
-          "Newton-Raphson (eq 41): full pseudoinverse step with backtracking line search")
+          "Newton-Raphson (eq 41): full pseudoinverse step with backtracking line search",
+          allocates=True)
 _register("gauss_newton", step_gauss_newton, (("rcond", False),), 100, 50,
           {"rcond": 1e-12, "stall_window": 20},
-          "Gauss-Newton on the normal equations (JᵀJ)⁺Jᵀe, full step")
+          "Gauss-Newton on the normal equations (JᵀJ)⁺Jᵀe, full step", allocates=True)
