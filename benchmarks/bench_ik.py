@@ -47,7 +47,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-from _common import Stat, record, wall_s  # noqa: E402
+from _common import Stat, header, record, wall_s  # noqa: E402
 
 from serialkin import Robot  # noqa: E402
 from serialkin.model.dh import DHLink  # noqa: E402
@@ -203,13 +203,15 @@ def main() -> None:
     methods = [m for m in args.methods.split(",") if m]
     print(f"IK benchmark: {args.targets} reachable full-pose targets per robot, success = FK "
           f"within {ACCURACY:g} m and {ACCURACY:g} rad and q inside the limits")
+    print(header())
     for rname in args.robots.split(","):
         rtb_robot = getattr(rtb.models.DH, rname)()
         robot = robot_from_rtb(rtb_robot, rname)
         Q = robot.random_q(args.targets, seed=1)
         targets = np.ascontiguousarray(robot.fk(Q))
         q0s = robot.random_q(args.targets, seed=2)
-        print(f"\n{rname} ({robot.n} joints, {robot.convention} DH)")
+        print(f"\n{rname} ({robot.n} joints, {robot.convention} DH; load average "
+              f"{os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs)")
         rows = []
         ref = None
         if not args.no_peers:

@@ -130,9 +130,13 @@ def main() -> None:
     IT = np.zeros(p, dtype=np.int64)
     ER = np.zeros(p)
 
+    lo = np.ascontiguousarray(s.robot.qlim[:, 0])
+    hi = np.ascontiguousarray(s.robot.qlim[:, 1])
+    revolute = s.robot.revolute.astype(float)
+
     def kernel():
-        dls_track(s.q0, targets, rows_, s.robot._F, s.robot._meta, lam, tol, max_iter, max_step,
-                  s.tolerance, False, 1e-3, Q, IT, ER)
+        dls_track(s.q0, targets, rows_, s.robot.chain.F, s.robot.chain.meta, lam, tol, max_iter,
+                  max_step, s.tolerance, False, 1e-3, lo, hi, revolute, Q, IT, ER)
 
     t_kernel = median_time(kernel, 21)
     t_track = median_time(s.run)

@@ -161,7 +161,7 @@ def test_method_target_kind_mismatch(ur5, T):
 
     spec = register_method(MethodSpec(name="_pose_only_test", family="jacobian",
                                       summary="test", limits="test", targets=("pose",),
-                                      kernel_code=ik.METHODS["lm"].kernel_code))
+                                      kernel=ik.METHODS["lm"].kernel))
     try:
         with pytest.raises(InputError, match="does not accept position targets"):
             ur5.ik(np.array([0.3, 0.1, 0.2]), method=spec.name)

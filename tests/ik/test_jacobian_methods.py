@@ -4,9 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from numba import njit
 
 import serialkin.ik as ik
 from serialkin import models
+from serialkin.errors import InputError
+from serialkin.ik import registry
+from serialkin.ik._kernels import W_A, W_G, W_JW, W_R, _normal, compile_method
+from serialkin.ik.registry import MethodSpec, register_method
+from serialkin.kinematics.dls import spd_solve_into
 from serialkin.spatial import transl
 from serialkin.spatial.pose import pose_error
 
@@ -250,3 +256,38 @@ def test_three_link_planar_pose(method):
             assert_reaches(robot, res, T, weights=[1, 1, 0, 0, 0, 1])
             solved += 1
     assert solved >= (2 if method == "transpose" else 3)
+
+
+@njit(cache=True)
+def _step_ridge(q, J, e, cost, p, ctx, ws, dq):
+    """Test step kernel: ridge regression (JwᵀJw + κI) Δq = Jwᵀ r with κ = p[0]."""
+    A = ws[W_A]
+    g = ws[W_G]
+    _normal(ws[W_JW], ws[W_R], A, g)
+    for i in range(dq.shape[0]):
+        A[i, i] += p[0]
+    return spd_solve_into(A, g, dq, dq.shape[0])
+
+
+def test_a_new_compiled_method_is_one_step_kernel_and_one_registration(near_solution):
+    """A step kernel plus one register call is a full method: its step, restarts and batch."""
+    robot, q0, T, J, e = near_solution
+    spec = register_method(MethodSpec(
+        name="_ridge_test", family="jacobian", summary="test", limits="test",
+        max_iter=100, restarts=20, options={"kappa": 1e-9, "stall_window": 20},
+        kernel=compile_method("_ridge_test", _step_ridge, (("kappa", False),))))
+    try:
+        kappa = 0.3
+        dq = np.linalg.solve(J.T @ J + kappa * np.eye(robot.n), J.T @ e)
+        assert np.allclose(_one_step(robot, spec.name, q0, T, kappa=kappa), q0 + dq,
+                           atol=1e-12)
+        with pytest.raises(InputError, match="kappa"):
+            robot.ik(T, method=spec.name, kappa=-1.0)
+        Ts = robot.fk(robot.random_q(4, seed=3))
+        batch = robot.ik(Ts, method=spec.name, seed=1)
+        assert batch.success.all()
+        for k in range(4):
+            one = robot.ik(Ts[k], method=spec.name, seed=1)
+            assert np.array_equal(one.q, batch.q[k])
+    finally:
+        registry._REGISTRY.pop(spec.name)

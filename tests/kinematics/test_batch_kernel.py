@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from numba import njit
 
 import serialkin as sk
-from serialkin.kinematics import _kernels as K
+from serialkin.kinematics import kernels as K
 from serialkin.model.chain import z_alignment
 from serialkin.model.dh import link_transform, parse_dh_rows
 from tests.kinematics._fd import dh_rows, random_transform

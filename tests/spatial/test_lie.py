@@ -10,7 +10,7 @@ from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
 
 from serialkin.errors import InputError
-from serialkin.spatial import _kernels as K
+from serialkin.spatial import kernels as K
 from serialkin.spatial import (
     se3_exp,
     se3_log,

@@ -10,7 +10,7 @@ from scipy.spatial.transform import Rotation
 
 from serialkin import Robot
 from serialkin.errors import InputError
-from serialkin.spatial import _kernels as K
+from serialkin.spatial import kernels as K
 from serialkin.spatial import (
     make_transform,
     pose_distance,

@@ -30,6 +30,7 @@ from serialkin.cli.io import (
 )
 from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot, robot_argument
 from serialkin.errors import SerialkinError
+from serialkin.model.tasks import TASK_COORDINATES, TASK_NAMES, get_task
 
 #: Longest error message printed [characters]: a message is one line, cut beyond this.
 MAX_ERROR_CHARS = 2000
@@ -170,7 +171,7 @@ def _angle_factor(robot: Any, degrees: bool) -> np.ndarray:
     """Per-joint factor from the user's unit to SI: π/180 for revolute joints with --degrees."""
     f = np.ones(robot.n)
     if degrees:
-        f[np.array(robot.joint_types) == "R"] = np.pi / 180.0
+        f[robot.revolute] = np.pi / 180.0
     return f
 
 
@@ -263,20 +264,20 @@ def _show_robot(r: Any) -> None:
     if r.source:
         click.echo(f"source: {r.source}")
 
-    def lim(lo: float, hi: float, t: str) -> str:
+    def lim(lo: float, hi: float, revolute: bool) -> str:
         if not (np.isfinite(lo) and np.isfinite(hi)):
             return "unlimited"
-        return (f"[{np.degrees(lo):.1f}, {np.degrees(hi):.1f}] deg" if t == "R"
+        return (f"[{np.degrees(lo):.1f}, {np.degrees(hi):.1f}] deg" if revolute
                 else f"[{lo:.4g}, {hi:.4g}] m")
 
     if r.dh is not None:
         rows = [(d.name, d.type, d.a, np.degrees(d.alpha), d.d, np.degrees(d.theta),
-                 lim(*d.qlim, d.type)) for d in r.dh]
+                 lim(*d.qlim, rev)) for d, rev in zip(r.dh, r.revolute)]
         click.echo(format_table(rows, ["joint", "type", "a [m]", "alpha [deg]", "d [m]",
                                        "theta [deg]", "limits"]))
     else:
         rows = [(j.name, j.type, fmt_vector(j.axis, 3), fmt_vector(j.origin[:3, 3], 4),
-                 lim(*j.qlim, j.type)) for j in r.joints]
+                 lim(*j.qlim, rev)) for j, rev in zip(r.joints, r.revolute)]
         click.echo(format_table(rows, ["joint", "type", "axis", "origin xyz [m]", "limits"]))
     for key in ("base", "tool"):
         T = getattr(r, key)
@@ -455,8 +456,8 @@ _JACOBIAN_CMD_HELP = command_help(
               help="The point on --link, in that link frame [m] (default its origin).")
 @click.option("--planar", is_flag=True,
               help="Planar task Jacobian: rows vx, vy, wz (eqs 30-32, 38).")
-@click.option("--task", type=click.Choice(["auto", "full", "position", "orientation", "planar",
-                                           "planar_pose"]), default="auto", show_default=True,
+@click.option("--task", type=click.Choice(["auto", *TASK_NAMES]), default="auto",
+              show_default=True,
               help="Task rows for manipulability and condition number (auto: planar/"
                    "planar_pose for planar robots, full with >= 6 joints, else position).")
 @degrees_option
@@ -475,20 +476,19 @@ def jacobian_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frame
     pt = parse_numbers(point, "--point", 3) if point is not None else None
     if pt is not None and link is None:
         raise CLIError("--point needs --link (the link frame the point is fixed on)")
-    from serialkin.model.robot import TASK_ROWS
     from serialkin.workspace.sampling import manipulability_task
 
-    rows_sel = [0, 1, 5] if planar else list(range(6))
-    names = ["vx", "vy", "vz", "wx", "wy", "wz"]
+    rows_sel = list(get_task("planar_pose" if planar else "pose").rows)
+    names = list(TASK_COORDINATES)
     task_name = manipulability_task(r, bool(r.is_planar)) if task == "auto" else task
-    task_rows = list(TASK_ROWS[task_name])
+    task_rows = list(get_task(task_name).rows)
     recs = []
     for q in Q:
         J6 = r.jacobian(q, frame=frame, link=link, point=pt)
         J = J6[rows_sel]
         Jt = J6[task_rows]
         s = np.linalg.svd(Jt, compute_uv=False)
-        w = float(np.sqrt(max(np.linalg.det(Jt @ Jt.T), 0.0)))
+        w = r.manipulability(q, task_name, frame=frame, link=link, point=pt)
         cond = float(s[0] / s[-1]) if s[-1] > 1e-15 * max(s[0], 1e-300) else float("inf")
         rank = int(np.sum(s > 1e-10 * max(s[0], 1e-300)))
         recs.append({"q": q, "J": J, "manipulability": w, "condition_number": cond,

@@ -27,6 +27,7 @@ from serialkin.cli.io import (
     write_text_atomic,
 )
 from serialkin.cli.robots import ROBOT_HELP, param_option, parse_params, resolve_robot
+from serialkin.model.tasks import TARGET_TASKS
 
 _COMPARE_HELP = command_help(
     "Solve the same targets with several IK methods and tabulate success rate, times, "
@@ -76,8 +77,7 @@ def _write_table(out: str, data: dict[str, Any]) -> Any:
 @click.argument("robot", metavar="ROBOT")
 @click.option("--targets", "count", type=int, default=50, show_default=True,
               help="Number of random reachable targets.")
-@click.option("--kind", type=click.Choice(["auto", "pose", "position", "planar",
-                                           "planar_pose"]), default="auto",
+@click.option("--kind", type=click.Choice(["auto", *TARGET_TASKS]), default="auto",
               show_default=True, help="Target kind (auto: planar_pose / planar for planar "
                                       "robots, pose otherwise).")
 @click.option("--target-file", type=click.Path(dir_okay=False),

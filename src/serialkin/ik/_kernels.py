@@ -1,16 +1,22 @@
-"""Compiled IK loop for the Jacobian family (numba, ``cache=True``).
+"""The compiled IK loop every Jacobian-family method shares (numba, ``cache=True``).
 
-One general kernel, :func:`solve_one`, runs every Jacobian-based method (chapter section
-5.3) selected by a method code, including restarts, the iteration budget, stagnation
-detection and joint-limit projection; :func:`solve_chunk` runs it over a range of N
-targets with the GIL released, so that the batch driver solves across all cores (one
-thread per core). It is built on the only FK/Jacobian implementation
-(``serialkin.kinematics._kernels.jacobian_into`` and ``fk_into``) and the only
-pose-error implementation
-(:func:`serialkin.spatial._kernels.pose_error_into`). The helpers every compiled IK
-method shares live here too: the cost and error norms (:func:`task_cost`,
-:func:`task_errors`), joint-limit projection, the random starts, and the stopping test
-of the heuristic attempts (:func:`stopping_test`, used by CCD and FABRIK).
+A compiled IK method is a small **step kernel** (written and registered in its family's
+file, e.g. :mod:`serialkin.ik.jacobian_methods`); everything else — restarts, the
+iteration budget, the tolerance test, joint-limit projection, stagnation detection, the
+final polish and the result — is this module's one loop. :func:`compile_method` builds,
+from a step kernel, the method's :class:`CompiledMethod`: a ``solve_one`` (one target with
+restarts) and a ``solve_chunk`` (targets ``start..stop-1`` with the GIL released, so the
+batch driver solves across all cores). It is built on the only FK/Jacobian implementation
+(``serialkin.kinematics.kernels.jacobian_into`` and ``fk_into``), the only pose-error
+implementation (:func:`serialkin.spatial.kernels.pose_error_into`) and the one
+Cholesky solve (:func:`serialkin.kinematics.dls.spd_solve_into`). The helpers every
+compiled IK method shares live here too: the cost and error norms (:func:`task_cost`,
+:func:`task_errors`), joint-limit projection, the random starts, small dense algebra
+(normal equations, a Jacobi SVD, the pseudoinverse step) and the stopping test of the
+heuristic attempts (:func:`stopping_test`, used by CCD and FABRIK).
+
+Kernel contract: these functions trust their input; validation happens at the public
+boundary (:func:`serialkin.ik.solver.solve`).
 
 Notation (shapes): n joints; ``e`` (6,) the pose error ``[p_t − p; log(R_t Rᵀ)^∨]``
 (world frame); ``w`` (6,) the task weights (0 drops a coordinate); ``r = √w ⊙ e`` and
@@ -18,31 +24,30 @@ Notation (shapes): n joints; ``e`` (6,) the pose error ``[p_t − p; log(R_t R�
 ``E = ½ Σ w_i e_i² = ½ rᵀr`` and a step ``Δq`` solves ``Jw Δq ≈ r`` (eq 39 read as
 ``Δx = J Δq``).
 
-Method codes and steps:
+**The step kernel** is an ``@njit`` function ``step(q, J, e, cost, p, ctx, ws, dq) -> bool``:
+from the configuration ``q`` (n,) with its Jacobian ``J`` (6, n), pose error ``e`` (6,) and
+cost ``E``, with the weighted ``Jw`` and ``r`` already in the workspace, it writes the
+step ``Δq`` into ``dq`` (n,) and returns True (False: no step possible, the attempt
+ends). It is inlined into the attempt loop, which is compiled without numba's reference
+counting (NRT: an incref/decref of every array the step touches, every iteration) unless
+the method is registered with ``allocates=True``: a step that allocates or copies arrays,
+itself or in a helper it calls (as :func:`_pinv_step` does), needs it. ``p`` holds the
+method's parameters (the option values named by
+``CompiledMethod.params``, in that order); ``ctx`` is the tuple
+``(F, meta, Tt, w, sw, lo, hi, revolute, respect)`` (chain, target, weights and
+``√w``, limits, whether to respect them) and ``ws`` the scratch tuple indexed by the
+``W_*`` constants (``Jw`` (6, n), ``r`` (6,), ``A`` (n, n), ``g`` (n,), ``M6`` (6, 6),
+``y6`` (6,), ``free`` (n,), ``qn`` (n,), ``Tn`` (4, 4), ``en`` (6,)). The loop then moves
+to ``q + Δq`` projected onto the joint ranges.
 
-* ``TRANSPOSE`` — ``Δq = α Jwᵀ r`` with the step length of Buss (2004) / Wolovich & Elliott
-  (1984), ``α = ⟨r, Jw Jwᵀ r⟩ / |Jw Jwᵀ r|²`` (the exact minimiser of the linearised
-  residual along the gradient).
-* ``PINV`` — ``Δq = Jw⁺ r`` (eq 40; Moore-Penrose pseudoinverse by a one-sided Jacobi
-  SVD, :func:`_jacobi_svd`, singular values below ``rcond·σ_max`` dropped), then scaled
-  so that ``max |Δq_i| ≤ max_step``.
-* ``DLS`` — ``Δq = Jwᵀ (Jw Jwᵀ + λ² I)⁻¹ r`` (eq 46 as corrected in the errata), fixed λ.
-* ``LM`` — Levenberg-Marquardt with error-adaptive damping,
-  ``(JwᵀJw + μI) Δq = Jwᵀ r`` with ``μ = λE`` (Chan & Lawrence's rule with a small λ,
-  so the step is strongly damped far from the target and becomes the Gauss-Newton
-  step — quadratic convergence — at it), every step taken (non-monotone: it escapes
-  shallow local minima that a monotone trust-region LM falls into), and a
-  **limit-aware step**: a joint at a limit whose step points outward is frozen (its
-  column removed) and the step recomputed for the others before projection.
-* ``LM_WAMPLER`` / ``LM_CHAN`` / ``LM_SUGIHARA`` — ``(JwᵀJw + W_N) Δq = Jwᵀ r`` with
-  ``W_N = λ I`` (Wampler 1986), ``W_N = λ E I`` (Chan & Lawrence 1988) and
-  ``W_N = E I + λ I`` (Sugihara 2011); every step is taken.
-* ``SDLS`` — selectively damped least squares (Buss & Kim 2005): each singular
-  direction's contribution is clamped by ``γ_i = min(1, N_i/M_i)·γ_max`` and the total
-  by ``γ_max``, with the position and orientation rows as the two "end effectors".
-* ``NEWTON`` — Newton-Raphson (eq 41 in n dimensions): the full step ``Δq = Jw⁺ r``,
-  then backtracking (halving) until the cost decreases.
-* ``GAUSS_NEWTON`` — ``Δq = (JwᵀJw)⁺ Jwᵀ r`` from the normal equations, full step.
+Why one loop compiled per method (rather than a dispatch on a method code or a step
+passed as a first-class function): numba specialises a function on the dispatcher of a
+function argument but cannot cache that specialisation across processes (every import
+would recompile the loop, seconds per method), and a dispatch on an integer needs the
+loop to know every step. :func:`compile_method` instead copies the loop's Python
+functions with the step bound as a global, under a name that carries the method's name
+and a hash of the sources, so each method's loop is cached on disk like any kernel and
+the step is a direct call that LLVM inlines.
 
 Joint limits (``respect`` true) are intervals whose ends may be infinite
 (:mod:`serialkin.model.limits`): after every step each joint is projected onto its
@@ -63,43 +68,45 @@ unreachable target returns the closest pose found.
 
 from __future__ import annotations
 
+import hashlib
 import math
+import types
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from numba import njit
 
-from serialkin.kinematics._kernels import fk_into, jacobian_into
+from serialkin.kinematics.dls import spd_solve_into
+from serialkin.kinematics.kernels import fk_into, jacobian_into
 from serialkin.model.limits import inside as interval_inside
 from serialkin.model.limits import normalize as interval_normalize
 from serialkin.model.limits import project as interval_project
-from serialkin.model.limits import wrap_angle as interval_wrap
-from serialkin.spatial._kernels import pose_error_into
+from serialkin.spatial.kernels import pose_error_into
 
-TRANSPOSE = 0
-PINV = 1
-DLS = 2
-LM = 3
-LM_WAMPLER = 4
-LM_CHAN = 5
-LM_SUGIHARA = 6
-SDLS = 7
-NEWTON = 8
-GAUSS_NEWTON = 9
-
-#: Layout of the configuration vector ``cfg`` (float64, length N_CFG).
+#: Layout of the configuration vector ``cfg`` (float64): the loop's slots, then the
+#: method's parameters ``cfg[N_LOOP:]`` (``CompiledMethod.params``, in order).
 C_WEIGHTS = 0  # 6 task weights w, indices 0..5
-C_METHOD = 6  # method code
-C_TOL = 7  # tolerance on position [m] and orientation [rad] errors
-C_MAX_ITER = 8  # iterations per attempt
-C_RESTARTS = 9  # restarts allowed
-C_RESPECT = 10  # 1: project onto the joint limits after every step
-C_USE_Q0 = 11  # 1: the first attempt starts from q0
-P_DAMPING = 12  # λ (DLS, LM, Wampler, Chan, Sugihara)
-P_WINDOW = 13  # stagnation window [iterations]
-P_MAX_STEP = 14  # max |Δq_i| (PINV) or γ_max (SDLS) [rad / m]
-P_RCOND = 15  # relative cut-off for singular values (PINV, NEWTON, GAUSS_NEWTON)
-C_POLISH = 16  # 1: after failed attempts, polish the best one with a monotone LM
-N_CFG = 17
+C_TOL = 6  # tolerance on position [m] and orientation [rad] errors
+C_MAX_ITER = 7  # iterations per attempt
+C_RESTARTS = 8  # restarts allowed
+C_RESPECT = 9  # 1: project onto the joint limits after every step
+C_USE_Q0 = 10  # 1: the first attempt starts from q0
+C_WINDOW = 11  # stagnation window [iterations]
+C_POLISH = 12  # 1: after failed attempts, polish the best one with a monotone LM
+N_LOOP = 13
+
+#: Indices of the step kernels' workspace tuple ``ws``.
+W_JW = 0  # (6, n) weighted Jacobian diag(√w) J
+W_R = 1  # (6,) weighted residual √w ⊙ e
+W_A = 2  # (n, n)
+W_G = 3  # (n,)
+W_M6 = 4  # (6, 6)
+W_Y6 = 5  # (6,)
+W_FREE = 6  # (n,)
+W_QN = 7  # (n,)
+W_TN = 8  # (4, 4)
+W_EN = 9  # (6,)
 
 #: Rows of the per-robot ``box`` array (5, n).
 B_LO = 0  # lower joint limits (-inf allowed)
@@ -115,7 +122,11 @@ I_POS_ERR = 2
 I_ORI_ERR = 3
 I_RESTARTS = 4
 I_COST = 5
-N_INFO = 6
+I_INSIDE = 6  # 1: the returned q lies inside the joint limits (within LIMIT_TOL)
+N_INFO = 7
+
+#: Tolerance of the final "q inside the joint limits" test of a success [rad or m].
+LIMIT_TOL = 1e-12
 
 #: Status codes of the heuristic attempts (:func:`stopping_test`; CCD and FABRIK).
 RUNNING = -1
@@ -177,35 +188,6 @@ def normalize_into(q, lo, hi, revolute):
 
 
 # ---------------------------------------------------------------- small dense algebra
-@njit(cache=True)
-def _chol_solve(A, b, x, m):
-    """Solve A x = b for the leading m×m block of the SPD matrix A (destroyed); False if not PD."""
-    for j in range(m):
-        s = A[j, j]
-        for k in range(j):
-            s -= A[j, k] * A[j, k]
-        if not s > 0.0:
-            return False
-        d = math.sqrt(s)
-        A[j, j] = d
-        for i in range(j + 1, m):
-            t = A[i, j]
-            for k in range(j):
-                t -= A[i, k] * A[j, k]
-            A[i, j] = t / d
-    for i in range(m):
-        t = b[i]
-        for k in range(i):
-            t -= A[i, k] * x[k]
-        x[i] = t / A[i, i]
-    for i in range(m - 1, -1, -1):
-        t = x[i]
-        for k in range(i + 1, m):
-            t -= A[k, i] * x[k]
-        x[i] = t / A[i, i]
-    return True
-
-
 @njit(cache=True, inline="always")
 def task_cost(e, w):
     """The weighted cost ``E = ½ Σ w_i e_i²`` of the pose error ``e`` (6,), weights ``w`` (6,)."""
@@ -378,56 +360,6 @@ def _pinv_step(M, rhs, dq, rcond):
             dq[j] += a * V[j, k]
 
 
-@njit(cache=True)
-def _sdls_step(Jw, r, dq, gamma_max):
-    """Selectively damped least squares step (Buss & Kim 2005), two 3-row blocks."""
-    n = Jw.shape[1]
-    W = np.empty((6, n))
-    V = np.empty((n, n))
-    s = np.empty(n)
-    _jacobi_svd(Jw, W, V, s)
-    rho = np.empty(n)
-    smax = 0.0
-    for j in range(n):
-        a = 0.0
-        b = 0.0
-        for i in range(3):
-            a += Jw[i, j] * Jw[i, j]
-            b += Jw[i + 3, j] * Jw[i + 3, j]
-        rho[j] = math.sqrt(a) + math.sqrt(b)
-        dq[j] = 0.0
-        smax = max(smax, s[j])
-    if not smax > 0.0:
-        return
-    phi = np.empty(n)
-    for k in range(n):
-        if s[k] <= 1e-12 * smax:
-            continue
-        alpha = 0.0
-        a = 0.0
-        b = 0.0
-        for i in range(3):
-            a += W[i, k] * W[i, k]
-            b += W[i + 3, k] * W[i + 3, k]
-        for i in range(6):
-            alpha += W[i, k] * r[i]
-        alpha /= s[k]  # α = u_kᵀ r
-        N = (math.sqrt(a) + math.sqrt(b)) / s[k]  # |u_k| over the two blocks
-        M = 0.0
-        for j in range(n):
-            M += abs(V[j, k]) * rho[j]
-        M /= s[k]
-        gamma = gamma_max * min(1.0, N / M) if M > 0.0 else gamma_max
-        big = 0.0
-        for j in range(n):
-            phi[j] = alpha / s[k] * V[j, k]
-            big = max(big, abs(phi[j]))
-        scale = gamma / big if big > gamma else 1.0
-        for j in range(n):
-            dq[j] += scale * phi[j]
-    _limit_step(dq, gamma_max)
-
-
 @njit(cache=True, inline="always")
 def _limit_step(dq, max_step):
     """Scale dq so that max |dq_i| ≤ max_step (direction kept)."""
@@ -439,16 +371,20 @@ def _limit_step(dq, max_step):
             dq[j] *= max_step / big
 
 
-# ---------------------------------------------------------------- one attempt
-@njit(cache=True)
-def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol, max_iter,
-             q, J, T, e, Jw, r, A, g, dq, qn, Jn, Tn, en, M6, y6, free):
-    """Iterate ``method`` from q (n,) in place; return (iterations, converged, cost).
+# ---------------------------------------------------------------- the shared loop
+# The three functions below are templates: compile_method copies them with the method's
+# step kernel (and the copies that call it) bound as globals, then compiles the copies.
+def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, p, window, tol, max_iter,
+             q, J, T, e, dq, ws):
+    """Iterate the step kernel from q (n,) in place; return (iterations, converged, cost).
 
-    On return q, J, T, e describe the final (last accepted) configuration.
+    On return q, J, T, e describe the final configuration.
     """
     n = q.shape[0]
-    window = int(params[P_WINDOW])
+    Jw = ws[W_JW]
+    r = ws[W_R]
+    qn = ws[W_QN]
+    ctx = (F, meta, Tt, w, sw, lo, hi, revolute, respect)
     jacobian_into(q, F, meta, J, T)
     pose_error_into(T, Tt, e)
     cost = task_cost(e, w)
@@ -466,122 +402,14 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, params, tol,
         elif it - ref_it > window:
             return it, False, cost
         _weigh(J, e, sw, Jw, r)
-        if method == LM:
-            # error-damped LM, μ = λE, with an active set for the joint limits: a joint
-            # that sits at a limit and whose step points outward is frozen (its column
-            # removed) and the step recomputed, at most n times.
-            for j in range(n):
-                free[j] = 1.0
-            lam = params[P_DAMPING]
-            for _pass in range(n + 1):
-                for i in range(6):
-                    for j in range(n):
-                        Jw[i, j] = sw[i] * J[i, j] * free[j]
-                _normal(Jw, r, A, g)
-                d = 0.0
-                for i in range(n):
-                    d = max(d, A[i, i])
-                mu = lam * cost + 1e-12 * (1.0 + d)
-                for i in range(n):
-                    A[i, i] += mu + (1.0 - free[i])
-                if not _chol_solve(A, g, dq, n):
-                    return it, False, cost
-                if not respect:
-                    break
-                changed = False
-                for i in range(n):
-                    x = q[i] + dq[i]
-                    if free[i] == 0.0 or (x >= lo[i] and x <= hi[i]):
-                        continue
-                    if revolute[i] != 0 and not math.isnan(interval_wrap(x, lo[i], hi[i])):
-                        continue  # a 2π shift brings it inside: not blocked
-                    if (x < lo[i] and q[i] <= lo[i] + 1e-12) \
-                            or (x > hi[i] and q[i] >= hi[i] - 1e-12):
-                        free[i] = 0.0
-                        changed = True
-                if not changed:
-                    break
-        elif method == TRANSPOSE:
-            _transpose_times(Jw, r, g)
-            num = 0.0
-            den = 0.0
-            for i in range(6):
-                v = 0.0
-                for j in range(n):
-                    v += Jw[i, j] * g[j]
-                num += r[i] * v
-                den += v * v
-            alpha = num / den if den > 0.0 else 0.0
-            for j in range(n):
-                dq[j] = alpha * g[j]
-        elif method == DLS:
-            lam2 = params[P_DAMPING] * params[P_DAMPING]
-            for _retry in range(2):
-                d = 0.0
-                for i in range(6):
-                    for k in range(i, 6):
-                        s = 0.0
-                        for j in range(n):
-                            s += Jw[i, j] * Jw[k, j]
-                        M6[i, k] = s
-                        M6[k, i] = s
-                    d = max(d, M6[i, i])
-                for i in range(6):
-                    M6[i, i] += lam2
-                if _chol_solve(M6, r, y6, 6):
-                    break
-                lam2 += 1e-12 * (1.0 + d)  # singular JJᵀ with λ = 0: retry with a floor
-            else:
-                return it, False, cost
-            for j in range(n):
-                s = 0.0
-                for i in range(6):
-                    s += Jw[i, j] * y6[i]
-                dq[j] = s
-        elif method == LM_WAMPLER or method == LM_CHAN or method == LM_SUGIHARA:
-            _normal(Jw, r, A, g)
-            lam = params[P_DAMPING]
-            if method == LM_WAMPLER:
-                wn = lam
-            elif method == LM_CHAN:
-                wn = lam * cost
-            else:
-                wn = cost + lam
-            d = 0.0
-            for i in range(n):
-                d = max(d, A[i, i])
-                A[i, i] += wn
-            if not _chol_solve(A, g, dq, n):
-                # singular normal matrix with a vanishing damping (e.g. a redundant arm
-                # at convergence): retry with a 1e-12 relative floor
-                _normal(Jw, r, A, g)
-                for i in range(n):
-                    A[i, i] += wn + 1e-12 * (1.0 + d)
-                if not _chol_solve(A, g, dq, n):
-                    return it, False, cost
-        elif method == PINV or method == NEWTON:
-            _pinv_step(Jw, r, dq, params[P_RCOND])
-            if method == PINV:
-                _limit_step(dq, params[P_MAX_STEP])
-        elif method == GAUSS_NEWTON:
-            _normal(Jw, r, A, g)
-            _pinv_step(A, g, dq, params[P_RCOND])
-        elif method == SDLS:
-            _sdls_step(Jw, r, dq, params[P_MAX_STEP])
-        step = 1.0
-        for _ls in range(12 if method == NEWTON else 1):
-            for j in range(n):
-                qn[j] = q[j] + step * dq[j]
-            if respect:
-                project_into(qn, lo, hi, revolute)
-            if method != NEWTON:
-                break
-            fk_into(qn, F, meta, Tn)
-            pose_error_into(Tn, Tt, en)
-            if task_cost(en, w) < cost:
-                break
-            step *= 0.5
-        q[:] = qn
+        if not step(q, J, e, cost, p, ctx, ws, dq):  # noqa: F821 (bound by compile_method)
+            return it, False, cost
+        for j in range(n):
+            qn[j] = q[j] + dq[j]
+        if respect:
+            project_into(qn, lo, hi, revolute)
+        for j in range(n):
+            q[j] = qn[j]
         jacobian_into(q, F, meta, J, T)
         pose_error_into(T, Tt, e)
         cost = task_cost(e, w)
@@ -621,7 +449,7 @@ def _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
             mu = 1e-3 * max(d, 1e-12)
         for i in range(n):
             A[i, i] += mu
-        if not _chol_solve(A, g, dq, n):
+        if not spd_solve_into(A, g, dq, n):
             return it, False, cost
         for i in range(n):
             qn[i] = q[i] + dq[i]
@@ -658,53 +486,44 @@ def _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
     return max_iter, (pe <= tol and oe <= tol), cost
 
 
-@njit(cache=True)
-def solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
+def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     """Solve one target with restarts; write the best q into ``q_out`` (n,) and ``info``.
 
     Args:
-        F: (n+1, 4, 4) chain fixed transforms (see :mod:`serialkin.kinematics._kernels`).
+        F: (n+1, 4, 4) chain fixed transforms (see :mod:`serialkin.kinematics.kernels`).
         meta: (n, 5) chain joint data.
         Tt: (4, 4) target pose.
         box: (5, n) joint limits, sampling box and joint types (rows ``B_*``).
         q0: (n,) first start configuration, read when ``cfg[C_USE_Q0]`` is 1.
-        cfg: (N_CFG,) weights, method code, tolerance, budget and method parameters
-            (indices ``C_*`` and ``P_*``).
+        cfg: weights, tolerance, budget (indices ``C_*``), then the method's parameters
+            ``cfg[N_LOOP:]``.
         seed: uint64 seed of this target's random stream.
         q_out: (n,) output, the best configuration found.
         info: (N_INFO,) output, see ``I_*``.
     """
     n = meta.shape[0]
     w = cfg[C_WEIGHTS:C_WEIGHTS + 6]
+    p = cfg[N_LOOP:]
     lo = box[B_LO]
     hi = box[B_HI]
     slo = box[B_SLO]
     shi = box[B_SHI]
     revolute = box[B_REVOLUTE]
-    method = int(cfg[C_METHOD])
     tol = cfg[C_TOL]
     max_iter = int(cfg[C_MAX_ITER])
     restarts = int(cfg[C_RESTARTS])
     respect = cfg[C_RESPECT] > 0.5
     use_q0 = cfg[C_USE_Q0] > 0.5
+    window = int(cfg[C_WINDOW])
     J = np.empty((6, n))
     T = np.empty((4, 4))
     e = np.empty(6)
-    Jw = np.empty((6, n))
-    r = np.empty(6)
-    A = np.empty((n, n))
-    g = np.empty(n)
     dq = np.empty(n)
-    qn = np.empty(n)
-    Jn = np.empty((6, n))
-    Tn = np.empty((4, 4))
-    en = np.empty(6)
-    M6 = np.empty((6, 6))
-    y6 = np.empty(6)
-    free = np.empty(n)
     q = np.empty(n)
     be = np.empty(6)
     sw = np.empty(6)
+    ws = (np.empty((6, n)), np.empty(6), np.empty((n, n)), np.empty(n), np.empty((6, 6)),
+          np.empty(6), np.empty(n), np.empty(n), np.empty((4, 4)), np.empty(6))
     for i in range(6):
         sw[i] = math.sqrt(w[i])
     state = np.empty(1, dtype=np.uint64)
@@ -732,9 +551,8 @@ def solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
             random_q_into(state, slo, shi, q)
         if respect:
             project_into(q, lo, hi, revolute)
-        its, ok, cost = _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, method, cfg,
-                                 tol, max_iter, q, J, T, e, Jw, r, A, g, dq, qn, Jn, Tn, en,
-                                 M6, y6, free)
+        its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
+                                     respect, p, window, tol, max_iter, q, J, T, e, dq, ws)
         total += its
         finite = math.isfinite(cost)
         for i in range(n):
@@ -750,7 +568,8 @@ def solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     if not success and cfg[C_POLISH] > 0.5:
         q[:] = q_out
         its, ok, cost = _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
-                                q, J, T, e, Jw, r, A, g, dq, qn, Jn, Tn, en)
+                                q, J, T, e, ws[W_JW], ws[W_R], ws[W_A], ws[W_G], dq,
+                                ws[W_QN], np.empty((6, n)), ws[W_TN], ws[W_EN])
         total += its
         if ok or cost < best_cost:
             best_cost = cost
@@ -765,11 +584,11 @@ def solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     info[I_ORI_ERR] = oe
     info[I_RESTARTS] = used
     info[I_COST] = best_cost
+    info[I_INSIDE] = 1.0 if inside_limits(q_out, lo, hi, LIMIT_TOL) else 0.0
 
 
-@njit(cache=True, nogil=True)
-def solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
-    """:func:`solve_one` for targets ``start..stop-1`` of ``Tt`` (N, 4, 4), GIL released.
+def _solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
+    """``solve_one`` for targets ``start..stop-1`` of ``Tt`` (N, 4, 4), GIL released.
 
     ``Q0`` (N, n) start configurations (read when ``cfg[C_USE_Q0]`` is 1), ``Q_out``
     (N, n) and ``info`` (N, N_INFO) outputs. The batch driver
@@ -779,4 +598,65 @@ def solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
     the single solves with that seed return, whatever the chunking.
     """
     for k in range(start, stop):
-        solve_one(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k])
+        solve_one(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k])  # noqa: F821
+
+
+@dataclass(frozen=True, eq=False)
+class CompiledMethod:
+    """A compiled IK method: its step kernel inside the shared loop.
+
+    Attributes:
+        step: the step kernel (see the module docstring).
+        params: ``(option name, zero allowed)`` of the values the step reads from ``p``,
+            in order (``cfg[N_LOOP + i]``); each is a finite number > 0 (or ≥ 0).
+        solve_one: ``solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info)``.
+        solve_chunk: ``solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start,
+            stop)``, GIL released.
+    """
+
+    step: object
+    params: tuple[tuple[str, bool], ...]
+    solve_one: object
+    solve_chunk: object
+
+
+_SOURCE = Path(__file__).read_bytes()
+
+
+def _bind(template, name: str, tag: str, **bound):
+    """A copy of the Python function ``template`` whose globals also hold ``bound``.
+
+    Its name carries the method's name and ``tag``, so that numba's on-disk cache (keyed
+    by name and source file) keeps one entry per method and per version of the sources.
+    """
+    g = dict(template.__globals__)
+    g.update(bound)
+    fn = types.FunctionType(template.__code__, g, f"{template.__name__}_{name}")
+    fn.__qualname__ = f"{template.__name__.lstrip('_')}_{name}_{tag}"
+    fn.__doc__ = template.__doc__
+    return fn
+
+
+def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *,
+                   allocates: bool = False) -> CompiledMethod:
+    """The shared loop around the step kernel ``step`` (an ``@njit`` function), for ``name``.
+
+    ``params`` names the options the step reads (see :class:`CompiledMethod`);
+    ``allocates`` must be True when the step, or a helper it calls, allocates arrays (the
+    attempt loop is then compiled with reference counting, about 0.1 µs slower per
+    iteration). Compilation is lazy (at the first call) and cached on disk; the cache
+    entry's name holds a hash of this module's and the step's module's sources, so
+    editing either recompiles.
+    """
+    import inspect
+
+    step_src = Path(inspect.getfile(step.py_func)).read_bytes()
+    tag = hashlib.sha1(_SOURCE + step_src).hexdigest()[:10]
+    # the attempt loop itself allocates nothing: without reference counting (NRT), which
+    # would incref/decref every array the inlined step touches, each iteration (about
+    # 0.1 µs per iteration, a fifth of an lm solve), unless the step allocates
+    attempt = njit(cache=True, _nrt=allocates)(_bind(_attempt, name, tag + str(int(allocates)),
+                                                     step=step))
+    one = njit(cache=True)(_bind(_solve_one, name, tag, attempt_loop=attempt))
+    chunk = njit(cache=True, nogil=True)(_bind(_solve_chunk, name, tag, solve_one=one))
+    return CompiledMethod(step=step, params=tuple(params), solve_one=one, solve_chunk=chunk)

@@ -27,7 +27,7 @@ depend on δ).
 
 Implementation notes:
 
-* One call of :func:`serialkin.kinematics._kernels.jacobian_into` per sweep gives every
+* One call of :func:`serialkin.kinematics.kernels.jacobian_into` per sweep gives every
   joint axis (``z_i`` in the Jacobian's angular rows, or its linear rows for prismatic
   joints) and, through ``v_i × z_i = (p − o_i)⊥``, a point on each axis. Going from the
   last joint to the first, the axes still to be visited do not move, so the end-effector
@@ -66,7 +66,7 @@ import numpy as np
 from numba import njit
 
 from serialkin.ik._kernels import MAX_ITER, RUNNING, TWO_PI, stopping_test
-from serialkin.kinematics._kernels import PRISMATIC, jacobian_into
+from serialkin.kinematics.kernels import PRISMATIC, jacobian_into
 
 
 @njit(cache=True, inline="always")
@@ -127,7 +127,7 @@ def ccd_sweep(q, F, meta, T_target, pos_sel, w_pos, w_orient, lo, hi, J, T):
 
     Args:
         q: joint values (n,), updated in place.
-        F: (n+1, 4, 4) chain fixed transforms (see :mod:`serialkin.kinematics._kernels`).
+        F: (n+1, 4, 4) chain fixed transforms (see :mod:`serialkin.kinematics.kernels`).
         meta: (n, 5) chain joint data.
         T_target: target pose (4, 4).
         pos_sel: (3,) 1.0 where the position coordinate is selected, else 0.0.

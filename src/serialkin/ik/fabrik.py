@@ -58,7 +58,7 @@ from numba import njit
 from serialkin.errors import NotSupportedError
 from serialkin.ik._kernels import MAX_ITER, RUNNING, stopping_test
 from serialkin.ik.ccd import _axis_point, _clamp_angle_step
-from serialkin.kinematics._kernels import fk_into, jacobian_into
+from serialkin.kinematics.kernels import fk_into, jacobian_into
 
 #: Axis alignment tolerance (|z_i × z_0|) for "parallel joint axes".
 PARALLEL_TOL = 1e-9

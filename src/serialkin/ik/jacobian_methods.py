@@ -1,7 +1,9 @@
 """Jacobian-based IK methods (chapter section 5.3), registered by name.
 
-All of them run in the compiled loop of :mod:`serialkin.ik._kernels` (see its docstring
-for each step's formula) and share the skeleton of :mod:`serialkin.ik.solver`: the same
+Each method is a small step kernel written here and compiled into the shared loop of
+:mod:`serialkin.ik._kernels` (:func:`~serialkin.ik._kernels.compile_method`), so adding a
+compiled method means adding its step and its :func:`register_method` call to this file.
+They share the skeleton of :mod:`serialkin.ik.solver`: the same
 targets, mask, tolerance, restarts and seeding. Joint limits are respected by
 projection after every step (2π shift or nearer limit for revolute joints, clamping for
 prismatic ones).
@@ -43,8 +45,34 @@ from __future__ import annotations
 
 import math
 
-from serialkin.ik import _kernels as K
+import numpy as np
+from numba import njit
+
+from serialkin.ik._kernels import (
+    W_A,
+    W_EN,
+    W_FREE,
+    W_G,
+    W_JW,
+    W_M6,
+    W_QN,
+    W_R,
+    W_TN,
+    W_Y6,
+    _jacobi_svd,
+    _limit_step,
+    _normal,
+    _pinv_step,
+    _transpose_times,
+    compile_method,
+    project_into,
+    task_cost,
+)
 from serialkin.ik.registry import MethodSpec, register_method
+from serialkin.kinematics.dls import dls_step_into, spd_solve_into
+from serialkin.kinematics.kernels import fk_into
+from serialkin.model.limits import wrap_angle as interval_wrap
+from serialkin.spatial.kernels import pose_error_into
 
 _PROJECTION = (
     "projection after every step: a revolute joint is shifted by 2π when that brings it "
@@ -55,49 +83,304 @@ _LIMIT_AWARE = (
     "the step recomputed for the others; then " + _PROJECTION
 )
 
-#: name, kernel code, max_iter, restarts, default options, summary (registration order).
-_TABLE = (
-    ("transpose", K.TRANSPOSE, 5000, 5, {"stall_window": 1000},
-     "Jacobian transpose with the Buss/Wolovich step length (slow, linear convergence)"),
-    ("pinv", K.PINV, 100, 50, {"max_step": 0.5, "rcond": 1e-10, "stall_window": 20},
-     "Moore-Penrose pseudoinverse step J⁺e (eq 40), steps capped at max_step"),
-    ("dls", K.DLS, 200, 50, {"damping": 0.01, "stall_window": 30},
-     "damped least squares Jᵀ(JJᵀ+λ²I)⁻¹e with fixed damping λ (eq 46)"),
-    ("lm", K.LM, 100, 100, {"damping": 0.03, "stall_window": 5, "polish": True},
-     "Levenberg-Marquardt, damping λE adapted to the error, limit-aware (default)"),
-    ("lm_wampler", K.LM_WAMPLER, 200, 50, {"damping": 1e-4, "stall_window": 30},
-     "Levenberg-Marquardt with constant damping λI (Wampler)"),
-    ("lm_chan", K.LM_CHAN, 200, 50, {"damping": 1.0, "stall_window": 30},
-     "Levenberg-Marquardt with error-proportional damping λE (Chan-Lawrence)"),
-    ("lm_sugihara", K.LM_SUGIHARA, 200, 50, {"damping": 1e-4, "stall_window": 30},
-     "Levenberg-Marquardt with damping E + λ (Sugihara)"),
-    ("sdls", K.SDLS, 500, 30, {"max_step": math.pi / 4, "stall_window": 60},
-     "selectively damped least squares by SVD (Buss & Kim)"),
-    ("newton", K.NEWTON, 100, 50, {"rcond": 1e-10, "stall_window": 20},
-     "Newton-Raphson (eq 41): full pseudoinverse step with backtracking line search"),
-    ("gauss_newton", K.GAUSS_NEWTON, 100, 50, {"rcond": 1e-12, "stall_window": 20},
-     "Gauss-Newton on the normal equations (JᵀJ)⁺Jᵀe, full step"),
-)
-
-
-
 #: Largest robot of the methods whose iteration costs O(n³) (an n×n system, or an SVD
 #: over the n columns of J): about a minute for a failing solve at 1000 joints.
 MAX_JOINTS_CUBIC = 1000
 
-#: Methods whose iteration cost grows linearly with the number of joints.
-_LINEAR = (K.TRANSPOSE, K.DLS)
+# Step kernels: step(q, J, e, cost, p, ctx, ws, dq) -> bool, see serialkin.ik._kernels.
+# ctx = (F, meta, Tt, w, sw, lo, hi, revolute, respect); Jw = ws[W_JW], r = ws[W_R] are
+# the weighted Jacobian and residual at q.
 
 
-def _register_all() -> None:
-    """Register every method of :data:`_TABLE` (family 'jacobian', compiled kernel)."""
-    for name, code, max_iter, restarts, options, summary in _TABLE:
-        register_method(MethodSpec(
-            name=name, family="jacobian", summary=summary,
-            limits=_LIMIT_AWARE if code == K.LM else _PROJECTION,
-            max_iter=max_iter, restarts=restarts, options=options, kernel_code=code,
-            max_joints=None if code in _LINEAR else MAX_JOINTS_CUBIC,
-        ))
+@njit(cache=True, inline="always")
+def step_transpose(q, J, e, cost, p, ctx, ws, dq):
+    """``Δq = α Jwᵀ r`` with ``α = ⟨r, Jw Jwᵀ r⟩ / |Jw Jwᵀ r|²`` (Buss 2004; Wolovich & Elliott).
+
+    The exact minimiser of the linearised residual along the gradient.
+    """
+    Jw = ws[W_JW]
+    r = ws[W_R]
+    g = ws[W_G]
+    n = q.shape[0]
+    _transpose_times(Jw, r, g)
+    num = 0.0
+    den = 0.0
+    for i in range(6):
+        v = 0.0
+        for j in range(n):
+            v += Jw[i, j] * g[j]
+        num += r[i] * v
+        den += v * v
+    alpha = num / den if den > 0.0 else 0.0
+    for j in range(n):
+        dq[j] = alpha * g[j]
+    return True
 
 
-_register_all()
+@njit(cache=True, inline="always")
+def step_pinv(q, J, e, cost, p, ctx, ws, dq):
+    """``Δq = Jw⁺ r`` (eq 40; σ below ``rcond·σ_max`` dropped), scaled to max |Δq_i| ≤ max_step.
+
+    ``p = (max_step, rcond)``.
+    """
+    _pinv_step(ws[W_JW], ws[W_R], dq, p[1])
+    _limit_step(dq, p[0])
+    return True
+
+
+@njit(cache=True, inline="always")
+def step_dls(q, J, e, cost, p, ctx, ws, dq):
+    """``Δq = Jwᵀ (Jw Jwᵀ + λ² I)⁻¹ r`` (eq 46 as corrected in the errata), fixed λ = ``p[0]``.
+
+    A singular ``Jw Jwᵀ`` with λ = 0 is retried with a 1e-12 relative floor.
+    """
+    return dls_step_into(ws[W_JW], ws[W_R], p[0] * p[0], 1e-12, ws[W_M6], ws[W_Y6], dq)
+
+
+@njit(cache=True, inline="always")
+def step_lm(q, J, e, cost, p, ctx, ws, dq):
+    """Error-damped Levenberg-Marquardt with a limit-aware active set, λ = ``p[0]``.
+
+    ``(JwᵀJw + μI) Δq = Jwᵀ r`` with ``μ = λE`` (Chan & Lawrence's rule with a small λ,
+    plus a 1e-12 relative floor): strongly damped far from the target, the Gauss-Newton
+    step (quadratic convergence) at it; every step is taken (non-monotone: it escapes
+    shallow local minima that a monotone trust-region LM falls into). With the limits
+    respected, a joint at a limit whose step points outward is frozen (its column
+    removed) and the step recomputed for the others, at most n times.
+    """
+    sw = ctx[4]
+    lo = ctx[5]
+    hi = ctx[6]
+    revolute = ctx[7]
+    respect = ctx[8]
+    Jw = ws[W_JW]
+    r = ws[W_R]
+    A = ws[W_A]
+    g = ws[W_G]
+    free = ws[W_FREE]
+    n = q.shape[0]
+    for j in range(n):
+        free[j] = 1.0
+    lam = p[0]
+    for _pass in range(n + 1):
+        for i in range(6):
+            for j in range(n):
+                Jw[i, j] = sw[i] * J[i, j] * free[j]
+        _normal(Jw, r, A, g)
+        d = 0.0
+        for i in range(n):
+            d = max(d, A[i, i])
+        mu = lam * cost + 1e-12 * (1.0 + d)
+        for i in range(n):
+            A[i, i] += mu + (1.0 - free[i])
+        if not spd_solve_into(A, g, dq, n):
+            return False
+        if not respect:
+            return True
+        changed = False
+        for i in range(n):
+            x = q[i] + dq[i]
+            if free[i] == 0.0 or (x >= lo[i] and x <= hi[i]):
+                continue
+            if revolute[i] != 0 and not math.isnan(interval_wrap(x, lo[i], hi[i])):
+                continue  # a 2π shift brings it inside: not blocked
+            if (x < lo[i] and q[i] <= lo[i] + 1e-12) or (x > hi[i] and q[i] >= hi[i] - 1e-12):
+                free[i] = 0.0
+                changed = True
+        if not changed:
+            return True
+    return True
+
+
+@njit(cache=True, inline="always")
+def _damped_normal_step(ws, wn, dq):
+    """``(JwᵀJw + wn I) Δq = Jwᵀ r``; a singular matrix is retried with a 1e-12 relative floor."""
+    Jw = ws[W_JW]
+    r = ws[W_R]
+    A = ws[W_A]
+    g = ws[W_G]
+    n = dq.shape[0]
+    _normal(Jw, r, A, g)
+    d = 0.0
+    for i in range(n):
+        d = max(d, A[i, i])
+        A[i, i] += wn
+    if spd_solve_into(A, g, dq, n):
+        return True
+    # singular normal matrix with a vanishing damping (e.g. a redundant arm at
+    # convergence): retry with a 1e-12 relative floor
+    _normal(Jw, r, A, g)
+    for i in range(n):
+        A[i, i] += wn + 1e-12 * (1.0 + d)
+    return spd_solve_into(A, g, dq, n)
+
+
+@njit(cache=True, inline="always")
+def step_lm_wampler(q, J, e, cost, p, ctx, ws, dq):
+    """``(JwᵀJw + λI) Δq = Jwᵀ r`` (Wampler 1986), λ = ``p[0]``; every step taken."""
+    return _damped_normal_step(ws, p[0], dq)
+
+
+@njit(cache=True, inline="always")
+def step_lm_chan(q, J, e, cost, p, ctx, ws, dq):
+    """``(JwᵀJw + λE I) Δq = Jwᵀ r`` (Chan & Lawrence 1988), λ = ``p[0]``; every step taken."""
+    return _damped_normal_step(ws, p[0] * cost, dq)
+
+
+@njit(cache=True, inline="always")
+def step_lm_sugihara(q, J, e, cost, p, ctx, ws, dq):
+    """``(JwᵀJw + (E + λ) I) Δq = Jwᵀ r`` (Sugihara 2011), λ = ``p[0]``; every step taken."""
+    return _damped_normal_step(ws, cost + p[0], dq)
+
+
+@njit(cache=True)
+def _sdls_into(Jw, r, dq, gamma_max):
+    """Selectively damped least squares step (Buss & Kim 2005), two 3-row blocks."""
+    n = Jw.shape[1]
+    W = np.empty((6, n))
+    V = np.empty((n, n))
+    s = np.empty(n)
+    _jacobi_svd(Jw, W, V, s)
+    rho = np.empty(n)
+    smax = 0.0
+    for j in range(n):
+        a = 0.0
+        b = 0.0
+        for i in range(3):
+            a += Jw[i, j] * Jw[i, j]
+            b += Jw[i + 3, j] * Jw[i + 3, j]
+        rho[j] = math.sqrt(a) + math.sqrt(b)
+        dq[j] = 0.0
+        smax = max(smax, s[j])
+    if not smax > 0.0:
+        return
+    phi = np.empty(n)
+    for k in range(n):
+        if s[k] <= 1e-12 * smax:
+            continue
+        alpha = 0.0
+        a = 0.0
+        b = 0.0
+        for i in range(3):
+            a += W[i, k] * W[i, k]
+            b += W[i + 3, k] * W[i + 3, k]
+        for i in range(6):
+            alpha += W[i, k] * r[i]
+        alpha /= s[k]  # α = u_kᵀ r
+        N = (math.sqrt(a) + math.sqrt(b)) / s[k]  # |u_k| over the two blocks
+        M = 0.0
+        for j in range(n):
+            M += abs(V[j, k]) * rho[j]
+        M /= s[k]
+        gamma = gamma_max * min(1.0, N / M) if M > 0.0 else gamma_max
+        big = 0.0
+        for j in range(n):
+            phi[j] = alpha / s[k] * V[j, k]
+            big = max(big, abs(phi[j]))
+        scale = gamma / big if big > gamma else 1.0
+        for j in range(n):
+            dq[j] += scale * phi[j]
+    _limit_step(dq, gamma_max)
+
+
+
+@njit(cache=True, inline="always")
+def step_sdls(q, J, e, cost, p, ctx, ws, dq):
+    """Selectively damped least squares (Buss & Kim 2005), γ_max = ``p[0]``.
+
+    Each singular direction's contribution is clamped by ``γ_i = min(1, N_i/M_i)·γ_max``
+    and the total by ``γ_max``, with the position and orientation rows as the two "end
+    effectors".
+    """
+    _sdls_into(ws[W_JW], ws[W_R], dq, p[0])
+    return True
+
+
+@njit(cache=True, inline="always")
+def step_newton(q, J, e, cost, p, ctx, ws, dq):
+    """Newton-Raphson (eq 41 in n dimensions): ``Δq = Jw⁺ r`` (rcond = ``p[0]``), backtracking.
+
+    The step is halved (at most 11 times) until the projected ``q + Δq`` lowers the cost.
+    """
+    F = ctx[0]
+    meta = ctx[1]
+    Tt = ctx[2]
+    w = ctx[3]
+    lo = ctx[5]
+    hi = ctx[6]
+    revolute = ctx[7]
+    respect = ctx[8]
+    qn = ws[W_QN]
+    Tn = ws[W_TN]
+    en = ws[W_EN]
+    n = q.shape[0]
+    _pinv_step(ws[W_JW], ws[W_R], dq, p[0])
+    s = 1.0
+    for _ls in range(12):
+        for j in range(n):
+            qn[j] = q[j] + s * dq[j]
+        if respect:
+            project_into(qn, lo, hi, revolute)
+        fk_into(qn, F, meta, Tn)
+        pose_error_into(Tn, Tt, en)
+        if task_cost(en, w) < cost or _ls == 11:
+            break
+        s *= 0.5
+    if s != 1.0:
+        for j in range(n):
+            dq[j] *= s
+    return True
+
+
+@njit(cache=True, inline="always")
+def step_gauss_newton(q, J, e, cost, p, ctx, ws, dq):
+    """Gauss-Newton on the normal equations, ``Δq = (JwᵀJw)⁺ Jwᵀ r`` (rcond ``p[0]``), full step."""
+    A = ws[W_A]
+    g = ws[W_G]
+    _normal(ws[W_JW], ws[W_R], A, g)
+    _pinv_step(A, g, dq, p[0])
+    return True
+
+
+def _register(name, step, params, max_iter, restarts, options, summary, *, limits=_PROJECTION,
+              linear=False, allocates=False):
+    """Register ``name`` as the step kernel ``step`` in the shared compiled loop."""
+    register_method(MethodSpec(
+        name=name, family="jacobian", summary=summary, limits=limits,
+        max_iter=max_iter, restarts=restarts, options=options,
+        kernel=compile_method(name, step, params, allocates=allocates),
+        max_joints=None if linear else MAX_JOINTS_CUBIC,
+    ))
+
+
+_register("transpose", step_transpose, (), 5000, 5, {"stall_window": 1000},
+          "Jacobian transpose with the Buss/Wolovich step length (slow, linear convergence)",
+          linear=True)
+_register("pinv", step_pinv, (("max_step", False), ("rcond", False)), 100, 50,
+          {"max_step": 0.5, "rcond": 1e-10, "stall_window": 20},
+          "Moore-Penrose pseudoinverse step J⁺e (eq 40), steps capped at max_step",
+          allocates=True)
+_register("dls", step_dls, (("damping", True),), 200, 50, {"damping": 0.01, "stall_window": 30},
+          "damped least squares Jᵀ(JJᵀ+λ²I)⁻¹e with fixed damping λ (eq 46)", linear=True)
+_register("lm", step_lm, (("damping", True),), 100, 100,
+          {"damping": 0.03, "stall_window": 5, "polish": True},
+          "Levenberg-Marquardt, damping λE adapted to the error, limit-aware (default)",
+          limits=_LIMIT_AWARE)
+_register("lm_wampler", step_lm_wampler, (("damping", True),), 200, 50,
+          {"damping": 1e-4, "stall_window": 30},
+          "Levenberg-Marquardt with constant damping λI (Wampler)")
+_register("lm_chan", step_lm_chan, (("damping", True),), 200, 50,
+          {"damping": 1.0, "stall_window": 30},
+          "Levenberg-Marquardt with error-proportional damping λE (Chan-Lawrence)")
+_register("lm_sugihara", step_lm_sugihara, (("damping", True),), 200, 50,
+          {"damping": 1e-4, "stall_window": 30},
+          "Levenberg-Marquardt with damping E + λ (Sugihara)")
+_register("sdls", step_sdls, (("max_step", False),), 500, 30,
+          {"max_step": math.pi / 4, "stall_window": 60},
+          "selectively damped least squares by SVD (Buss & Kim)", allocates=True)
+_register("newton", step_newton, (("rcond", False),), 100, 50, {"rcond": 1e-10, "stall_window": 20},
+          "Newton-Raphson (eq 41): full pseudoinverse step with backtracking line search",
+          allocates=True)
+_register("gauss_newton", step_gauss_newton, (("rcond", False),), 100, 50,
+          {"rcond": 1e-12, "stall_window": 20},
+          "Gauss-Newton on the normal equations (JᵀJ)⁺Jᵀe, full step", allocates=True)

@@ -46,8 +46,8 @@ from scipy.optimize import minimize
 from threadpoolctl import ThreadpoolController
 
 from serialkin.ik._kernels import task_cost, task_errors
-from serialkin.kinematics._kernels import fk_into, jacobian_into
-from serialkin.spatial._kernels import pose_error_into
+from serialkin.kinematics.kernels import fk_into, jacobian_into
+from serialkin.spatial.kernels import pose_error_into
 
 #: Names of the methods implemented here (scipy method used for each).
 SCIPY_METHODS = {"bfgs": "L-BFGS-B", "powell": "Powell"}

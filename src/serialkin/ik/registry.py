@@ -9,8 +9,9 @@ method ``'analytic'`` when that package provides ``ik_all``.
 
 Two kinds of methods share the same skeleton (:mod:`serialkin.ik.solver`):
 
-* compiled methods (``kernel_code`` set): the whole loop — iterations, restarts,
-  stagnation, limits — runs in :mod:`serialkin.ik._kernels`;
+* compiled methods (``kernel`` set): a step kernel, written and registered in its
+  family's file, inside the one compiled loop of :mod:`serialkin.ik._kernels` that owns
+  iterations, restarts, stagnation and limits (:func:`~serialkin.ik._kernels.compile_method`);
 * Python methods (``attempt`` set): the method supplies one attempt from a start
   configuration; the shared Python loop in :func:`serialkin.ik.solver.run_attempts` owns
   restarts, seeding, the iteration budget, success test and the result.
@@ -30,6 +31,7 @@ from serialkin.errors import InputError
 if TYPE_CHECKING:
     import numpy as np
 
+    from serialkin.ik._kernels import CompiledMethod
     from serialkin.ik.solver import IKProblem
 
 #: Signature of a Python method's attempt: ``attempt(problem, q_start, max_iter, options)``
@@ -53,7 +55,8 @@ class MethodSpec:
         max_iter: default iteration budget per attempt.
         restarts: default number of restarts from random configurations.
         options: method-specific keyword options and their defaults.
-        kernel_code: method code of the compiled kernel, or None for a Python method.
+        kernel: the compiled method (a step kernel in the shared loop, built by
+            :func:`serialkin.ik._kernels.compile_method`), or None for a Python method.
         attempt: the Python attempt function (see :data:`AttemptFn`), or None.
         max_joints: the largest robot (number of joints) the method accepts, or None for
             any: methods whose iteration costs O(n³) (an n×n system or an SVD over n
@@ -67,7 +70,7 @@ class MethodSpec:
             or None.
 
     Raises:
-        InputError: not exactly one of ``kernel_code``, ``attempt``, ``solve`` given.
+        InputError: not exactly one of ``kernel``, ``attempt``, ``solve`` given.
     """
 
     name: str
@@ -78,15 +81,15 @@ class MethodSpec:
     max_iter: int = 100
     restarts: int = 50
     options: Mapping[str, Any] = field(default_factory=dict)
-    kernel_code: int | None = None
+    kernel: CompiledMethod | None = None
     attempt: AttemptFn | None = None
     solve: Callable[..., Any] | None = None
     max_joints: int | None = None
 
     def __post_init__(self) -> None:
-        if (self.kernel_code is None) + (self.attempt is None) + (self.solve is None) != 2:
+        if (self.kernel is None) + (self.attempt is None) + (self.solve is None) != 2:
             raise InputError(
-                f"method {self.name!r} needs exactly one of kernel_code, attempt, solve"
+                f"method {self.name!r} needs exactly one of kernel, attempt, solve"
             )
 
 

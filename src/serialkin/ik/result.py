@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+_NEW = object.__new__
+
 
 @dataclass(frozen=True, eq=False)
 class IKResult:
@@ -43,6 +45,19 @@ class IKResult:
     reason: str | np.ndarray
     restarts: int | np.ndarray
     method: str
+
+    @classmethod
+    def make(cls, q: np.ndarray, success: bool, iterations: int, position_error: float,
+             orientation_error: float, reason: str, restarts: int, method: str) -> IKResult:
+        """The result with these fields, built without the frozen ``__init__``'s overhead.
+
+        For the solvers' hot path (about 1 µs less per call); the fields are trusted.
+        """
+        r = _NEW(cls)
+        r.__dict__.update(q=q, success=success, iterations=iterations,
+                          position_error=position_error, orientation_error=orientation_error,
+                          reason=reason, restarts=restarts, method=method)
+        return r
 
     @property
     def batch(self) -> bool:

@@ -3,10 +3,10 @@
 :func:`solve` (what ``robot.ik`` calls) validates the arguments, looks the method up in
 the registry and runs it:
 
-* compiled methods (the Jacobian family) run entirely in
-  :func:`serialkin.ik._kernels.solve_one`; a batch runs
-  :func:`~serialkin.ik._kernels.solve_chunk` on every core (GIL released, chunks
-  handed out by :func:`serialkin.kinematics.parallel.run`);
+* compiled methods (the Jacobian family) run entirely in their ``solve_one``, the
+  shared loop of :mod:`serialkin.ik._kernels` around the method's step kernel; a batch
+  runs their ``solve_chunk`` on every core (GIL released, chunks handed out by
+  :func:`serialkin.kinematics.parallel.run`);
 * Python methods supply one attempt and :func:`run_attempts` owns the rest.
 
 Both follow the same semantics:
@@ -49,10 +49,10 @@ from serialkin.ik.target import (
     parse_target,
     robot_arrays,
 )
-from serialkin.kinematics import _kernels as FK
+from serialkin.kinematics import kernels as FK
 from serialkin.kinematics import parallel
 from serialkin.model.robot import Robot
-from serialkin.spatial import _kernels as SK
+from serialkin.spatial import kernels as SK
 
 #: Default tolerance on the position [m] and orientation [rad] errors.
 DEFAULT_TOL = 1e-9
@@ -155,6 +155,8 @@ class IKProblem:
 
 def _stream_seed(seed: object) -> int:
     """A uint64 stream seed from ``seed`` (None: fresh OS entropy; int; Generator)."""
+    if type(seed) is int:
+        return seed & _MASK64
     if seed is None:
         return int.from_bytes(os.urandom(8), "little")
     if isinstance(seed, np.random.Generator):
@@ -309,7 +311,11 @@ def _same_options(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
 
 
 def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
-    """The method-parameter tail ``cfg[P_DAMPING:]`` of the kernel configuration."""
+    """The tail ``cfg[C_WINDOW:]`` of the kernel configuration.
+
+    The loop's stagnation window and polish flag, then the method's own parameters
+    (``spec.kernel.params``, in order).
+    """
     from serialkin._checks import check_positive
 
     default = opts is spec.options or _same_options(opts, spec.options)
@@ -317,17 +323,17 @@ def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
         cached = _PARAMS.get(spec.name)
         if cached is not None and cached[0] is spec:
             return cached[1]
-    base = K.P_DAMPING
-    p = np.zeros(K.N_CFG - base)
+    names = spec.kernel.params
+    base = K.C_WINDOW
+    p = np.zeros(K.N_LOOP - base + len(names))
     polish = opts.get("polish", False)
     if not isinstance(polish, (bool, np.bool_)):
         raise InputTypeError(f"polish must be True or False, got {polish!r}")
     p[K.C_POLISH - base] = 1.0 if polish else 0.0
-    p[K.P_DAMPING - base] = check_positive(opts.get("damping", 1e-3), "damping", allow_zero=True)
-    p[K.P_WINDOW - base] = check_int(opts.get("stall_window", 20), "stall_window", minimum=1,
+    p[K.C_WINDOW - base] = check_int(opts.get("stall_window", 20), "stall_window", minimum=1,
                                      maximum=MAX_ITERATIONS)
-    p[K.P_MAX_STEP - base] = check_positive(opts.get("max_step", 0.5), "max_step")
-    p[K.P_RCOND - base] = check_positive(opts.get("rcond", 1e-10), "rcond")
+    for i, (name, zero_ok) in enumerate(names):
+        p[K.N_LOOP - base + i] = check_positive(opts[name], name, allow_zero=zero_ok)
     if default:
         p.setflags(write=False)
         _PARAMS[spec.name] = (spec, p)
@@ -406,7 +412,7 @@ def solve(
     n_targets = tgt.T.shape[0] if tgt.batch else None
     q0a = None if q0 is None else check_q0(robot, q0, n_targets, bool(respect_limits))
     stream = _stream_seed(seed)
-    if spec.kernel_code is not None:
+    if spec.kernel is not None:
         return _solve_compiled(robot, tgt, spec, q0a, tol_v, iters, nrest, stream,
                                bool(respect_limits), opts)
     return _solve_python(robot, tgt, spec, q0a, tol_v, iters, nrest, stream,
@@ -428,31 +434,31 @@ def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray 
         info = np.empty(K.N_INFO)
         q0k = q0 if q0 is not None and q0.flags.writeable else (
             np.zeros(n) if q0 is None else q0.copy())
-        K.solve_one(F, meta, Tt, box, q0k, cfg, seed64, q, info)
+        spec.kernel.solve_one(F, meta, Tt, box, q0k, cfg, seed64, q, info)
         return _result_single(robot, tgt, spec, q, info, tol, respect)
     N = Tt.shape[0]
     Q = np.empty((N, n))
     info = np.empty((N, K.N_INFO))
     Q0 = np.zeros((N, n)) if q0 is None else np.array(q0, dtype=np.float64, order="C")
-    _run_chunks(F, meta, Tt, box, Q0, cfg, seed64, Q, info)
+    _run_chunks(spec.kernel.solve_chunk, F, meta, Tt, box, Q0, cfg, seed64, Q, info)
     return _result_batch(robot, tgt, spec, Q, info, tol, respect)
 
 
-def _run_chunks(F: np.ndarray, meta: np.ndarray, Tt: np.ndarray, box: np.ndarray,
+def _run_chunks(solve_chunk: Any, F: np.ndarray, meta: np.ndarray, Tt: np.ndarray, box: np.ndarray,
                 Q0: np.ndarray, cfg: np.ndarray, seed64: np.uint64, Q: np.ndarray,
                 info: np.ndarray) -> None:
-    """Solve a batch with :func:`~serialkin.ik._kernels.solve_chunk` on every core.
+    """Solve a batch with the method's ``solve_chunk`` on every core.
 
     Scheduled by :func:`serialkin.kinematics.parallel.run` (chunks of 8 targets claimed
     dynamically, so a few slow targets or a busy core do not leave the batch waiting).
     """
-    parallel.run(K.solve_chunk, (F, meta, Tt, box, Q0, cfg, seed64, Q, info), Tt.shape[0],
+    parallel.run(solve_chunk, (F, meta, Tt, box, Q0, cfg, seed64, Q, info), Tt.shape[0],
                  grain=8)
 
 
 def _kernel_config(spec: MethodSpec, tgt: Target, tol: float, max_iter: int, restarts: int,
                    respect: bool, use_q0: bool, opts: Mapping[str, Any]) -> np.ndarray:
-    """The kernel configuration vector ``cfg`` (N_CFG,) (see :mod:`serialkin.ik._kernels`).
+    """The kernel configuration vector ``cfg`` (see :mod:`serialkin.ik._kernels`).
 
     With default weights and options the vector is cached (the kernels never write it).
     """
@@ -462,15 +468,15 @@ def _kernel_config(spec: MethodSpec, tgt: Target, tol: float, max_iter: int, res
         cfg = _CONFIGS.get(key)
         if cfg is not None:
             return cfg
-    cfg = np.empty(K.N_CFG)
+    tail = _method_params(spec, opts)
+    cfg = np.empty(K.C_WINDOW + tail.shape[0])
     cfg[K.C_WEIGHTS:K.C_WEIGHTS + 6] = tgt.weights
-    cfg[K.C_METHOD] = spec.kernel_code
     cfg[K.C_TOL] = tol
     cfg[K.C_MAX_ITER] = max_iter
     cfg[K.C_RESTARTS] = restarts
     cfg[K.C_RESPECT] = 1.0 if respect else 0.0
     cfg[K.C_USE_Q0] = 1.0 if use_q0 else 0.0
-    cfg[K.P_DAMPING:] = _method_params(spec, opts)
+    cfg[K.C_WINDOW:] = tail
     if key is not None:
         if len(_CONFIGS) > 256:
             _CONFIGS.clear()
@@ -479,7 +485,7 @@ def _kernel_config(spec: MethodSpec, tgt: Target, tol: float, max_iter: int, res
 
 
 #: Tolerance of the final "q inside the joint limits" test of a success [rad or m].
-LIMIT_TOL = 1e-12
+LIMIT_TOL = K.LIMIT_TOL
 
 _OUTSIDE = ("the configuration found lies outside the joint limits; the target may be "
             "reachable only outside them")
@@ -499,14 +505,14 @@ def honest_success(robot: Robot, q: np.ndarray, ok: bool, respect: bool) -> bool
 
 def _result_single(robot: Robot, tgt: Target, spec: MethodSpec, q: np.ndarray,
                    info: np.ndarray, tol: float, respect: bool) -> IKResult:
-    ok = honest_success(robot, q, bool(info[K.I_SUCCESS]), respect)
+    # the final guard of honest_success, evaluated by the kernel (info[I_INSIDE])
+    ok = bool(info[K.I_SUCCESS] > 0.5 and (not respect or info[K.I_INSIDE] > 0.5))
     pe, oe = float(info[K.I_POS_ERR]), float(info[K.I_ORI_ERR])
     its, used = int(info[K.I_ITERATIONS]), int(info[K.I_RESTARTS])
     reason = "" if ok else failure_reason(
         pe, oe, tol, used + 1, its, tgt.kind,
         failure_hint(robot, q, tgt.weights, respect, tgt.T))
-    return IKResult(q=q, success=ok, iterations=its, position_error=pe, orientation_error=oe,
-                    reason=reason, restarts=used, method=spec.name)
+    return IKResult.make(q, ok, its, pe, oe, reason, used, spec.name)
 
 
 def _result_batch(robot: Robot, tgt: Target, spec: MethodSpec, Q: np.ndarray,

@@ -29,18 +29,12 @@ from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, chec
 from serialkin.errors import InputError
 from serialkin.ik._kernels import inside_limits
 from serialkin.model.robot import Robot
-from serialkin.spatial._kernels import transforms_valid
+from serialkin.model.tasks import TARGET_TASKS, TASK_COORDINATES, task_weights
+from serialkin.spatial.kernels import transforms_valid
 
-#: Names of the six task coordinates, in the order of the pose error and Jacobian rows.
-TASK_COORDINATES = ("vx", "vy", "vz", "wx", "wy", "wz")
-
-#: Default weights per target kind.
-KIND_WEIGHTS = {
-    "pose": (1.0, 1.0, 1.0, 1.0, 1.0, 1.0),
-    "position": (1.0, 1.0, 1.0, 0.0, 0.0, 0.0),
-    "planar": (1.0, 1.0, 0.0, 0.0, 0.0, 0.0),
-    "planar_pose": (1.0, 1.0, 0.0, 0.0, 0.0, 1.0),
-}
+#: Default weights per target kind: 1 on the task's rows (the target kinds of
+#: :data:`serialkin.model.tasks.TASKS`, the one task table).
+KIND_WEIGHTS = {kind: task_weights(kind) for kind in TARGET_TASKS}
 
 
 def _frozen(values: tuple[float, ...]) -> np.ndarray:
@@ -80,7 +74,7 @@ def robot_arrays(robot: Robot) -> RobotArrays:
     a = _ARRAYS.get(robot)
     if a is None:
         samp = robot.sampling_limits()
-        revolute = np.array([t == "R" for t in robot.joint_types])
+        revolute = robot.revolute
         box = np.ascontiguousarray(
             np.stack([robot.qlim[:, 0], robot.qlim[:, 1], samp[:, 0], samp[:, 1],
                       revolute.astype(np.float64)]), dtype=np.float64)

@@ -2,7 +2,7 @@
 
 :func:`compile_chain` turns joints in general form (:class:`~serialkin.model.joint.Joint`)
 plus base and tool transforms into the arrays documented in
-:mod:`serialkin.kinematics._kernels`. Standard DH, modified DH, general axes and URDF
+:mod:`serialkin.kinematics.kernels`. Standard DH, modified DH, general axes and URDF
 all end here, so every algorithm serves every robot.
 """
 

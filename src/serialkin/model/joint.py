@@ -126,8 +126,3 @@ class Joint:
         object.__setattr__(self, "offset", definition_real(
             self.offset, where, "offset", MAX_JOINT_VALUE, "rad or m"))
         object.__setattr__(self, "qlim", check_interval(self.qlim, where))
-
-    @property
-    def is_revolute(self) -> bool:
-        """True for a revolute joint."""
-        return self.type == "R"

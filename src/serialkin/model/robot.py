@@ -30,12 +30,14 @@ from serialkin._checks import (
     short_repr,
 )
 from serialkin.errors import InputError, RobotDefinitionError
-from serialkin.kinematics import _kernels as K
+from serialkin.kinematics import kernels as K
 from serialkin.kinematics import parallel
+from serialkin.kinematics.dls import manipulability_batch
 from serialkin.model.chain import compile_chain
 from serialkin.model.dh import CONVENTIONS, DHLink, dh_to_joints, parse_dh_rows
 from serialkin.model.joint import Joint, check_fixed_transform
 from serialkin.model.limits import DEFAULT_HALF_RANGE, check_interval, inside_mask, sampling_box
+from serialkin.model.tasks import TASKS, task_rows
 
 if TYPE_CHECKING:
     from serialkin.ik.result import IKResult
@@ -89,14 +91,9 @@ def _out_array(out: object, shape: tuple[int, ...]) -> np.ndarray:
     return out
 
 
-#: Named task-row selections for manipulability and condition number.
-TASK_ROWS: dict[str, tuple[int, ...]] = {
-    "full": (0, 1, 2, 3, 4, 5),
-    "position": (0, 1, 2),
-    "orientation": (3, 4, 5),
-    "planar": (0, 1),
-    "planar_pose": (0, 1, 5),
-}
+#: Named task-row selections for manipulability and condition number, by name and alias
+#: (a view of :data:`serialkin.model.tasks.TASKS`, the one task table).
+TASK_ROWS: dict[str, tuple[int, ...]] = {name: t.rows for name, t in TASKS.items()}
 
 
 class Robot:
@@ -114,6 +111,10 @@ class Robot:
         base: (4, 4) world-from-base transform.
         tool: (4, 4) last-link-from-tool transform.
         qlim: (n, 2) joint limits [rad or m], ±inf where unlimited.
+        revolute: (n,) read-only bool array, True for a revolute joint, False for a
+            prismatic one (``joint_types`` holds the same as 'R'/'P').
+        chain: the compiled chain arrays (:class:`~serialkin.model.chain.Chain`: ``F``,
+            ``L``, ``meta``, ``packed``) that compiled kernels of other subpackages take.
     """
 
     def __init__(
@@ -154,10 +155,11 @@ class Robot:
         self.link_names: tuple[str, ...] | None = None
         self.qlim = np.array([j.qlim for j in joints], dtype=float)
         self.joint_types = tuple(j.type for j in joints)
+        self.revolute = np.array([t == "R" for t in self.joint_types], dtype=bool)
         self.joint_names = tuple(j.name or f"joint{i + 1}" for i, j in enumerate(joints))
         if len(set(self.joint_names)) != self.n:
             raise RobotDefinitionError(f"joint names must be unique, got {self.joint_names}")
-        for a in (self.base, self.tool, self.qlim):
+        for a in (self.base, self.tool, self.qlim, self.revolute):
             a.setflags(write=False)
         self.chain = compile_chain(self.joints, self.base, self.tool)
         self._F, self._L, self._meta = self.chain.F, self.chain.L, self.chain.meta
@@ -545,37 +547,34 @@ class Robot:
         return jacobian_analytic(self, q, rep)
 
     def _task_jacobian(self, q: object, task: str | Sequence[int]) -> np.ndarray:
-        if isinstance(task, str):
-            rows = TASK_ROWS[check_choice(task, "task", TASK_ROWS)]
-        else:
-            if not isinstance(task, (Sequence, np.ndarray)) or len(task) > 6:
-                raise InputError("task must be a name or a list of distinct row indices in "
-                                 f"0..5, got {short_repr(task)}")
-            rows = tuple(check_int(r, "task row", maximum=5) for r in task)
-            if not rows or len(set(rows)) != len(rows):
-                raise InputError("task rows must be a nonempty list of distinct indices in "
-                                 f"0..5, got {short_repr(task)}")
-        return self.jacobian(q)[..., list(rows), :]
+        return self.jacobian(q)[..., task_rows(task), :]
 
-    def manipulability(self, q: object, task: str | Sequence[int] = "full") -> np.ndarray | float:
+    def manipulability(self, q: object, task: str | Sequence[int] = "full", *,
+                       frame: str = "base", link: int | None = None,
+                       point: object = None) -> np.ndarray | float:
         """Yoshikawa manipulability ``w = sqrt(det(J Jᵀ))`` (eq 43) of the task Jacobian.
 
         Args:
             q: joint values, shape (..., n).
-            task: rows of J that form the task: 'full', 'position', 'orientation',
-                'planar' (vx, vy), 'planar_pose' (vx, vy, wz) or a list of row indices.
+            task: rows of J that form the task: a name of :data:`serialkin.model.tasks.TASKS`
+                ('full'/'pose', 'position', 'orientation', 'planar' (vx, vy),
+                'planar_pose' (vx, vy, wz)) or a list of row indices.
+            frame: frame of the Jacobian, as in :meth:`jacobian` ('base' or 'ee').
+            link: Jacobian of a point on this link frame, as in :meth:`jacobian`.
+            point: that point, as in :meth:`jacobian`.
 
         Returns:
             float or (...) array; 0 at singular configurations (and when n < m). Computed
             as the product of J's singular values, which equals sqrt(det(J Jᵀ)) and is
-            exactly representable near singularities.
+            exactly representable near singularities
+            (:func:`serialkin.kinematics.dls.manipulability_of`).
         """
-        J = self._task_jacobian(q, task)
-        m, n = J.shape[-2:]
-        if m > n:  # J Jᵀ (m x m) has rank <= n < m
-            w = np.zeros(J.shape[:-2])
-        else:  # sqrt(det(J Jᵀ)) = product of the singular values: exact 0 at singularities
-            w = np.prod(np.linalg.svd(J, compute_uv=False), axis=-1)
+        rows = task_rows(task)
+        J = np.ascontiguousarray(self.jacobian(q, frame, link=link, point=point)[..., rows, :])
+        flat = J.reshape((-1,) + J.shape[-2:])
+        w = np.empty(flat.shape[0])
+        manipulability_batch(flat, w)
+        w = w.reshape(J.shape[:-2])
         return float(w) if w.ndim == 0 else w
 
     def condition_number(self, q: object, task: str | Sequence[int] = "full") -> np.ndarray | float:

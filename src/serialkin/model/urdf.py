@@ -347,7 +347,7 @@ def robot_to_urdf(robot) -> str:
     from scipy.spatial.transform import Rotation
 
     F, meta = robot.chain.F, robot.chain.meta
-    names = getattr(robot, "link_names", None)
+    names = robot.link_names
     if names is None or len(names) < robot.n + 1:
         names = ["base_link"] + [f"link{i + 1}" for i in range(robot.n)]
     names = [_xml_name(str(n), "link name") for n in names[: robot.n + 1]]

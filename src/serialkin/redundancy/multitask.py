@@ -47,7 +47,8 @@ from serialkin._checks import (
     short_repr,
 )
 from serialkin.errors import InputError
-from serialkin.kinematics import _kernels as K
+from serialkin.kinematics import kernels as K
+from serialkin.kinematics.dls import manipulability_of, spd_solve_into
 from serialkin.model.limits import check_interval
 from serialkin.redundancy.objectives import task_rows
 from serialkin.redundancy.obstacles import (
@@ -59,7 +60,7 @@ from serialkin.redundancy.obstacles import (
     check_obstacles,
     update_geometry_into,
 )
-from serialkin.spatial._kernels import pose_error_into
+from serialkin.spatial.kernels import pose_error_into
 
 __all__ = [
     "MultiTaskResolver",
@@ -212,14 +213,11 @@ def eq48_into(q, xdot, J, rows, F, L, meta, cfg, qlim, enc, influence, link, fra
             A[a, b] = w * s
     lam2 = cfg[_DAMP] * cfg[_DAMP]
     if cfg[_SING] > 0.0 and cfg[_W0] > 0.0:
-        M = np.empty((m, m))
+        Jt = np.empty((m, n))
         for r in range(m):
-            for c in range(m):
-                s = 0.0
-                for a in range(n):
-                    s += J[rows[r], a] * J[rows[c], a]
-                M[r, c] = s
-        wm = math.sqrt(max(np.linalg.det(M), 0.0))
+            for a in range(n):
+                Jt[r, a] = J[rows[r], a]
+        wm = manipulability_of(Jt)
         if wm < cfg[_W0]:
             ls = cfg[_SING] * (1.0 - wm / cfg[_W0])
             lam2 += ls * ls
@@ -236,9 +234,8 @@ def eq48_into(q, xdot, J, rows, F, L, meta, cfg, qlim, enc, influence, link, fra
                              P1, Tee, T, SC, B, D, C)
         accumulate_obstacle_task(q, F, L, meta, frames, P0, P1, link, T, SC, B, D, C, influence,
                                  cfg[_WC], cfg[_KREP], A, rhs, Jbuf, pbuf)
-    x = np.linalg.solve(A, rhs)
-    for a in range(n):
-        qdot[a] = x[a]
+    # SPD: damping > 0 is validated by MultiTaskResolver, the other terms are PSD
+    spd_solve_into(A, rhs, qdot, n)
 
 
 @njit(cache=True)
@@ -469,14 +466,14 @@ class _State:
     def _args(self):
         g = self.geom
         rb = self.robot
-        return (rb._F, rb._L, rb._meta, self.cfg, self.lim, g.enc, self.infl, g.link,
+        return (rb.chain.F, rb.chain.L, rb.chain.meta, self.cfg, self.lim, g.enc, self.infl, g.link,
                 g.frames, g.P0, g.P1, g.Tee, g.T, g.SC, g.B, g.D, g.C, g.Jbuf, g.pbuf, self.A,
                 self.rhs, self.qdot_buf)
 
     def qdot(self, q: np.ndarray, xdot: np.ndarray) -> np.ndarray:
         """Eq 48 at q (n,) for the task velocity ẋ (m,)."""
         rb = self.robot
-        K.jacobian_into(q, rb._F, rb._meta, self.J, self.T)
+        K.jacobian_into(q, rb.chain.F, rb.chain.meta, self.J, self.T)
         eq48_into(q, np.ascontiguousarray(xdot, dtype=float), self.J, self.rows, *self._args())
         return self.qdot_buf.copy()
 

@@ -21,6 +21,7 @@ import numpy as np
 from serialkin._budget import check_allocation
 from serialkin._checks import as_float_array, check_choice, check_int, check_positive
 from serialkin.errors import InputError
+from serialkin.kinematics.dls import dls_inverse_into
 from serialkin.redundancy.objectives import Objective, task_rows
 
 __all__ = [
@@ -60,8 +61,11 @@ def dls_inverse(J: object, damping: float) -> np.ndarray:
     """
     a = _matrix(J)
     lam = check_positive(damping, "damping")
-    m = a.shape[0]
-    return a.T @ np.linalg.solve(a @ a.T + lam * lam * np.eye(m), np.eye(m))
+    m, n = a.shape
+    out = np.empty((n, m))
+    dls_inverse_into(np.ascontiguousarray(a), lam * lam, 0.0, np.empty((m, m)), np.empty(m),
+                     out)
+    return out
 
 
 def nullspace_projector(J: object, rcond: float = 1e-10) -> np.ndarray:

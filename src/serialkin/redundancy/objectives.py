@@ -27,12 +27,15 @@ import numpy as np
 
 from serialkin._checks import check_positive
 from serialkin.errors import InputError, InputTypeError
+from serialkin.kinematics.dls import manipulability_of
+from serialkin.model.tasks import TASKS, task_rows
 
 if TYPE_CHECKING:
     from serialkin.model.robot import Robot
     from serialkin.redundancy.obstacles import Obstacle
 
 __all__ = [
+    "TASKS",  # re-exported from serialkin.model.tasks, the one task table
     "Objective",
     "custom_objective",
     "finite_difference_gradient",
@@ -43,37 +46,6 @@ __all__ = [
     "obstacle_distance",
     "task_rows",
 ]
-
-#: Task-space row selections of the geometric Jacobian [vx, vy, vz, wx, wy, wz].
-TASKS: dict[str, tuple[int, ...]] = {
-    "planar": (0, 1),
-    "planar_pose": (0, 1, 5),
-    "position": (0, 1, 2),
-    "pose": (0, 1, 2, 3, 4, 5),
-    "full": (0, 1, 2, 3, 4, 5),
-}
-
-
-def task_rows(task: str | Sequence[int]) -> np.ndarray:
-    """Row indices of the geometric Jacobian that form a task.
-
-    Args:
-        task: 'planar' (vx, vy), 'planar_pose' (vx, vy, wz), 'position' (vx, vy, vz),
-            'pose'/'full' (all six) or an explicit sequence of row indices in 0..5.
-
-    Raises:
-        InputError: unknown name or rows outside 0..5.
-    """
-    if isinstance(task, str):
-        if task not in TASKS:
-            raise InputError(f"unknown task {task!r}; expected one of: {', '.join(TASKS)}")
-        return np.array(TASKS[task], dtype=np.int64)
-    rows = np.asarray(task)
-    if rows.ndim != 1 or rows.size == 0 or rows.dtype.kind not in "iu" \
-            or rows.min() < 0 or rows.max() > 5 or len(set(rows.tolist())) != rows.size:
-        raise InputError(f"task rows must be distinct integers in 0..5, got {task!r}")
-    return rows.astype(np.int64)
-
 
 @dataclass(frozen=True)
 class Objective:
@@ -120,7 +92,7 @@ def jacobian_derivative(robot: Robot, q: object) -> np.ndarray:
     if qv.ndim != 1:
         raise InputError(f"q must have shape ({robot.n},), got {qv.shape}")
     J = robot.jacobian(qv)
-    return _jacobian_derivative_from(J, np.array([t == "R" for t in robot.joint_types]))
+    return _jacobian_derivative_from(J, robot.revolute)
 
 
 def _jacobian_derivative_from(J: np.ndarray, revolute: np.ndarray) -> np.ndarray:
@@ -165,11 +137,10 @@ def manipulability_gradient(robot: Robot, q: object, task: str | Sequence[int] =
     J = robot.jacobian(qv)
     Jt = J[rows]
     A = Jt @ Jt.T
-    det = float(np.linalg.det(A))
-    w = float(np.sqrt(max(det, 0.0)))
+    w = float(manipulability_of(np.ascontiguousarray(Jt)))
     if w <= 1e-300 or Jt.shape[0] > Jt.shape[1]:
         return w, np.zeros(robot.n)
-    H = _jacobian_derivative_from(J, np.array([t == "R" for t in robot.joint_types]))[:, rows, :]
+    H = _jacobian_derivative_from(J, robot.revolute)[:, rows, :]
     B = np.linalg.solve(A, Jt)  # (m, n)
     grad = w * np.einsum("mn,kmn->k", B, H)
     return w, grad

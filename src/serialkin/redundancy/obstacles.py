@@ -39,7 +39,7 @@ from numba import njit
 
 from serialkin._checks import as_vector, check_positive
 from serialkin.errors import InputError, InputTypeError
-from serialkin.kinematics import _kernels as K
+from serialkin.kinematics import kernels as K
 from serialkin.spatial.segments import closest_segment_segment
 
 __all__ = [
@@ -347,7 +347,8 @@ class _Geometry:
 
     def update(self, q: np.ndarray) -> None:
         r = self.robot
-        update_geometry_into(q, r._F, r._L, r._meta, self.has_tool, self.enc, self.link_radius,
+        c = r.chain
+        update_geometry_into(q, c.F, c.L, c.meta, self.has_tool, self.enc, self.link_radius,
                              self.frames, self.P0, self.P1, self.Tee, self.T, self.SC, self.B,
                              self.D, self.C)
 
@@ -359,7 +360,8 @@ class _Geometry:
         r = self.robot
         u = np.empty(3)
         g = np.empty(r.n)
-        pair_gradient_into(q, r._F, r._L, r._meta, self.frames, self.P0, self.P1, self.link,
+        c = r.chain
+        pair_gradient_into(q, c.F, c.L, c.meta, self.frames, self.P0, self.P1, self.link,
                            self.T, self.SC, self.B, self.D, i, j, self.Jbuf, self.pbuf, u, g)
         return u, g
 

@@ -13,7 +13,7 @@ Conventions:
 
 All functions accept batches through leading dimensions: ``w`` of shape (..., 3) gives
 rotations of shape (..., 3, 3). Closed forms switch to Taylor series near θ = 0, and the
-SO(3) logarithm (compiled kernel :func:`serialkin.spatial._kernels.so3_log_into`) reads
+SO(3) logarithm (compiled kernel :func:`serialkin.spatial.kernels.so3_log_into`) reads
 the rotation axis from the symmetric part of R near θ = π, so every function stays
 accurate over its whole domain.
 """
@@ -24,7 +24,7 @@ import numpy as np
 
 from serialkin._checks import as_float_array, check_last_dims, check_rotation, check_transform
 from serialkin.errors import InputError
-from serialkin.spatial import _kernels as K
+from serialkin.spatial import kernels as K
 
 #: Below this angle [rad] the closed-form coefficients are replaced by Taylor series.
 SERIES_ANGLE = 0.05

@@ -8,7 +8,7 @@ order, eqs 33-36)::
 It is zero exactly when the poses coincide, and for a small displacement it equals the
 small twist ``[dv; dω]`` with ``p_target = p + dv`` and ``R_target = exp([dω]^) R``, so
 that ``e ≈ J(q) dq``. It is computed by the compiled kernel
-:func:`serialkin.spatial._kernels.pose_error_into`, which IK kernels call directly.
+:func:`serialkin.spatial.kernels.pose_error_into`, which IK kernels call directly.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import numpy as np
 
 from serialkin._checks import ROTATION_TOL, check_transform
 from serialkin.errors import InputError
-from serialkin.spatial import _kernels as K
+from serialkin.spatial import kernels as K
 
 
 def _validated(x: object, name: str, check: bool) -> np.ndarray:

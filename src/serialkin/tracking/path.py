@@ -30,11 +30,13 @@ from serialkin._checks import (
     short_repr,
 )
 from serialkin.errors import InputError
+from serialkin.model.tasks import TARGET_TASKS, TASK_NAMES, get_task
 
 __all__ = ["TASKS", "Path", "sample_parameter"]
 
-#: Path tasks and the number of task coordinates of each point.
-TASKS: dict[str, int] = {"planar": 2, "planar_pose": 3, "position": 3, "pose": 6}
+#: Path tasks and the number of task coordinates of each point (the target kinds of
+#: :data:`serialkin.model.tasks.TASKS`, the one task table).
+TASKS: dict[str, int] = {name: get_task(name).point_size for name in TARGET_TASKS}
 
 
 def sample_parameter(start: float, stop: float, step: float) -> np.ndarray:
@@ -81,9 +83,7 @@ class Path:
 
     def __init__(self, targets: np.ndarray, task: str, points: np.ndarray,
                  parameter: np.ndarray | None = None) -> None:
-        if task not in TASKS:
-            raise InputError(f"unknown path task {short_repr(task)}; expected one of: "
-                             f"{', '.join(TASKS)}")
+        task = get_task(task, targets_only=True, what="path task").name
         if targets.shape[0] == 0:
             raise InputError("a path needs at least one point")
         self.task = task
@@ -126,6 +126,8 @@ class Path:
             task = {2: "planar", 3: "position"}.get(cols)
             if task is None:
                 raise InputError(f"path points must have 2 or 3 columns, got shape {P.shape}")
+        if isinstance(task, str) and task in TASK_NAMES:
+            task = get_task(task).name
         if task not in TASKS or task == "pose":
             raise InputError(f"task for points must be 'planar', 'planar_pose' or 'position', "
                              f"got {short_repr(task)}")
@@ -152,7 +154,7 @@ class Path:
         T = check_last_dims(check_transform(poses, "path poses"), "path poses", (4, 4))
         if T.ndim != 3:
             raise InputError(f"path poses must have shape (p, 4, 4), got {T.shape}")
-        from serialkin.spatial._kernels import so3_log_batch
+        from serialkin.spatial.kernels import so3_log_batch
 
         W = np.empty((T.shape[0], 3))
         so3_log_batch(np.ascontiguousarray(T[:, :3, :3]), W)

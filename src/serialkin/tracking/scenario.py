@@ -49,6 +49,7 @@ import numpy as np
 from serialkin._checks import MAX_ITERATIONS, MAX_JOINTS, MAX_LENGTH, short_repr
 from serialkin._files import MAX_ITEMS, Field, load_document
 from serialkin.errors import InputError, InputTypeError, SerialkinError
+from serialkin.model.tasks import TARGET_TASKS, get_task
 from serialkin.redundancy.multitask import MultiTaskResolver
 from serialkin.redundancy.obstacles import check_obstacles, obstacle_from_field
 from serialkin.tracking.path import Path
@@ -108,7 +109,8 @@ _PATH_FIELDS = {"circle": {"center", "radius", "start", "stop", "step"},
                 "points": {"points"},
                 "polyline": {"waypoints", "step"},
                 "wave": {"start", "end", "amplitude", "periods", "step"}}
-_TASKS = ("planar", "position", "planar_pose")
+#: tasks of point paths (the target kinds given as [x, y], [x, y, φ] or [x, y, z])
+_TASKS = tuple(name for name in TARGET_TASKS if get_task(name).point_size <= 3)
 
 
 @dataclass

@@ -28,12 +28,14 @@ from numba import njit
 
 from serialkin._checks import MAX_ITERATIONS, check_choice, check_int, check_positive
 from serialkin.errors import InputError, InputTypeError
-from serialkin.kinematics import _kernels as K
+from serialkin.kinematics import kernels as K
+from serialkin.kinematics.dls import dls_step_into, weigh_rows_into
 from serialkin.model.limits import project as interval_project
+from serialkin.model.tasks import get_task
 from serialkin.redundancy.multitask import MultiTaskResolver
 from serialkin.redundancy.objectives import task_rows
 from serialkin.redundancy.obstacles import _Geometry, check_obstacles, encode_obstacles
-from serialkin.spatial._kernels import pose_error_into
+from serialkin.spatial.kernels import pose_error_into
 from serialkin.tracking.path import Path
 from serialkin.tracking.trajectory import PathFailure, Trajectory
 
@@ -88,29 +90,18 @@ def dls_track(q0, targets, rows, F, meta, lam, tol, max_iter, max_step, accept, 
     e = np.empty(m)
     Jt = np.empty((m, n))
     A = np.empty((m, m))
+    y = np.empty(m)
+    dq = np.empty(n)
+    ones = np.ones(m)
     for k in range(p):
         it = 0
         while True:
             K.jacobian_into(q, F, meta, J, T)
             pose_error_into(T, targets[k], e6)
-            err2 = 0.0
-            for r in range(m):
-                e[r] = e6[rows[r]]
-                err2 += e[r] * e[r]
-                for c in range(n):
-                    Jt[r, c] = J[rows[r], c]
-            err = np.sqrt(err2)
+            err = np.sqrt(weigh_rows_into(J, e6, rows, ones, Jt, e))
             if err < tol or it >= max_iter:
                 break
-            for r in range(m):
-                for c in range(m):
-                    s = 0.0
-                    for j in range(n):
-                        s += Jt[r, j] * Jt[c, j]
-                    A[r, c] = s
-                A[r, r] += lam * lam
-            y = np.linalg.solve(A, e)
-            dq = Jt.T @ y
+            dls_step_into(Jt, e, lam * lam, 0.0, A, y, dq)
             nrm = np.sqrt(np.sum(dq * dq))
             if nrm > max_step:
                 dq *= max_step / nrm
@@ -142,7 +133,7 @@ def limit_margins(q: np.ndarray, qlim: np.ndarray) -> np.ndarray:
 
 
 def _ik_target(path: Path, k: int) -> np.ndarray:
-    if path.task in ("planar", "position", "planar_pose"):
+    if get_task(path.task).point_size <= 3:  # point tasks: IK takes the coordinates
         return np.array(path.points[k])
     return np.array(path.targets[k])
 
@@ -224,9 +215,9 @@ def track(
     if isinstance(solver, str) and solver == "dls":
         label = f"DLS (eq 46), λ = {lam:g} m"
         t0 = time.perf_counter()
-        revolute = np.array([t == "R" for t in robot.joint_types], dtype=float)
-        count = dls_track(q_start, targets, rows, robot._F, robot._meta, lam, conv, budget, cap,
-                          accept, stop, 1e-3, np.ascontiguousarray(robot.qlim[:, 0]),
+        revolute = robot.revolute.astype(float)
+        count = dls_track(q_start, targets, rows, robot.chain.F, robot.chain.meta, lam, conv,
+                          budget, cap, accept, stop, 1e-3, np.ascontiguousarray(robot.qlim[:, 0]),
                           np.ascontiguousarray(robot.qlim[:, 1]), revolute, Q, ITER, ERR)
         elapsed = time.perf_counter() - t0
         # per-point time: shared in proportion to the iterations used
@@ -244,11 +235,6 @@ def track(
             state = solver.prepare(robot)
             step = lambda k, q: state.solve(targets[k], q)  # noqa: E731
         elif isinstance(solver, str):
-            from serialkin import ik as ik_module
-
-            if not hasattr(ik_module, "solve"):
-                raise InputError(f"IK method {solver!r} needs serialkin.ik.solve, which is not "
-                                 "available; use solver='dls' or 'multitask'")
             label = f"IK method {solver!r}"
             opts = dict(ik_options or {})
             opts.setdefault("max_iter", budget)
@@ -289,7 +275,7 @@ def _ik_step(robot, path: Path, method: str, opts: dict):
     def step(k: int, q: np.ndarray) -> _IKStats:
         res = robot.ik(_ik_target(path, k), method=method, q0=q, **opts)
         qn = np.ascontiguousarray(res.q, dtype=float)
-        K.jacobian_into(qn, robot._F, robot._meta, J, T)
+        K.jacobian_into(qn, robot.chain.F, robot.chain.meta, J, T)
         pose_error_into(T, path.targets[k], e6)
         return _IKStats(qn, int(getattr(res, "iterations", 0)),
                         float(np.linalg.norm(e6[rows])))
@@ -302,7 +288,7 @@ def _assemble(robot, path: Path, Q, ITER, ERR, TIMES, obstacles, link_radius, ac
     count = Q.shape[0]
     poses = np.empty((count, 4, 4))
     for k in range(count):  # serial: the parallel batch kernel costs ms of thread start-up
-        K.fk_into(np.ascontiguousarray(Q[k]), robot._F, robot._meta, poses[k])
+        K.fk_into(np.ascontiguousarray(Q[k]), robot.chain.F, robot.chain.meta, poses[k])
     if obstacles and count:
         g = _Geometry(robot, obstacles, link_radius)
         clear = np.empty((count, len(obstacles)))

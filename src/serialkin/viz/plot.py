@@ -79,7 +79,7 @@ def robot_points(robot: Robot, q: object) -> np.ndarray:
 def joint_positions(robot: Robot, q: object) -> np.ndarray:
     """Points on the joint axes: the origin of the frame right after each joint motion.
 
-    Link frame i is ``(pose after M_i) · L[i]`` (see :mod:`serialkin.kinematics._kernels`),
+    Link frame i is ``(pose after M_i) · L[i]`` (see :mod:`serialkin.kinematics.kernels`),
     so the joint frame is ``world_T_i · L[i]⁻¹``. For a standard-DH robot this is the
     origin of DH frame i-1, where joint i's axis z_{i-1} passes.
 
@@ -106,8 +106,8 @@ def robot_scale(robot: Robot) -> float:
     """
     F = robot.chain.F
     total = float(np.linalg.norm(F[1:, :3, 3], axis=-1).sum())
-    for i, t in enumerate(robot.joint_types):
-        if t == "P":
+    for i, revolute in enumerate(robot.revolute):
+        if not revolute:
             lim = np.abs(robot.qlim[i])
             finite = lim[np.isfinite(lim)]
             total += float(finite.max()) if finite.size else 1.0
@@ -167,7 +167,7 @@ def _mechanism_points(robot: Robot, q: np.ndarray) -> np.ndarray:
     then the rest (the DH length a). Returns (k, 3) points [m], consecutive duplicates
     removed, ending at the tool point.
     """
-    from serialkin.kinematics._kernels import PRISMATIC
+    from serialkin.kinematics.kernels import PRISMATIC
 
     F, meta = robot.chain.F, robot.chain.meta
     W = F[0].copy()

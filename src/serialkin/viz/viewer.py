@@ -101,9 +101,9 @@ def _initial_q(robot: Robot, q: object, Q: np.ndarray | None) -> np.ndarray:
 def _slider_limits(robot: Robot, scale: float, qs: np.ndarray) -> list[list[float]]:
     """Slider range per joint: finite limits, else ±π rad or ±scale m, widened to fit ``qs``."""
     out = []
-    for i, kind in enumerate(robot.joint_types):
+    for i, revolute in enumerate(robot.revolute):
         lo, hi = (float(v) for v in robot.qlim[i])
-        default = np.pi if kind == "R" else scale
+        default = np.pi if revolute else scale
         lo = lo if np.isfinite(lo) else -default
         hi = hi if np.isfinite(hi) else default
         lo = min(lo, float(qs[:, i].min()))

@@ -139,10 +139,6 @@ class OccupancyGrid:
             inner &= pad[sl]
         return inner
 
-    def boundary_cells(self) -> np.ndarray:
-        """Occupied cells that are not interior (boolean array)."""
-        return self.occupied & ~self.interior()
-
     def measure(self) -> MeasureEstimate:
         """Area/volume estimate with its error bound (see the module docstring)."""
         vol = self.cell ** self.dim

@@ -19,6 +19,7 @@ import numpy as np
 
 from serialkin._budget import check_allocation
 from serialkin._checks import as_generator, check_int
+from serialkin.kinematics.dls import dls_step_batch
 from serialkin.spatial import so3_log, wrap_angle
 
 #: Configurations per chunk (bounds memory: a chunk's Jacobians take chunk·6·n·8 bytes).
@@ -142,7 +143,7 @@ def project_orientation(robot: object, Q: np.ndarray, R_target: np.ndarray, *,
     lo, hi = robot.sampling_limits().T  # type: ignore[attr-defined]
     phi_t = float(planar_angle(R_target))
     # revolute joints whose range spans a full turn wrap around instead of stopping
-    wrap = (np.array(robot.joint_types) == "R") & (hi - lo >= 2 * np.pi - 1e-12)  # type: ignore[attr-defined]
+    wrap = robot.revolute & (hi - lo >= 2 * np.pi - 1e-12)  # type: ignore[attr-defined]
     lam2 = damping * damping
     for sl in chunks(Q.shape[0]):
         Qc = Q[sl]
@@ -182,9 +183,10 @@ def project_orientation(robot: object, Q: np.ndarray, R_target: np.ndarray, *,
 
 def _dls_step(Jw: np.ndarray, err: np.ndarray, lam2: float) -> np.ndarray:
     """Batched DLS step ``Jᵀ (J Jᵀ + λ² I)⁻¹ e`` for J (N, m, n), e (N, m) → (N, n)."""
-    A = Jw @ np.swapaxes(Jw, -1, -2) + lam2 * np.eye(Jw.shape[1])
-    y = np.linalg.solve(A, err[..., None])
-    return (np.swapaxes(Jw, -1, -2) @ y)[..., 0]
+    dq = np.empty((Jw.shape[0], Jw.shape[2]))
+    dls_step_batch(np.ascontiguousarray(Jw, dtype=float), np.ascontiguousarray(err, dtype=float),
+                   lam2, 0.0, dq)
+    return dq
 
 
 def random_rotations(count: int, seed: None | int | np.random.Generator) -> np.ndarray:

@@ -87,10 +87,6 @@ def _dof_table(ctx: ReportContext) -> str:
                             "task space", "m = rank J", "redundancy n − m"])
 
 
-def _fig_close(ctx: ReportContext, ax: object, name: str, caption: str) -> str:
-    return ctx.figure(ax.figure, name, caption)  # type: ignore[attr-defined]
-
-
 def build(ctx: ReportContext) -> Section:
     """Compute section 1's workspace examples and return the report section."""
     import matplotlib

@@ -183,7 +183,7 @@ def analyse(robot: Robot) -> Structure:
     """
     W, P, M = joint_lines(robot)
     n = robot.n
-    rev = np.array([t == "R" for t in robot.joint_types])
+    rev = robot.revolute
     scale = max(1.0, float(np.max(np.linalg.norm(np.vstack([P, M[:3, 3]]) - P[0], axis=1))))
     ltol = LENGTH_TOL * scale
 

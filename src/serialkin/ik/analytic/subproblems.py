@@ -32,7 +32,7 @@ import math
 import numpy as np
 from numba import njit
 
-from serialkin.kinematics._kernels import fk_into
+from serialkin.kinematics.kernels import fk_into
 
 #: arccos arguments within this distance of ±1 are clamped (workspace boundary).
 CLAMP = 1e-9

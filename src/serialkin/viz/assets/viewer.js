@@ -5,7 +5,7 @@
 // and the scene, see viewer_data() in viewer.py) have been defined.
 //
 // Forward kinematics is computed here, in the page, from the robot's general chain data,
-// exactly as serialkin's compiled kernels do (serialkin/kinematics/_kernels.py, eq 11):
+// exactly as serialkin's compiled kernels do (serialkin/kinematics/kernels.py, eq 11):
 //     T = F[0] · M_1(q_1) · F[1] · M_2(q_2) ··· M_n(q_n) · F[n]
 // where M_i rotates by q_i + offset_i about (revolute) or translates by q_i + offset_i
 // along (prismatic) the joint's unit axis. Link frame i is the pose right after M_i

@@ -1,5 +1,9 @@
 """Compiled kernels over the chain representation (numba, ``cache=True``).
 
+Kernel contract: trusts its input; validation happens at the public boundary (the
+:class:`~serialkin.model.robot.Robot` methods). Other subpackages call these kernels
+with the arrays of ``robot.chain``.
+
 Every robot, whatever convention it was described in (standard DH, modified DH,
 general joint axes, URDF), is compiled by :mod:`serialkin.model.chain` into the same
 arrays, and these kernels are the only implementation of forward kinematics and

@@ -1,5 +1,8 @@
 """Compiled rotation-log and pose-error kernels (numba, ``cache=True``).
 
+Kernel contract: trusts its input; validation happens at the public boundary. Other
+subpackages call these kernels directly from their compiled code.
+
 These are scalar kernels meant to be called from other njit code (IK iterations,
 trajectory tracking loops) and, through the thin batch loops below, from the numpy
 wrappers in :mod:`serialkin.spatial.pose` and :mod:`serialkin.spatial.lie`. They are the

@@ -1,0 +1,85 @@
+"""The shared damped least-squares kernel against the closed-form NumPy expressions."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from serialkin.kinematics import dls
+
+
+def _reference(J, e, lam):
+    m = J.shape[0]
+    return J.T @ np.linalg.solve(J @ J.T + lam * lam * np.eye(m), e)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(1, 6), st.integers(1, 8), st.floats(1e-3, 1.0), st.integers(0, 2**32 - 1))
+def test_step_matches_closed_form(m, n, lam, seed):
+    """Δq = Jᵀ(JJᵀ+λ²I)⁻¹e and it satisfies the normal equations (JᵀJ+λ²I)Δq = Jᵀe."""
+    rng = np.random.default_rng(seed)
+    J = rng.standard_normal((m, n))
+    e = rng.standard_normal(m)
+    dq = np.empty(n)
+    assert dls.dls_step_into(J, e, lam * lam, 0.0, np.empty((m, m)), np.empty(m), dq)
+    np.testing.assert_allclose(dq, _reference(J, e, lam), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose((J.T @ J + lam * lam * np.eye(n)) @ dq, J.T @ e,
+                               rtol=1e-8, atol=1e-10)
+
+
+def test_singular_without_floor_fails_and_floor_recovers():
+    """λ = 0 on a rank-deficient J: False without a floor, a finite least-squares step with one."""
+    J = np.array([[1.0, 0.0], [1.0, 0.0]])
+    e = np.array([1.0, 1.0])
+    dq = np.full(2, 7.0)
+    assert not dls.dls_step_into(J, e, 0.0, 0.0, np.empty((2, 2)), np.empty(2), dq)
+    assert dls.dls_step_into(J, e, 0.0, 1e-12, np.empty((2, 2)), np.empty(2), dq)
+    np.testing.assert_allclose(dq, [1.0, 0.0], atol=1e-6)
+
+
+def test_inverse_and_batch_agree_with_the_step():
+    """J^# e equals the step, and the batch equals the single steps."""
+    rng = np.random.default_rng(3)
+    J = rng.standard_normal((5, 3, 7))
+    e = rng.standard_normal((5, 3))
+    out = np.empty((5, 7))
+    assert dls.dls_step_batch(J, e, 0.04, 0.0, out) == 0
+    inv = np.empty((7, 3))
+    for k in range(5):
+        assert dls.dls_inverse_into(J[k], 0.04, 0.0, np.empty((3, 3)), np.empty(3), inv)
+        np.testing.assert_allclose(inv @ e[k], out[k], rtol=1e-12, atol=1e-14)
+        np.testing.assert_allclose(out[k], _reference(J[k], e[k], 0.2), rtol=1e-9, atol=1e-12)
+
+
+def test_spd_solve_and_weighted_rows():
+    """Cholesky solve of an SPD system; weighted rows scale the selected rows by √w."""
+    rng = np.random.default_rng(4)
+    B = rng.standard_normal((4, 4))
+    A = B @ B.T + 4 * np.eye(4)
+    b = rng.standard_normal(4)
+    x = np.empty(4)
+    assert dls.spd_solve_into(A.copy(), b, x, 4)
+    np.testing.assert_allclose(A @ x, b, atol=1e-12)
+    assert not dls.spd_solve_into(-A.copy(), b, x, 4)
+    J = rng.standard_normal((6, 3))
+    e = rng.standard_normal(6)
+    rows = np.array([0, 1, 5])
+    sw = np.array([1.0, 2.0, 0.5])
+    Jw, ew = np.empty((3, 3)), np.empty(3)
+    s2 = dls.weigh_rows_into(J, e, rows, sw, Jw, ew)
+    np.testing.assert_allclose(Jw, sw[:, None] * J[rows])
+    np.testing.assert_allclose(ew, sw * e[rows])
+    assert abs(s2 - float(ew @ ew)) < 1e-12
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(1, 6), st.integers(1, 8), st.integers(0, 2**32 - 1))
+def test_manipulability_is_the_product_of_singular_values(m, n, seed):
+    """Manipulability = Π σ_i = sqrt(det(J Jᵀ)) for m ≤ n; 0 for m > n and a repeated row."""
+    J = np.random.default_rng(seed).standard_normal((m, n))
+    want = float(np.prod(np.linalg.svd(J, compute_uv=False))) if m <= n else 0.0
+    assert abs(dls.manipulability_of(J) - want) <= 1e-12 * max(1.0, want)
+    if m >= 2 and m <= n:
+        J[1] = J[0]
+        assert dls.manipulability_of(J) <= 1e-12 * np.linalg.norm(J) ** m
