@@ -80,9 +80,12 @@ def cli() -> None:
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar.")
 @click.option("--section", "sections", multiple=True,
               help="Build only this section (repeatable), e.g. --section forward.")
+@click.option("--jobs", "-j", type=click.IntRange(1, 64), default=None,
+              help="Worker processes building sections side by side (default: the cores "
+                   "other processes leave free).")
 @memory_budget_option
 @handle_errors
-def chapter(out: str, quiet: bool, sections: tuple[str, ...]) -> None:
+def chapter(out: str, quiet: bool, sections: tuple[str, ...], jobs: int | None) -> None:
     r"""Reproduce the chapter's worked examples into an HTML report.
 
     \b
@@ -99,7 +102,7 @@ def chapter(out: str, quiet: bool, sections: tuple[str, ...]) -> None:
         )
     ensure_dir(out)  # a file, a read-only or uncreatable folder: refused before any work
     try:
-        path = build_report(out, quiet=quiet, sections=sections or None)
+        path = build_report(out, quiet=quiet, sections=sections or None, jobs=jobs)
     except (OSError, SerialkinError) as exc:
         raise CLIError(f"cannot write the report to {short_repr(str(out))}: "
                        f"{getattr(exc, 'strerror', None) or exc}") from exc
