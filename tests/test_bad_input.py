@@ -129,7 +129,8 @@ def test_jacobian_options(ur5):
 
 def test_limits_and_seed(ur5):
     """with_limits checks its shape and order; random_q checks the seed type."""
-    with pytest.raises(InputError, match=r"qlim must have shape \(6, 2\), got \(5, 2\)"):
+    with pytest.raises(InputError, match=r"qlim must be a pair \(lower, upper\) or have "
+                                         r"shape \(6, 2\), got shape \(5, 2\)"):
         ur5.with_limits(np.zeros((5, 2)))
     with pytest.raises(RobotDefinitionError, match="lower 1 is greater than upper -1"):
         ur5.with_limits([[1.0, -1.0]] * 6)

@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from serialkin._checks import MAX_JOINT_VALUE, short_repr
-from serialkin.errors import RobotDefinitionError
+from serialkin.errors import InputError, RobotDefinitionError
 
 TWO_PI = 2.0 * math.pi
 
@@ -98,6 +98,31 @@ def check_interval(qlim: object, where: str) -> tuple[float, float]:
             "an unlimited joint"
         )
     return lo, hi
+
+
+def limits_table(qlim: object, n: int, where: str = "qlim") -> np.ndarray:
+    """Joint limits of ``n`` joints as an (n, 2) float array [rad or m], each row checked.
+
+    Accepted: one (lower, upper) pair for every joint, or an (n, 2) table; ±inf for an
+    open side. Each row then passes :func:`check_interval`.
+
+    Raises:
+        InputError: a string, non-numbers, or another shape (naming ``where``).
+        RobotDefinitionError: a row that is not a valid interval.
+    """
+    expected = f"{where} must be a pair (lower, upper) or have shape ({n}, 2)"
+    if isinstance(qlim, (str, bytes)):
+        raise InputError(f"{expected}, got {short_repr(qlim)}")
+    try:
+        lim = np.asarray(qlim, dtype=float)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise InputError(f"{expected}, got {short_repr(qlim)}") from exc
+    if lim.shape == (2,):
+        lim = np.tile(lim, (n, 1))
+    if lim.shape != (n, 2):
+        raise InputError(f"{expected}, got shape {lim.shape}")
+    rows = [check_interval(lim[i], f"{where}[{i}]") for i in range(n)]
+    return np.array(rows, dtype=float).reshape(n, 2)
 
 
 @njit(cache=True)

@@ -36,7 +36,7 @@ from serialkin.kinematics.dls import manipulability_batch
 from serialkin.model.chain import compile_chain
 from serialkin.model.dh import CONVENTIONS, DHLink, dh_to_joints, parse_dh_rows
 from serialkin.model.joint import Joint, check_fixed_transform
-from serialkin.model.limits import DEFAULT_HALF_RANGE, check_interval, inside_mask, sampling_box
+from serialkin.model.limits import DEFAULT_HALF_RANGE, inside_mask, limits_table, sampling_box
 from serialkin.model.tasks import TASKS, task_rows
 
 if TYPE_CHECKING:
@@ -247,18 +247,13 @@ class Robot:
         return self._copy(base=base)
 
     def with_limits(self, qlim: object) -> Robot:
-        """A copy of this robot with other joint limits, shape (n, 2) [rad or m], ±inf allowed."""
-        if isinstance(qlim, (str, bytes)):
-            raise InputError(f"qlim must be an ({self.n}, 2) array of numbers, got "
-                             f"{short_repr(qlim)}")
-        try:
-            lim = np.asarray(qlim, dtype=float)
-        except (TypeError, ValueError, OverflowError) as exc:
-            raise InputError(f"qlim must be an ({self.n}, 2) array of numbers, got "
-                             f"{short_repr(qlim)}") from exc
-        if lim.shape != (self.n, 2):
-            raise InputError(f"qlim must have shape ({self.n}, 2), got {lim.shape}")
-        rows = [check_interval(lim[i], f"qlim[{i}]") for i in range(self.n)]
+        """A copy of this robot with other joint limits [rad or m], ±inf for an open side.
+
+        Args:
+            qlim: an (n, 2) table, or one (lower, upper) pair for every joint.
+        """
+        lim = limits_table(qlim, self.n)
+        rows = [(float(lo), float(hi)) for lo, hi in lim]
         joints = [dataclasses.replace(j, qlim=rows[i]) for i, j in enumerate(self.joints)]
         dh = None if self.dh is None else [
             dataclasses.replace(r, qlim=rows[i]) for i, r in enumerate(self.dh)]

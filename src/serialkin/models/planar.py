@@ -14,6 +14,7 @@ import numpy as np
 from serialkin._checks import MAX_JOINTS, as_float_array, check_int, short_repr
 from serialkin.errors import InputError
 from serialkin.model.dh import DHLink
+from serialkin.model.limits import limits_table
 from serialkin.model.robot import Robot
 
 PLANAR_SOURCE = "chapter sections 4-5 (eqs 21-22, 30-31): standard DH rows (L_i, 0, 0, q_i)"
@@ -33,21 +34,7 @@ def _lengths(n: int, lengths: float | Sequence[float]) -> np.ndarray:
 def _limits(n: int, qlim: object) -> np.ndarray:
     if qlim is None:
         return np.tile([-np.inf, np.inf], (n, 1))
-    if isinstance(qlim, (str, bytes)):
-        raise InputError(f"qlim must be a pair (lower, upper) or ({n}, 2) numbers [rad], got "
-                         f"{short_repr(qlim)}")
-    try:
-        lim = np.asarray(qlim, dtype=float)
-    except (TypeError, ValueError, OverflowError) as exc:
-        raise InputError(f"qlim must be a pair (lower, upper) or ({n}, 2) numbers [rad], got "
-                         f"{short_repr(qlim)}") from exc
-    if lim.shape == (2,):
-        lim = np.tile(lim, (n, 1))
-    if lim.shape != (n, 2):
-        raise InputError(
-            f"qlim must be a pair (lower, upper) or have shape ({n}, 2), got shape {lim.shape}"
-        )
-    return lim
+    return limits_table(qlim, n)
 
 
 def planar(
