@@ -41,6 +41,7 @@ from serialkin.model.tasks import TASKS, task_rows
 
 if TYPE_CHECKING:
     from serialkin.ik.result import IKResult
+    from serialkin.model.geometry import LinkGeometry
 
 _F64 = np.dtype(np.float64)
 _NDARRAY = np.ndarray
@@ -153,6 +154,8 @@ class Robot:
         self.source = source
         #: link names (base..tip) when known, e.g. from a URDF; else None.
         self.link_names: tuple[str, ...] | None = None
+        #: visual and collision shapes per link (:mod:`serialkin.model.geometry`)
+        self.geometry: tuple[LinkGeometry, ...] = ()
         self.qlim = np.array([j.qlim for j in joints], dtype=float)
         self.joint_types = tuple(j.type for j in joints)
         self.revolute = np.array([t == "R" for t in self.joint_types], dtype=bool)
@@ -216,11 +219,16 @@ class Robot:
 
     @classmethod
     def from_urdf(cls, path_or_string: str, base_link: str | None = None,
-                  tip_link: str | None = None) -> Robot:
-        """Build a robot from a URDF file or string (see :mod:`serialkin.model.urdf`)."""
+                  tip_link: str | None = None, **geometry_options: Any) -> Robot:
+        """Build a robot from a URDF file or string (see :mod:`serialkin.model.urdf`).
+
+        ``geometry_options``: ``package_map``, ``search_path``, ``resolve_meshes`` for
+        the mesh paths of :func:`~serialkin.model.urdf.robot_from_urdf`.
+        """
         from serialkin.model.urdf import robot_from_urdf
 
-        return robot_from_urdf(path_or_string, base_link=base_link, tip_link=tip_link)
+        return robot_from_urdf(path_or_string, base_link=base_link, tip_link=tip_link,
+                               **geometry_options)
 
     def to_urdf(self) -> str:
         """Return the robot's kinematics as a URDF string (see :mod:`serialkin.model.urdf`)."""
@@ -229,13 +237,14 @@ class Robot:
         return robot_to_urdf(self)
 
     def _copy(self, **changes: Any) -> Robot:
-        """A new robot with some constructor arguments changed (link names kept)."""
+        """A new robot with some constructor arguments changed (link names, geometry kept)."""
         args: dict[str, Any] = dict(joints=self.joints, base=self.base, tool=self.tool,
                                     name=self.name, dh=self.dh, convention=self.convention,
                                     source=self.source)
         args.update(changes)
         robot = Robot(args.pop("joints"), **args)
         robot.link_names = self.link_names
+        robot.geometry = self.geometry
         return robot
 
     def with_tool(self, tool: object) -> Robot:

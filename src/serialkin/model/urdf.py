@@ -18,6 +18,7 @@ import math
 import os
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,6 +27,7 @@ import numpy as np
 from serialkin._checks import short_repr
 from serialkin._files import MAX_NUMBER
 from serialkin.errors import NotSupportedError, RobotDefinitionError
+from serialkin.model.geometry import Box, Capsule, Cylinder, LinkGeometry, Mesh, Shape, Sphere
 from serialkin.model.joint import Joint
 from serialkin.spatial.transforms import make_transform, rotx, roty, rotz
 
@@ -151,21 +153,34 @@ def _parse_joint(el: ET.Element, source: str) -> _UJoint:
 
 
 def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | None = None,
-                    tip_link: str | None = None):
+                    tip_link: str | None = None, *,
+                    package_map: Mapping[str, str | os.PathLike[str]] | None = None,
+                    search_path: Sequence[str | os.PathLike[str]] = (),
+                    resolve_meshes: bool = False):
     """Build a :class:`~serialkin.Robot` from the serial chain of a URDF.
 
     Args:
         path_or_string: a URDF file path, or the XML text itself.
         base_link: link whose frame is the robot's base (default: the tree's root).
         tip_link: link whose frame is the tool (default: the single leaf).
+        package_map: package name -> folder, for mesh paths ``package://NAME/rest``.
+        search_path: folders where ``package://NAME/rest`` is looked up as
+            ``FOLDER/NAME/rest`` and a relative mesh path as ``FOLDER/path`` (after the
+            URDF's own folder).
+        resolve_meshes: if true, a mesh path that does not resolve to an existing file is
+            an error; otherwise it is kept as written.
 
     Returns:
         Robot with one joint per moving (revolute, continuous, prismatic) URDF joint,
-        limits read (continuous: unlimited), joint names kept, ``link_names`` set.
+        limits read (continuous: unlimited), joint names kept, ``link_names`` set, and
+        ``geometry``: one :class:`~serialkin.model.geometry.LinkGeometry` per link of the
+        chain or fixed to it through fixed joints, with ``<visual>``/``<collision>``
+        shapes posed in the chain frame the link is merged into.
 
     Raises:
         RobotDefinitionError: malformed XML (with line), a joint referring to a missing link,
-            a loop, a branching tree without ``tip_link``, a zero axis, lower > upper.
+            a loop, a branching tree without ``tip_link``, a zero axis, lower > upper, a
+            negative or non-finite geometry size, an unresolved mesh with ``resolve_meshes``.
         NotSupportedError: mimic, floating or planar joints on the chain.
     """
     from serialkin.model.robot import Robot
@@ -258,7 +273,136 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
     robot = Robot(out, tool=fixed, name=root.get("name") or "urdf_robot",
                   source=f"URDF {source} ({base} -> {tip})")
     robot.link_names = tuple(link_names) + ((tip,) if link_names[-1] != tip else ())
+    folder = None if source == "<string>" else Path(source).resolve().parent
+    places = _link_frames(base, chain, children, by_child)
+    resolver = _MeshResolver(folder, package_map or {}, search_path, resolve_meshes)
+    robot.geometry = tuple(
+        _link_geometry(el, places[el.get("name")], source, resolver)
+        for el in root.findall("link") if el.get("name") in places)
     return robot
+
+
+def _link_frames(base: str, chain: list[_UJoint], children: dict[str, list[str]],
+                 by_child: dict[str, _UJoint]) -> dict[str, tuple[int, np.ndarray]]:
+    """Chain frame index and pose in it of every chain link and its fixed-joint descendants."""
+    places: dict[str, tuple[int, np.ndarray]] = {base: (0, np.eye(4))}
+    frame, T = 0, np.eye(4)
+    for j in chain:
+        if j.type == "fixed":
+            T = T @ j.origin
+        else:
+            frame, T = frame + 1, np.eye(4)
+        places[j.child] = (frame, T)
+    todo = list(places)
+    while todo:
+        link = todo.pop()
+        frame, T = places[link]
+        for c in children[link]:
+            j = by_child[c]
+            if c not in places and j.type == "fixed":
+                places[c] = (frame, T @ j.origin)
+                todo.append(c)
+    return places
+
+
+class _MeshResolver:
+    """Turn a URDF mesh path into an existing absolute path (or keep it, or refuse it)."""
+
+    def __init__(self, folder: Path | None, package_map: Mapping[str, object],
+                 search_path: Sequence[object], strict: bool) -> None:
+        self.folder = folder
+        self.package_map = {str(k): Path(str(v)) for k, v in package_map.items()}
+        if isinstance(search_path, str | os.PathLike):
+            search_path = [search_path]
+        self.search = [Path(str(p)) for p in search_path]
+        self.strict = strict
+
+    def candidates(self, name: str) -> list[Path]:
+        """The files ``name`` may denote, in the order they are tried."""
+        if name.startswith("package://"):
+            pkg, _, rest = name[len("package://"):].partition("/")
+            out = [self.package_map[pkg] / rest] if pkg in self.package_map else []
+            return out + [d / pkg / rest for d in self.search]
+        if name.startswith("file://"):
+            return [Path(name[len("file://"):])]
+        p = Path(name)
+        if p.is_absolute():
+            return [p]
+        return ([self.folder / p] if self.folder is not None else []) + [d / p for d in self.search]
+
+    def __call__(self, name: str, where: str) -> str:
+        tried = self.candidates(name)
+        for p in tried:
+            if p.is_file():
+                return str(p.resolve())
+        if self.strict:
+            looked = ", ".join(short_repr(str(p), 120) for p in tried) or (
+                "nowhere: give package_map= or search_path=")
+            raise RobotDefinitionError(
+                f"{where}: mesh {short_repr(name, 120)} does not resolve to a file; looked in "
+                f"{looked}")
+        return name
+
+
+def _link_geometry(el: ET.Element, place: tuple[int, np.ndarray], source: str,
+                   resolve: _MeshResolver) -> LinkGeometry:
+    """The ``<visual>`` and ``<collision>`` shapes of one link, posed in its chain frame."""
+    name = el.get("name")
+    frame, T = place
+    shapes: dict[str, list[Shape]] = {"visual": [], "collision": []}
+    for kind, out in shapes.items():
+        for k, sub in enumerate(el.findall(kind)):
+            where = f"{source}: link {short_repr(name)} <{kind}> #{k + 1}"
+            geo = sub.find("geometry")
+            if geo is None or len(geo) != 1:
+                raise RobotDefinitionError(f"{where}: expected one element in <geometry>")
+            try:
+                geometry = _geometry(geo[0], where, resolve)
+            except RobotDefinitionError as exc:
+                msg = str(exc)
+                raise RobotDefinitionError(
+                    msg if msg.startswith(where) else f"{where}: {msg}") from None
+            material, rgba = None, None
+            mat = sub.find("material")
+            if mat is not None:
+                material = mat.get("name")
+                color = mat.find("color")
+                if color is not None and color.get("rgba") is not None:
+                    rgba = tuple(_floats(color.get("rgba"), 4, (0, 0, 0, 1),
+                                         f"{where} <color rgba>"))
+            try:
+                out.append(Shape(geometry, T @ _origin(sub.find("origin"), where),
+                                 name=sub.get("name") or "", material=material, rgba=rgba))
+            except RobotDefinitionError as exc:
+                raise RobotDefinitionError(f"{where}: {exc}") from None
+    return LinkGeometry(name, frame, tuple(shapes["visual"]), tuple(shapes["collision"]))
+
+
+def _geometry(g: ET.Element, where: str, resolve: _MeshResolver):
+    """One URDF geometry element as a :mod:`~serialkin.model.geometry` object."""
+    def num(attr: str) -> float:
+        if g.get(attr) is None:
+            raise RobotDefinitionError(f"<{g.tag}> has no {attr} attribute")
+        return float(_floats(g.get(attr), 1, (0.0,), f"{where} <{g.tag} {attr}>")[0])
+
+    if g.tag == "box":
+        if g.get("size") is None:
+            raise RobotDefinitionError("<box> has no size attribute")
+        return Box(tuple(_floats(g.get("size"), 3, (0, 0, 0), f"{where} <box size>")))
+    if g.tag == "sphere":
+        return Sphere(num("radius"))
+    if g.tag == "cylinder":
+        return Cylinder(num("radius"), num("length"))
+    if g.tag == "capsule":
+        return Capsule(num("radius"), num("length"))
+    if g.tag == "mesh":
+        filename = g.get("filename")
+        if not filename:
+            raise RobotDefinitionError("<mesh> has no filename attribute")
+        scale = _floats(g.get("scale"), 3, (1.0, 1.0, 1.0), f"{where} <mesh scale>")
+        return Mesh(resolve(filename, where), tuple(scale))
+    raise RobotDefinitionError(
+        f"unknown geometry <{g.tag}>; expected box, cylinder, sphere, capsule or mesh")
 
 
 def _names(names: list[str]) -> str:
