@@ -1,4 +1,4 @@
-"""URDF import and export (kinematics only; meshes are never loaded).
+"""URDF import and export: kinematics and link geometry (meshes are named, never loaded).
 
 Parsing uses the standard library's :mod:`xml.etree.ElementTree`: URDF is plain XML, the
 parser is well kept and adds no dependency. The serial chain between ``base_link`` and
@@ -474,19 +474,60 @@ def _origin_el(parent: ET.Element, T: np.ndarray) -> None:
                   rpy=" ".join(_fmt(v) for v in rpy))
 
 
+def _geometry_els(robot, link_els: list[ET.Element]) -> None:
+    """Write ``robot.geometry`` into the link elements of frames 0..n."""
+    L = robot.chain.L
+    for lg in getattr(robot, "geometry", ()):
+        if lg.frame > robot.n:
+            raise RobotDefinitionError(
+                f"link {short_repr(lg.link_name)} geometry is on frame {lg.frame}; the robot "
+                f"has frames 0..{robot.n}")
+        for kind, shapes in (("visual", lg.visual), ("collision", lg.collision)):
+            for shape in shapes:
+                el = ET.SubElement(link_els[lg.frame], kind)
+                if shape.name:
+                    el.set("name", _xml_name(str(shape.name), f"{kind} name"))
+                _origin_el(el, L[lg.frame] @ shape.origin)
+                _geometry_el(ET.SubElement(el, "geometry"), shape.geometry)
+                if kind == "visual" and (shape.material is not None or shape.rgba is not None):
+                    mat = ET.SubElement(el, "material",
+                                        name=_xml_name(shape.material or "", "material name"))
+                    if shape.rgba is not None:
+                        ET.SubElement(mat, "color", rgba=" ".join(_fmt(c) for c in shape.rgba))
+
+
+def _geometry_el(parent: ET.Element, g) -> None:
+    """One geometry as its URDF element (``capsule`` is the common non-standard extension)."""
+    if isinstance(g, Box):
+        ET.SubElement(parent, "box", size=" ".join(_fmt(v) for v in g.size))
+    elif isinstance(g, Sphere):
+        ET.SubElement(parent, "sphere", radius=_fmt(g.radius))
+    elif isinstance(g, Cylinder | Capsule):
+        ET.SubElement(parent, "cylinder" if isinstance(g, Cylinder) else "capsule",
+                      radius=_fmt(g.radius), length=_fmt(g.length))
+    else:
+        ET.SubElement(parent, "mesh", filename=_xml_name(g.filename, "mesh filename"),
+                      scale=" ".join(_fmt(v) for v in g.scale))
+
+
 def robot_to_urdf(robot) -> str:
-    """The robot's kinematics as a URDF string (no geometry, no inertia).
+    """The robot's kinematics and geometry as a URDF string (no inertia).
 
     Joint *i*'s origin is the chain's fixed transform before its motion (``chain.F[i-1]``,
     base included for the first joint) composed with the joint offset, so that
     :func:`robot_from_urdf` reproduces the same forward kinematics; the tool becomes a
-    fixed joint to a link named ``tool``. Infinite revolute limits export as
+    fixed joint to a link named ``tool``. The shapes of ``robot.geometry`` are written to
+    the link of their frame (a link merged into a chain frame is written into that
+    frame's link, so its own name is not kept), with origin
+    ``L[frame] @ origin`` since the exported link frame is the compiled frame (its joint
+    axis turned onto z): world poses are kept. Infinite revolute limits export as
     ``continuous`` joints. The document is built with :mod:`xml.etree.ElementTree`,
     which escapes every name (``&``, ``<``, quotes, newlines): no name can add markup.
 
     Raises:
         RobotDefinitionError: a robot, joint or link name holds a character XML cannot
-            represent (a control character other than tab, newline and carriage return).
+            represent (a control character other than tab, newline and carriage return);
+            a geometry on a frame the robot does not have.
     """
     from scipy.spatial.transform import Rotation
 
@@ -503,8 +544,8 @@ def robot_to_urdf(robot) -> str:
     while tool_joint in joint_names:
         tool_joint = "_" + tool_joint
     root = ET.Element("robot", name=_xml_name(str(robot.name), "robot name"))
-    for n in [*names, tool_link]:
-        ET.SubElement(root, "link", name=n)
+    link_els = [ET.SubElement(root, "link", name=n) for n in [*names, tool_link]]
+    _geometry_els(robot, link_els)
     for i, j in enumerate(robot.joints):
         M = np.eye(4)
         if j.type == "R":
