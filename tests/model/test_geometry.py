@@ -242,3 +242,13 @@ def test_unresolved_mesh_is_kept_or_refused_with_where_it_looked(urdf_dir: Path)
         Robot.from_urdf(path, tip_link="tcp", search_path=[urdf_dir], resolve_meshes=True)
     with pytest.raises(RobotDefinitionError, match=r"link 'link1'.*meshes/l1\.stl.*nowhere"):
         Robot.from_urdf(URDF, tip_link="tcp", resolve_meshes=True)
+
+
+def test_hostile_mesh_paths_are_unresolved_not_crashes() -> None:
+    """A mesh name too long for the file system is kept, or refused with the library's error."""
+    urdf = URDF.replace("meshes/l1.stl", "x" * 5000)
+    robot = Robot.from_urdf(urdf, tip_link="tcp", search_path=["/tmp"])
+    l1 = {lg.link_name: lg for lg in robot.geometry}["link1"]
+    assert l1.visual[0].geometry.filename == "x" * 5000
+    with pytest.raises(RobotDefinitionError, match=r"link 'link1'.*does not resolve"):
+        Robot.from_urdf(urdf, tip_link="tcp", search_path=["/tmp"], resolve_meshes=True)

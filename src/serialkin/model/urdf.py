@@ -333,8 +333,11 @@ class _MeshResolver:
     def __call__(self, name: str, where: str) -> str:
         tried = self.candidates(name)
         for p in tried:
-            if p.is_file():
-                return str(p.resolve())
+            try:
+                if p.is_file():
+                    return str(p.resolve())
+            except (OSError, ValueError):  # a name too long, a loop of links: not a file
+                continue
         if self.strict:
             looked = ", ".join(short_repr(str(p), 120) for p in tried) or (
                 "nowhere: give package_map= or search_path=")
