@@ -219,16 +219,18 @@ class Robot:
 
     @classmethod
     def from_urdf(cls, path_or_string: str, base_link: str | None = None,
-                  tip_link: str | None = None, **geometry_options: Any) -> Robot:
+                  tip_link: str | None = None, *, package_map: Any = None,
+                  search_path: Any = (), resolve_meshes: bool = False) -> Robot:
         """Build a robot from a URDF file or string (see :mod:`serialkin.model.urdf`).
 
-        ``geometry_options``: ``package_map``, ``search_path``, ``resolve_meshes`` for
-        the mesh paths of :func:`~serialkin.model.urdf.robot_from_urdf`.
+        ``package_map``, ``search_path`` and ``resolve_meshes`` locate the mesh files of
+        the links' geometry, as in :func:`~serialkin.model.urdf.robot_from_urdf`.
         """
         from serialkin.model.urdf import robot_from_urdf
 
         return robot_from_urdf(path_or_string, base_link=base_link, tip_link=tip_link,
-                               **geometry_options)
+                               package_map=package_map, search_path=search_path,
+                               resolve_meshes=resolve_meshes)
 
     def to_urdf(self) -> str:
         """Return the robot's kinematics as a URDF string (see :mod:`serialkin.model.urdf`)."""
