@@ -22,7 +22,7 @@ $(STAMP_RUN): pyproject.toml | $(PY)
 	touch $@
 
 $(STAMP_TEST): pyproject.toml | $(PY)
-	$(PY) -m pip install --quiet -e ".[dev,bench]"
+	$(PY) -m pip install --quiet -e ".[dev,bench,mesh,xacro,dist]"
 	touch $@ $(STAMP_RUN)
 
 # numba's on-disk cache only notices edits to a kernel's own file, not to the kernels it

@@ -215,7 +215,7 @@ def main(argv: list[str] | None = None) -> int:
             if robot.name in ("UR5", "Panda", "ur5", "panda") and b is not None and (
                     name.startswith("fk(q) ") or name.startswith("jacobian(q) ")):
                 r = a / b
-                record("1", f"{robot.name} {name.split(' [')[0]} / Pinocchio "
+                record("11.1", f"{robot.name} {name.split(' [')[0]} / Pinocchio "
                        f"{'FK update' if name.startswith('fk') else 'computeFrameJacobian'}",
                        r, "x (median ratio)", "<= 1", r <= 1.0)
     return 0

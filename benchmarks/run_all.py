@@ -1,8 +1,8 @@
 """Run every benchmark script in this folder, then print one summary table (``make bench``).
 
 Each script prints its own table (medians and spread of repeated runs, peers measured in
-the same run when the ``bench`` extra is installed). The figures on which the goals of
-issue 11 are judged are collected from the scripts (``SERIALKIN_BENCH_RESULTS``, see
+the same run when the ``bench`` extra is installed). The figures on which the issues' goals
+are judged are collected from the scripts (``SERIALKIN_BENCH_RESULTS``, see
 ``_common.record``) into the closing table: goal, measured figure, target, met or not.
 Benchmarks are run by hand, never as timed assertions in tests.
 
@@ -21,10 +21,12 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 
+#: Goal id -> what it asks. Ids are "<issue>.<item>"; a script records its rows under one.
 GOALS = {
-    "1": "single calls no slower than Pinocchio (UR5, Panda)",
-    "2": "parallel batches never slower than serial; 6-DOF batch FK >= 40 M/s",
-    "3": "IK lm single <= 8 us at 100 % success; batch <= 4 us per target",
+    "11.1": "single calls no slower than Pinocchio (UR5, Panda)",
+    "11.2": "parallel batches never slower than serial; 6-DOF batch FK >= 40 M/s",
+    "11.3": "IK lm single <= 8 us at 100 % success; batch <= 4 us per target",
+    "12.1": "Panda self_clearance batched on one core <= 2 us per configuration",
 }
 
 
@@ -32,11 +34,11 @@ def summary(path: Path) -> str:
     """The closing table from the recorded JSON lines."""
     rows = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()
             if line.strip()] if path.exists() else []
-    out = ["", "=== summary: goals of issue 11 ===", ""]
-    head = f"{'goal':4s} {'measure':72s} {'measured':>12s} {'target':>14s} {'met':>4s}"
+    out = ["", "=== summary: goals of the issues ===", ""]
+    head = f"{'goal':5s} {'measure':72s} {'measured':>12s} {'target':>14s} {'met':>4s}"
     out += [head, "-" * len(head)]
     for r in rows:
-        out.append(f"{r['goal']:4s} {r['measure'][:72]:72s} {r['value']:12.3f} "
+        out.append(f"{r['goal']:5s} {r['measure'][:72]:72s} {r['value']:12.3f} "
                    f"{r['target']:>14s} {'yes' if r['met'] else 'NO':>4s}")
     for goal, text in GOALS.items():
         mine = [r for r in rows if r["goal"] == goal]
