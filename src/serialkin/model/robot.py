@@ -29,7 +29,7 @@ from serialkin._checks import (
     check_positive,
     short_repr,
 )
-from serialkin.errors import InputError, RobotDefinitionError
+from serialkin.errors import InputError, InputTypeError, RobotDefinitionError
 from serialkin.kinematics import kernels as K
 from serialkin.kinematics import parallel
 from serialkin.kinematics.dls import manipulability_batch
@@ -116,6 +116,8 @@ class Robot:
             prismatic one (``joint_types`` holds the same as 'R'/'P').
         chain: the compiled chain arrays (:class:`~serialkin.model.chain.Chain`: ``F``,
             ``L``, ``meta``, ``packed``) that compiled kernels of other subpackages take.
+        collision: the robot's :class:`~serialkin.collision.model.CollisionModel`
+            (capsules and spheres per link frame) or None; set with :meth:`with_collision`.
     """
 
     def __init__(
@@ -156,6 +158,8 @@ class Robot:
         self.link_names: tuple[str, ...] | None = None
         #: visual and collision shapes per link (:mod:`serialkin.model.geometry`)
         self.geometry: tuple[LinkGeometry, ...] = ()
+        #: capsule/sphere collision model (:mod:`serialkin.collision`), or None
+        self.collision: Any = None
         self.qlim = np.array([j.qlim for j in joints], dtype=float)
         self.joint_types = tuple(j.type for j in joints)
         self.revolute = np.array([t == "R" for t in self.joint_types], dtype=bool)
@@ -247,6 +251,33 @@ class Robot:
         robot = Robot(args.pop("joints"), **args)
         robot.link_names = self.link_names
         robot.geometry = self.geometry
+        robot.collision = self.collision
+        return robot
+
+    def with_collision(self, model: object) -> Robot:
+        """A copy of this robot carrying ``model`` as its collision model (None removes it).
+
+        Args:
+            model: a :class:`~serialkin.collision.model.CollisionModel` whose body frames
+                are frames of this robot (0..n), or None.
+
+        Raises:
+            InputTypeError: ``model`` is neither a CollisionModel nor None.
+            InputError: a body is fixed to a frame this robot does not have.
+        """
+        if model is not None:
+            from serialkin.collision.model import CollisionModel
+
+            if not isinstance(model, CollisionModel):
+                raise InputTypeError(f"model must be a CollisionModel or None, got "
+                                     f"{type(model).__name__} {short_repr(model)}")
+            frames = np.asarray(model.body_frames)
+            if frames.size and int(frames.max()) > self.n:
+                i = int(np.argmax(frames > self.n))
+                raise InputError(f"model body {model.body_names[i]!r} is fixed to frame "
+                                 f"{int(frames[i])} but robot {self.name!r} has frames 0..{self.n}")
+        robot = self._copy()
+        robot.collision = model
         return robot
 
     def with_tool(self, tool: object) -> Robot:

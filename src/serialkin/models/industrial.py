@@ -126,7 +126,10 @@ def ur5() -> Robot:
                  alpha=[h, 0.0, 0.0, h, -h, 0.0],
                  d=[0.089159, 0.0, 0.0, 0.10915, 0.09465, 0.0823],
                  theta=[0.0] * 6, qlim_deg=lim)
-    return Robot.from_dh(rows, "standard", name="UR5", source=UR5_SOURCE)
+    from serialkin.collision.robots import ur5_collision_model
+
+    robot = Robot.from_dh(rows, "standard", name="UR5", source=UR5_SOURCE)
+    return robot.with_collision(ur5_collision_model())
 
 
 def panda() -> Robot:
@@ -153,7 +156,10 @@ def panda() -> Robot:
                  d=[0.333, 0.0, 0.316, 0.0, 0.384, 0.0, 0.0],
                  theta=[0.0] * 7, qlim_deg=lim)
     flange = make_transform(p=[0.0, 0.0, 0.107])
-    return Robot.from_dh(rows, "modified", tool=flange, name="panda", source=PANDA_SOURCE)
+    from serialkin.collision.robots import panda_collision_model
+
+    robot = Robot.from_dh(rows, "modified", tool=flange, name="panda", source=PANDA_SOURCE)
+    return robot.with_collision(panda_collision_model())
 
 
 def iiwa7() -> Robot:
