@@ -1,0 +1,46 @@
+"""Kinematic calibration: identify a robot's real geometry from measurements.
+
+* :mod:`~serialkin.calibration.models` — error models (DH with Hayati's β, joint origin
+  and axis errors, base and tool) as an extended chain;
+* :mod:`~serialkin.calibration.measurements` — pose / position measurements, CSV files;
+* :mod:`~serialkin.calibration.jacobian` — residuals and the identification Jacobian;
+* :mod:`~serialkin.calibration.identifiability` — SVD, condition number, minimal set;
+* :mod:`~serialkin.calibration.fit` — :func:`calibrate` (scipy least squares);
+* :mod:`~serialkin.calibration.selection` — choosing poses by observability indices;
+* :mod:`~serialkin.calibration.simulate` — perturbed robots and noisy measurements;
+* :mod:`~serialkin.calibration.export` — the calibrated robot as a robot file or URDF.
+
+See ``docs/calibration.md``.
+"""
+
+from serialkin.calibration.export import save_robot
+from serialkin.calibration.fit import CalibrationResult, calibrate
+from serialkin.calibration.identifiability import Identifiability, identifiability
+from serialkin.calibration.measurements import (
+    Measurements,
+    make_measurements,
+    read_measurements,
+    write_measurements,
+)
+from serialkin.calibration.models import ErrorModel, Parameter, error_model
+from serialkin.calibration.selection import observability, select_poses
+from serialkin.calibration.simulate import perturb, simulate_measurements
+
+__all__ = [
+    "CalibrationResult",
+    "ErrorModel",
+    "Identifiability",
+    "Measurements",
+    "Parameter",
+    "calibrate",
+    "error_model",
+    "identifiability",
+    "make_measurements",
+    "observability",
+    "perturb",
+    "read_measurements",
+    "save_robot",
+    "select_poses",
+    "simulate_measurements",
+    "write_measurements",
+]

@@ -1,0 +1,152 @@
+"""Which parameters the measurements can identify: SVD, condition number, a minimal set.
+
+The identification Jacobian J (m·k, p) is scaled column by column to unit norm,
+``J_s = J · D⁻¹`` with ``D = diag(‖J_k‖)`` (so that metres and radians compare). Then:
+
+* the singular values σ of ``J_s`` (descending) and the condition number σ_max/σ_min of
+  the identifiable set say how well it is determined (the fit's parameter errors grow
+  with 1/σ_min);
+* the minimal identifiable set is chosen column by column in a fixed priority order
+  (base, tool, then the links from the base out): a column is kept when its part
+  orthogonal to the kept columns has norm above ``tol`` (Gram–Schmidt with
+  re-orthogonalisation), else it is a combination of kept columns and its parameter
+  cannot be told apart from them — it is fixed at its current value, never fitted to
+  noise. The combination (``J_s,k ≈ Σ c_j J_s,j``) names the parameters involved:
+  "d1 and base z cannot be separated". A column of zero norm does not affect the
+  measurements at all (e.g. the tool rotations for positions).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from serialkin._checks import check_positive
+from serialkin.calibration.measurements import Measurements
+from serialkin.calibration.models import ErrorModel
+
+#: Relative norm below which a scaled column counts as a combination of the kept ones.
+RANK_TOL = 1e-6
+
+
+@dataclass(frozen=True, eq=False)
+class Identifiability:
+    """The identifiability of an error model's parameters from a set of measurements.
+
+    Attributes:
+        names: (p,) parameter names.
+        identifiable: (p,) bool, True for the minimal identifiable set the fit uses.
+        singular_values: the scaled Jacobian's singular values over the identifiable set
+            (descending).
+        condition_number: σ_max/σ_min over the identifiable set (inf if empty).
+        condition_number_all: σ_max/σ_min over every parameter (inf when some cannot be
+            identified).
+        reasons: one sentence per parameter left out, e.g. 'd1 and base z cannot be
+            separated'.
+        kind: the measurement kind analysed.
+    """
+
+    names: tuple[str, ...]
+    identifiable: np.ndarray
+    singular_values: np.ndarray
+    condition_number: float
+    condition_number_all: float
+    reasons: tuple[str, ...]
+    kind: str
+
+    @property
+    def rank(self) -> int:
+        """Size of the minimal identifiable set."""
+        return int(self.identifiable.sum())
+
+    @property
+    def unidentifiable(self) -> tuple[str, ...]:
+        """Names of the parameters left out of the fit."""
+        return tuple(n for n, ok in zip(self.names, self.identifiable) if not ok)
+
+    def summary(self) -> str:
+        """A few lines for people: counts, condition numbers, what is left out and why."""
+        lines = [f"{self.rank} of {len(self.names)} parameters identifiable from "
+                 f"{self.kind} measurements; condition number {self.condition_number:.4g} "
+                 f"(all parameters: {self.condition_number_all:.4g})"]
+        lines += [f"  - {r}" for r in self.reasons]
+        return "\n".join(lines)
+
+
+def _condition(s: np.ndarray) -> float:
+    if s.size == 0 or s[-1] <= 1e-15 * s[0]:
+        return float("inf")
+    return float(s[0] / s[-1])
+
+
+def analyse(J: np.ndarray, names: Sequence[str], *, kind: str = "",
+            order: Sequence[int] | None = None, tol: float = RANK_TOL) -> Identifiability:
+    """Identifiability from an identification Jacobian (see the module docstring).
+
+    Args:
+        J: (rows, p) identification Jacobian (whitened or not).
+        names: (p,) parameter names.
+        kind: measurement kind, for sentences.
+        order: priority order of the columns (default 0..p-1).
+        tol: relative norm below which a scaled column is dependent.
+
+    Returns:
+        :class:`Identifiability`.
+    """
+    tol = check_positive(tol, "tol")
+    J = np.asarray(J, dtype=float)
+    p = J.shape[1]
+    norms = np.linalg.norm(J, axis=0)
+    big = norms.max() if p and norms.max() > 0 else 1.0
+    effect = norms > 1e-12 * big
+    Js = J / np.where(effect, norms, 1.0)
+    keep = np.zeros(p, dtype=bool)
+    basis = np.zeros((J.shape[0], 0))
+    reasons = []
+    what = f"{kind} measurements" if kind else "the measurements"
+    for k in (range(p) if order is None else order):
+        if not effect[k]:
+            reasons.append(f"{names[k]} has no effect on {what}")
+            continue
+        c = Js[:, k]
+        r = c - basis @ (basis.T @ c)
+        r = r - basis @ (basis.T @ r)
+        nr = float(np.linalg.norm(r))
+        if nr > tol:
+            keep[k] = True
+            basis = np.column_stack([basis, r / nr])
+            continue
+        idx = np.flatnonzero(keep)
+        coef = np.linalg.lstsq(Js[:, idx], c, rcond=None)[0]
+        big_c = np.abs(coef) > 0.05 * np.abs(coef).max()
+        others = [names[idx[i]] for i in np.flatnonzero(big_c)]
+        if len(others) == 1:
+            reasons.append(f"{names[k]} and {others[0]} cannot be separated from {what}")
+        else:
+            reasons.append(f"{names[k]} cannot be separated from {', '.join(others)} "
+                           f"(a combination of them) using {what}")
+    s = np.linalg.svd(Js[:, keep], compute_uv=False) if keep.any() else np.zeros(0)
+    s_all = np.linalg.svd(Js, compute_uv=False) if p else np.zeros(0)
+    cond_all = _condition(s_all) if effect.all() else float("inf")
+    return Identifiability(tuple(names), keep, s, _condition(s), cond_all, tuple(reasons),
+                           kind)
+
+
+def identifiability(model: ErrorModel, measurements: Measurements, params: object = None,
+                    *, tol: float = RANK_TOL) -> Identifiability:
+    """Identifiability of ``model``'s parameters from ``measurements`` at ``params``.
+
+    The priority order is base, tool, then the links (a redundant link parameter is
+    fixed at its nominal value, so the data-sheet value stays where the data cannot
+    tell).
+    """
+    from serialkin.calibration.jacobian import identification_jacobian
+
+    J = identification_jacobian(model, measurements, params)
+    groups = [p.group for p in model.parameters]
+    order = ([i for i, g in enumerate(groups) if g == "base"]
+             + [i for i, g in enumerate(groups) if g == "tool"]
+             + [i for i, g in enumerate(groups) if g not in ("base", "tool")])
+    return analyse(J, model.names, kind=measurements.kind, order=order, tol=tol)

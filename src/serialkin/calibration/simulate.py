@@ -1,0 +1,75 @@
+"""Simulated calibrations: a perturbed "real" robot and noisy measurements of it.
+
+``perturb`` draws every parameter of an error model uniformly in ``nominal ± length``
+(translations) or ``± angle`` (rotations); ``simulate_measurements`` measures a robot
+at configurations with Gaussian noise of standard deviation ``noise_position`` [m] per
+coordinate and ``noise_rotation`` [rad] about each axis (a rotation ``exp(n)·R`` with
+``n ~ N(0, σ² I)``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from serialkin._checks import as_generator, check_choice, check_int, check_positive
+from serialkin.calibration.measurements import (
+    KINDS,
+    SIGMA_POSITION,
+    SIGMA_ROTATION,
+    Measurements,
+    make_measurements,
+)
+from serialkin.calibration.models import ErrorModel
+from serialkin.model.robot import Robot
+
+
+def perturb(model: ErrorModel, *, length: float = 1e-3, angle: float = np.radians(0.5),
+            seed: None | int | np.random.Generator = None) -> np.ndarray:
+    """Parameters (p,) drawn uniformly in ``nominal ± length`` [m] / ``± angle`` [rad]."""
+    length = check_positive(length, "length", allow_zero=True)
+    angle = check_positive(angle, "angle", allow_zero=True)
+    rng = as_generator(seed)
+    half = np.array([length if p.unit == "m" else angle for p in model.parameters])
+    return model.nominal + rng.uniform(-1.0, 1.0, model.size) * half
+
+
+def simulate_measurements(robot: Robot, q: object, *, kind: str = "position",
+                          noise_position: float = 5e-5, noise_rotation: float = 0.0,
+                          sigma_position: float | None = None,
+                          sigma_rotation: float | None = None,
+                          seed: None | int | np.random.Generator = None) -> Measurements:
+    """Noisy measurements of ``robot``'s tool at configurations ``q``.
+
+    Args:
+        robot: the "real" robot (e.g. ``model.calibrated_robot(perturb(model))``).
+        q: (m, n) configurations, or an int m for m random ones inside the limits.
+        kind: 'position' or 'pose'.
+        noise_position: standard deviation of each coordinate [m] (0 for exact).
+        noise_rotation: standard deviation of the rotation about each axis [rad].
+        sigma_position: the sigma stated in the measurements (default the noise, or
+            :data:`~serialkin.calibration.measurements.SIGMA_POSITION` when 0).
+        sigma_rotation: likewise for rotations.
+        seed: None, int or numpy Generator.
+
+    Returns:
+        :class:`~serialkin.calibration.measurements.Measurements`.
+    """
+    from serialkin.spatial.lie import so3_exp
+
+    check_choice(kind, "kind", KINDS)
+    rng = as_generator(seed)
+    npos = check_positive(noise_position, "noise_position", allow_zero=True)
+    nrot = check_positive(noise_rotation, "noise_rotation", allow_zero=True)
+    if isinstance(q, (int, np.integer)) and not isinstance(q, bool):
+        qa = robot.random_q(check_int(q, "q", minimum=1), seed=rng)
+    else:
+        qa = robot.check_q(q).reshape(-1, robot.n)
+    T = robot.fk(qa)
+    sp = sigma_position or (npos if npos > 0 else SIGMA_POSITION)
+    sr = sigma_rotation or (nrot if nrot > 0 else SIGMA_ROTATION)
+    pos = T[:, :3, 3] + rng.normal(0.0, 1.0, (len(qa), 3)) * npos
+    if kind == "position":
+        return make_measurements(robot, qa, positions=pos, sigma_position=sp)
+    T[:, :3, 3] = pos
+    T[:, :3, :3] = so3_exp(rng.normal(0.0, 1.0, (len(qa), 3)) * nrot) @ T[:, :3, :3]
+    return make_measurements(robot, qa, poses=T, sigma_position=sp, sigma_rotation=sr)
