@@ -1,0 +1,87 @@
+"""Identifiability: named redundancies, flagged parameters, Hayati against plain DH."""
+
+from __future__ import annotations
+
+import numpy as np
+
+import serialkin as sk
+from serialkin.calibration import error_model, identifiability, make_measurements
+from serialkin.calibration.identifiability import analyse
+
+
+def _measure(robot, model, kind, count=40, seed=1):
+    q = robot.random_q(count, seed=seed)
+    T = model.fk(q)
+    return (make_measurements(robot, q, positions=T[:, :3, 3]) if kind == "position"
+            else make_measurements(robot, q, poses=T))
+
+
+def test_ur5_pose_redundancies_are_named():
+    """Full poses: d1/base z and theta1/base rz and the last link against the tool."""
+    robot = sk.models.ur5()
+    model = error_model(robot)
+    ident = identifiability(model, _measure(robot, model, "pose"))
+    assert ident.rank == 30  # 4 R + 6 for a 6R arm
+    assert "d1 and base z cannot be separated from pose measurements" in ident.reasons
+    assert "theta1 and base rz cannot be separated from pose measurements" in ident.reasons
+    assert set(ident.unidentifiable) == {"theta1", "d1", "theta6", "d6", "a6", "alpha6"}
+    assert np.isfinite(ident.condition_number) and ident.condition_number < 100
+    assert ident.condition_number_all == np.inf
+
+
+def test_positions_flag_the_tool_rotations():
+    """From positions, the three tool rotations are flagged as having no effect."""
+    robot = sk.models.ur5().with_tool(sk.spatial.make_transform(p=[0.05, 0.02, 0.06]))
+    model = error_model(robot)
+    ident = identifiability(model, _measure(robot, model, "position"))
+    assert ident.rank == 27  # 30 - 3 tool orientation
+    for name in ("tool rx", "tool ry", "tool rz"):
+        assert f"{name} has no effect on position measurements" in ident.reasons
+        assert not ident.identifiable[model.names.index(name)]
+
+
+def test_hayati_is_well_conditioned_where_plain_dh_is_not():
+    """Puma 560 joints 2-3 (parallel): plain DH's Jacobian is singular, Hayati's is not."""
+    robot = sk.models.puma560()
+    plain = error_model(robot, hayati="none", base=False, tool=False)
+    hayati = error_model(robot, hayati="auto", base=False, tool=False)
+    a = identifiability(plain, _measure(robot, plain, "pose"))
+    b = identifiability(hayati, _measure(robot, hayati, "pose"))
+    assert plain.size == hayati.size == 24
+    assert a.condition_number_all > 1e12  # d2 and d3 slide along the same direction
+    assert "d3 and d2 cannot be separated from pose measurements" in a.reasons
+    assert b.condition_number_all < 100 and b.rank == 24
+
+
+def test_plain_dh_degrades_as_axes_approach_parallel():
+    """A tilt t of axis 3 makes plain DH's d grow like 1/t and its condition number like 1/t².
+
+    Hayati's model of the same tilted arm stays well conditioned.
+    """
+    from serialkin.model.dh_extract import to_dh_robot
+
+    robot = sk.models.puma560()
+    hay = error_model(robot, base=False, tool=False)
+    conds = []
+    for tilt in (1e-2, 1e-3):
+        p = hay.nominal.copy()
+        p[hay.names.index("beta2")] = tilt
+        tilted = to_dh_robot(hay.calibrated_robot(p))  # the same arm as a plain DH table
+        plain = error_model(tilted, hayati="none", base=False, tool=False)
+        assert abs(tilted.dh[1].d) > 0.4 / tilt  # the common normal runs off
+        conds.append(identifiability(plain, _measure(tilted, plain, "pose")
+                                     ).condition_number_all)
+        again = identifiability(hay, _measure(robot, hay, "pose"), p)
+        assert again.condition_number < 100
+    assert conds[0] > 1e4 and conds[1] > 50 * conds[0]
+
+
+def test_analyse_finds_a_dependent_column():
+    """A column that is a sum of two others is left out and named with both."""
+    rng = np.random.default_rng(0)
+    J = rng.normal(size=(20, 3))
+    J = np.column_stack([J, J[:, 0] + 2 * J[:, 1]])
+    ident = analyse(J, ["a", "b", "c", "d"])
+    assert ident.identifiable.tolist() == [True, True, True, False]
+    assert ident.reasons == ("d cannot be separated from a, b (a combination of them) using "
+                             "the measurements",)
