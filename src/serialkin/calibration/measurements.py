@@ -137,28 +137,15 @@ def make_measurements(robot: Robot, q: object, *, positions: object = None,
                          f"got {qa.shape})")
     m = qa.shape[0]
     ln = np.zeros(m, dtype=int) if lines is None else np.asarray(lines, dtype=int)
-    src = f" of {source}" if source else ""
-
-    def _finite(a: np.ndarray, name: str) -> None:
-        bad = ~np.isfinite(a.reshape(m, -1)).all(axis=1)
-        if bad.any():
-            i = int(np.argmax(bad))
-            at = f" (line {int(ln[i])}{src})" if ln[i] else ""
-            raise InputError(f"{name} of measurement {i}{at} is not finite: "
-                             f"{short_repr(a[i].tolist())}")
-
-    _finite(qa, "q")
     rot = None
     if kind == "position":
         pos = as_float_array(positions, "positions", ndim=2)
         if pos.shape != (m, 3):
             raise InputError(f"positions must have shape ({m}, 3) like q, got {pos.shape}")
-        _finite(pos, "position")
     else:
         T = as_float_array(poses, "poses", ndim=3)
         if T.shape != (m, 4, 4):
             raise InputError(f"poses must have shape ({m}, 4, 4) like q, got {T.shape}")
-        _finite(T, "pose")
         T = check_transform(T, "poses")
         pos, rot = T[:, :3, 3].copy(), T[:, :3, :3].copy()
     k = KINDS[kind]
