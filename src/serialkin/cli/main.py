@@ -111,6 +111,7 @@ def chapter(out: str, quiet: bool, sections: tuple[str, ...], jobs: int | None) 
 
 def _register() -> None:
     """Add the subcommands of this package to :data:`cli`."""
+    from serialkin.cli.calibrate_cmd import calibrate_cmd
     from serialkin.cli.commands import fk_cmd, ik_cmd, jacobian_cmd, models_cmd
     from serialkin.cli.compare_cmd import compare_cmd
     from serialkin.cli.track_cmd import track_cmd
@@ -118,7 +119,7 @@ def _register() -> None:
     from serialkin.cli.workspace_cmd import workspace_cmd
 
     for command in (models_cmd, fk_cmd, jacobian_cmd, ik_cmd, compare_cmd, track_cmd,
-                    workspace_cmd, view_cmd):
+                    workspace_cmd, view_cmd, calibrate_cmd):
         cli.add_command(command)
 
 

@@ -1,0 +1,198 @@
+"""The ``calibrate`` subcommand: identify a robot's geometry from measurements, or simulate them."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from serialkin.cli.commands import handle_errors, json_option, quiet_option
+from serialkin.cli.io import (
+    EXIT_NOT_REACHED,
+    CLIError,
+    command_help,
+    csv_text,
+    dumps_json,
+    write_output,
+    write_text_atomic,
+)
+from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot, robot_argument
+
+_HELP = command_help(
+    "Calibrate ROBOT: fit its geometry (DH with Hayati's β for parallel axes, or joint "
+    "origin errors for URDF robots; base and tool) to measured tool positions or poses, "
+    "say which parameters the measurements cannot identify, and write the calibrated robot."
+    "\n\nThe measurement CSV has a header q1..qn,x,y,z (positions, metres) and optionally "
+    "quat_w,quat_x,quat_y,quat_z (poses) and weight. With --simulate N the robot is "
+    "perturbed instead and N noisy measurements of it are written to --measurements (and "
+    "the perturbed robot to --truth). ROBOT is " + ROBOT_HELP + ".",
+    ["serialkin calibrate ur5 --simulate 60 --measurements meas.csv --truth real.urdf",
+     "serialkin calibrate ur5 --measurements meas.csv --out calibrated.yaml",
+     "serialkin calibrate arm.urdf --measurements meas.csv --out cal.urdf --report res.csv",
+     "serialkin calibrate ur5 --measurements poses.csv --loss soft_l1 --json"],
+)
+
+
+@click.command("calibrate", help=_HELP,
+               short_help="Calibrate a robot's geometry from measurements.")
+@robot_argument
+@click.option("--measurements", "-m", "measurements", type=click.Path(dir_okay=False),
+              required=True, help="Measurement CSV to read (or, with --simulate, to write).")
+@click.option("--out", "-o", type=click.Path(dir_okay=False), default=None,
+              help="Write the calibrated robot (.yaml/.yml/.json robot file or .urdf).")
+@click.option("--urdf", type=click.Path(dir_okay=False), default=None,
+              help="Also write the calibrated robot as URDF.")
+@click.option("--report", type=click.Path(dir_okay=False), default=None,
+              help="Write per-measurement errors before/after (.csv) or the full report (.json).")
+@click.option("--model", "kind", type=click.Choice(["auto", "dh", "joints"]), default="auto",
+              show_default=True, help="Error model: the DH table, or joint origin/axis errors.")
+@click.option("--hayati", type=click.Choice(["auto", "none"]), default="auto",
+              show_default=True, help="Hayati's β on links with (nearly) parallel axes.")
+@click.option("--no-base", is_flag=True, help="Keep the base pose fixed.")
+@click.option("--no-tool", is_flag=True, help="Keep the tool pose (marker offset) fixed.")
+@click.option("--loss", type=click.Choice(["linear", "huber", "soft_l1", "cauchy", "arctan"]),
+              default="linear", show_default=True, help="Least squares or a robust loss.")
+@click.option("--loss-scale", type=float, default=3.0, show_default=True,
+              help="Residual size in sigmas where a robust loss bends.")
+@click.option("--sigma-position", type=float, default=1e-4, show_default=True,
+              help="Standard deviation of a measured coordinate [m].")
+@click.option("--sigma-rotation", type=float, default=1e-3, show_default=True,
+              help="Standard deviation of a measured rotation [rad].")
+@click.option("--max-evaluations", type=int, default=200, show_default=True,
+              help="Residual evaluations before giving up (exit code 1).")
+@click.option("--simulate", type=int, default=None, metavar="N",
+              help="Simulation mode: perturb ROBOT and write N noisy measurements.")
+@click.option("--kind", "sim_kind", type=click.Choice(["position", "pose"]), default="position",
+              show_default=True, help="Simulation: what is measured.")
+@click.option("--noise-position", type=float, default=5e-5, show_default=True,
+              help="Simulation: noise of each coordinate [m].")
+@click.option("--noise-rotation", type=float, default=1e-4, show_default=True,
+              help="Simulation: noise of each rotation [rad] (poses).")
+@click.option("--perturb-length", type=float, default=1e-3, show_default=True,
+              help="Simulation: largest length error [m].")
+@click.option("--perturb-angle", type=float, default=0.5, show_default=True,
+              help="Simulation: largest angle error [deg].")
+@click.option("--select", "select", type=int, default=None, metavar="N_CANDIDATES",
+              help="Simulation: pick the N poses out of this many random candidates by O1.")
+@click.option("--truth", type=click.Path(dir_okay=False), default=None,
+              help="Simulation: write the perturbed robot (.yaml/.json/.urdf).")
+@click.option("--seed", type=int, default=0, show_default=True, help="Simulation: random seed.")
+@param_option
+@json_option
+@quiet_option
+@handle_errors
+def calibrate_cmd(robot: str, measurements: str, out: str | None, urdf: str | None,
+                  report: str | None, kind: str, hayati: str, no_base: bool, no_tool: bool,
+                  loss: str, loss_scale: float, sigma_position: float, sigma_rotation: float,
+                  max_evaluations: int, simulate: int | None, **opts: Any) -> None:
+    """Calibrate a robot from measurements, or simulate measurements (see the help)."""
+    from serialkin.calibration import calibrate, error_model, read_measurements, save_robot
+
+    r = resolve_robot(robot, opts.pop("params"))
+    model = error_model(r, kind, hayati=hayati, base=not no_base, tool=not no_tool)
+    as_json, quiet = opts.pop("as_json"), opts.pop("quiet")
+    say = (lambda text: None) if quiet or as_json else click.echo
+    if simulate is not None:
+        _simulate(model, simulate, measurements, say, as_json, **opts)
+        return
+    meas = read_measurements(measurements, r, sigma_position=sigma_position,
+                             sigma_rotation=sigma_rotation)
+    res = calibrate(model, meas, loss=loss, loss_scale=loss_scale,
+                    max_evaluations=max_evaluations)
+    written = []
+    if out:
+        written.append(save_robot(res.robot, out))
+        if res.robot.dh is None and Path(out).suffix.lower() != ".urdf":
+            say("note: the calibrated axes are not exactly DH (Hayati β or joint errors); "
+                f"{out} holds the DH table extracted from them, exact but with long offsets "
+                "for nearly parallel axes: a URDF (--urdf) keeps the identified joints")
+    if urdf:
+        written.append(save_robot(res.robot, Path(urdf).with_suffix(".urdf")
+                                  if Path(urdf).suffix.lower() != ".urdf" else urdf))
+    data = _report(res)
+    if report:
+        if Path(report).suffix.lower() == ".csv":
+            header, rows = res.residual_table()
+            written.append(write_text_atomic(report, csv_text(header, rows)))
+        else:
+            written.append(write_output(report, data))
+    if as_json:
+        click.echo(dumps_json(data))
+    else:
+        say(res.summary())
+        say(_parameter_lines(res))
+        for w in written:
+            say(f"wrote {w}")
+    if not res.success:
+        raise SystemExit(EXIT_NOT_REACHED)
+
+
+def _report(res: Any) -> dict[str, Any]:
+    header, rows = res.residual_table()
+    pb, rb = res.rms_before
+    pa, ra = res.rms_after
+    return {"success": res.success, "reason": res.reason, "model": repr(res.model),
+            "measurements": len(res.errors_before), "kind": res.identifiability.kind,
+            "rms_position_before": pb, "rms_position_after": pa,
+            "rms_rotation_before": None if math.isnan(rb) else rb,
+            "rms_rotation_after": None if math.isnan(ra) else ra,
+            "condition_number": res.identifiability.condition_number,
+            "not_identifiable": list(res.identifiability.reasons),
+            "parameters": [{k: (None if isinstance(v, float) and math.isnan(v) else v)
+                            for k, v in row.items()} for row in res.parameter_table()],
+            "residuals": {"columns": header, "rows": rows.tolist()}}
+
+
+def _parameter_lines(res: Any) -> str:
+    lines = ["fitted parameters (change from nominal ± standard error):"]
+    for row in res.parameter_table():
+        if not row["fitted"]:
+            continue
+        if row["unit"] == "m":
+            lines.append(f"  {row['name']:<22} {row['change'] * 1e3:+.4f} mm "
+                         f"± {row['std_error'] * 1e3:.4f}")
+        else:
+            lines.append(f"  {row['name']:<22} {math.degrees(row['change']):+.5f}° "
+                         f"± {math.degrees(row['std_error']):.5f}")
+    return "\n".join(lines)
+
+
+def _simulate(model: Any, count: int, path: str, say: Any, as_json: bool, *, sim_kind: str,
+              noise_position: float, noise_rotation: float, perturb_length: float,
+              perturb_angle: float, select: int | None, truth: str | None, seed: int) -> None:
+    from serialkin._checks import check_int
+    from serialkin.calibration import (
+        perturb,
+        save_robot,
+        select_poses,
+        simulate_measurements,
+        write_measurements,
+    )
+
+    kind = sim_kind
+    count = check_int(count, "--simulate", minimum=1)
+    rng = np.random.default_rng(seed)
+    params = perturb(model, length=perturb_length, angle=math.radians(perturb_angle), seed=rng)
+    real = model.calibrated_robot(params, name=f"{model.robot.name} (simulated real)")
+    if select is not None:
+        cand = model.robot.random_q(check_int(select, "--select", minimum=1), seed=rng)
+        if count > len(cand):
+            raise CLIError(f"--simulate {count} poses cannot be picked out of --select "
+                           f"{len(cand)} candidates")
+        q: Any = cand[select_poses(model, cand, count, kind=kind, seed=rng)]
+    else:
+        q = count
+    meas = simulate_measurements(real, q, kind=kind, noise_position=noise_position,
+                                 noise_rotation=noise_rotation, seed=rng)
+    written = [write_measurements(path, meas)]
+    if truth:
+        written.append(save_robot(real, truth))
+    if as_json:
+        click.echo(dumps_json({"measurements": len(meas), "kind": kind,
+                               "written": [str(w) for w in written],
+                               "parameters": dict(zip(model.names, params.tolist()))}))
+    for w in written:
+        say(f"wrote {w}")
