@@ -157,9 +157,8 @@ def calibrate(robot: Robot | ErrorModel, measurements: Measurements, *,
         InputError: measurements of another robot (joint count), too few measurements for
             the identifiable set (the message says how many are needed), a bad option.
     """
-    from scipy.optimize import least_squares
-
     from serialkin.calibration.identifiability import RANK_TOL
+    from serialkin.ik.optimize import _single_threaded_blas
 
     model = _as_model(robot)
     if not isinstance(measurements, Measurements):
@@ -173,6 +172,16 @@ def calibrate(robot: Robot | ErrorModel, measurements: Measurements, *,
     max_evaluations = check_int(max_evaluations, "max_evaluations", minimum=1)
     tol = check_positive(tol, "tol")
     rank_tol = RANK_TOL if rank_tol is None else check_positive(rank_tol, "rank_tol")
+    # small dense problems: a multi-threaded BLAS next to numba's thread pool costs 10-40x
+    with _single_threaded_blas():  # type: ignore[attr-defined]
+        return _calibrate(model, measurements, loss, loss_scale, max_evaluations, tol,
+                          rank_tol)
+
+
+def _calibrate(model: ErrorModel, measurements: Measurements, loss: str, loss_scale: float,
+               max_evaluations: int, tol: float, rank_tol: float) -> CalibrationResult:
+    from scipy.optimize import least_squares
+
     kind = measurements.kind
     # the identifiable set at generic configurations, to say how many measurements it needs
     generic_q = model.robot.random_q(max(60, model.size), seed=0)

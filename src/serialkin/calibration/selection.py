@@ -95,8 +95,17 @@ def select_poses(model: ErrorModel, candidates: object, count: int, *, kind: str
     if K > N:
         raise InputError(f"count must be at most the number of candidates {N}, got {K}")
     passes = check_int(passes, "passes")
+    from serialkin.ik.optimize import _single_threaded_blas
+
+    with _single_threaded_blas():  # type: ignore[attr-defined]
+        return _select(model, q, K, kind, index, passes, rng)
+
+
+def _select(model: ErrorModel, q: np.ndarray, K: int, kind: str, index: str, passes: int,
+            rng: np.random.Generator) -> np.ndarray:
     J = candidate_jacobians(model, q, kind)
     k, r = J.shape[1], J.shape[2]
+    N = q.shape[0]
     if K * k < r:
         raise InputError(f"count must give at least {r} equations for the {r} identifiable "
                          f"parameters: at least {-(-r // k)} {kind} measurements, got {K}")
