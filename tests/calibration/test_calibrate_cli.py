@@ -48,8 +48,12 @@ def test_json_report_and_non_convergence(tmp_path):
     data = json.loads(r.output)
     assert data["success"] and data["kind"] == "pose" and len(data["residuals"]["rows"]) == 30
     assert data["rms_position_after"] < data["rms_position_before"]
-    r = _run("ur5", "--measurements", str(meas), "--max-evaluations", "1")
+    report = tmp_path / "report.json"
+    r = _run("ur5", "--measurements", str(meas), "--max-evaluations", "1", "--report",
+             str(report))
     assert r.exit_code == 1 and "NOT converged" in r.output
+    saved = json.loads(report.read_text())
+    assert saved["success"] is False and "not converged" in saved["reason"]
 
 
 def test_bad_measurement_file_is_an_input_error(tmp_path):
@@ -61,3 +65,5 @@ def test_bad_measurement_file_is_an_input_error(tmp_path):
     meas.write_text("q1,q2,q3,q4,q5,q6,x,y,z\n" + "0,0,0,0,0,0,0.1,0.2,0.3\n" * 3)
     r = _run("ur5", "--measurements", str(meas))
     assert r.exit_code == 2 and "at least 9 are needed" in r.output
+    r = _run("ur5", "--measurements", str(meas), "--report", str(tmp_path / "r.txt"))
+    assert r.exit_code == 2 and "--report" in r.output and ".csv, .json" in r.output

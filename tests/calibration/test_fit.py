@@ -73,7 +73,7 @@ def test_standard_errors_cover_the_fitted_changes(ur5_case):
     assert np.median(se[lengths]) < 2e-4  # well below the 1 mm perturbations
 
 
-@pytest.mark.parametrize("name", ["ur5", "panda"])
+@pytest.mark.parametrize("name", ["ur5", "panda", "stanford"])
 def test_noise_free_poses_recover_the_parameters(name):
     """With exact full-pose measurements the perturbed identifiable parameters come back to 1e-8."""
     robot = sk.models.get(name)

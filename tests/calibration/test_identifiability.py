@@ -85,3 +85,19 @@ def test_analyse_finds_a_dependent_column():
     assert ident.identifiable.tolist() == [True, True, True, False]
     assert ident.reasons == ("d cannot be separated from a, b (a combination of them) using "
                              "the measurements",)
+
+
+def test_complete_minimal_counts():
+    """4R + 2P + 6 for full poses: Stanford arm (5R 1P) 28; Puma in modified DH 30, no d2."""
+    from serialkin.model.dh import standard_to_modified
+
+    stanford = sk.models.stanford()
+    model = error_model(stanford)
+    assert identifiability(model, _measure(stanford, model, "pose")).rank == 28
+    puma = sk.models.puma560()
+    rows, base, tool = standard_to_modified(puma.dh, puma.base, puma.tool)
+    modified = sk.Robot.from_dh(rows, "modified", base=base, tool=tool)
+    model = error_model(modified)
+    assert model.hayati == (2,) and "beta3" in model.names and "d2" not in model.names
+    ident = identifiability(model, _measure(modified, model, "pose"))
+    assert ident.rank == 30 and ident.condition_number < 100

@@ -28,6 +28,9 @@ def test_csv_round_trip(tmp_path, kind):
     if kind == "pose":
         np.testing.assert_allclose(back.rotations, meas.rotations, atol=1e-15)
     assert back.lines.tolist() == list(range(2, 9))
+    part = back.subset([1, 4])
+    assert len(part) == 2 and part.lines.tolist() == [3, 6] and part.kind == kind
+    assert "m.csv, line 6" in part.where(1)
     # weight w divides the covariance: the whitening grows with sqrt(w)
     np.testing.assert_allclose(back.whitening[3, 0, 0] / back.whitening[0, 0, 0], 2.0)
 

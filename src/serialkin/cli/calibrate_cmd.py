@@ -91,6 +91,9 @@ def calibrate_cmd(robot: str, measurements: str, out: str | None, urdf: str | No
     """Calibrate a robot from measurements, or simulate measurements (see the help)."""
     from serialkin.calibration import calibrate, error_model, read_measurements, save_robot
 
+    _check_suffix("--out", out, (".yaml", ".yml", ".json", ".urdf"))
+    _check_suffix("--report", report, (".csv", ".json"))
+    _check_suffix("--truth", opts["truth"], (".yaml", ".yml", ".json", ".urdf"))
     r = resolve_robot(robot, opts.pop("params"))
     model = error_model(r, kind, hayati=hayati, base=not no_base, tool=not no_tool)
     as_json, quiet = opts.pop("as_json"), opts.pop("quiet")
@@ -128,6 +131,12 @@ def calibrate_cmd(robot: str, measurements: str, out: str | None, urdf: str | No
             say(f"wrote {w}")
     if not res.success:
         raise SystemExit(EXIT_NOT_REACHED)
+
+
+def _check_suffix(option: str, path: str | None, allowed: tuple[str, ...]) -> None:
+    if path is not None and Path(path).suffix.lower() not in allowed:
+        raise CLIError(f"{option} {path}: unsupported file type {Path(path).suffix!r}; use "
+                       f"{', '.join(allowed)}")
 
 
 def _report(res: Any) -> dict[str, Any]:
