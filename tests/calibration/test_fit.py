@@ -166,3 +166,23 @@ def test_residual_and_parameter_tables():
     assert rows[:, 1].mean() > rows[:, 2].mean() and rows[:, 3].mean() > rows[:, 4].mean()
     table = res.parameter_table()
     assert len(table) == model.size and sum(r["fitted"] for r in table) == 30
+
+
+def test_standard_errors_match_the_spread_over_noise_draws():
+    """Over 40 noise draws the fitted parameters scatter as their standard errors predict."""
+    robot = sk.models.ur5().with_tool(MARKER)
+    model = error_model(robot)
+    real = model.calibrated_robot(perturb(model, seed=20))
+    q = robot.random_q(40, seed=21)
+    fits, ses = [], []
+    for seed in range(40):
+        res = calibrate(model, simulate_measurements(real, q, noise_position=5e-5, seed=seed))
+        fits.append(res.params)
+        ses.append(res.std_errors)
+    keep = res.identifiability.identifiable
+    spread = np.std(np.array(fits)[:, keep], axis=0, ddof=1)
+    predicted = np.median(np.array(ses)[:, keep], axis=0)
+    ratio = spread / predicted
+    # 40 draws: the sample std is within ±25 % of the truth with high probability
+    assert 0.75 < np.median(ratio) < 1.25
+    assert np.all((ratio > 0.5) & (ratio < 1.6))

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import serialkin as sk
 from serialkin.calibration import error_model, identifiability, make_measurements
 from serialkin.calibration.identifiability import analyse
+from tests.kinematics._fd import dh_rows, random_transform
 
 
 def _measure(robot, model, kind, count=40, seed=1):
@@ -101,3 +104,28 @@ def test_complete_minimal_counts():
     assert model.hayati == (2,) and "beta3" in model.names and "d2" not in model.names
     ident = identifiability(model, _measure(modified, model, "pose"))
     assert ident.rank == 30 and ident.condition_number < 100
+
+
+@settings(max_examples=15, deadline=None)
+@given(rows=dh_rows(min_joints=2, max_joints=6), seed=st.integers(0, 2**32 - 1),
+       kind=st.sampled_from(["position", "pose"]))
+def test_minimal_set_has_full_rank_and_explains_the_rest(rows, seed, kind):
+    """The kept columns have full rank; every dropped one lies in their span or has no effect."""
+    from serialkin.calibration.jacobian import identification_jacobian
+
+    rng = np.random.default_rng(seed)
+    robot = sk.Robot.from_dh(rows, "standard", base=random_transform(rng))
+    model = error_model(robot)
+    meas = _measure(robot, model, kind, count=30, seed=rng)
+    ident = identifiability(model, meas)
+    J = identification_jacobian(model, meas)
+    norms = np.linalg.norm(J, axis=0)
+    effect = norms > 1e-12 * norms.max()
+    Js = J / np.where(effect, norms, 1.0)
+    kept = Js[:, ident.identifiable]
+    assert np.linalg.matrix_rank(kept, tol=1e-8) == ident.rank
+    assert len(ident.reasons) == model.size - ident.rank
+    for k in np.flatnonzero(~ident.identifiable & effect):
+        resid = Js[:, k] - kept @ np.linalg.lstsq(kept, Js[:, k], rcond=None)[0]
+        assert np.linalg.norm(resid) < 1e-5
+    assert ident.rank <= 4 * int(robot.revolute.sum()) + 2 * int((~robot.revolute).sum()) + 6
