@@ -67,3 +67,12 @@ def test_bad_measurement_file_is_an_input_error(tmp_path):
     assert r.exit_code == 2 and "at least 9 are needed" in r.output
     r = _run("ur5", "--measurements", str(meas), "--report", str(tmp_path / "r.txt"))
     assert r.exit_code == 2 and "--report" in r.output and ".csv, .json" in r.output
+
+
+def test_options_of_the_other_mode_are_refused(tmp_path):
+    """--out with --simulate, and --truth without it, are input errors rather than ignored."""
+    meas = str(tmp_path / "m.csv")
+    r = _run("ur5", "--simulate", "20", "--measurements", meas, "--out", "x.yaml")
+    assert r.exit_code == 2 and "with --simulate nothing is calibrated" in r.output
+    r = _run("ur5", "--measurements", meas, "--truth", "t.urdf")
+    assert r.exit_code == 2 and "--truth only apply with --simulate" in r.output

@@ -91,6 +91,15 @@ def calibrate_cmd(robot: str, measurements: str, out: str | None, urdf: str | No
     """Calibrate a robot from measurements, or simulate measurements (see the help)."""
     from serialkin.calibration import calibrate, error_model, read_measurements, save_robot
 
+    if simulate is not None:
+        given = [o for o, v in (("--out", out), ("--urdf", urdf), ("--report", report)) if v]
+        if given:
+            raise CLIError(f"{', '.join(given)} write a calibration; with --simulate nothing "
+                           "is calibrated (run again without --simulate)")
+    else:
+        given = [o for o in ("truth", "select") if opts[o] is not None]
+        if given:
+            raise CLIError(f"{', '.join('--' + o for o in given)} only apply with --simulate")
     _check_suffix("--out", out, (".yaml", ".yml", ".json", ".urdf"))
     _check_suffix("--report", report, (".csv", ".json"))
     _check_suffix("--truth", opts["truth"], (".yaml", ".yml", ".json", ".urdf"))
