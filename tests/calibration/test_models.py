@@ -79,3 +79,12 @@ def test_bad_model_arguments():
         error_model(general, "dh")
     with pytest.raises(InputError, match="outside 1..6"):
         error_model(robot, hayati=[7])
+
+
+def test_dh_calibration_keeps_the_collision_model():
+    """A calibrated plain-DH robot carries the nominal capsules; a general-joint one none."""
+    robot = sk.models.ur5()
+    plain = error_model(robot, hayati="none")
+    assert plain.calibrated_robot(perturb(plain, seed=0)).collision is robot.collision
+    hayati = error_model(robot)
+    assert hayati.calibrated_robot(perturb(hayati, seed=0)).collision is None

@@ -158,7 +158,9 @@ class ErrorModel:
         A DH model without β gives a DH robot (the same convention, base and tool updated),
         which a robot file can hold; otherwise a robot of general joints (each joint's
         origin is the product of the fixed and parameter motions before it), which a URDF
-        holds. Joint names and limits are the nominal robot's.
+        holds. Joint names and limits are the nominal robot's; the DH robot keeps the
+        nominal collision model (its link frames are the same DH frames), a robot of general
+        joints has none (its link frames sit on the joint axes).
         """
         p = self.check_params(params)
         nm = self.robot.name if name is None else name
@@ -173,8 +175,10 @@ class ErrorModel:
                 rows.append(dataclasses.replace(
                     r, a=float(values[f"a{k}"]), alpha=float(values[f"alpha{k}"]),
                     d=float(values[f"d{k}"]), theta=float(values[f"theta{k}"])))
-            return Robot.from_dh(rows, self.robot.convention, base=base, tool=tool, name=nm,
-                                 source=source)
+            out = Robot.from_dh(rows, self.robot.convention, base=base, tool=tool, name=nm,
+                                source=source)
+            # the DH frames are the nominal ones, moved by the errors: the capsules follow
+            return out.with_collision(self.robot.collision)
         joints: list[Joint] = []
         pending = np.eye(4)
         for step, j in self._steps:
@@ -211,7 +215,7 @@ class ErrorModel:
 
 
 def _motion(j: Joint, value: float) -> np.ndarray:
-    """The motion of a virtual joint (its axis is x, y or z) by ``value``."""
+    """The motion (4, 4) of a parameter's virtual joint by ``value`` about/along its unit axis."""
     from serialkin.spatial.rotations import axis_angle_to_matrix
 
     if j.type == "P":
