@@ -11,7 +11,7 @@ STAMP_TEST := $(VENV)/.stamp-test
 STAMP_NUMBA := $(VENV)/.stamp-numba
 SOURCES := $(shell find src -name '*.py')
 
-.PHONY: run test lint bench browser-deps clean
+.PHONY: run test lint bench docs browser-deps clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -22,7 +22,7 @@ $(STAMP_RUN): pyproject.toml | $(PY)
 	touch $@
 
 $(STAMP_TEST): pyproject.toml | $(PY)
-	$(PY) -m pip install --quiet -e ".[dev,bench,mesh,xacro,dist]"
+	$(PY) -m pip install --quiet -e ".[dev,bench,docs,mesh,xacro,dist]"
 	touch $@ $(STAMP_RUN)
 
 # numba's on-disk cache only notices edits to a kernel's own file, not to the kernels it
@@ -49,8 +49,12 @@ test: $(STAMP_TEST) $(STAMP_NUMBA) browser-deps
 lint: $(STAMP_TEST)
 	$(VENV)/bin/ruff check src tests benchmarks examples
 
+# The documentation site into site/ (strict: a warning fails); open site/index.html.
+docs: $(STAMP_TEST)
+	DISABLE_MKDOCS_2_WARNING=true NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict
+
 bench: $(STAMP_TEST)
 	$(PY) benchmarks/run_all.py
 
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) out site .pytest_cache
