@@ -236,6 +236,21 @@ class Robot:
                                package_map=package_map, search_path=search_path,
                                resolve_meshes=resolve_meshes)
 
+    @classmethod
+    def from_mjcf(cls, path_or_string: str, base_body: str | None = None,
+                  end_body: str | None = None, *, tool_site: str | None = None,
+                  resolve_meshes: bool = False) -> Robot:
+        """Build a robot from a MuJoCo MJCF file or string (see :mod:`serialkin.model.mjcf`).
+
+        The chain runs from ``base_body`` (default: the world) to ``end_body`` (default:
+        the end of the unbranched chain); ``tool_site`` names a site used as the tool.
+        ``q`` is MuJoCo's ``qpos`` of the chain's hinge and slide joints.
+        """
+        from serialkin.model.mjcf import robot_from_mjcf
+
+        return robot_from_mjcf(path_or_string, base_body=base_body, end_body=end_body,
+                               tool_site=tool_site, resolve_meshes=resolve_meshes)
+
     def to_urdf(self) -> str:
         """Return the robot's kinematics as a URDF string (see :mod:`serialkin.model.urdf`)."""
         from serialkin.model.urdf import robot_to_urdf
