@@ -55,3 +55,11 @@ def test_xacro_args_and_packages():
     T = _fk([str(XACRO), "--param", f"search_path={pkg.parent}", "--q", "0.1,0.2,0.3"])
     np.testing.assert_allclose(T, sk.Robot.from_xacro(XACRO, search_path=[pkg.parent])
                                .fk([0.1, 0.2, 0.3]), atol=1e-12)
+
+
+def test_urdf_saved_as_xml_gets_a_hint(tmp_path):
+    """A URDF named .xml is read as MJCF; the error suggests naming it .urdf."""
+    path = tmp_path / "arm.xml"
+    path.write_text("<robot name='r'><link name='a'/></robot>")
+    res = CliRunner().invoke(cli, ["fk", str(path), "--q", "0"])
+    assert res.exit_code == 2 and "(a URDF? name it .urdf)" in res.output

@@ -43,7 +43,6 @@ FILE_PARAMS = {
     ".mjcf": ("base_body", "end_body", "tool_site"),
     ".xacro": ("base_link", "tip_link", "search_path", "arg:NAME", "package:NAME"),
 }
-_CHAIN_HINTS = {"tip_link": "tip_link", "end_body": "end_body", "tool_site": "end_body"}
 
 
 def parse_params(params: Sequence[str]) -> dict[str, Any]:
@@ -153,13 +152,11 @@ def _load(spec: str, loader: Any, kwargs: dict[str, Any]) -> Any:
         return loader(spec, **kwargs)
     except SerialkinError as exc:
         msg = str(exc)
-        for word, param in _CHAIN_HINTS.items():
-            if f"{word}=" in msg.replace(" ", "") and param not in kwargs:
-                msg += f" (on the command line: --param {param}=NAME)"
-                break
-        else:
-            if "tip_link" in msg and "tip_link" not in kwargs:
-                msg += " (on the command line: --param tip_link=NAME)"
+        for key in ("tip_link", "end_body"):  # a branching tree: say how to choose
+            if f"pass {key}=" in msg and key not in kwargs:
+                msg += f" (on the command line: --param {key}=NAME)"
+        if "root element must be <mujoco>, got <robot>" in msg:
+            msg += " (a URDF? name it .urdf)"
         raise CLIError(msg) from exc
     except OSError as exc:
         raise CLIError(f"{spec}: cannot read ({exc.strerror or exc})") from exc
