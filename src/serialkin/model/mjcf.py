@@ -35,7 +35,8 @@ physics options, is ignored):
 * ``<geom>``: ``sphere``, ``capsule``, ``cylinder``, ``box`` (``size`` = radius,
   half-length, half-sizes, as MuJoCo) with ``fromto`` for the three elongated types, and
   ``mesh`` through ``<asset><mesh file scale>`` found in ``meshdir`` (relative to the
-  model file's folder), else ``assetdir``, else the model's folder. A mesh geom is placed
+  model file's folder), else ``assetdir``, else the model's folder (a negative ``scale``,
+  MuJoCo's mirroring, is kept as its magnitude: ``Mesh.scale`` is >= 0). A mesh geom is placed
   at its ``pos``/orientation with the file's vertices as written (MuJoCo re-centres a mesh
   on its inertia frame and moves the geom by the same amount, so what is drawn is the
   same). A geom's ``rgba`` other than MuJoCo's default grey overrides its material's
