@@ -447,3 +447,98 @@ def test_random_chains_agree_with_mujoco(xml, seed):
             g = m.geom(s.name).id
             np.testing.assert_allclose(frames[lg.frame] @ s.origin,
                                        _pose(d.geom_xpos[g], d.geom_xmat[g]), atol=1e-10)
+
+
+def _tetrahedron_stl(size: float) -> bytes:
+    """A binary STL (what MuJoCo reads) of the tetrahedron 0, size·e_x, size·e_y, size·e_z."""
+    import struct
+
+    v = np.array([[0, 0, 0], [size, 0, 0], [0, size, 0], [0, 0, size]], dtype=float)
+    faces = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    data = bytearray(80) + struct.pack("<I", len(faces))
+    for f in faces:
+        n = np.cross(v[f[1]] - v[f[0]], v[f[2]] - v[f[0]])
+        data += struct.pack("<12fH", *(n / np.linalg.norm(n)), *v[list(f)].ravel(), 0)
+    return bytes(data)
+
+
+_MESH_ARM = """<mujoco model="mesh_arm">
+  <compiler angle="radian" meshdir="parts" autolimits="true"/>
+  <default>
+    <default class="arm">
+      <joint axis="0 0 1" range="-2.5 2.5"/>
+      <mesh scale="0.5 0.5 0.5"/>
+      <default class="visual"><geom type="mesh" contype="0" conaffinity="0" group="2"/></default>
+      <default class="collision"><geom type="mesh" group="3"/>
+        <default class="pad"><geom type="box" size="0.01 0.02 0.03" pos="0 0.01 0.04"/></default>
+      </default>
+    </default>
+  </default>
+  <asset>
+    <material class="arm" name="blue" rgba="0 0 1 1"/>
+    <mesh class="arm" file="shell.stl"/>
+    <mesh class="arm" name="shell_c" file="shell.stl" scale="1 1 1"/>
+  </asset>
+  <worldbody>
+    <body name="base" childclass="arm">
+      <geom mesh="shell" class="visual" material="blue"/>
+      <geom mesh="shell_c" class="collision"/>
+      <body name="upper" pos="0 0 0.3" quat="1 -1 0 0">
+        <joint name="shoulder"/>
+        <geom mesh="shell" class="visual"/>
+        <geom name="upper_pad" class="pad"/>
+        <body name="fore" pos="0 -0.3 0" quat="1 1 0 0">
+          <joint name="elbow" range="-1 1"/>
+          <geom mesh="shell_c" class="collision"/>
+          <geom name="fore_pad" class="pad" quat="0 0 0 1"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
+def test_menagerie_style_classes_and_meshes(tmp_path):
+    """Visual/collision classes, mesh class defaults, meshdir and materials read as MuJoCo does."""
+    (tmp_path / "parts").mkdir()
+    (tmp_path / "parts" / "shell.stl").write_bytes(_tetrahedron_stl(0.1))
+    path = tmp_path / "mesh_arm.xml"
+    path.write_text(_MESH_ARM)
+    robot = Robot.from_mjcf(path, resolve_meshes=True)
+    assert robot.joint_names == ("shoulder", "elbow")
+    np.testing.assert_allclose(robot.qlim, [[-2.5, 2.5], [-1.0, 1.0]])
+    by_link = {lg.link_name: lg for lg in robot.geometry}
+    shell = str((tmp_path / "parts" / "shell.stl").resolve())
+    base = by_link["base"]
+    assert base.visual[0].geometry == Mesh(shell, (0.5, 0.5, 0.5))  # scale from the class
+    assert base.visual[0].rgba == (0.0, 0.0, 1.0, 1.0) and base.visual[0].material == "blue"
+    assert [s.geometry for s in base.collision] == [Mesh(shell, (1.0, 1.0, 1.0))]
+    assert by_link["upper"].collision[0].geometry == Box((0.02, 0.04, 0.06))
+    assert by_link["upper"].visual[0].geometry.scale == (0.5, 0.5, 0.5)
+    assert [len(by_link["fore"].visual), len(by_link["fore"].collision)] == [0, 2]
+    worst, checked = _mujoco_agrees_primitives(path, robot)
+    assert checked >= 10 and worst < 1e-10
+
+
+def _mujoco_agrees_primitives(path: Path, robot: Robot):
+    """Like :func:`_mujoco_agrees`, over named (primitive) geoms and bodies only."""
+    mujoco = pytest.importorskip("mujoco")
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    worst, checked = 0.0, 0
+    for q in robot.random_q(5, seed=3):
+        d.qpos[[m.joint(name).qposadr[0] for name in robot.joint_names]] = q
+        mujoco.mj_kinematics(m, d)
+        frames = robot.fk_all(q)
+        for i, link in enumerate(robot.link_names):
+            b = m.body(link).id
+            worst = max(worst, np.abs(frames[i] - _pose(d.xpos[b], d.xmat[b])).max())
+            checked += 1
+        for lg in robot.geometry:
+            for s in lg.collision:
+                if s.name:
+                    g = m.geom(s.name).id
+                    worst = max(worst, np.abs(frames[lg.frame] @ s.origin
+                                              - _pose(d.geom_xpos[g], d.geom_xmat[g])).max())
+                    checked += 1
+    return worst, checked
