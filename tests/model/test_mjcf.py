@@ -422,7 +422,9 @@ def _random_chain(draw):
             count += 1
         xml += f"<geom size='0.05' {draw(_orientation())} pos='{_fmt(draw(_vec))}' name='g{b}'/>"
         close = "</body>" + close
-    return (f"<mujoco><compiler angle='{angle}' eulerseq='{seq}'/><worldbody>{xml}{close}"
+    # armature keeps MuJoCo's mass matrix regular (no warning log) for any joint axes
+    return (f"<mujoco><compiler angle='{angle}' eulerseq='{seq}'/>"
+            f"<default><joint armature='0.1'/></default><worldbody>{xml}{close}"
             "</worldbody></mujoco>")
 
 
