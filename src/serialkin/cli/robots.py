@@ -7,7 +7,13 @@
   ``--param key=value`` passes keyword arguments to the model function;
 * a robot file ``*.yaml`` / ``*.yml`` / ``*.json`` (:mod:`serialkin.model.robotfile`);
 * a URDF file ``*.urdf`` (:meth:`serialkin.Robot.from_urdf`); ``--param base_link=NAME``
-  and ``--param tip_link=NAME`` choose the chain of a branching tree.
+  and ``--param tip_link=NAME`` choose the chain of a branching tree;
+* a MuJoCo MJCF file ``*.xml`` / ``*.mjcf`` (:meth:`serialkin.Robot.from_mjcf`);
+  ``--param base_body=NAME``, ``end_body=NAME`` and ``tool_site=NAME`` choose the chain;
+* a xacro file ``*.xacro`` / ``*.urdf.xacro`` (:meth:`serialkin.Robot.from_xacro`, needs
+  the ``xacro`` extra); ``base_link``/``tip_link`` as for URDF, ``arg:NAME=VALUE`` sets a
+  ``<xacro:arg>``, ``package:NAME=FOLDER`` and ``search_path=FOLDER`` locate
+  ``$(find NAME)`` and ``package://NAME`` paths.
 
 An unknown name gets the nearest names suggested.
 """
@@ -26,9 +32,17 @@ from serialkin.cli.io import CLIError
 from serialkin.errors import SerialkinError
 
 ROBOT_HELP = (
-    "a built-in model name (see 'serialkin models'), a robot file (.yaml/.yml/.json) "
-    "or a URDF file (.urdf)"
+    "a built-in model name (see 'serialkin models'), a robot file (.yaml/.yml/.json), "
+    "a URDF file (.urdf), an MJCF file (.xml/.mjcf) or a xacro file (.xacro)"
 )
+
+#: --param keys each description file takes (xacro also takes arg:NAME and package:NAME).
+FILE_PARAMS = {
+    ".urdf": ("base_link", "tip_link"),
+    ".xml": ("base_body", "end_body", "tool_site"),
+    ".mjcf": ("base_body", "end_body", "tool_site"),
+    ".xacro": ("base_link", "tip_link", "search_path", "arg:NAME", "package:NAME"),
+}
 
 
 def parse_params(params: Sequence[str]) -> dict[str, Any]:
@@ -62,35 +76,19 @@ def resolve_robot(spec: str, params: Sequence[str] = ()) -> Any:
     """
     suffix = Path(spec).suffix.lower()
     kwargs = parse_params(params)
-    if suffix in (".yaml", ".yml", ".json", ".urdf"):
-        urdf_keys = {"base_link", "tip_link"}
-        if suffix == ".urdf" and set(kwargs) - urdf_keys:
-            raise CLIError(f"--param for a URDF takes base_link=NAME and tip_link=NAME only, got "
-                           f"{', '.join(sorted(set(kwargs) - urdf_keys))}")
-        if suffix != ".urdf" and kwargs:
-            raise CLIError("--param applies to built-in models and URDF links only, not to "
-                           "robot files")
+    if suffix in (".yaml", ".yml", ".json"):
+        if kwargs:
+            raise CLIError("--param applies to built-in models and URDF/MJCF/xacro files only, "
+                           "not to robot files")
         if not Path(spec).exists():
             raise CLIError(f"robot file {spec} not found")
-        try:
-            if suffix == ".urdf":
-                from serialkin.model.robot import Robot
+        from serialkin.model.robotfile import load_robot_file
 
-                links = {k: str(v) for k, v in kwargs.items()}
-                try:
-                    return Robot.from_urdf(spec, **links)
-                except SerialkinError as exc:
-                    if "tip_link" in str(exc) and "tip_link" not in links:
-                        raise CLIError(f"{exc} (on the command line: --param tip_link=NAME)") \
-                            from exc
-                    raise
-            from serialkin.model.robotfile import load_robot_file
-
-            return load_robot_file(spec)
-        except SerialkinError as exc:
-            raise CLIError(str(exc)) from exc
-        except OSError as exc:
-            raise CLIError(f"{spec}: cannot read ({exc.strerror or exc})") from exc
+        return _load(spec, load_robot_file, {})
+    if suffix in FILE_PARAMS:
+        if not Path(spec).exists():
+            raise CLIError(f"robot file {spec} not found")
+        return _load(spec, _file_loader(suffix), _file_kwargs(suffix, kwargs))
     from serialkin import models
 
     try:
@@ -108,13 +106,66 @@ def resolve_robot(spec: str, params: Sequence[str] = ()) -> Any:
                 msg += f" Nearest: {', '.join(near)}."
         if unknown and Path(spec[:4096]).suffix:
             msg += (f" (A file {short_repr(spec)}? Robot files end in .yaml, .yml or .json; "
-                    "URDF in .urdf.)")
+                    "URDF in .urdf, MJCF in .xml or .mjcf, xacro in .xacro.)")
         raise CLIError(msg) from exc
+
+
+def _file_loader(suffix: str) -> Any:
+    from serialkin.model.robot import Robot
+
+    if suffix == ".urdf":
+        return Robot.from_urdf
+    if suffix == ".xacro":
+        return Robot.from_xacro
+    return Robot.from_mjcf
+
+
+def _file_kwargs(suffix: str, kwargs: dict[str, Any]) -> dict[str, Any]:
+    """The loader's keyword arguments from the --param pairs of a description file."""
+    allowed = FILE_PARAMS[suffix]
+    out: dict[str, Any] = {}
+    mappings: dict[str, str] = {}
+    packages: dict[str, str] = {}
+    for key, value in kwargs.items():
+        kind, colon, name = key.partition(":")
+        if suffix == ".xacro" and colon and kind in ("arg", "package") and name:
+            (mappings if kind == "arg" else packages)[name] = (
+                str(value).lower() if isinstance(value, bool) else str(value))
+        elif key in allowed:
+            if key == "search_path":
+                out[key] = [str(v) for v in value] if isinstance(value, list) else [str(value)]
+            else:
+                out[key] = str(value)
+        else:
+            raise CLIError(f"--param {short_repr(key)} is not an option for a {suffix} file; "
+                           f"it takes {', '.join(f'{k}=...' for k in allowed)}")
+    if mappings:
+        out["mappings"] = mappings
+    if packages:
+        out["package_map"] = packages
+    return out
+
+
+def _load(spec: str, loader: Any, kwargs: dict[str, Any]) -> Any:
+    """Call ``loader(spec, **kwargs)``, turning library and OS errors into CLIError."""
+    try:
+        return loader(spec, **kwargs)
+    except SerialkinError as exc:
+        msg = str(exc)
+        for key in ("tip_link", "end_body"):  # a branching tree: say how to choose
+            if f"pass {key}=" in msg and key not in kwargs:
+                msg += f" (on the command line: --param {key}=NAME)"
+        if "root element must be <mujoco>, got <robot>" in msg:
+            msg += " (a URDF? name it .urdf)"
+        raise CLIError(msg) from exc
+    except OSError as exc:
+        raise CLIError(f"{spec}: cannot read ({exc.strerror or exc})") from exc
 
 
 robot_argument = click.argument("robot", metavar="ROBOT")
 param_option = click.option(
     "--param", "params", multiple=True, metavar="KEY=VALUE",
-    help="Keyword argument for a built-in model (e.g. --param l1=0.4), or base_link=/tip_link= "
-         "for a URDF; repeatable.",
+    help="Keyword argument for a built-in model (e.g. --param l1=0.4); base_link=/tip_link= "
+         "for a URDF or xacro file (xacro also arg:NAME=, package:NAME=, search_path=); "
+         "base_body=/end_body=/tool_site= for an MJCF file; repeatable.",
 )

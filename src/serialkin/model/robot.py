@@ -236,6 +236,37 @@ class Robot:
                                package_map=package_map, search_path=search_path,
                                resolve_meshes=resolve_meshes)
 
+    @classmethod
+    def from_mjcf(cls, path_or_string: str, base_body: str | None = None,
+                  end_body: str | None = None, *, tool_site: str | None = None,
+                  resolve_meshes: bool = False) -> Robot:
+        """Build a robot from a MuJoCo MJCF file or string (see :mod:`serialkin.model.mjcf`).
+
+        The chain runs from ``base_body`` (default: the world) to ``end_body`` (default:
+        the end of the unbranched chain); ``tool_site`` names a site used as the tool.
+        ``q`` is MuJoCo's ``qpos`` of the chain's hinge and slide joints.
+        """
+        from serialkin.model.mjcf import robot_from_mjcf
+
+        return robot_from_mjcf(path_or_string, base_body=base_body, end_body=end_body,
+                               tool_site=tool_site, resolve_meshes=resolve_meshes)
+
+    @classmethod
+    def from_xacro(cls, path: str, base_link: str | None = None, tip_link: str | None = None,
+                   *, mappings: Mapping[str, str] | None = None, package_map: Any = None,
+                   search_path: Any = (), resolve_meshes: bool = False) -> Robot:
+        """Build a robot from a xacro file (needs ``pip install "serialkin[xacro]"``).
+
+        The file is expanded by the ROS ``xacro`` processor with ``mappings`` as its
+        ``<xacro:arg>`` values, ``$(find pkg)`` resolved through ``package_map`` and
+        ``search_path``, then read as URDF (see :mod:`serialkin.model.xacro`).
+        """
+        from serialkin.model.xacro import robot_from_xacro
+
+        return robot_from_xacro(path, base_link=base_link, tip_link=tip_link,
+                                mappings=mappings, package_map=package_map,
+                                search_path=search_path, resolve_meshes=resolve_meshes)
+
     def to_urdf(self) -> str:
         """Return the robot's kinematics as a URDF string (see :mod:`serialkin.model.urdf`)."""
         from serialkin.model.urdf import robot_to_urdf
