@@ -158,7 +158,7 @@ def calibrate(robot: Robot | ErrorModel, measurements: Measurements, *,
             the identifiable set (the message says how many are needed), a bad option.
     """
     from serialkin.calibration.identifiability import RANK_TOL
-    from serialkin.ik.optimize import _single_threaded_blas
+    from serialkin.kinematics.parallel import single_threaded_blas
 
     model = _as_model(robot)
     if not isinstance(measurements, Measurements):
@@ -173,7 +173,7 @@ def calibrate(robot: Robot | ErrorModel, measurements: Measurements, *,
     tol = check_positive(tol, "tol")
     rank_tol = RANK_TOL if rank_tol is None else check_positive(rank_tol, "rank_tol")
     # small dense problems: a multi-threaded BLAS next to numba's thread pool costs 10-40x
-    with _single_threaded_blas():  # type: ignore[attr-defined]
+    with single_threaded_blas():
         return _calibrate(model, measurements, loss, loss_scale, max_evaluations, tol,
                           rank_tol)
 

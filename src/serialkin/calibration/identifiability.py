@@ -143,12 +143,12 @@ def identifiability(model: ErrorModel, measurements: Measurements, params: objec
     tell).
     """
     from serialkin.calibration.jacobian import identification_jacobian
-    from serialkin.ik.optimize import _single_threaded_blas
+    from serialkin.kinematics.parallel import single_threaded_blas
 
     J = identification_jacobian(model, measurements, params)
     groups = [p.group for p in model.parameters]
     order = ([i for i, g in enumerate(groups) if g == "base"]
              + [i for i, g in enumerate(groups) if g == "tool"]
              + [i for i, g in enumerate(groups) if g not in ("base", "tool")])
-    with _single_threaded_blas():  # type: ignore[attr-defined]
+    with single_threaded_blas():
         return analyse(J, model.names, kind=measurements.kind, order=order, tol=tol)

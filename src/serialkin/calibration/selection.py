@@ -95,9 +95,9 @@ def select_poses(model: ErrorModel, candidates: object, count: int, *, kind: str
     if K > N:
         raise InputError(f"count must be at most the number of candidates {N}, got {K}")
     passes = check_int(passes, "passes")
-    from serialkin.ik.optimize import _single_threaded_blas
+    from serialkin.kinematics.parallel import single_threaded_blas
 
-    with _single_threaded_blas():  # type: ignore[attr-defined]
+    with single_threaded_blas():
         return _select(model, q, K, kind, index, passes, rng)
 
 

@@ -43,28 +43,15 @@ from collections.abc import Callable
 import numpy as np
 from numba import njit
 from scipy.optimize import minimize
-from threadpoolctl import ThreadpoolController
 
 from serialkin.ik._kernels import task_cost, task_errors
 from serialkin.kinematics.kernels import fk_into, jacobian_into
+from serialkin.kinematics.parallel import single_threaded_blas
 from serialkin.spatial.kernels import pose_error_into
 
 #: Names of the methods implemented here (scipy method used for each).
 SCIPY_METHODS = {"bfgs": "L-BFGS-B", "powell": "Powell"}
 
-_THREADPOOLS: list[ThreadpoolController] = []
-
-
-def _single_threaded_blas() -> object:
-    """Context limiting BLAS to one thread during a minimisation.
-
-    scipy's L-BFGS-B calls BLAS on n-vectors, and waking a BLAS thread pool for each tiny
-    call costs milliseconds on a busy machine (measured: 225 ms vs 9 ms per planar
-    3-link solve on 2 shared cores).
-    """
-    if not _THREADPOOLS:
-        _THREADPOOLS.append(ThreadpoolController())
-    return _THREADPOOLS[0].limit(limits=1, user_api="blas")
 
 
 @njit(cache=True)
@@ -231,7 +218,7 @@ def minimize_attempt(
     x0 = np.array(q_start, dtype=np.float64)
     try:
         check(x0)
-        with _single_threaded_blas():  # type: ignore[attr-defined]
+        with single_threaded_blas():
             res = minimize(fun, x0, method=scipy_method, jac=jac, bounds=bounds,
                            options=options, callback=callback)
         iterations = max(iterations, int(getattr(res, "nit", iterations)))

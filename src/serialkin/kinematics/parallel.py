@@ -174,3 +174,21 @@ def run(kernel: Callable[..., Any], args: tuple, N: int, grain: int) -> None:
         job.idle.wait()
     if job.error is not None:
         raise job.error
+
+
+_BLAS_CONTROLLER: list[Any] = []
+
+
+def single_threaded_blas() -> Any:
+    """Context manager limiting BLAS (numpy/scipy linear algebra) to one thread inside it.
+
+    Small dense problems (scipy's L-BFGS-B on n-vectors, the SVDs and least squares of a
+    calibration) pay for waking a BLAS thread pool on every call, and that pool competes
+    with numba's threads: measured 225 ms vs 9 ms per planar 3-link minimisation, and
+    10-40× slower calibration SVDs, on 2 shared cores. ``with single_threaded_blas(): ...``
+    """
+    if not _BLAS_CONTROLLER:
+        from threadpoolctl import ThreadpoolController
+
+        _BLAS_CONTROLLER.append(ThreadpoolController())
+    return _BLAS_CONTROLLER[0].limit(limits=1, user_api="blas")
