@@ -50,6 +50,7 @@ def test_another_seed_changes_only_the_starts():
     assert np.array_equal(a.reached, b.reached)
 
 
+@pytest.mark.slow
 def test_dask_local_cluster_matches_embedded_bit_for_bit(tmp_path):
     """A LocalCluster with 2 worker processes gives the embedded map, bit for bit."""
     from serialkin.reach import local_cluster
@@ -75,11 +76,12 @@ _KILLED_RUN = """
 import sys
 from serialkin.models.planar import planar
 from serialkin.reach import reachability_map
-reachability_map(planar(3, [1.0, 0.8, 0.3]), 0.1, 12, solver="numerical", chunk_voxels=40,
+reachability_map(planar(3, [1.0, 0.8, 0.3]), 0.2, 12, solver="numerical", chunk_voxels=10,
                  out=sys.argv[1], progress=False)
 """
 
 
+@pytest.mark.slow
 def test_killed_run_resumes_to_the_same_map(tmp_path):
     """A run killed (SIGKILL) mid-way, resumed, recomputes only missing chunks: same map."""
     out = tmp_path / "m"
@@ -96,7 +98,7 @@ def test_killed_run_resumes_to_the_same_map(tmp_path):
         proc.wait()
     before = {p.name: p.read_bytes() for p in (out / CHUNKS).glob("c*.npz")}
     assert len(before) >= 3
-    resumed = reachability_map(planar(*ARM), 0.1, 12, solver="numerical", chunk_voxels=40,
+    resumed = reachability_map(planar(*ARM), 0.2, 12, solver="numerical", chunk_voxels=10,
                                out=out, resume=True, progress=False)
     meta = json.loads((out / "metadata.json").read_text())
     assert meta["resumed_chunks"] >= len(before)  # nothing finished is recomputed
@@ -104,7 +106,7 @@ def test_killed_run_resumes_to_the_same_map(tmp_path):
     assert meta["recomputed_chunks"] == len(resumed.chunk_seconds) - meta["resumed_chunks"]
     for name, data in before.items():  # finished chunk files are left as they were
         assert (out / CHUNKS / name).read_bytes() == data
-    fresh = reachability_map(planar(*ARM), 0.1, 12, solver="numerical", chunk_voxels=40,
+    fresh = reachability_map(planar(*ARM), 0.2, 12, solver="numerical", chunk_voxels=1000,
                              progress=False)
     _same(fresh, resumed)
 
