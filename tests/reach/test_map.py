@@ -3,9 +3,15 @@
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from serialkin import models
 from serialkin.models.planar import planar
@@ -13,6 +19,7 @@ from serialkin.reach import reachability_map, super_fibonacci
 from serialkin.reach.orientations import approach_orientations, fibonacci_sphere
 
 L1, L2, L3 = 1.0, 0.6, 0.3
+SRC = str(Path(__file__).resolve().parents[2] / "src")
 
 
 def _radii(m) -> np.ndarray:
@@ -124,3 +131,25 @@ def test_approach_orientations_point_along_the_directions():
     cos = np.einsum("dki,dki->dk", R[:, 1:, :, 0], R[:, :-1, :, 0])
     np.testing.assert_allclose(cos, 0.0, atol=1e-12)  # 4 rolls: 90° apart
     np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-12)
+
+
+@settings(max_examples=25, deadline=None)
+@given(n=st.integers(1, 300), d=st.integers(1, 40), k=st.integers(1, 12))
+def test_orientation_sets_are_rotations(n, d, k):
+    """Any count gives proper rotations; approach sets have d·k distinct rotations."""
+    for R in (super_fibonacci(n), approach_orientations(d, k)):
+        np.testing.assert_allclose(R @ R.transpose(0, 2, 1),
+                                   np.broadcast_to(np.eye(3), R.shape), atol=1e-12)
+        np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-12)
+    A = approach_orientations(d, k).reshape(d * k, 9)
+    assert len(np.unique(np.round(A, 9), axis=0)) == d * k
+
+
+def test_importing_reach_loads_neither_dask_nor_matplotlib():
+    """`import serialkin.reach` imports no optional extra (Dask, matplotlib)."""
+    code = ("import sys, serialkin, serialkin.reach; "
+            "print(any(m.split('.')[0] in ('dask', 'distributed', 'matplotlib') "
+            "for m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=dict(os.environ, PYTHONPATH=SRC), timeout=120)
+    assert out.stdout.strip() == "False", out.stderr
