@@ -121,6 +121,9 @@ def make_job(robot: Robot, resolution: float, orientations: int = 50, *,
     check_allocation("one chunk's IK targets", (min(chunk_voxels, grid.size), n_ori, 16), 8,
                      setting="chunk_voxels (--chunk-voxels)")
     solver = resolve_solver(robot, task, solver, scene)
+    if scene is not None:  # refuse a scene the IK does not take before anything is written
+        robot.ik(robot.fk(np.zeros(robot.n)), method="lm", scene=scene, max_iter=1,
+                 restarts=0, seed=0)
     return ReachJob(robot, grid, task, solver, rotations, headings, sampling, seed, numerical,
                     chunk_voxels, scene)
 
@@ -243,4 +246,7 @@ def reachability_map(robot: Robot, resolution: float, orientations: int = 50, *,
     job = make_job(robot, resolution, orientations, sampling=sampling, rolls=rolls,
                    bounds=bounds, task=task, solver=solver, restarts=restarts, tol=tol,
                    max_iter=max_iter, seed=seed, scene=scene, chunk_voxels=chunk_voxels)
+    if client is not None and not callable(getattr(client, "submit", None)):
+        raise InputTypeError(f"client must be a dask.distributed.Client, got "
+                             f"{type(client).__name__}")
     return run_job(job, out=out, resume=resume, client=client, progress=progress)
