@@ -61,3 +61,10 @@ def test_base_placement_command(tmp_path):
     tasks.write_text("tasks:\n  - [1, 2, 3]\n")
     res = _run("base-placement", "ur5", "--tasks", str(tasks), "--out", str(out))
     assert res.exit_code != 0 and "tasks[0] has 3 numbers" in res.output
+
+
+def test_help_has_examples():
+    """Both commands have --help with example invocations."""
+    for name in ("reach", "base-placement"):
+        out = _run(name, "--help").output
+        assert "Usage: " in out and f"serialkin {name} ur5" in out.split("Example")[1]
