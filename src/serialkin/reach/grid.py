@@ -94,7 +94,7 @@ def make_grid(robot: object, resolution: float, bounds: object = None, *,
     Without bounds the box of sampled tool positions is widened by 5 % of its largest
     extent plus one voxel on every side (sampling misses the outermost rim). The lower
     corner is a multiple of the resolution, so maps of one robot line up. A planar arm's
-    grid has one layer at the height of its plane.
+    grid has one layer centred on its plane (whatever the z bounds).
 
     Raises:
         InputError: resolution <= 0 or not finite; bounds not (3, 2) with lower < upper.
@@ -118,9 +118,8 @@ def make_grid(robot: object, resolution: float, bounds: object = None, *,
         raise InputError(f"resolution {res!r} m is too fine for the box {lo.tolist()} .. "
                          f"{hi.tolist()} m")
     shape = [max(1, int(c)) for c in counts]
-    if planar:
-        z = 0.5 * (lo[2] + hi[2]) if bounds is not None else float(robot.fk(  # type: ignore
-            robot.random_q(seed=0))[2, 3])  # type: ignore[attr-defined]
+    if planar:  # one layer centred on the plane of the arm (the z bounds do not matter)
+        z = float(robot.fk(robot.random_q(seed=0))[2, 3])  # type: ignore[attr-defined]
         lower[2] = z - 0.5 * res
         shape[2] = 1
     return VoxelGrid(tuple(float(v) for v in lower), float(res), tuple(shape))  # type: ignore
