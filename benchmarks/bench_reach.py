@@ -11,9 +11,10 @@ R times:
 
 * **embedded** — ``compute_chunk`` in this process (what ``reachability_map`` runs
   without a client);
-* **Dask, 1 and 2 worker processes** — a ``LocalCluster`` with one thread per worker,
-  the same chunks as tasks (after one untimed warm-up round that loads the compiled
-  kernels in every worker); scaling efficiency = rate(2) / (2 · rate(1));
+* **Dask, 1 and 2 worker processes** — ``LocalCluster``s with one thread per worker,
+  the same chunks as tasks (after an untimed warm-up that loads the compiled kernels in
+  every worker), the runs of the two clusters interleaved; scaling efficiency =
+  rate(2) / (2 · rate(1));
 * the **numerical** solver (batch LM, 5 restarts) on one chunk, for robots without a
   closed form;
 * peer, same run: Robotics Toolbox for Python's compiled ``ik_LM`` (one call per target,
@@ -66,24 +67,34 @@ def _embedded(job, chunks: list[int], repeat: int) -> Stat:
     return Stat(rates)
 
 
-def _dask(job, chunks: list[int], workers: int, repeat: int) -> Stat:
+def _dask(job, chunks: list[int], workers: tuple[int, ...], repeat: int) -> dict[int, Stat]:
+    """IK calls/s on LocalClusters of each size in ``workers``, runs interleaved.
+
+    All clusters stay up during the measurement and their runs alternate, so a change in
+    the machine's load hits them alike (the scaling ratio is what matters).
+    """
     from dask.distributed import wait
 
     calls = _targets(job, chunks)
-    client = local_cluster(workers)
+    clients = {w: local_cluster(w) for w in workers}
     try:
-        [jf] = client.scatter([job], broadcast=True, hash=False)
-        wait([client.submit(compute_chunk, jf, c, pure=False) for c in chunks[:2 * workers]])
-        rates = []
+        jobs = {}
+        for w, client in clients.items():
+            [jobs[w]] = client.scatter([job], broadcast=True, hash=False)
+            wait([client.submit(compute_chunk, jobs[w], c, pure=False)
+                  for c in chunks[:2 * w]])  # load the compiled kernels in every worker
+        rates: dict[int, list[float]] = {w: [] for w in workers}
         for _ in range(repeat):
-            t0 = time.perf_counter()
-            futs = [client.submit(compute_chunk, jf, c, pure=False) for c in chunks]
-            client.gather(futs)
-            rates.append(calls / (time.perf_counter() - t0))
+            for w, client in clients.items():
+                t0 = time.perf_counter()
+                client.gather([client.submit(compute_chunk, jobs[w], c, pure=False)
+                               for c in chunks])
+                rates[w].append(calls / (time.perf_counter() - t0))
     finally:
-        client.close()
-        client.cluster.close()
-    return Stat(rates)
+        for client in clients.values():
+            client.close()
+            client.cluster.close()
+    return {w: Stat(v) for w, v in rates.items()}
 
 
 def _rtb_rate(job, chunk: int, limit: int) -> Stat | None:
@@ -125,9 +136,8 @@ def main(argv: list[str] | None = None) -> int:
     rows: dict[str, Stat] = {}
     rows["embedded (this process)"] = _embedded(job, chunks, args.repeat)
     if not args.no_dask:
-        for w in (1, 2):
-            rows[f"Dask LocalCluster, {w} worker process(es)"] = _dask(job, chunks, w,
-                                                                        args.repeat)
+        for w, stat in _dask(job, chunks, (1, 2), args.repeat).items():
+            rows[f"Dask LocalCluster, {w} worker process(es)"] = stat
     num = make_job(ur5, 0.05, 50, solver="numerical", restarts=5)
     rows["embedded, numerical LM (5 restarts), 1 chunk"] = _embedded(num, chunks[len(chunks) // 2:
                                                                          len(chunks) // 2 + 1], 1)
