@@ -81,7 +81,8 @@ def local_cluster(workers: int, threads_per_worker: int = 1) -> Any:
     workers = check_int(workers, "workers", minimum=1)
     dd = _distributed()
     cluster = dd.LocalCluster(n_workers=workers, threads_per_worker=threads_per_worker,
-                              processes=True, dashboard_address=None)
+                              processes=True, dashboard_address=":0",
+                              scheduler_kwargs={"dashboard": False})  # HTTP on a free port
     return dd.Client(cluster)
 
 
