@@ -10,7 +10,7 @@ grid (every C/K-th chunk: inside, rim and outside of the workspace alike) are co
 R times:
 
 * **embedded** — ``compute_chunk`` in this process (what ``reachability_map`` runs
-  without a client);
+  without a client), its runs interleaved with the Dask runs below;
 * **Dask, 1 and 2 worker processes** — ``LocalCluster``s with one thread per worker,
   the same chunks as tasks (after an untimed warm-up that loads the compiled kernels in
   every worker), the runs of the two clusters interleaved; scaling efficiency =
@@ -32,6 +32,7 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -67,34 +68,55 @@ def _embedded(job, chunks: list[int], repeat: int) -> Stat:
     return Stat(rates)
 
 
-def _dask(job, chunks: list[int], workers: tuple[int, ...], repeat: int) -> dict[int, Stat]:
-    """IK calls/s on LocalClusters of each size in ``workers``, runs interleaved.
+def _interleaved(job, chunks: list[int], workers: tuple[int, ...], repeat: int
+                 ) -> dict[str, Stat]:
+    """IK calls/s embedded and on LocalClusters of each size in ``workers``, interleaved.
 
-    All clusters stay up during the measurement and their runs alternate, so a change in
-    the machine's load hits them alike (the scaling ratio is what matters).
+    All clusters stay up during the measurement and the runs alternate (embedded, 1
+    worker, 2 workers, embedded, ...), so a change in the machine's load hits them alike.
     """
-    from dask.distributed import wait
-
     calls = _targets(job, chunks)
     clients = {w: local_cluster(w) for w in workers}
     try:
         jobs = {}
         for w, client in clients.items():
+            from dask.distributed import wait
+
             [jobs[w]] = client.scatter([job], broadcast=True, hash=False)
             wait([client.submit(compute_chunk, jobs[w], c, pure=False)
                   for c in chunks[:2 * w]])  # load the compiled kernels in every worker
-        rates: dict[int, list[float]] = {w: [] for w in workers}
+        compute_chunk(job, chunks[0])
+
+        def embedded() -> None:
+            for c in chunks:
+                compute_chunk(job, c)
+
+        runs: dict[str, Any] = {"embedded (this process)": embedded}
+        for w, client in clients.items():
+            runs[f"Dask LocalCluster, {w} worker process(es)"] = (
+                lambda cl=client, jf=jobs[w]: cl.gather(
+                    [cl.submit(compute_chunk, jf, c, pure=False) for c in chunks]))
+        rates: dict[str, list[float]] = {k: [] for k in runs}
+        busy: dict[str, list[float]] = {k: [] for k in runs if k.startswith("Dask")}
+        chunk_s: dict[str, list[float]] = {k: [] for k in busy}
         for _ in range(repeat):
-            for w, client in clients.items():
+            for name, fn in runs.items():
                 t0 = time.perf_counter()
-                client.gather([client.submit(compute_chunk, jobs[w], c, pure=False)
-                               for c in chunks])
-                rates[w].append(calls / (time.perf_counter() - t0))
+                out = fn()
+                wall = time.perf_counter() - t0
+                rates[name].append(calls / wall)
+                if name in busy:  # Σ chunk wall times / (workers · wall): Dask's overhead
+                    w = int(name.split(", ")[1].split()[0])
+                    busy[name].append(sum(r["seconds"] for r in out) / (w * wall))
+                    chunk_s[name] += [r["seconds"] for r in out]
     finally:
         for client in clients.values():
             client.close()
             client.cluster.close()
-    return {w: Stat(v) for w, v in rates.items()}
+    for k, v in busy.items():  # low busy: Dask overhead or imbalance; long chunks: no free CPU
+        print(f"{k}: workers busy {Stat(v).fmt(2)} of the wall time, one chunk takes "
+              f"{Stat(chunk_s[k]).fmt(2)} s")
+    return {k: Stat(v) for k, v in rates.items()}
 
 
 def _rtb_rate(job, chunk: int, limit: int) -> Stat | None:
@@ -134,10 +156,10 @@ def main(argv: list[str] | None = None) -> int:
           f"{job.grid.size * 50:.3g} IK calls, {job.chunks} chunks; timing {len(chunks)} "
           f"chunks = {calls} IK calls ({job.solver}), {args.repeat} repeats")
     rows: dict[str, Stat] = {}
-    rows["embedded (this process)"] = _embedded(job, chunks, args.repeat)
-    if not args.no_dask:
-        for w, stat in _dask(job, chunks, (1, 2), args.repeat).items():
-            rows[f"Dask LocalCluster, {w} worker process(es)"] = stat
+    if args.no_dask:
+        rows["embedded (this process)"] = _embedded(job, chunks, args.repeat)
+    else:
+        rows.update(_interleaved(job, chunks, (1, 2), args.repeat))
     num = make_job(ur5, 0.05, 50, solver="numerical", restarts=5)
     rows["embedded, numerical LM (5 restarts), 1 chunk"] = _embedded(num, chunks[len(chunks) // 2:
                                                                          len(chunks) // 2 + 1], 1)
