@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from serialkin._budget import check_allocation
 from serialkin._checks import check_choice, check_int, check_positive
 from serialkin._io import write_text_atomic
 from serialkin.errors import InputError, InputTypeError
@@ -117,8 +118,6 @@ def make_job(robot: Robot, resolution: float, orientations: int = 50, *,
     n_ori = 1 if rotations is None and headings is None else \
         (len(rotations) if rotations is not None else len(headings))  # type: ignore[arg-type]
     check_map_size(grid.shape, n_ori)
-    from serialkin._budget import check_allocation
-
     check_allocation("one chunk's IK targets", (min(chunk_voxels, grid.size), n_ori, 16), 8,
                      setting="chunk_voxels (--chunk-voxels)")
     solver = resolve_solver(robot, task, solver, scene)
