@@ -3,6 +3,7 @@
 Layout of ``folder``::
 
     manifest.json        format, the job's settings (robot hash, grid, orientations, ...)
+                         and their hash
     chunks/c0000012.npz  chunk 12's per-voxel arrays and its wall time, written atomically
     map.npz              the assembled map (ReachMap.save), once every chunk is there
     metadata.json        summary and per-chunk timings
@@ -15,6 +16,7 @@ refused, naming each difference.
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
 from pathlib import Path
@@ -36,6 +38,12 @@ def chunk_path(folder: Path, c: int) -> Path:
     return folder / CHUNKS / f"c{c:07d}.npz"
 
 
+def settings_hash(settings: dict[str, Any]) -> str:
+    """SHA-256 (16 hex digits) of the settings' canonical JSON: equal settings, equal hash."""
+    text = json.dumps(settings, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
 def _differences(old: dict[str, Any], new: dict[str, Any]) -> list[str]:
     out = []
     for key in sorted(set(old) | set(new)):
@@ -55,7 +63,7 @@ def open_folder(folder: str | Path, settings: dict[str, Any], resume: bool) -> P
     """
     path = Path(folder)
     man = path / MANIFEST
-    record = {"format": FORMAT, "settings": settings}
+    record = {"format": FORMAT, "settings_hash": settings_hash(settings), "settings": settings}
     if man.exists():
         if not resume:
             raise InputError(f"{str(path)!r} already holds a reachability map; pass "
