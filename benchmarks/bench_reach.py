@@ -116,6 +116,8 @@ def _interleaved(job, chunks: list[int], workers: tuple[int, ...], repeat: int
     for k, v in busy.items():  # low busy: Dask overhead or imbalance; long chunks: no free CPU
         print(f"{k}: workers busy {Stat(v).fmt(2)} of the wall time, one chunk takes "
               f"{Stat(chunk_s[k]).fmt(2)} s")
+        record("15.1", f"{k}: workers busy / wall (Dask overhead, imbalance)",
+               Stat(v).median, "", "(info)", True)
     return {k: Stat(v) for k, v in rates.items()}
 
 
