@@ -201,3 +201,9 @@ def test_scene_only_removes_reached_targets():
     free = reachability_map(r, 0.1, 4, **opts)
     assert blocked.settings["scene_hash"] is not None
     assert np.all(blocked.reached <= free.reached)
+
+
+def test_huge_orientation_count_is_refused_before_allocating():
+    """10¹² orientations are refused by the memory budget, naming the setting."""
+    with pytest.raises(BudgetError, match="orientations"):
+        reachability_map(models.get("ur5"), 0.3, 10**12, progress=False)

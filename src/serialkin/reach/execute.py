@@ -106,6 +106,9 @@ def make_job(robot: Robot, resolution: float, orientations: int = 50, *,
                                  check_positive(tol, "tol"),
                                  None if max_iter is None else check_int(max_iter, "max_iter",
                                                                          minimum=1))
+    rolls = check_int(rolls, "rolls", minimum=1)
+    count = orientations * rolls if sampling == "approach" and task == "pose" else orientations
+    check_allocation("the orientation set", (count, 3, 3), 8, setting="orientations")
     rotations = headings = None
     if task == "pose":
         rotations = orientation_set(orientations, sampling, rolls=rolls)
