@@ -86,3 +86,11 @@ def test_point_layer_and_figures():
     T = _tasks(r, base_pose(0.0, 0.0, 0.0), 2, seed=1)
     ax = plot_base_placement(base_placement(r, T, resolution=0.3, yaws=2), tasks=T)
     assert _png(ax).startswith(b"\x89PNG")
+
+
+def test_base_placement_too_fine_grid_is_refused():
+    """A floor grid beyond the memory budget is refused before any allocation."""
+    from serialkin.errors import BudgetError
+
+    with pytest.raises(BudgetError, match="resolution"):
+        base_placement(models.get("ur5"), np.eye(4), resolution=1e-7)

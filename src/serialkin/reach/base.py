@@ -146,12 +146,14 @@ def base_placement(robot: Robot, tasks: object, *, resolution: float = 0.1, yaws
         if box.shape != (2, 2) or not np.all(box[:, 0] <= box[:, 1]):
             raise InputError("region must be ((xmin, xmax), (ymin, ymax)) with min <= max "
                              f"[m], got {box.tolist() if box.size <= 8 else box.shape}")
-    xs = np.arange(math.floor(box[0, 0] / res), math.ceil(box[0, 1] / res) + 1) * res
-    ys = np.arange(math.floor(box[1, 0] / res), math.ceil(box[1, 1] / res) + 1) * res
-    psi = 2.0 * math.pi * np.arange(yaws) / yaws
+    ix = (math.floor(box[0, 0] / res), math.ceil(box[0, 1] / res) + 1)
+    iy = (math.floor(box[1, 0] / res), math.ceil(box[1, 1] / res) + 1)
     M = T.shape[0]
-    K = xs.size * ys.size * yaws
+    K = (ix[1] - ix[0]) * (iy[1] - iy[0]) * yaws
     check_allocation("the base-placement targets", (K, M, 16), 8, setting="resolution / region")
+    xs = np.arange(*ix) * res
+    ys = np.arange(*iy) * res
+    psi = 2.0 * math.pi * np.arange(yaws) / yaws
     sol = resolve_solver(robot, task, solver, scene)
     X, Y, P = np.meshgrid(xs, ys, psi, indexing="ij")
     c, s = np.cos(P.ravel()), np.sin(P.ravel())
