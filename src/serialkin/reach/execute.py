@@ -71,6 +71,12 @@ def connect(address: str, timeout: float = CONNECT_TIMEOUT) -> Any:
         raise InputError(f"the Dask scheduler {address!r} did not answer within "
                          f"{timeout:g} s ({type(exc).__name__}: {exc}); check the address "
                          "and that the scheduler runs") from exc
+    except Exception as exc:  # noqa: BLE001 - something answered, not in Dask's protocol
+        # (e.g. another service on that port: Dask then reads garbage frame lengths and
+        # fails with MemoryError or a deserialisation error)
+        raise InputError(f"{address!r} answered but not as a Dask scheduler "
+                         f"({type(exc).__name__}: {str(exc)[:120]}); check the address and "
+                         "the port") from exc
 
 
 def local_cluster(workers: int, threads_per_worker: int = 1) -> Any:
