@@ -3,7 +3,10 @@
 Three sources, combined with :meth:`AllowedCollisionMatrix.allow`:
 
 * :func:`default_acm` — every body with itself, bodies on the same link frame (one rigid
-  part) and bodies on adjacent frames ``i, i+1`` (joined by a joint, usually touching);
+  part) and bodies on adjacent frames (joined by a joint, usually touching): frames that
+  follow each other among the frames carrying bodies, so that a frame without a body (a
+  massless link between coincident joint axes, as in a spherical wrist) does not separate
+  its neighbours;
 * :func:`acm_from_srdf` — an SRDF's ``<disable_collisions>`` pairs, added to the default;
 * :func:`sampled_acm` — pairs in contact in *every* sampled configuration (as MoveIt's
   setup assistant finds "always in collision" pairs): ``q`` drawn uniformly within the
@@ -72,9 +75,14 @@ class AllowedCollisionMatrix:
 
 
 def default_acm(model: CollisionModel) -> AllowedCollisionMatrix:
-    """Allow bodies on the same frame and on adjacent frames (``|frame_i − frame_j| ≤ 1``)."""
+    """Allow bodies on the same frame and on adjacent frames.
+
+    Frames ``i < j`` are adjacent when no body is fixed to a frame strictly between them
+    (for a model with bodies on every frame: ``|frame_i − frame_j| ≤ 1``).
+    """
     f = model.body_frames
-    return AllowedCollisionMatrix(model.body_names, np.abs(f[:, None] - f[None, :]) <= 1)
+    rank = np.searchsorted(np.unique(f), f)  # index of each body's frame among used frames
+    return AllowedCollisionMatrix(model.body_names, np.abs(rank[:, None] - rank[None, :]) <= 1)
 
 
 def acm_from_srdf(model: CollisionModel, srdf: Srdf | str | os.PathLike[str],

@@ -134,7 +134,7 @@ def bounding_capsule(points: object) -> Capsule3:
         raise InputError(f"points must be a non-empty finite (k, 3) array, got {P.shape}")
     if P.shape[0] == 1 or np.ptp(P, axis=0).max() == 0.0:
         return P[0].copy(), P[0].copy(), 0.0
-    _, _, Vt = np.linalg.svd(P - P.mean(axis=0), full_matrices=False)
+    _, _, Vt = np.linalg.svd(P - P.mean(axis=0), full_matrices=True)
     best = None
     for cap in (_quick_capsule(P), *(_capsule_along(P, u / np.linalg.norm(u)) for u in Vt)):
         vol = capsule_volume(*cap)
@@ -170,7 +170,7 @@ def _hull(P: np.ndarray):
 def _quick_capsule(P: np.ndarray) -> Capsule3:
     """A cheap bounding capsule (principal axis, bounding-square centre) to rank cuts."""
     m = P.mean(axis=0)
-    _, _, Vt = np.linalg.svd(P - m, full_matrices=False)
+    _, _, Vt = np.linalg.svd(P - m, full_matrices=True)
     u, e1, e2 = Vt[0], Vt[1], Vt[2]
     x, y = (P - m) @ e1, (P - m) @ e2
     c = m + e1 * (x.max() + x.min()) / 2 + e2 * (y.max() + y.min()) / 2
