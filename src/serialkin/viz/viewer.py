@@ -293,7 +293,7 @@ def _load_visual_mesh(link: str, g: Any) -> Any:
         hint = ""
         if g.filename.startswith("package://") or not Path(g.filename).is_absolute():
             hint = (" (the path was never resolved: load the URDF with package_map= or "
-                    "search_path=, or draw without meshes: meshes=False, --no-meshes)")
+                    "search_path=, or pass meshes=False)")
         raise RobotDefinitionError(f"link {short_repr(link)} visual mesh: {exc}{hint}") from None
     v, f = _welded(m.vertices, m.faces)
     return TriangleMesh(v, f, m.source)
@@ -426,10 +426,10 @@ def viewer_data(
     if P is not None:
         frame_pts.append(P)
     frame_pts.extend(o.extent_points() for o in obs)
-    if pdata is not None and pdata["count"]:
-        frame_pts.append(as_float_array(points, "points", ndim=2))
     allpts = np.vstack(frame_pts)
     ground_z = float(allpts[:, 2].min()) - (0.002 * scale if planar else 0.0)
+    if pdata is not None and pdata["count"]:  # framed by the camera, not under the grid
+        allpts = np.vstack([allpts, as_float_array(points, "points", ndim=2)])
     qlim = [[float(v) if np.isfinite(v) else None for v in row] for row in robot.qlim]
     seg = np.linalg.norm(np.diff(robot_points(robot, q0), axis=0), axis=1)
     seg = seg[seg > 1e-9]

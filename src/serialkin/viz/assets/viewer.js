@@ -421,7 +421,7 @@ if (DATA.points && DATA.points.count > 0) {
   const g = new THREE.BufferGeometry();
   g.setAttribute("position", new THREE.BufferAttribute(pos, 3));
   g.setAttribute("color", new THREE.BufferAttribute(rgb, 3, true));
-  pointCloud = new THREE.Points(g, new THREE.PointsMaterial({ size: 0.008 * S, vertexColors: true }));
+  pointCloud = new THREE.Points(g, new THREE.PointsMaterial({ size: 0.012 * S, vertexColors: true }));
   scene.add(pointCloud);
 }
 
@@ -444,6 +444,15 @@ function drawn() {
     points: pointCloud && shownOnScreen(pointCloud) ? DATA.points.count : 0,
     skeleton: shownOnScreen(skeletonGroup),
   };
+}
+
+function shapePoses() {
+  // World matrix (row-major 4x4) of every visual shape as drawn, in DATA.shapes order
+  // (cylinders and capsules include the turn of three.js's y axis onto the shape's z).
+  return visualObjects.map((o) => {
+    o.updateMatrixWorld(true);
+    return rows4(o.matrixWorld.clone().transpose().elements);
+  });
 }
 
 function clearance() {
@@ -853,5 +862,6 @@ window.serialkin = {
   render,
   drawn,
   clearance,
+  shapePoses,
 };
 document.body.dataset.ready = "true";
