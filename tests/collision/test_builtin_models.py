@@ -87,3 +87,41 @@ def test_bodyless_frames_do_not_separate_neighbours() -> None:
     assert acm.is_allowed("forearm", "wrist") and acm.is_allowed("wrist", "flange")
     assert not acm.is_allowed("forearm", "flange")
     assert not acm.is_allowed("pedestal", "upper_arm")
+
+
+@pytest.mark.parametrize(("name", "rel", "tip", "offsets"), [
+    ("panda", "panda_description/urdf/panda.urdf", "panda_hand", [0.0] * 7),
+    ("ur5", "ur_description/urdf/ur5_robot.urdf", "tool0", [np.pi, 0, 0, 0, 0, 0]),
+])
+def test_shipped_capsules_contain_the_collision_meshes(name, rel, tip, offsets) -> None:
+    """Every collision-mesh vertex of the Panda and UR5 lies inside its body's capsules."""
+    from tests.erd import robots_dir, urdf
+
+    pytest.importorskip("trimesh")
+    from serialkin import Robot
+    from serialkin.model.mesh import link_meshes
+
+    path = urdf(rel)
+    if path is None:
+        pytest.skip("example-robot-data (bench extra) is not installed")
+    zoo = models.get(name)
+    src = Robot.from_urdf(str(path), tip_link=tip, resolve_meshes=True,
+                          package_map={"example-robot-data": robots_dir().parent})
+    q = np.random.default_rng(0).uniform(-1, 1, zoo.n)
+    X = np.linalg.inv(zoo.fk_all(q)) @ src.fk_all(q + np.asarray(offsets))  # zoo ← URDF
+    model, checked = zoo.collision, 0
+    for lm in link_meshes(src, "collision"):
+        if lm.link_name not in model.body_names:
+            continue
+        T = X[lm.frame]
+        P = lm.mesh.vertices @ T[:3, :3].T + T[:3, 3]
+        i = model.body_index(lm.link_name)
+        inside = np.zeros(len(P), bool)
+        for s in np.flatnonzero(model.shape_body == i):
+            a, b, r = model.a[s], model.b[s], model.radius[s]
+            d = b - a
+            t = np.clip((P - a) @ d / max(d @ d, 1e-30), 0, 1)
+            inside |= np.linalg.norm(P - a - t[:, None] * d, axis=1) <= r
+        assert inside.all(), lm.link_name
+        checked += 1
+    assert checked == (9 if name == "panda" else 7)

@@ -74,6 +74,13 @@ def _directions(count: int) -> np.ndarray:
 _DIRS = _directions(GAP_DIRECTIONS)
 
 
+def _principal_axes(P: np.ndarray) -> np.ndarray:
+    """(3, 3): unit principal directions of the points (rows), largest variance first."""
+    Q = P - P.mean(axis=0)
+    _, vecs = np.linalg.eigh(Q.T @ Q)
+    return vecs.T[::-1].copy()
+
+
 def _enclosing_circle(xy: np.ndarray, iterations: int = 100) -> np.ndarray:
     """Centre (2,) of an approximately smallest circle holding the points ``xy`` (k, 2).
 
@@ -134,7 +141,7 @@ def bounding_capsule(points: object) -> Capsule3:
         raise InputError(f"points must be a non-empty finite (k, 3) array, got {P.shape}")
     if P.shape[0] == 1 or np.ptp(P, axis=0).max() == 0.0:
         return P[0].copy(), P[0].copy(), 0.0
-    _, _, Vt = np.linalg.svd(P - P.mean(axis=0), full_matrices=True)
+    Vt = _principal_axes(P)
     best = None
     for cap in (_quick_capsule(P), *(_capsule_along(P, u / np.linalg.norm(u)) for u in Vt)):
         vol = capsule_volume(*cap)
@@ -170,7 +177,7 @@ def _hull(P: np.ndarray):
 def _quick_capsule(P: np.ndarray) -> Capsule3:
     """A cheap bounding capsule (principal axis, bounding-square centre) to rank cuts."""
     m = P.mean(axis=0)
-    _, _, Vt = np.linalg.svd(P - m, full_matrices=True)
+    Vt = _principal_axes(P)
     u, e1, e2 = Vt[0], Vt[1], Vt[2]
     x, y = (P - m) @ e1, (P - m) @ e2
     c = m + e1 * (x.max() + x.min()) / 2 + e2 * (y.max() + y.min()) / 2
@@ -191,7 +198,7 @@ def _split(P: np.ndarray, hull, cuts: int = 19):
     """
     V = P[hull.vertices]
     c = V.mean(axis=0)
-    u = np.linalg.svd(V - c, full_matrices=False)[2][0]
+    u = _principal_axes(V)[0]
     s = hull.simplices
     E = np.unique(np.sort(np.concatenate([s[:, [0, 1]], s[:, [1, 2]], s[:, [2, 0]]]), axis=1),
                   axis=0)
@@ -341,6 +348,52 @@ def _shape_points(geometry: object) -> tuple[str, np.ndarray, float]:
     return "cylinder", pts, math.pi * geometry.radius ** 2 * geometry.length
 
 
+def _exact_fit(shape: object, link_name: str, frame: int) -> ShapeFit | None:
+    """A sphere or capsule shape as itself (gap 0), or None for other shapes."""
+    from serialkin.model.geometry import Capsule, Sphere
+
+    g, T = shape.geometry, shape.origin
+    R, p = T[:3, :3], T[:3, 3]
+    if isinstance(g, Sphere):
+        vol = 4.0 / 3.0 * math.pi * g.radius ** 3
+        return ShapeFit(link_name, frame, "sphere", ((p.copy(), p.copy(), g.radius),), vol,
+                        vol, 0.0)
+    if isinstance(g, Capsule):
+        half = R[:, 2] * g.length / 2.0
+        cap = (p - half, p + half, g.radius)
+        vol = capsule_volume(*cap)
+        return ShapeFit(link_name, frame, "capsule", (cap,), vol, vol, 0.0)
+    return None
+
+
+def _posed_points(shape: object, link_name: str) -> tuple[str, np.ndarray, float]:
+    """Name, points (in the chain frame) whose hull holds the shape, and its volume."""
+    from serialkin.model.geometry import Mesh
+    from serialkin.model.mesh import load_mesh
+
+    g, T = shape.geometry, shape.origin
+    if isinstance(g, Mesh):
+        try:
+            m = load_mesh(g.filename, g.scale)
+        except RobotDefinitionError as exc:
+            raise RobotDefinitionError(f"link {link_name!r} collision mesh: {exc}") from None
+        name, P, vol = f"mesh {g.filename}", m.vertices, m.volume
+    else:
+        name, P, vol = _shape_points(g)
+    return name, P @ T[:3, :3].T + T[:3, 3], vol
+
+
+def _fit_cloud(name: str, P: np.ndarray, vol: float, link_name: str, frame: int,
+               options: dict) -> ShapeFit:
+    """Capsules of a point cloud and their fitting error."""
+    caps, pieces, hull_vol = fit_points(P, **options)
+    gap = max(max_gap(c, piece) for c, piece in zip(caps, pieces, strict=True))
+    if vol <= 0.0:
+        vol = hull_vol
+    return ShapeFit(link_name, frame, name, tuple(caps), vol,
+                    sum(capsule_volume(*c) for c in caps), gap)
+
+
 def fit_shape(shape: object, link_name: str = "", frame: int = 0, *,
               max_capsules: int = 3, loose: float = 1.5, gain: float = 0.8) -> ShapeFit:
     """Fit capsules to one posed :class:`~serialkin.model.geometry.Shape`.
@@ -353,43 +406,45 @@ def fit_shape(shape: object, link_name: str = "", frame: int = 0, *,
         RobotDefinitionError: a mesh file is missing or corrupt (the message names the link).
         NotSupportedError: a mesh needs trimesh (``serialkin[mesh]``) and it is missing.
     """
-    from serialkin.model.geometry import Capsule, Mesh, Shape, Sphere
-    from serialkin.model.mesh import load_mesh
+    from serialkin.model.geometry import Shape
 
     if not isinstance(shape, Shape):
         raise InputTypeError(f"shape must be a Shape, got {type(shape).__name__}")
-    g, T = shape.geometry, shape.origin
-    R, p = T[:3, :3], T[:3, 3]
-    if isinstance(g, Sphere):
-        vol = 4.0 / 3.0 * math.pi * g.radius ** 3
-        return ShapeFit(link_name, frame, "sphere", ((p.copy(), p.copy(), g.radius),), vol,
-                        vol, 0.0)
-    if isinstance(g, Capsule):
-        half = R[:, 2] * g.length / 2.0
-        cap = (p - half, p + half, g.radius)
-        vol = capsule_volume(*cap)
-        return ShapeFit(link_name, frame, "capsule", (cap,), vol, vol, 0.0)
-    if isinstance(g, Mesh):
-        try:
-            m = load_mesh(g.filename, g.scale)
-        except RobotDefinitionError as exc:
-            raise RobotDefinitionError(f"link {link_name!r} collision mesh: {exc}") from None
-        name, P, vol = f"mesh {g.filename}", m.vertices, m.volume
-    else:
-        name, P, vol = _shape_points(g)
-    P = P @ R.T + p
-    caps, pieces, hull_vol = fit_points(P, max_capsules=max_capsules, loose=loose, gain=gain)
-    gap = max(max_gap(c, piece) for c, piece in zip(caps, pieces, strict=True))
-    if vol <= 0.0:
-        vol = hull_vol
-    return ShapeFit(link_name, frame, name, tuple(caps), vol,
-                    sum(capsule_volume(*c) for c in caps), gap)
+    exact = _exact_fit(shape, link_name, frame)
+    if exact is not None:
+        return exact
+    name, P, vol = _posed_points(shape, link_name)
+    return _fit_cloud(name, P, vol, link_name, frame,
+                      {"max_capsules": max_capsules, "loose": loose, "gain": gain})
+
+
+def _fit_link(shapes: Sequence, link_name: str, frame: int, merge: bool,
+              options: dict) -> list[ShapeFit]:
+    """The fits of one link's shapes: each on its own, or the non-exact ones merged."""
+    if not merge:
+        return [fit_shape(s, link_name, frame, **options) for s in shapes]
+    fits, clouds = [], []
+    for s in shapes:
+        exact = _exact_fit(s, link_name, frame)
+        if exact is not None:
+            fits.append(exact)
+        else:
+            clouds.append(_posed_points(s, link_name))
+    if len(clouds) == 1:
+        fits.append(_fit_cloud(*clouds[0], link_name, frame, options))
+    elif clouds:
+        P = np.vstack([c[1] for c in clouds])
+        vol = sum(c[2] for c in clouds)
+        fits.append(_fit_cloud(f"{len(clouds)} shapes merged", P, vol, link_name, frame,
+                               options))
+    return fits
 
 
 def collision_model_from_geometry(robot: object, kind: str = "collision", *,
                                   max_capsules: int = 3, loose: float = 1.5,
                                   gain: float = 0.8,
                                   links: Sequence[str] | None = None,
+                                  merge: bool = False,
                                   ) -> tuple[CollisionModel, FitReport]:
     """Fit a capsule collision model to a robot's link geometry.
 
@@ -405,6 +460,8 @@ def collision_model_from_geometry(robot: object, kind: str = "collision", *,
         loose: split a shape's capsule while capsule volume > ``loose`` × hull volume.
         gain: keep a split only if it saves at least ``1 − gain`` of the volume.
         links: only these links (default: all).
+        merge: fit the boxes, cylinders and meshes of a link together (one cloud, fewer
+            capsules) instead of each on its own; spheres and capsules stay as they are.
 
     Returns:
         ``(model, report)``: the :class:`CollisionModel` and the :class:`FitReport` with
@@ -436,9 +493,8 @@ def collision_model_from_geometry(robot: object, kind: str = "collision", *,
         if not shapes:
             continue
         body = {"name": lg.link_name, "frame": lg.frame, "capsules": [], "spheres": []}
-        for s in shapes:
-            f = fit_shape(s, lg.link_name, lg.frame, max_capsules=max_capsules, loose=loose,
-                          gain=gain)
+        options = {"max_capsules": max_capsules, "loose": loose, "gain": gain}
+        for f in _fit_link(shapes, lg.link_name, lg.frame, bool(merge), options):
             fits.append(f)
             for a, b, r in f.capsules:
                 if np.array_equal(a, b):

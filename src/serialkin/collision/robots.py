@@ -9,23 +9,24 @@ get a capsule along each link (radius 5 % of the link length for planar arms; th
 radii are given for its default size and scale with ``l1 + l2``). All models are free of
 self-collision at q = 0 with the default allowed-collision matrix (adjacent frames allowed).
 
-Each body is one bounding capsule of its URDF collision geometry (STL mesh, or boxes for
-the Panda's fingers), moved into the link frame of :mod:`serialkin.models` (the fixed
-transform was checked to be the same at several configurations, which proves the frame
-correspondence). Axis along the principal direction of the vertices, radius the largest
-distance of a vertex from the axis, ends pulled in as far as every vertex stays inside:
-every capsule *contains* its mesh. One capsule per mesh is loose, about ×2.2-2.8 the
-mesh volume (×7 for the UR5's flat base); the fit script also tries two capsules per mesh
-(hull cut across its principal axis) but none saved 20 % of the volume (at best 13 %, on
-panda_link1 and link2), so every body has one. Reproduce with
-``benchmarks/fit_capsules.py`` (example-robot-data 4.x, the ``bench`` extra); numbers
-rounded to 0.1 mm.
+Panda and UR5: each body is the bounding capsule of its URDF collision geometry (STL
+meshes, or boxes for the Panda's fingers), fitted by :mod:`serialkin.collision.fit`
+(``merge=True``: one point cloud per link) and moved into the link frame of
+:mod:`serialkin.models` (the fixed transform was checked to be the same at several
+configurations, which proves the frame correspondence): every capsule *contains* its
+mesh. One capsule per mesh is loose, about ×1.8-2.5 the mesh volume (×3.9 for the
+fingers, ×6.8 for the UR5's flat base); a split into two capsules saved less than the
+required 20 % everywhere, so every body has one. Reproduce with
+``benchmarks/fit_capsules.py`` (example-robot-data 4.x, the ``bench`` extra; trimesh,
+the ``mesh`` extra); ends rounded to 0.1 mm, radii rounded up and grown by 0.1 mm so that
+the rounded capsule still contains the mesh.
 
-Volumes [litre], mesh → capsule: Panda link0 3.00 → 8.46, link1 2.98 → 7.29, link2
-3.00 → 7.11, link3 2.33 → 5.21, link4 2.37 → 5.30, link5 3.42 → 7.76, link6 1.43 → 3.34,
-link7 0.45 → 0.97, hand 0.71 → 1.68, each finger 0.016 → 0.06 (boxes); UR5 base 0.35 →
-2.41, shoulder 1.55 → 2.89, upper arm 5.36 → 13.29, forearm 2.49 → 6.85, wrists 0.51 →
-0.95, 0.51 → 0.97, 0.14 → 0.32.
+Volumes [litre], mesh → capsule (largest gap capsule ↔ hull [mm]): Panda link0 3.00 →
+7.11 (79), link1 2.98 → 7.39 (52), link2 3.00 → 7.14 (50), link3 2.33 → 5.04 (44),
+link4 2.37 → 5.00 (40), link5 3.42 → 7.68 (47), link6 1.43 → 3.35 (43), link7 0.45 → 0.93
+(31), hand 0.71 → 1.62 (35), each finger 0.016 → 0.06 (15); UR5 base 0.35 → 2.35 (64),
+shoulder 1.55 → 2.79 (31), upper arm 5.36 → 12.35 (38), forearm 2.49 → 6.64 (42),
+wrists 0.51 → 0.95 (19), 0.51 → 0.95 (19), 0.14 → 0.30 (25).
 
 * Panda (:func:`serialkin.models.panda`, modified DH frames = the URDF's ``panda_link0..7``
   frames): bodies named as in the URDF/SRDF, hand and fingers fixed to frame 7 with the
@@ -48,27 +49,27 @@ SOURCE = ("bounding capsules of example-robot-data's collision meshes "
           "(benchmarks/fit_capsules.py)")
 
 _PANDA = [  # body, frame, a, b, radius [m]
-    ("panda_link0", 0, [-0.0216, 0.0079, 0.0543], [-0.0529, 0.0086, 0.0384], 0.1182),
-    ("panda_link1", 1, [-0.0012, 0.0114, -0.1294], [0.0035, -0.0728, 0.0016], 0.0914),
-    ("panda_link2", 2, [-0.001, 0.0031, 0.0721], [0.0003, -0.138, -0.0143], 0.0892),
-    ("panda_link3", 3, [0.0843, 0.0517, -0.0147], [0.0135, -0.003, -0.0685], 0.0868),
-    ("panda_link4", 4, [0.0023, 0.0142, 0.0526], [-0.0696, 0.0705, -0.0036], 0.0870),
-    ("panda_link5", 5, [0.0051, 0.0836, -0.0035], [0.0013, -0.0041, -0.1959], 0.0869),
-    ("panda_link6", 6, [0.0215, -0.0107, 0.0144], [0.0881, 0.0127, -0.0005], 0.0778),
-    ("panda_link7", 7, [-0.0022, -0.0023, 0.079], [0.0306, 0.0322, 0.081], 0.0516),
-    ("panda_hand", 7, [0.0525, 0.0521, 0.1302], [-0.0647, -0.0637, 0.1265], 0.0483),
-    ("panda_leftfinger", 7, [0.0389, 0.0389, 0.1668], [0.0361, 0.0361, 0.2108], 0.0168),
-    ("panda_rightfinger", 7, [-0.0389, -0.0389, 0.1668], [-0.0361, -0.0361, 0.2108], 0.0168),
+    ("panda_link0", 0, [-0.0009, -0.0001, 0.0507], [-0.0576, 0.0002, 0.0234], 0.1056),
+    ("panda_link1", 1, [-0.0006, 0.0156, -0.1346], [0.0012, -0.0732, 0.0013], 0.0912),
+    ("panda_link2", 2, [0.0, 0.0011, 0.0713], [-0.0002, -0.1401, -0.016], 0.0895),
+    ("panda_link3", 3, [0.082, 0.0564, -0.005], [-0.0049, -0.0112, -0.0708], 0.0823),
+    ("panda_link4", 4, [-0.0015, 0.005, 0.0565], [-0.0862, 0.0704, -0.008], 0.0825),
+    ("panda_link5", 5, [0.0001, 0.0859, 0.001], [-0.0022, -0.0109, -0.2068], 0.0847),
+    ("panda_link6", 6, [0.0891, 0.0115, -0.0001], [0.0145, -0.0156, 0.0164], 0.0765),
+    ("panda_link7", 7, [0.0341, 0.0349, 0.0761], [-0.0049, -0.005, 0.0741], 0.0494),
+    ("panda_hand", 7, [0.0548, 0.054, 0.1303], [-0.0646, -0.0643, 0.1275], 0.0474),
+    ("panda_leftfinger", 7, [0.0356, 0.0356, 0.2096], [0.0391, 0.0391, 0.1672], 0.0171),
+    ("panda_rightfinger", 7, [-0.0356, -0.0356, 0.2096], [-0.0391, -0.0391, 0.1672], 0.0171),
 ]
 
 _UR5 = [
-    ("base_link", 0, [-0.0012, -0.0362, 0.0087], [0.0002, 0.0037, 0.009], 0.0744),
-    ("shoulder_link", 1, [0.0016, -0.012, 0.0081], [0.0007, 0.0005, 0.0086], 0.0853),
-    ("upper_arm_link", 2, [0.4254, -0.001, 0.1359], [-0.0007, 0.0008, 0.1361], 0.0882),
-    ("forearm_link", 3, [0.387, 0.0029, 0.0485], [0.008, 0.0023, 0.0137], 0.0680),
-    ("wrist_1_link", 4, [-0.0007, -0.0032, -0.0093], [-0.0005, -0.005, 0.0107], 0.0563),
-    ("wrist_2_link", 5, [0.0015, 0.0058, 0.0114], [0.001, 0.0032, -0.0091], 0.0566),
-    ("wrist_3_link", 6, [-0.0, -0.0023, -0.0183], [-0.0001, 0.0039, -0.0177], 0.0411),
+    ("base_link", 0, [0.0001, 0.0014, 0.0062], [0.0007, -0.0362, 0.0057], 0.0742),
+    ("shoulder_link", 1, [-0.0074, -0.0156, 0.0017], [0.0006, 0.0009, 0.0129], 0.0825),
+    ("upper_arm_link", 2, [0.4377, -0.0012, 0.1319], [0.0007, 0.0001, 0.1309], 0.0847),
+    ("forearm_link", 3, [0.3887, -0.0006, 0.0473], [-0.0046, 0.0001, 0.0087], 0.0663),
+    ("wrist_1_link", 4, [-0.0011, -0.0037, -0.0102], [-0.0002, -0.0054, 0.0116], 0.0561),
+    ("wrist_2_link", 5, [0.0011, 0.0053, 0.0112], [0.0005, 0.0035, -0.0091], 0.0565),
+    ("wrist_3_link", 6, [0.0001, 0.0033, -0.021], [-0.0001, -0.0033, -0.0213], 0.0401),
 ]
 
 
