@@ -55,7 +55,8 @@ def write_package(folder: Path, link1: str = "LINK1") -> Path:
     (pkg / "meshes").mkdir(parents=True, exist_ok=True)
     trimesh.creation.icosphere(subdivisions=2).export(str(pkg / "meshes" / "ball.stl"))
     urdf = pkg / "body3.urdf"
-    urdf.write_text(URDF.replace('"LINK1"', f'"{escape(link1, {chr(34): "&quot;"})}"'), encoding="utf-8")
+    name = escape(link1, {'"': "&quot;"})
+    urdf.write_text(URDF.replace('"LINK1"', f'"{name}"'), encoding="utf-8")
     return urdf
 
 
