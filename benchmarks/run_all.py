@@ -28,6 +28,7 @@ GOALS = {
     "11.3": "IK lm single <= 8 us at 100 % success; batch <= 4 us per target",
     "12.1": "Panda self_clearance batched on one core <= 2 us per configuration",
     "12.2": "URDF with meshes (Panda, UR5): cold load and capsule fit <= 2 s each",
+    "12.5": "viewer with meshes: Panda page <= 5 MB, opens in headless Chromium < 2 s",
 }
 
 
