@@ -526,7 +526,7 @@ def viewer_html(
 
     Returns:
         The HTML text (about 0.7 MB of three.js, plus about 12 bytes per mesh triangle
-        and 16 per point).
+        and 20 per point).
 
     Raises:
         InputError: a configuration with the wrong number of joints or non-finite values,
