@@ -124,25 +124,33 @@ def test_folded_panda_highlights_the_pair_self_clearance_reports(driver, tmp_pat
     assert _severe(driver) == []
 
 
-def test_panda_meshes_drawn(driver, tmp_path):
-    """The Panda from example-robot-data opens with its nine meshes drawn and the canvas busy."""
+def test_panda_meshes_drawn_and_turn_red(driver, tmp_path):
+    """The Panda of example-robot-data: nine meshes drawn; folded, the colliding links' go red."""
     pytest.importorskip("trimesh", reason='needs the mesh extra (serialkin[mesh])')
     path = erd_urdf("panda_description/urdf/panda.urdf")
     if path is None:
         pytest.skip("example-robot-data (bench extra) is not installed")
     from serialkin import Robot
 
-    robot = Robot.from_urdf(str(path), "panda_link0", "panda_hand",
-                            package_map={"example-robot-data": Path(path).parents[3]},
-                            resolve_meshes=True)
+    robot, _ = Robot.from_urdf(str(path), "panda_link0", "panda_hand",
+                               package_map={"example-robot-data": Path(path).parents[3]},
+                               resolve_meshes=True).fit_collision()
     page = write_viewer(robot, tmp_path / "panda.html", q=READY)
     _load(driver, page)
     d = _drawn(driver)
     assert d["meshes"] == 9 and d["skeleton"] is False and 0 < d["triangles"] <= 60_000
+    assert d["highlighted"] == [] and d["capsulesHit"] == 0
     state = driver.execute_script("return window.serialkin.state")
     assert state["webgl"] is True and state["renders"] >= 1
     _slide(driver, 3, -1.5)
     np.testing.assert_allclose(
         driver.execute_script("return window.serialkin.endEffector().matrix"),
         robot.fk(np.r_[READY[:3], -1.5, READY[4:]]), atol=1e-9)
+    driver.execute_script("window.serialkin.setJoints(arguments[0])", FOLDED.tolist())
+    pair = self_clearance(robot, robot.collision, FOLDED).names(robot.collision)[0]
+    colliding = driver.execute_script("return window.serialkin.clearance().colliding")
+    red = set(_drawn(driver)["highlighted"])
+    assert set(pair) <= red
+    assert red == {name for c in colliding for name in c[:2]}
+    assert _drawn(driver)["capsulesHit"] > 0  # red even while hidden
     assert _severe(driver) == []

@@ -63,7 +63,7 @@ def test_bad_package_options_named(tmp_path):
 
 
 def test_collision_and_srdf(tmp_path):
-    """--collision shows the Panda capsules; a robot without a model is refused; --srdf applies."""
+    """--collision shows the Panda's capsules or fits a URDF's; --srdf skips pairs."""
     out = tmp_path / "p.html"
     info = json.loads(run("view", "panda", "--collision", "--out", out, "--json").stdout)
     assert info["collision"] is True
@@ -72,6 +72,15 @@ def test_collision_and_srdf(tmp_path):
     urdf = write_package(tmp_path)  # a URDF robot carries no capsules unless fitted
     assert "no collision model" in run("view", urdf, "--param", "tip_link=tcp", "--no-meshes",
                                        "--collision", "--out", out, code=2).output
+    text = urdf.read_text(encoding="utf-8")
+    for link in ("base", "link2"):
+        text = text.replace(f'<link name="{link}">', f'<link name="{link}"><collision>'
+                            '<geometry><sphere radius="0.05"/></geometry></collision>')
+    urdf.write_text(text, encoding="utf-8")
+    info = json.loads(run("view", urdf, "--param", "tip_link=tcp", "--no-meshes", "--collision",
+                          "--out", out, "--json").stdout)
+    assert info["capsules_fitted"] is True
+    assert _page_data(out)["collision"]["bodies"] == ["base", "link2"]
     srdf = erd_urdf("panda_description/srdf/panda.srdf")
     if srdf is None:
         pytest.skip("example-robot-data (bench extra) is not installed")

@@ -35,10 +35,10 @@ _VIEW_HELP = command_help(
     "drawn with its visual meshes (the 'mesh' extra: pip install \"serialkin[mesh]\"), "
     "decimated to --mesh-budget triangles; --package and --mesh-path say where a URDF's "
     "package:// and relative mesh paths are. A robot with a collision model (the built-in "
-    "Panda and UR5) gets its capsules as a toggle (--collision shows them at once) and the "
-    "colliding pairs turn red while you move the sliders (--srdf: skip the pairs an SRDF "
-    "disables). --points draws a CSV of x,y,z[,r,g,b] rows (colours in [0, 1]) as a point "
-    "cloud.",
+    "models) gets its capsules as a toggle (--collision shows them at once, and fits them "
+    "to a URDF's collision geometry) and the colliding pairs turn red while you move the "
+    "sliders (--srdf: skip the pairs an SRDF disables). --points draws a CSV of "
+    "x,y,z[,r,g,b] rows (colours in [0, 1]) as a point cloud.",
     ["serialkin view ur5 --q \"0,-1.2,1.4,0,0.5,0\" --out ur5.html --open",
      "serialkin view --scenario six_link_circle --out six.html",
      "serialkin view planar20 --trajectory out/track/twenty_link_free.npz",
@@ -138,8 +138,9 @@ def _is_serialkin_csv(p: Path) -> bool:
               metavar="FOLDER", help="Folder where a URDF's package://NAME/... is looked up "
                    "as FOLDER/NAME/... and relative mesh paths as FOLDER/...; repeatable.")
 @click.option("--collision", "show_collision", is_flag=True,
-              help="Show the collision capsules when the page opens (needs a robot with a "
-                   "collision model).")
+              help="Show the collision capsules when the page opens; a robot without a "
+                   "collision model gets capsules fitted to its links' collision geometry "
+                   "(Robot.fit_collision).")
 @click.option("--srdf", type=click.Path(dir_okay=False), default=None,
               help="SRDF whose <disable_collisions> pairs the in-page check skips.")
 @click.option("--points", "points_file", type=click.Path(dir_okay=False), default=None,
@@ -188,9 +189,13 @@ def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
     elif scenario is not None:
         traj = sc.run()
         Q, path_points = traj.q, traj.targets[:, :3, 3]
+    fitted = False
     if show_collision and r.collision is None:
-        raise CLIError(f"--collision: robot {short_repr(r.name)} has no collision model "
-                       "(give a robot that carries one, e.g. the built-in panda)")
+        if not any(lg.collision for lg in r.geometry):
+            raise CLIError(f"--collision: robot {short_repr(r.name)} has no collision model "
+                           "and no collision geometry to fit one to")
+        r, _ = r.fit_collision()  # bounding capsules of the links' collision shapes
+        fitted = True
     acm = None
     if srdf is not None:
         if r.collision is None:
@@ -221,7 +226,7 @@ def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
         raise
     info = {"file": str(path), "robot": r.name, "n": r.n,
             "frames": int(Q.shape[0]) if Q is not None else 0,
-            "collision": r.collision is not None,
+            "collision": r.collision is not None, "capsules_fitted": fitted,
             "points": 0 if points is None else int(points.shape[0])}
     if as_json:
         click.echo(dumps_json(info), nl=False)

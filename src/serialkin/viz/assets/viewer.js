@@ -432,7 +432,8 @@ function shownOnScreen(obj) {
 
 function drawn() {
   // What is on screen now: visual shapes (meshes and primitives), their triangles,
-  // collision capsules, points, and whether the skeleton is shown.
+  // collision capsules, points, whether the skeleton is shown, and what is drawn red
+  // for a collision (links of the visual shapes, number of capsules; shown or not).
   const vis = visualObjects.filter(shownOnScreen);
   const tri = (o) => (o.geometry.index ? o.geometry.index.count : o.geometry.attributes.position.count) / 3;
   return {
@@ -443,6 +444,8 @@ function drawn() {
     capsules: capsuleObjects.filter(shownOnScreen).length,
     points: pointCloud && shownOnScreen(pointCloud) ? DATA.points.count : 0,
     skeleton: shownOnScreen(skeletonGroup),
+    highlighted: visualObjects.filter((o) => o.material === hitMat).map((o) => o.userData.link),
+    capsulesHit: capsuleObjects.filter((o) => o.material === capsuleHitMat).length,
   };
 }
 
