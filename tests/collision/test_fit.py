@@ -206,3 +206,32 @@ def test_panda_fitted_from_urdf_is_free_at_default_and_collides_folded() -> None
     assert self_clearance(fitted, fitted.collision, q, acm).distance > 0
     folded = np.array([0.0, 0.0, 0.0, -3.0, 0.0, 0.5, 0.0])
     assert self_clearance(fitted, fitted.collision, folded, acm).distance < 0
+
+
+def test_refined_axis_is_never_larger_and_still_contains() -> None:
+    """The direction search never gives a larger capsule than the principal axes; it holds P."""
+    rng = np.random.default_rng(5)
+    # an elbow: two bars at 120°, whose principal axis is not the best capsule axis
+    t = rng.uniform(0, 1, (300, 1))
+    bar1 = t * [0.3, 0, 0] + rng.normal(0, 0.01, (300, 3))
+    bar2 = [0.3, 0, 0] + t * [-0.1, 0.17, 0] + rng.normal(0, 0.01, (300, 3))
+    P = np.vstack([bar1, bar2])
+    plain, refined = bounding_capsule(P, refine=False), bounding_capsule(P)
+    assert capsule_volume(*refined) <= capsule_volume(*plain) * (1 + 1e-12)
+    assert np.all(_segment_distance(P, refined[0], refined[1]) <= refined[2] + 1e-12)
+
+
+def test_merge_fits_a_links_boxes_together() -> None:
+    """merge=True: the three boxes of a link become one cloud; spheres stay spheres."""
+    text = URDF.replace(
+        '<collision><geometry><box size="0.3 0.3 0.1"/></geometry></collision>',
+        "".join(f'<collision><origin xyz="0 0 {z}"/><geometry><box size="0.05 0.05 0.05"/>'
+                "</geometry></collision>" for z in (0.0, 0.05, 0.1)))
+    robot = Robot.from_urdf(text, tip_link="l2")
+    apart, rep_apart = collision_model_from_geometry(robot)
+    merged, rep_merged = collision_model_from_geometry(robot, merge=True)
+    base = merged.body_index("base")
+    assert int((apart.shape_body == base).sum()) == 3
+    assert int((merged.shape_body == base).sum()) == 1
+    assert [f.shape for f in rep_merged.fits if f.link_name == "base"] == ["3 shapes merged"]
+    assert len(rep_merged.fits) == 3 and len(rep_apart.fits) == 5

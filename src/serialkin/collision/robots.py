@@ -14,19 +14,19 @@ meshes, or boxes for the Panda's fingers), fitted by :mod:`serialkin.collision.f
 (``merge=True``: one point cloud per link) and moved into the link frame of
 :mod:`serialkin.models` (the fixed transform was checked to be the same at several
 configurations, which proves the frame correspondence): every capsule *contains* its
-mesh. One capsule per mesh is loose, about ×1.8-2.5 the mesh volume (×3.9 for the
-fingers, ×6.8 for the UR5's flat base); a split into two capsules saved less than the
-required 20 % everywhere, so every body has one. Reproduce with
-``benchmarks/fit_capsules.py`` (example-robot-data 4.x, the ``bench`` extra; trimesh,
-the ``mesh`` extra); ends rounded to 0.1 mm, radii rounded up and grown by 0.1 mm so that
-the rounded capsule still contains the mesh.
+mesh. One capsule per link is ×1.4-2.4 the mesh volume (×3.9 for the fingers, ×6.7 for
+the UR5's flat base plate); a split into two capsules saved less than the required 20 %
+everywhere, so every body has one. Reproduce with ``benchmarks/fit_capsules.py``
+(example-robot-data 4.x, the ``bench`` extra; trimesh, the ``mesh`` extra); ends rounded
+to 0.1 mm, radii rounded up and grown by 0.1 mm so that the rounded capsule still
+contains the mesh.
 
 Volumes [litre], mesh → capsule (largest gap capsule ↔ hull [mm]): Panda link0 3.00 →
-7.11 (79), link1 2.98 → 7.39 (52), link2 3.00 → 7.14 (50), link3 2.33 → 5.04 (44),
-link4 2.37 → 5.00 (40), link5 3.42 → 7.68 (47), link6 1.43 → 3.35 (43), link7 0.45 → 0.93
-(31), hand 0.71 → 1.62 (35), each finger 0.016 → 0.06 (15); UR5 base 0.35 → 2.35 (64),
-shoulder 1.55 → 2.79 (31), upper arm 5.36 → 12.35 (38), forearm 2.49 → 6.64 (42),
-wrists 0.51 → 0.95 (19), 0.51 → 0.95 (19), 0.14 → 0.30 (25).
+7.08 (81), link1 2.98 → 4.64 (27), link2 3.00 → 4.71 (28), link3 2.33 → 3.26 (26), link4
+2.37 → 3.31 (29), link5 3.42 → 4.87 (48), link6 1.43 → 2.93 (40), link7 0.45 → 0.92 (27),
+hand 0.71 → 1.59 (34), each finger 0.016 → 0.06 (16); UR5 base 0.35 → 2.34 (63),
+shoulder 1.55 → 2.64 (26), upper arm 5.36 → 12.18 (35), forearm 2.49 → 6.18 (37), wrists
+0.51 → 0.95 (19), 0.51 → 0.95 (19), 0.14 → 0.29 (25).
 
 * Panda (:func:`serialkin.models.panda`, modified DH frames = the URDF's ``panda_link0..7``
   frames): bodies named as in the URDF/SRDF, hand and fingers fixed to frame 7 with the
@@ -49,27 +49,27 @@ SOURCE = ("bounding capsules of example-robot-data's collision meshes "
           "(benchmarks/fit_capsules.py)")
 
 _PANDA = [  # body, frame, a, b, radius [m]
-    ("panda_link0", 0, [-0.0009, -0.0001, 0.0507], [-0.0576, 0.0002, 0.0234], 0.1056),
-    ("panda_link1", 1, [-0.0006, 0.0156, -0.1346], [0.0012, -0.0732, 0.0013], 0.0912),
-    ("panda_link2", 2, [0.0, 0.0011, 0.0713], [-0.0002, -0.1401, -0.016], 0.0895),
-    ("panda_link3", 3, [0.082, 0.0564, -0.005], [-0.0049, -0.0112, -0.0708], 0.0823),
-    ("panda_link4", 4, [-0.0015, 0.005, 0.0565], [-0.0862, 0.0704, -0.008], 0.0825),
-    ("panda_link5", 5, [0.0001, 0.0859, 0.001], [-0.0022, -0.0109, -0.2068], 0.0847),
-    ("panda_link6", 6, [0.0891, 0.0115, -0.0001], [0.0145, -0.0156, 0.0164], 0.0765),
-    ("panda_link7", 7, [0.0341, 0.0349, 0.0761], [-0.0049, -0.005, 0.0741], 0.0494),
-    ("panda_hand", 7, [0.0548, 0.054, 0.1303], [-0.0646, -0.0643, 0.1275], 0.0474),
-    ("panda_leftfinger", 7, [0.0356, 0.0356, 0.2096], [0.0391, 0.0391, 0.1672], 0.0171),
-    ("panda_rightfinger", 7, [-0.0356, -0.0356, 0.2096], [-0.0391, -0.0391, 0.1672], 0.0171),
+    ("panda_link0", 0, [0.0, -0.0, 0.0507], [-0.0572, -0.0001, 0.0209], 0.1051),
+    ("panda_link1", 1, [0.0, -0.0002, -0.1402], [0.0, -0.0548, 0.0059], 0.0760),
+    ("panda_link2", 2, [-0.0003, 0.0078, 0.0556], [0.0001, -0.1424, 0.0002], 0.0759),
+    ("panda_link3", 3, [0.0843, 0.0433, 0.0018], [0.0003, 0.0002, -0.0799], 0.0693),
+    ("panda_link4", 4, [0.0019, -0.0018, 0.0434], [-0.0809, 0.0844, 0.0004], 0.0694),
+    ("panda_link5", 5, [-0.0, 0.0639, 0.003], [0.0002, 0.0104, -0.2438], 0.0674),
+    ("panda_link6", 6, [0.0886, 0.0086, -0.0003], [0.0201, 0.0119, 0.0048], 0.0746),
+    ("panda_link7", 7, [0.0329, 0.033, 0.0808], [-0.0051, -0.0051, 0.0733], 0.0494),
+    ("panda_hand", 7, [0.0433, 0.0434, 0.1383], [-0.0624, -0.0624, 0.1263], 0.0486),
+    ("panda_leftfinger", 7, [0.0364, 0.0364, 0.2114], [0.0388, 0.0388, 0.1667], 0.0169),
+    ("panda_rightfinger", 7, [-0.0364, -0.0364, 0.2114], [-0.0388, -0.0388, 0.1667], 0.0169),
 ]
 
 _UR5 = [
-    ("base_link", 0, [0.0001, 0.0014, 0.0062], [0.0007, -0.0362, 0.0057], 0.0742),
-    ("shoulder_link", 1, [-0.0074, -0.0156, 0.0017], [0.0006, 0.0009, 0.0129], 0.0825),
-    ("upper_arm_link", 2, [0.4377, -0.0012, 0.1319], [0.0007, 0.0001, 0.1309], 0.0847),
-    ("forearm_link", 3, [0.3887, -0.0006, 0.0473], [-0.0046, 0.0001, 0.0087], 0.0663),
+    ("base_link", 0, [-0.0, 0.001, 0.006], [0.001, -0.0363, 0.0064], 0.0742),
+    ("shoulder_link", 1, [0.0007, -0.0111, 0.0034], [-0.0, -0.0, 0.0123], 0.0824),
+    ("upper_arm_link", 2, [0.4252, 0.0003, 0.131], [-0.0106, -0.0003, 0.1317], 0.0843),
+    ("forearm_link", 3, [0.3994, -0.0006, 0.0445], [0.0031, -0.0019, 0.0152], 0.0640),
     ("wrist_1_link", 4, [-0.0011, -0.0037, -0.0102], [-0.0002, -0.0054, 0.0116], 0.0561),
     ("wrist_2_link", 5, [0.0011, 0.0053, 0.0112], [0.0005, 0.0035, -0.0091], 0.0565),
-    ("wrist_3_link", 6, [0.0001, 0.0033, -0.021], [-0.0001, -0.0033, -0.0213], 0.0401),
+    ("wrist_3_link", 6, [-0.0001, 0.0004, -0.0212], [0.0006, -0.0033, -0.0212], 0.0401),
 ]
 
 
