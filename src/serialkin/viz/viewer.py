@@ -35,8 +35,9 @@ without geometry keeps the skeleton of cylinders.
 
 **Self-collision in the page.** With a collision model (:attr:`Robot.collision`, capsules
 and spheres per body, :mod:`serialkin.collision`) the page can draw the capsules (a toggle)
-and checks, after every slider move, the shape pairs :func:`serialkin.collision.queries.
-checked_shape_pairs` lists for the allowed-collision matrix: shape ``s`` with axis ends
+and checks, after every slider move, the shape pairs that
+:func:`~serialkin.collision.queries.checked_shape_pairs` lists for the allowed-collision
+matrix: shape ``s`` with axis ends
 ``a_s, b_s`` in frame ``f_s`` has world ends ``A_s = T_f a_s``, ``B_s = T_f b_s``, and a pair
 collides when ``dist(A_s B_s, A_t B_t) − r_s − r_t < 0`` (segment–segment distance, as
 :func:`serialkin.collision.self_clearance` computes it). The bodies of a colliding pair are
