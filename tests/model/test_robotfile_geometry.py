@@ -198,3 +198,46 @@ def test_geometry_survives_units_of_the_written_file(folder: Path) -> None:
     assert rpy[1] == pytest.approx(math.pi / 2)
     back = robot_from_dict(data, "x.yaml", folder=folder)
     np.testing.assert_allclose(back.collision.radius, robot.collision.radius)
+
+
+_FUZZ_DIR = None
+
+
+def _fuzz_doc() -> dict:
+    """DOC with its mesh in a temporary folder (made once), as a plain mapping."""
+    global _FUZZ_DIR
+    import tempfile
+
+    if _FUZZ_DIR is None:
+        _FUZZ_DIR = Path(tempfile.mkdtemp())
+        (_FUZZ_DIR / "meshes").mkdir()
+        (_FUZZ_DIR / "meshes" / "upper.stl").write_bytes(b"\0" * 84)
+    return yaml.safe_load(DOC)
+
+
+def test_fuzz_geometry_and_collision_fields() -> None:
+    """Any geometry or collision field replaced by junk: a robot or a RobotDefinitionError."""
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    from serialkin.errors import SerialkinError
+    from tests.test_hostile_files import _json, _paths, _replace, guard
+
+    doc = _fuzz_doc()
+    paths = [p for p in _paths(doc) if p and p[0] in ("geometry", "collision", "mesh_path")]
+
+    @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(path=st.sampled_from(paths), junk=_json)
+    def run(path: tuple, junk: object) -> None:
+        with guard():
+            try:
+                robot = robot_from_dict(_replace(doc, path, junk), "fuzz.yaml",
+                                        folder=_FUZZ_DIR)
+            except RobotDefinitionError as exc:
+                assert "fuzz.yaml" in str(exc)
+                return
+            except SerialkinError as exc:  # pragma: no cover - a wrong error type
+                raise AssertionError(f"{type(exc).__name__}: {exc}") from exc
+        assert np.isfinite(robot.fk(np.zeros(robot.n))).all()
+
+    run()
