@@ -197,10 +197,10 @@ def test_panda_fitted_from_urdf_is_free_at_default_and_collides_folded() -> None
     robot = _panda_from_urdf()
     fitted, _ = robot.fit_collision()
     srdf = read_srdf(robots_dir() / "panda_description" / "srdf" / "panda.srdf")
-    known = set(fitted.collision.body_names)
-    srdf_ok = type(srdf)(tuple(p for p in srdf.disabled if {p[0], p[1]} <= known),
-                         srdf.group_states, srdf.source)
-    acm = acm_from_srdf(fitted.collision, srdf_ok)
+    with pytest.raises(RobotDefinitionError, match="panda_leftfinger.*skip_links"):
+        acm_from_srdf(fitted.collision, srdf)  # the fingers are off the chain: no bodies
+    acm = acm_from_srdf(fitted.collision, srdf,
+                        skip_links=["panda_leftfinger", "panda_rightfinger"])
     state = srdf.group_state("default")
     q = np.array([state[f"panda_joint{i}"] for i in range(1, 8)])
     assert self_clearance(fitted, fitted.collision, q, acm).distance > 0

@@ -86,23 +86,38 @@ def default_acm(model: CollisionModel) -> AllowedCollisionMatrix:
 
 
 def acm_from_srdf(model: CollisionModel, srdf: Srdf | str | os.PathLike[str],
-                  acm: AllowedCollisionMatrix | None = None) -> AllowedCollisionMatrix:
+                  acm: AllowedCollisionMatrix | None = None, *,
+                  skip_links: Iterable[str] = ()) -> AllowedCollisionMatrix:
     """Add an SRDF's ``<disable_collisions>`` pairs to ``acm`` (default: :func:`default_acm`).
 
+    Args:
+        model: the collision model whose bodies the SRDF's links name.
+        srdf: an :class:`Srdf`, a file or an XML string.
+        acm: the matrix to extend (default: :func:`default_acm` of ``model``).
+        skip_links: links that exist in the robot but carry no body in ``model`` (e.g.
+            gripper fingers on joints off the chain): pairs naming them are skipped.
+
     Raises:
-        RobotDefinitionError: the SRDF names a link that is not a body of ``model`` (the
-            message names the SRDF, the link and lists the bodies).
+        RobotDefinitionError: the SRDF names a link that is neither a body of ``model``
+            nor in ``skip_links`` (the message names the SRDF, the link and lists the
+            bodies).
     """
     s = srdf if isinstance(srdf, Srdf) else read_srdf(srdf)
     known = set(model.body_names)
+    skip = {str(x) for x in skip_links} - known
+    pairs = []
     for a, b, _ in s.disabled:
         for x in (a, b):
-            if x not in known:
+            if x not in known and x not in skip:
                 raise RobotDefinitionError(
                     f"{s.source}: disable_collisions names link {x!r}, which is not a body of "
-                    f"the collision model; bodies: {', '.join(model.body_names)}")
+                    f"the collision model; bodies: {', '.join(model.body_names)} (a link "
+                    "without capsules, such as a finger off the chain, can be given in "
+                    "skip_links)")
+        if a not in skip and b not in skip:
+            pairs.append((a, b))
     base = default_acm(model) if acm is None else acm
-    return base.allow((a, b) for a, b, _ in s.disabled)
+    return base.allow(pairs)
 
 
 def sampled_acm(robot, model: CollisionModel, acm: AllowedCollisionMatrix | None = None, *,
