@@ -433,14 +433,10 @@ def _posed_points(shape: object, link_name: str) -> tuple[str, np.ndarray, float
 
 def _fit_cloud(name: str, P: np.ndarray, vol: float, link_name: str, frame: int,
                options: dict) -> ShapeFit:
-    """Capsules of a point cloud and their fitting error.
+    """Capsules of a point cloud and their fitting error (BLAS on one thread: small products)."""
+    from serialkin._blas import single_threaded_blas
 
-    BLAS is held to one thread: its thread pool, woken for each small product, costs
-    more than the product (measured ×7 on the gap's 2000 × k product on 2 busy cores).
-    """
-    from threadpoolctl import threadpool_limits
-
-    with threadpool_limits(limits=1, user_api="blas"):
+    with single_threaded_blas():
         caps, pieces, hull_vol = fit_points(P, **options)
         gap = max(max_gap(c, piece) for c, piece in zip(caps, pieces, strict=True))
     if vol <= 0.0:
