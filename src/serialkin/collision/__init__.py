@@ -27,7 +27,15 @@ from serialkin.collision.queries import (
     scene_clearance,
     self_clearance,
 )
-from serialkin.collision.robots import panda_collision_model, ur5_collision_model
+from serialkin.collision.robots import (
+    iiwa7_collision_model,
+    panda_collision_model,
+    planar_collision_model,
+    puma560_collision_model,
+    scara_collision_model,
+    stanford_collision_model,
+    ur5_collision_model,
+)
 from serialkin.collision.shapes import Box, HalfSpace
 from serialkin.collision.srdf import Srdf, read_srdf
 
@@ -43,11 +51,16 @@ __all__ = [
     "acm_from_srdf",
     "collision_model_from_geometry",
     "default_acm",
+    "iiwa7_collision_model",
     "in_collision",
     "panda_collision_model",
+    "planar_collision_model",
+    "puma560_collision_model",
     "read_srdf",
     "sampled_acm",
+    "scara_collision_model",
     "scene_clearance",
     "self_clearance",
+    "stanford_collision_model",
     "ur5_collision_model",
 ]
