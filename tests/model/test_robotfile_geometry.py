@@ -241,3 +241,10 @@ def test_fuzz_geometry_and_collision_fields() -> None:
         assert np.isfinite(robot.fk(np.zeros(robot.n))).all()
 
     run()
+
+
+def test_relative_mesh_without_a_folder_says_where_to_look() -> None:
+    """A relative mesh in a mapping with no file folder and no mesh_path: the fix is named."""
+    data = _doc(geometry=[{"link": "x", "frame": 0, "visual": [{"mesh": {"file": "a.stl"}}]}])
+    with pytest.raises(RobotDefinitionError, match=r"link 'x'.*'a\.stl'.*nowhere: give mesh_path"):
+        robot_from_dict(data, "arm.yaml")

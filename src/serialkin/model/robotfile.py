@@ -340,7 +340,9 @@ def robot_from_dict(data: object, origin: str = "<robot description>",
                 d = Path(item.string(max_len=4096))
                 search.append(base_dir / d if base_dir is not None and not d.is_absolute()
                               else d)
-        resolve = MeshResolver(base_dir, {}, search, strict=True)
+        resolve = MeshResolver(base_dir, {}, search, strict=True,
+                               nowhere="nowhere: give mesh_path, or load the robot file "
+                                       "from its folder")
         robot.geometry = _geometry_field(doc["geometry"], robot.n,
                                          (angle_unit, length_unit), resolve)
     elif doc["mesh_path"].present:

@@ -315,7 +315,9 @@ class MeshResolver:
     """
 
     def __init__(self, folder: Path | None, package_map: Mapping[str, object],
-                 search_path: Sequence[object], strict: bool) -> None:
+                 search_path: Sequence[object], strict: bool,
+                 nowhere: str = "nowhere: give package_map= or search_path=") -> None:
+        self.nowhere = nowhere
         self.folder = folder
         self.package_map = {str(k): Path(str(v)) for k, v in package_map.items()}
         if isinstance(search_path, str | os.PathLike):
@@ -351,8 +353,7 @@ class MeshResolver:
             except (OSError, ValueError):  # a name too long, a loop of links: not a file
                 continue
         if self.strict:
-            looked = ", ".join(short_repr(str(p), 400) for p in tried) or (
-                "nowhere: give package_map= or search_path=")
+            looked = ", ".join(short_repr(str(p), 400) for p in tried) or self.nowhere
             raise RobotDefinitionError(
                 f"{where}: mesh {short_repr(name, 120)} does not resolve to a file; looked in "
                 f"{looked}")
