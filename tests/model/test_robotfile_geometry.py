@@ -248,3 +248,36 @@ def test_relative_mesh_without_a_folder_says_where_to_look() -> None:
     data = _doc(geometry=[{"link": "x", "frame": 0, "visual": [{"mesh": {"file": "a.stl"}}]}])
     with pytest.raises(RobotDefinitionError, match=r"link 'x'.*'a\.stl'.*nowhere: give mesh_path"):
         robot_from_dict(data, "arm.yaml")
+
+
+@pytest.mark.parametrize("suffix", [".yaml", ".json"])
+def test_capsule_file_round_trip(tmp_path: Path, suffix: str) -> None:
+    """A collision model saved to a capsule file (mm) loads back the same in metres."""
+    from serialkin.model.robotfile import load_collision_file, save_collision_file
+
+    puma = models.puma560()
+    path = save_collision_file(puma.collision, tmp_path / f"caps{suffix}", length_unit="mm")
+    back = load_collision_file(path, puma)
+    for field in ("a", "b", "radius"):
+        np.testing.assert_allclose(getattr(back, field), getattr(puma.collision, field),
+                                   atol=1e-12)
+    assert back.body_names == puma.collision.body_names
+    np.testing.assert_array_equal(back.body_frames, puma.collision.body_frames)
+    assert puma.with_collision(back).collision is back
+
+
+def test_capsule_file_errors_name_the_file(tmp_path: Path) -> None:
+    """A frame beyond the robot, a missing section or a bad unit: errors naming the file."""
+    from serialkin.model.robotfile import collision_from_dict, load_collision_file
+
+    p = tmp_path / "caps.yaml"
+    p.write_text("collision:\n  - {name: a, frame: 7, spheres: [{center: [0, 0, 0], "
+                 "radius: 0.1}]}\n")
+    with pytest.raises(RobotDefinitionError, match=r"caps\.yaml: field 'collision\[0\]\.frame'"
+                                                   r" must be an integer in \[0, 6\]"):
+        load_collision_file(p, models.puma560())
+    assert load_collision_file(p).body_frames.tolist() == [7]
+    with pytest.raises(RobotDefinitionError, match=r"x\.yaml: field 'collision' is missing"):
+        collision_from_dict({"units": {"length": "m"}}, "x.yaml")
+    with pytest.raises(RobotDefinitionError, match=r"'units\.length' must be one of m, cm, mm"):
+        collision_from_dict({"units": {"length": "ft"}, "collision": []}, "x.yaml")

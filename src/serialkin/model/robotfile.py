@@ -443,19 +443,29 @@ def robot_to_dict(robot: Any, angle_unit: str = "deg", length_unit: str = "m", *
         out["geometry"] = [_link_geometry_dict(lg, ang, lin, mesh_base, num)
                            for lg in robot.geometry]
     if getattr(robot, "collision", None) is not None:
-        bodies = robot.collision.to_dicts()
-        for body in bodies:
-            for c in body["capsules"]:
-                c.update(a=[num(v / lin) for v in c["a"]], b=[num(v / lin) for v in c["b"]],
-                         radius=num(c["radius"] / lin))
-            for c in body["spheres"]:
-                c.update(center=[num(v / lin) for v in c["center"]],
-                         radius=num(c["radius"] / lin))
-            for kind in ("capsules", "spheres"):
-                if not body[kind]:
-                    del body[kind]
-        out["collision"] = bodies
+        out["collision"] = _collision_list(robot.collision, lin)
     return out
+
+
+def _num(x: float) -> float | None:
+    """A finite number rounded to 12 decimals (no -0.0); None for ±inf."""
+    return None if not math.isfinite(x) else float(round(x, 12)) + 0.0
+
+
+def _collision_list(model: Any, lin: float) -> list[dict]:
+    """The ``collision`` section of a collision model, lengths divided by ``lin``."""
+    bodies = model.to_dicts()
+    for body in bodies:
+        for c in body["capsules"]:
+            c.update(a=[_num(v / lin) for v in c["a"]], b=[_num(v / lin) for v in c["b"]],
+                     radius=_num(c["radius"] / lin))
+        for c in body["spheres"]:
+            c.update(center=[_num(v / lin) for v in c["center"]],
+                     radius=_num(c["radius"] / lin))
+        for kind in ("capsules", "spheres"):
+            if not body[kind]:
+                del body[kind]
+    return bodies
 
 
 def _link_geometry_dict(lg: Any, ang: float, lin: float, mesh_base: Any, num: Any) -> dict:
@@ -520,15 +530,99 @@ def save_robot_file(robot: Any, path: str | os.PathLike[str], *, angle_unit: str
         )
     data = robot_to_dict(robot, angle_unit=angle_unit, length_unit=length_unit,
                          mesh_base=p.resolve().parent)
-    if p.suffix.lower() == ".json":
-        text = json.dumps(data, indent=2) + "\n"
-    else:
-        import yaml
+    write_text_atomic(p, _dump(data, p, "serialkin robot file"))
+    return p
 
-        # The dumper quotes and escapes every name and free text: nothing a name holds
-        # (newlines, ':', '#', quotes) can add a line or a key to the file. Non-ASCII is
-        # escaped too (allow_unicode would write U+0085 raw, which reads back as a space).
-        text = "# serialkin robot file\n" + yaml.safe_dump(
-            data, sort_keys=False, default_flow_style=None)
-    write_text_atomic(p, text)
+
+def _dump(data: dict, p: Path, title: str) -> str:
+    """``data`` as JSON (``.json``) or YAML text with a ``# title`` line."""
+    if p.suffix.lower() == ".json":
+        return json.dumps(data, indent=2) + "\n"
+    import yaml
+
+    # The dumper quotes and escapes every name and free text: nothing a name holds
+    # (newlines, ':', '#', quotes) can add a line or a key to the file. Non-ASCII is
+    # escaped too (allow_unicode would write U+0085 raw, which reads back as a space).
+    return f"# {title}\n" + yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
+
+
+# ------------------------------------------------------------------ capsule files
+_CAPSULE_FIELDS = ("units", "source", "collision")
+
+
+def collision_from_dict(data: object, origin: str = "<collision model>",
+                        frames: int | None = None) -> Any:
+    """A :class:`~serialkin.collision.model.CollisionModel` from a capsule-file mapping.
+
+    A capsule file holds only a collision model, for robots that cannot be saved as robot
+    files (a URDF robot) or to share capsules between files::
+
+        units: {length: m}           # optional, m | cm | mm (default m)
+        source: "fitted to ..."      # optional, free text
+        collision:                   # as the collision section of a robot file
+          - {name: link1, frame: 1, capsules: [{a: [0, 0, 0], b: [0, 0, 0.3], radius: 0.06}]}
+
+    Args:
+        data: the parsed mapping.
+        origin: what to call it in errors (the file path).
+        frames: the robot's joint count n; frames must lie in 0..n (default: not checked
+            beyond >= 0, :meth:`Robot.with_collision` checks them).
+
+    Raises:
+        RobotDefinitionError: a missing, unknown or malformed field (named).
+    """
+    doc = Field(data, "", origin, RobotDefinitionError)
+    doc.mapping(_CAPSULE_FIELDS, ("collision",),
+                what=f"a mapping with fields {', '.join(_CAPSULE_FIELDS)}")
+    unit = "m"
+    if doc["units"].present:
+        units = doc["units"].mapping({"length"}, what="a mapping {length: m|cm|mm}")
+        unit = units["length"].string(choices=LENGTH_UNITS, default="m")
+    source = doc["source"].string(default=f"capsule file {origin}", nonempty=False)
+    n = MAX_JOINTS if frames is None else frames
+    return _collision_field(doc["collision"], n, unit, source)
+
+
+def load_collision_file(path: str | os.PathLike[str], robot: Any = None) -> Any:
+    """Read a capsule file (YAML or JSON, :func:`collision_from_dict`).
+
+    Args:
+        path: the file.
+        robot: if given, frames are checked against its frames 0..n.
+
+    Returns:
+        The :class:`~serialkin.collision.model.CollisionModel` (metres); attach it with
+        ``robot.with_collision(model)``.
+
+    Raises:
+        RobotDefinitionError: unreadable file or a malformed field (named).
+    """
+    data = read_robot_data(path)
+    return collision_from_dict(data, str(path), None if robot is None else robot.n)
+
+
+def save_collision_file(model: Any, path: str | os.PathLike[str], *,
+                        length_unit: str = "m") -> Path:
+    """Write a collision model to a capsule file (YAML or JSON by suffix), atomically.
+
+    Returns:
+        The path written; :func:`load_collision_file` gives the same model.
+    """
+    from serialkin._checks import check_choice
+    from serialkin._io import write_text_atomic
+    from serialkin.collision.model import CollisionModel
+
+    if not isinstance(model, CollisionModel):
+        raise InputTypeError(f"model must be a CollisionModel, got {type(model).__name__}")
+    check_choice(length_unit, "length_unit", LENGTH_UNITS)
+    p = Path(path)
+    if p.suffix.lower() not in ROBOT_FILE_SUFFIXES:
+        raise RobotDefinitionError(
+            f"{p}: unknown capsule file type {p.suffix!r}; expected one of "
+            f"{', '.join(ROBOT_FILE_SUFFIXES)}")
+    data: dict[str, Any] = {"units": {"length": length_unit}}
+    if model.source:
+        data["source"] = model.source
+    data["collision"] = _collision_list(model, LENGTH_UNITS[length_unit])
+    write_text_atomic(p, _dump(data, p, "serialkin capsule file"))
     return p
