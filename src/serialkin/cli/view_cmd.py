@@ -19,6 +19,11 @@ from serialkin.cli.commands import (
 )
 from serialkin.cli.io import CLIError, command_help, dumps_json, ensure_dir, parse_numbers
 from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot
+from serialkin.errors import SerialkinError
+
+#: ``serialkin.viz.viewer.MESH_BUDGET``, repeated so that the command line does not import
+#: the viewer at start-up (a test checks they agree).
+_MESH_BUDGET = 60_000
 
 _VIEW_HELP = command_help(
     "Write the interactive 3D viewer page of a robot, a configuration or a trajectory.\n\n"
@@ -26,10 +31,20 @@ _VIEW_HELP = command_help(
     "joint (forward kinematics in the page), play through a trajectory, the target path "
     "and obstacles. ROBOT is " + ROBOT_HELP + "; with --scenario it may be omitted. "
     "--trajectory reads a trajectory written by 'serialkin track' (.csv/.npz) or a CSV of "
-    "joint values (one configuration per row).",
+    "joint values (one configuration per row). A robot with link geometry (a URDF) is "
+    "drawn with its visual meshes (the 'mesh' extra: pip install \"serialkin[mesh]\"), "
+    "decimated to --mesh-budget triangles; --package and --mesh-path say where a URDF's "
+    "package:// and relative mesh paths are. A robot with a collision model (the built-in "
+    "models) gets its capsules as a toggle (--collision shows them at once, and fits them "
+    "to a URDF's collision geometry) and the colliding pairs turn red while you move the "
+    "sliders (--srdf: skip the pairs an SRDF disables). --points draws a CSV of "
+    "x,y,z[,r,g,b] rows (colours in [0, 1]) as a point cloud.",
     ["serialkin view ur5 --q \"0,-1.2,1.4,0,0.5,0\" --out ur5.html --open",
      "serialkin view --scenario six_link_circle --out six.html",
-     "serialkin view planar20 --trajectory out/track/twenty_link_free.npz"],
+     "serialkin view planar20 --trajectory out/track/twenty_link_free.npz",
+     "serialkin view panda --collision --q \"0,0,0,-3,0,0.5,0\" --out folded.html",
+     "serialkin view robots/panda.urdf --package example-robot-data=share/example-robot-data "
+     "--param tip_link=panda_hand --out panda.html"],
 )
 
 
@@ -49,6 +64,42 @@ def _load_trajectory(path: str, robot: Any) -> tuple[np.ndarray, np.ndarray | No
                            f"{short_repr(robot.name)} has {robot.n}")
         return traj.q, traj.targets[:, :3, 3]
     return read_csv_rows(p, "q", robot.n), None
+
+
+def _parse_packages(packages: tuple[str, ...]) -> dict[str, str]:
+    """``NAME=FOLDER`` pairs of --package into a package map (the folders must exist)."""
+    out: dict[str, str] = {}
+    for item in packages:
+        name, sep, folder = item.partition("=")
+        if not sep or not name.strip() or not folder.strip():
+            raise CLIError(f"--package {short_repr(item)}: expected NAME=FOLDER, e.g. "
+                           "--package my_description=/opt/ros/share/my_description")
+        if not Path(folder).is_dir():
+            raise CLIError(f"--package {short_repr(item)}: folder {folder} not found")
+        out[name.strip()] = folder
+    return out
+
+
+def _urdf_with_meshes(spec: str, params: tuple[str, ...], packages: tuple[str, ...],
+                      mesh_paths: tuple[str, ...]) -> Any:
+    """A URDF robot whose mesh paths are looked up with --package and --mesh-path."""
+    from serialkin.cli.robots import parse_params
+    from serialkin.model.robot import Robot
+
+    if Path(spec).suffix.lower() != ".urdf":
+        raise CLIError(f"--package and --mesh-path apply to a URDF file (.urdf), not "
+                       f"{short_repr(spec)}")
+    if not Path(spec).is_file():
+        raise CLIError(f"robot file {spec} not found")
+    for folder in mesh_paths:
+        if not Path(folder).is_dir():
+            raise CLIError(f"--mesh-path {folder}: folder not found")
+    links = {k: str(v) for k, v in parse_params(params).items()}
+    if set(links) - {"base_link", "tip_link"}:
+        raise CLIError(f"--param for a URDF takes base_link=NAME and tip_link=NAME only, got "
+                       f"{', '.join(sorted(set(links) - {'base_link', 'tip_link'}))}")
+    return Robot.from_urdf(spec, **links, package_map=_parse_packages(packages),
+                           search_path=list(mesh_paths))
 
 
 def _is_serialkin_csv(p: Path) -> bool:
@@ -74,6 +125,28 @@ def _is_serialkin_csv(p: Path) -> bool:
               show_default=True, help="The HTML file to write.")
 @click.option("--open", "open_browser", is_flag=True, help="Open the page in a web browser.")
 @click.option("--degrees", "-d", is_flag=True, help="--q angles in degrees.")
+@click.option("--meshes/--no-meshes", default=True, show_default=True,
+              help="Draw the visual mesh files of the robot's links (else primitives only, "
+                   "or the skeleton).")
+@click.option("--mesh-budget", type=click.IntRange(min=4), default=None, metavar="TRIANGLES",
+              help=f"Most triangles of all meshes together [default: {_MESH_BUDGET}]; about "
+                   "12 bytes of page each.")
+@click.option("--package", "packages", multiple=True, metavar="NAME=FOLDER",
+              help="Folder of a ROS package, for a URDF's package://NAME/... mesh paths; "
+                   "repeatable.")
+@click.option("--mesh-path", "mesh_paths", multiple=True, type=click.Path(file_okay=False),
+              metavar="FOLDER", help="Folder where a URDF's package://NAME/... is looked up "
+                   "as FOLDER/NAME/... and relative mesh paths as FOLDER/...; repeatable.")
+@click.option("--collision", "show_collision", is_flag=True,
+              help="Show the collision capsules when the page opens; a robot without a "
+                   "collision model gets capsules fitted to its links' collision geometry "
+                   "(Robot.fit_collision).")
+@click.option("--srdf", type=click.Path(dir_okay=False), default=None,
+              help="SRDF whose <disable_collisions> pairs the in-page check skips.")
+@click.option("--points", "points_file", type=click.Path(dir_okay=False), default=None,
+              help="CSV of x,y,z or x,y,z,r,g,b rows [m; colours in 0..1] drawn as points.")
+@click.option("--points-label", default=None, help="Name of the point layer in the page "
+              "[default: the file name].")
 @param_option
 @json_option
 @quiet_long_option
@@ -81,8 +154,12 @@ def _is_serialkin_csv(p: Path) -> bool:
 @handle_errors
 def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
              scenario: str | None, title: str | None, out: str, open_browser: bool,
-             degrees: bool, params: tuple[str, ...], as_json: bool, quiet: bool) -> None:
+             degrees: bool, meshes: bool, mesh_budget: int | None, packages: tuple[str, ...],
+             mesh_paths: tuple[str, ...], show_collision: bool, srdf: str | None,
+             points_file: str | None, points_label: str | None, params: tuple[str, ...],
+             as_json: bool, quiet: bool) -> None:
     """Write the interactive viewer page (and open it with --open)."""
+    from serialkin.cli.io import read_csv_rows
     from serialkin.viz.viewer import write_viewer
 
     obstacles: tuple[Any, ...] = ()
@@ -97,6 +174,8 @@ def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
         title = title or sc.name
     elif robot is None:
         raise CLIError("missing ROBOT (or --scenario): " + ROBOT_HELP)
+    elif packages or mesh_paths:
+        r = _urdf_with_meshes(robot, params, packages, mesh_paths)
     else:
         r = resolve_robot(robot, params)
     # every input is checked before the scenario runs and before the page is written
@@ -110,11 +189,45 @@ def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
     elif scenario is not None:
         traj = sc.run()
         Q, path_points = traj.q, traj.targets[:, :3, 3]
+    fitted = False
+    if show_collision and r.collision is None:
+        if not any(lg.collision for lg in r.geometry):
+            raise CLIError(f"--collision: robot {short_repr(r.name)} has no collision model "
+                           "and no collision geometry to fit one to")
+        r, _ = r.fit_collision()  # bounding capsules of the links' collision shapes
+        fitted = True
+    acm = None
+    if srdf is not None:
+        if r.collision is None:
+            raise CLIError(f"--srdf: robot {short_repr(r.name)} has no collision model to "
+                           "check")
+        from serialkin.collision import acm_from_srdf
+
+        acm = acm_from_srdf(r.collision, srdf)
+    points = colors = None
+    if points_file is not None:
+        rows = read_csv_rows(points_file, "points", (3, 6))
+        points = rows[:, :3]
+        colors = rows[:, 3:] if rows.shape[1] == 6 else None
+        points_label = points_label if points_label is not None else Path(points_file).name
+    elif points_label is not None:
+        raise CLIError("--points-label needs --points FILE")
     ensure_dir(Path(out).parent)
-    path = write_viewer(r, out, q=q, trajectory=Q, path_points=path_points,
-                        obstacles=obstacles or None, title=title)
+    try:
+        path = write_viewer(r, out, q=q, trajectory=Q, path_points=path_points,
+                            obstacles=obstacles or None, title=title, meshes=meshes,
+                            mesh_budget=_MESH_BUDGET if mesh_budget is None else mesh_budget,
+                            acm=acm, show_collision=show_collision, points=points,
+                            point_colors=colors, points_label=points_label or "points")
+    except SerialkinError as exc:
+        if "visual mesh" in str(exc):
+            raise CLIError(f"{exc} (on the command line: --package NAME=FOLDER or --mesh-path "
+                           "FOLDER, or --no-meshes)") from exc
+        raise
     info = {"file": str(path), "robot": r.name, "n": r.n,
-            "frames": int(Q.shape[0]) if Q is not None else 0}
+            "frames": int(Q.shape[0]) if Q is not None else 0,
+            "collision": r.collision is not None, "capsules_fitted": fitted,
+            "points": 0 if points is None else int(points.shape[0])}
     if as_json:
         click.echo(dumps_json(info), nl=False)
     elif not quiet:

@@ -5,6 +5,8 @@
 * :mod:`~serialkin.collision.shapes` — scene shapes (boxes, half-spaces, and the obstacles
   of :mod:`serialkin.redundancy.obstacles`);
 * :mod:`~serialkin.collision.model` — :class:`CollisionModel`, capsules per body per frame;
+* :mod:`~serialkin.collision.fit` — capsules fitted to link geometry (meshes, primitives),
+  with the fitting error;
 * :mod:`~serialkin.collision.robots` — fitted models of built-in robots;
 * :mod:`~serialkin.collision.acm` — the allowed-collision matrix (default, SRDF, sampled);
 * :mod:`~serialkin.collision.srdf` — reading an SRDF;
@@ -17,6 +19,7 @@ from serialkin.collision.acm import (
     default_acm,
     sampled_acm,
 )
+from serialkin.collision.fit import FitReport, ShapeFit, collision_model_from_geometry
 from serialkin.collision.model import CollisionModel
 from serialkin.collision.queries import (
     Clearance,
@@ -24,7 +27,15 @@ from serialkin.collision.queries import (
     scene_clearance,
     self_clearance,
 )
-from serialkin.collision.robots import panda_collision_model, ur5_collision_model
+from serialkin.collision.robots import (
+    iiwa7_collision_model,
+    panda_collision_model,
+    planar_collision_model,
+    puma560_collision_model,
+    scara_collision_model,
+    stanford_collision_model,
+    ur5_collision_model,
+)
 from serialkin.collision.shapes import Box, HalfSpace
 from serialkin.collision.srdf import Srdf, read_srdf
 
@@ -33,15 +44,23 @@ __all__ = [
     "Box",
     "Clearance",
     "CollisionModel",
+    "FitReport",
     "HalfSpace",
+    "ShapeFit",
     "Srdf",
     "acm_from_srdf",
+    "collision_model_from_geometry",
     "default_acm",
+    "iiwa7_collision_model",
     "in_collision",
     "panda_collision_model",
+    "planar_collision_model",
+    "puma560_collision_model",
     "read_srdf",
     "sampled_acm",
+    "scara_collision_model",
     "scene_clearance",
     "self_clearance",
+    "stanford_collision_model",
     "ur5_collision_model",
 ]

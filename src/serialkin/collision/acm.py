@@ -3,7 +3,10 @@
 Three sources, combined with :meth:`AllowedCollisionMatrix.allow`:
 
 * :func:`default_acm` — every body with itself, bodies on the same link frame (one rigid
-  part) and bodies on adjacent frames ``i, i+1`` (joined by a joint, usually touching);
+  part) and bodies on adjacent frames (joined by a joint, usually touching): frames that
+  follow each other among the frames carrying bodies, so that a frame without a body (a
+  massless link between coincident joint axes, as in a spherical wrist) does not separate
+  its neighbours;
 * :func:`acm_from_srdf` — an SRDF's ``<disable_collisions>`` pairs, added to the default;
 * :func:`sampled_acm` — pairs in contact in *every* sampled configuration (as MoveIt's
   setup assistant finds "always in collision" pairs): ``q`` drawn uniformly within the
@@ -72,29 +75,49 @@ class AllowedCollisionMatrix:
 
 
 def default_acm(model: CollisionModel) -> AllowedCollisionMatrix:
-    """Allow bodies on the same frame and on adjacent frames (``|frame_i − frame_j| ≤ 1``)."""
+    """Allow bodies on the same frame and on adjacent frames.
+
+    Frames ``i < j`` are adjacent when no body is fixed to a frame strictly between them
+    (for a model with bodies on every frame: ``|frame_i − frame_j| ≤ 1``).
+    """
     f = model.body_frames
-    return AllowedCollisionMatrix(model.body_names, np.abs(f[:, None] - f[None, :]) <= 1)
+    rank = np.searchsorted(np.unique(f), f)  # index of each body's frame among used frames
+    return AllowedCollisionMatrix(model.body_names, np.abs(rank[:, None] - rank[None, :]) <= 1)
 
 
 def acm_from_srdf(model: CollisionModel, srdf: Srdf | str | os.PathLike[str],
-                  acm: AllowedCollisionMatrix | None = None) -> AllowedCollisionMatrix:
+                  acm: AllowedCollisionMatrix | None = None, *,
+                  skip_links: Iterable[str] = ()) -> AllowedCollisionMatrix:
     """Add an SRDF's ``<disable_collisions>`` pairs to ``acm`` (default: :func:`default_acm`).
 
+    Args:
+        model: the collision model whose bodies the SRDF's links name.
+        srdf: an :class:`Srdf`, a file or an XML string.
+        acm: the matrix to extend (default: :func:`default_acm` of ``model``).
+        skip_links: links that exist in the robot but carry no body in ``model`` (e.g.
+            gripper fingers on joints off the chain): pairs naming them are skipped.
+
     Raises:
-        RobotDefinitionError: the SRDF names a link that is not a body of ``model`` (the
-            message names the SRDF, the link and lists the bodies).
+        RobotDefinitionError: the SRDF names a link that is neither a body of ``model``
+            nor in ``skip_links`` (the message names the SRDF, the link and lists the
+            bodies).
     """
     s = srdf if isinstance(srdf, Srdf) else read_srdf(srdf)
     known = set(model.body_names)
+    skip = {str(x) for x in skip_links} - known
+    pairs = []
     for a, b, _ in s.disabled:
         for x in (a, b):
-            if x not in known:
+            if x not in known and x not in skip:
                 raise RobotDefinitionError(
                     f"{s.source}: disable_collisions names link {x!r}, which is not a body of "
-                    f"the collision model; bodies: {', '.join(model.body_names)}")
+                    f"the collision model; bodies: {', '.join(model.body_names)} (a link "
+                    "without capsules, such as a finger off the chain, can be given in "
+                    "skip_links)")
+        if a not in skip and b not in skip:
+            pairs.append((a, b))
     base = default_acm(model) if acm is None else acm
-    return base.allow((a, b) for a, b, _ in s.disabled)
+    return base.allow(pairs)
 
 
 def sampled_acm(robot, model: CollisionModel, acm: AllowedCollisionMatrix | None = None, *,

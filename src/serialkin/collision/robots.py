@@ -1,22 +1,32 @@
-"""Collision models of built-in robots, fitted to example-robot-data's collision meshes.
+"""Collision models of the built-in robots: capsules and spheres on their DH link frames.
 
-Each body is one bounding capsule of its URDF collision geometry (STL mesh, or boxes for
-the Panda's fingers), moved into the link frame of :mod:`serialkin.models` (the fixed
-transform was checked to be the same at several configurations, which proves the frame
-correspondence). Axis along the principal direction of the vertices, radius the largest
-distance of a vertex from the axis, ends pulled in as far as every vertex stays inside:
-every capsule *contains* its mesh. One capsule per mesh is loose, about ×2.2-2.8 the
-mesh volume (×7 for the UR5's flat base); the fit script also tries two capsules per mesh
-(hull cut across its principal axis) but none saved 20 % of the volume (at best 13 %, on
-panda_link1 and link2), so every body has one. Reproduce with
-``benchmarks/fit_capsules.py`` (example-robot-data 4.x, the ``bench`` extra); numbers
-rounded to 0.1 mm.
+**Panda and UR5** are fitted to example-robot-data's collision meshes (below). **Puma 560,
+Stanford arm and iiwa 7** are envelopes built from their published dimensions (the DH
+lengths, and link diameters from the manufacturers' drawings, rounded up to 5 mm): one
+capsule along each link's body, spheres on wrist housings; every radius is stated in the
+table of each function. **Planar arms, the chapter's 2-/3-link arms and the SCARA**
+get a capsule along each link (radius 5 % of the link length for planar arms; the SCARA's
+radii are given for its default size and scale with ``l1 + l2``). All models are free of
+self-collision at q = 0 with the default allowed-collision matrix (adjacent frames allowed).
 
-Volumes [litre], mesh → capsule: Panda link0 3.00 → 8.46, link1 2.98 → 7.29, link2
-3.00 → 7.11, link3 2.33 → 5.21, link4 2.37 → 5.30, link5 3.42 → 7.76, link6 1.43 → 3.34,
-link7 0.45 → 0.97, hand 0.71 → 1.68, each finger 0.016 → 0.06 (boxes); UR5 base 0.35 →
-2.41, shoulder 1.55 → 2.89, upper arm 5.36 → 13.29, forearm 2.49 → 6.85, wrists 0.51 →
-0.95, 0.51 → 0.97, 0.14 → 0.32.
+Panda and UR5: each body is the bounding capsule of its URDF collision geometry (STL
+meshes, or boxes for the Panda's fingers), fitted by :mod:`serialkin.collision.fit`
+(``merge=True``: one point cloud per link) and moved into the link frame of
+:mod:`serialkin.models` (the fixed transform was checked to be the same at several
+configurations, which proves the frame correspondence): every capsule *contains* its
+mesh. One capsule per link is ×1.4-2.4 the mesh volume (×3.9 for the fingers, ×6.7 for
+the UR5's flat base plate); a split into two capsules saved less than the required 20 %
+everywhere, so every body has one. Reproduce with ``benchmarks/fit_capsules.py``
+(example-robot-data 4.x, the ``bench`` extra; trimesh, the ``mesh`` extra); ends rounded
+to 0.1 mm, radii rounded up and grown by 0.1 mm so that the rounded capsule still
+contains the mesh.
+
+Volumes [litre], mesh → capsule (largest gap capsule ↔ hull [mm]): Panda link0 3.00 →
+7.08 (81), link1 2.98 → 4.64 (27), link2 3.00 → 4.71 (28), link3 2.33 → 3.26 (26), link4
+2.37 → 3.31 (29), link5 3.42 → 4.87 (48), link6 1.43 → 2.93 (40), link7 0.45 → 0.92 (27),
+hand 0.71 → 1.59 (34), each finger 0.016 → 0.06 (16); UR5 base 0.35 → 2.34 (63),
+shoulder 1.55 → 2.64 (26), upper arm 5.36 → 12.18 (35), forearm 2.49 → 6.18 (37), wrists
+0.51 → 0.95 (19), 0.51 → 0.95 (19), 0.14 → 0.29 (25).
 
 * Panda (:func:`serialkin.models.panda`, modified DH frames = the URDF's ``panda_link0..7``
   frames): bodies named as in the URDF/SRDF, hand and fingers fixed to frame 7 with the
@@ -27,42 +37,46 @@ link7 0.45 → 0.97, hand 0.71 → 1.68, each finger 0.016 → 0.06 (boxes); UR5
 
 from __future__ import annotations
 
+import numpy as np
+
 from serialkin.collision.model import CollisionModel
 
-__all__ = ["panda_collision_model", "ur5_collision_model"]
+__all__ = ["iiwa7_collision_model", "panda_collision_model", "planar_collision_model",
+           "puma560_collision_model", "scara_collision_model", "stanford_collision_model",
+           "ur5_collision_model"]
 
 SOURCE = ("bounding capsules of example-robot-data's collision meshes "
           "(benchmarks/fit_capsules.py)")
 
 _PANDA = [  # body, frame, a, b, radius [m]
-    ("panda_link0", 0, [-0.0216, 0.0079, 0.0543], [-0.0529, 0.0086, 0.0384], 0.1182),
-    ("panda_link1", 1, [-0.0012, 0.0114, -0.1294], [0.0035, -0.0728, 0.0016], 0.0914),
-    ("panda_link2", 2, [-0.001, 0.0031, 0.0721], [0.0003, -0.138, -0.0143], 0.0892),
-    ("panda_link3", 3, [0.0843, 0.0517, -0.0147], [0.0135, -0.003, -0.0685], 0.0868),
-    ("panda_link4", 4, [0.0023, 0.0142, 0.0526], [-0.0696, 0.0705, -0.0036], 0.0870),
-    ("panda_link5", 5, [0.0051, 0.0836, -0.0035], [0.0013, -0.0041, -0.1959], 0.0869),
-    ("panda_link6", 6, [0.0215, -0.0107, 0.0144], [0.0881, 0.0127, -0.0005], 0.0778),
-    ("panda_link7", 7, [-0.0022, -0.0023, 0.079], [0.0306, 0.0322, 0.081], 0.0516),
-    ("panda_hand", 7, [0.0525, 0.0521, 0.1302], [-0.0647, -0.0637, 0.1265], 0.0483),
-    ("panda_leftfinger", 7, [0.0389, 0.0389, 0.1668], [0.0361, 0.0361, 0.2108], 0.0168),
-    ("panda_rightfinger", 7, [-0.0389, -0.0389, 0.1668], [-0.0361, -0.0361, 0.2108], 0.0168),
+    ("panda_link0", 0, [0.0, -0.0, 0.0507], [-0.0572, -0.0001, 0.0209], 0.1051),
+    ("panda_link1", 1, [0.0, -0.0002, -0.1402], [0.0, -0.0548, 0.0059], 0.0760),
+    ("panda_link2", 2, [-0.0003, 0.0078, 0.0556], [0.0001, -0.1424, 0.0002], 0.0759),
+    ("panda_link3", 3, [0.0843, 0.0433, 0.0018], [0.0003, 0.0002, -0.0799], 0.0693),
+    ("panda_link4", 4, [0.0019, -0.0018, 0.0434], [-0.0809, 0.0844, 0.0004], 0.0694),
+    ("panda_link5", 5, [-0.0, 0.0639, 0.003], [0.0002, 0.0104, -0.2438], 0.0674),
+    ("panda_link6", 6, [0.0886, 0.0086, -0.0003], [0.0201, 0.0119, 0.0048], 0.0746),
+    ("panda_link7", 7, [0.0329, 0.033, 0.0808], [-0.0051, -0.0051, 0.0733], 0.0494),
+    ("panda_hand", 7, [0.0433, 0.0434, 0.1383], [-0.0624, -0.0624, 0.1263], 0.0486),
+    ("panda_leftfinger", 7, [0.0364, 0.0364, 0.2114], [0.0388, 0.0388, 0.1667], 0.0169),
+    ("panda_rightfinger", 7, [-0.0364, -0.0364, 0.2114], [-0.0388, -0.0388, 0.1667], 0.0169),
 ]
 
 _UR5 = [
-    ("base_link", 0, [-0.0012, -0.0362, 0.0087], [0.0002, 0.0037, 0.009], 0.0744),
-    ("shoulder_link", 1, [0.0016, -0.012, 0.0081], [0.0007, 0.0005, 0.0086], 0.0853),
-    ("upper_arm_link", 2, [0.4254, -0.001, 0.1359], [-0.0007, 0.0008, 0.1361], 0.0882),
-    ("forearm_link", 3, [0.387, 0.0029, 0.0485], [0.008, 0.0023, 0.0137], 0.0680),
-    ("wrist_1_link", 4, [-0.0007, -0.0032, -0.0093], [-0.0005, -0.005, 0.0107], 0.0563),
-    ("wrist_2_link", 5, [0.0015, 0.0058, 0.0114], [0.001, 0.0032, -0.0091], 0.0566),
-    ("wrist_3_link", 6, [-0.0, -0.0023, -0.0183], [-0.0001, 0.0039, -0.0177], 0.0411),
+    ("base_link", 0, [-0.0, 0.001, 0.006], [0.001, -0.0363, 0.0064], 0.0742),
+    ("shoulder_link", 1, [0.0007, -0.0111, 0.0034], [-0.0, -0.0, 0.0123], 0.0824),
+    ("upper_arm_link", 2, [0.4252, 0.0003, 0.131], [-0.0106, -0.0003, 0.1317], 0.0843),
+    ("forearm_link", 3, [0.3994, -0.0006, 0.0445], [0.0031, -0.0019, 0.0152], 0.0640),
+    ("wrist_1_link", 4, [-0.0011, -0.0037, -0.0102], [-0.0002, -0.0054, 0.0116], 0.0561),
+    ("wrist_2_link", 5, [0.0011, 0.0053, 0.0112], [0.0005, 0.0035, -0.0091], 0.0565),
+    ("wrist_3_link", 6, [-0.0001, 0.0004, -0.0212], [0.0006, -0.0033, -0.0212], 0.0401),
 ]
 
 
-def _build(rows, name: str) -> CollisionModel:
+def _build(rows, name: str, source: str = SOURCE) -> CollisionModel:
     return CollisionModel.from_dicts(
         [{"name": b, "frame": f, "capsules": [{"a": a, "b": e, "radius": r}]}
-         for b, f, a, e, r in rows], source=f"{name}: {SOURCE}")
+         for b, f, a, e, r in rows], source=f"{name}: {source}")
 
 
 def panda_collision_model() -> CollisionModel:
@@ -73,3 +87,145 @@ def panda_collision_model() -> CollisionModel:
 def ur5_collision_model() -> CollisionModel:
     """Collision capsules of the Universal Robots UR5 (7 bodies on frames 0..6, see module)."""
     return _build(_UR5, "UR5")
+
+
+ENVELOPE = "envelope from published dimensions (serialkin.collision.robots)"
+
+# Puma 560 (standard DH, frames of serialkin.models.puma560): frame 1 at the shoulder with
+# y1 up, frame 2 at the elbow (upper arm along -x2), forearm along z3 (0.4318 m to the wrist
+# centre, offset 0.15005 m along the shoulder axis), frames 4-6 at the wrist centre.
+_PUMA560 = [
+    ("pedestal", 0, [0, 0, 0.0], [0, 0, 0.38], 0.12),
+    ("trunk", 1, [0, -0.20, 0], [0, 0, 0], 0.11),
+    ("upper_arm", 2, [-0.4318, 0, 0], [0, 0, 0], 0.08),
+    ("forearm", 3, [0, 0, -0.05], [0, 0, 0.33], 0.055),
+    ("wrist", 5, [0, 0, 0], [0, 0, 0], 0.05),
+    ("flange", 6, [0, 0, 0.02], [0, 0, 0.056], 0.035),
+]
+
+# Stanford arm (standard DH): frame 1 at the shoulder (up is -y1), frame 2 on the boom's
+# guide 0.154 m aside, the boom slides along z3 and ends at the wrist centre (frame 3
+# origin; stroke 0.305-1.27 m, the boom is 0.6 m long), the hand reaches 0.263 m along z6.
+_STANFORD = [
+    ("base", 0, [0, 0, 0], [0, 0, 0.12], 0.15),
+    ("column", 1, [0, 0.22, 0], [0, 0, 0], 0.08),
+    ("guide", 2, [0, 0, -0.06], [0, 0, 0.06], 0.09),
+    ("boom", 3, [0, 0, -0.60], [0, 0, -0.06], 0.045),
+    ("wrist", 5, [0, 0, 0], [0, 0, 0], 0.055),
+    ("hand", 6, [0, 0, -0.19], [0, 0, -0.03], 0.045),
+]
+
+# KUKA LBR iiwa 7 R800 (standard DH, Faria et al. frames): shoulder frames 1-2 at 0.34 m
+# (down is +y1), elbow frames 3-4 0.4 m further (shoulder towards -y3), wrist frames 5-6
+# 0.4 m further (elbow towards +y5), flange frame 7 0.126 m along z6. Link diameters about
+# 0.12-0.14 m (KUKA data sheet drawing).
+_IIWA7 = [
+    ("link0", 0, [0, 0, 0.0], [0, 0, 0.10], 0.10),
+    ("link1", 1, [0, 0.12, 0], [0, 0, 0], 0.075),
+    ("link2", 2, [0, 0, 0], [0, 0, 0.18], 0.07),
+    ("link3", 3, [0, -0.20, 0], [0, 0, 0], 0.07),
+    ("link4", 4, [0, 0, 0], [0, 0, 0.19], 0.065),
+    ("link5", 5, [0, 0.21, 0], [0, 0.09, 0], 0.065),
+    ("link6", 6, [0, 0, -0.01], [0, 0, 0.05], 0.07),
+    ("link7", 7, [0, 0, -0.045], [0, 0, -0.015], 0.045),
+]
+
+
+def puma560_collision_model() -> CollisionModel:
+    """Capsules of the Unimation PUMA 560 (6 bodies on frames 0..6, envelope, see module).
+
+    ==========  =====  ==========================  ==========
+    body        frame  axis (frame coordinates)    radius [m]
+    ==========  =====  ==========================  ==========
+    pedestal    0      z 0 .. 0.38                 0.12
+    trunk       1      y -0.20 .. 0                0.11
+    upper_arm   2      x -0.4318 .. 0              0.08
+    forearm     3      z -0.05 .. 0.33             0.055
+    wrist       5      sphere at the origin        0.05
+    flange      6      z 0.02 .. 0.056             0.035
+    ==========  =====  ==========================  ==========
+    """
+    return _build(_PUMA560, "puma560", ENVELOPE)
+
+
+def stanford_collision_model() -> CollisionModel:
+    """Capsules of the Stanford arm (6 bodies, envelope; the boom moves with q3).
+
+    ======  =====  ==========================  ==========
+    body    frame  axis (frame coordinates)    radius [m]
+    ======  =====  ==========================  ==========
+    base    0      z 0 .. 0.12                 0.15
+    column  1      y 0.22 .. 0                 0.08
+    guide   2      z -0.06 .. 0.06             0.09
+    boom    3      z -0.60 .. -0.06            0.045
+    wrist   5      sphere at the origin        0.055
+    hand    6      z -0.19 .. -0.03            0.045
+    ======  =====  ==========================  ==========
+    """
+    return _build(_STANFORD, "stanford", ENVELOPE)
+
+
+def iiwa7_collision_model() -> CollisionModel:
+    """Capsules of the KUKA LBR iiwa 7 R800 (8 bodies on frames 0..7, envelope).
+
+    =====  =====  ==========================  ==========
+    body   frame  axis (frame coordinates)    radius [m]
+    =====  =====  ==========================  ==========
+    link0  0      z 0 .. 0.10                 0.10
+    link1  1      y 0.12 .. 0                 0.075
+    link2  2      z 0 .. 0.18                 0.07
+    link3  3      y -0.20 .. 0                0.07
+    link4  4      z 0 .. 0.19                 0.065
+    link5  5      y 0.21 .. 0.09              0.065
+    link6  6      z -0.01 .. 0.05             0.07
+    link7  7      z -0.045 .. -0.015          0.045
+    =====  =====  ==========================  ==========
+    """
+    return _build(_IIWA7, "iiwa7", ENVELOPE)
+
+
+#: Radius of a planar arm's link capsule as a fraction of the link length.
+PLANAR_RADIUS = 0.05
+
+
+def planar_collision_model(lengths: object) -> CollisionModel:
+    """One capsule per link of a planar arm (standard DH rows ``(L_i, 0, 0, q_i)``).
+
+    Link ``i`` runs from the origin of frame ``i−1`` to that of frame ``i``: in frame ``i``
+    the segment ``(−L_i, 0, 0) .. (0, 0, 0)``, radius ``0.05 L_i``
+    (:data:`PLANAR_RADIUS`); bodies ``link1 .. linkn`` on frames 1..n.
+    """
+    L = np.asarray(lengths, dtype=float).reshape(-1)
+    n = L.shape[0]
+    a = np.zeros((n, 3))
+    a[:, 0] = -L
+    return CollisionModel(tuple(f"link{i + 1}" for i in range(n)),
+                          np.arange(1, n + 1, dtype=np.int64), np.arange(n, dtype=np.int64),
+                          a, np.zeros((n, 3)), PLANAR_RADIUS * L,
+                          source=f"planar arm: capsules along the links, radius "
+                                 f"{PLANAR_RADIUS:g} x length")
+
+
+def scara_collision_model(d1: float = 0.4, d2: float = 0.1, l1: float = 0.35,
+                          l2: float = 0.30, q3_range: tuple[float, float] = (-0.3, 0.0)
+                          ) -> CollisionModel:
+    """Capsules of the chapter's SCARA (:func:`serialkin.models.scara`, standard DH).
+
+    Radii for the default size (l1 + l2 = 0.65 m), scaled by ``(l1 + l2) / 0.65``:
+
+    =======  =====  ======================================  ==========
+    body     frame  axis (frame coordinates)                radius [m]
+    =======  =====  ======================================  ==========
+    column   0      z 0 .. d1 − 0.1                         0.08
+    arm1     1      x −l1 .. 0                              0.04
+    arm2     2      x −l2 .. 0                              0.03
+    quill    3      z 0 .. −stroke (z3 points down)         0.015
+    =======  =====  ======================================  ==========
+    """
+    s = (l1 + l2) / 0.65
+    stroke = float(q3_range[1] - q3_range[0])
+    rows = [("column", 0, [0, 0, 0], [0, 0, max(d1 - 0.1 * s, 0.0)], 0.08 * s),
+            ("arm1", 1, [-l1, 0, 0], [0, 0, 0], 0.04 * s),
+            ("arm2", 2, [-l2, 0, 0], [0, 0, 0], 0.03 * s),
+            ("quill", 3, [0, 0, 0], [0, 0, -stroke], 0.015 * s)]
+    return _build(rows, "scara", ENVELOPE)

@@ -311,6 +311,32 @@ class Robot:
         robot.collision = model
         return robot
 
+    def fit_collision(self, kind: str = "collision", *, max_capsules: int = 3,
+                      loose: float = 1.5, gain: float = 0.8,
+                      merge: bool = False) -> tuple[Robot, Any]:
+        """A copy carrying capsules fitted to its link geometry, and the fit report.
+
+        Bounding capsules of each link's ``kind`` shapes (meshes, boxes, cylinders;
+        spheres and capsules as they are), see
+        :func:`~serialkin.collision.fit.collision_model_from_geometry`; meshes need the
+        ``serialkin[mesh]`` extra. ``merge=True`` fits one cloud per link instead of
+        one per shape.
+
+        Returns:
+            ``(robot, report)``: the robot with its :attr:`collision` model set, and the
+            :class:`~serialkin.collision.fit.FitReport` (volume ratio and largest gap of
+            every shape).
+
+        Raises:
+            InputError: the robot has no geometry of that kind.
+            RobotDefinitionError: a mesh file is missing or corrupt.
+        """
+        from serialkin.collision.fit import collision_model_from_geometry
+
+        model, report = collision_model_from_geometry(
+            self, kind, max_capsules=max_capsules, loose=loose, gain=gain, merge=merge)
+        return self.with_collision(model), report
+
     def with_tool(self, tool: object) -> Robot:
         """A copy of this robot with another tool transform (4, 4)."""
         return self._copy(tool=tool)

@@ -275,7 +275,7 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
     robot.link_names = tuple(link_names) + ((tip,) if link_names[-1] != tip else ())
     folder = None if source == "<string>" else Path(source).resolve().parent
     places = _link_frames(base, chain, children, by_child)
-    resolver = _MeshResolver(folder, package_map or {}, search_path, resolve_meshes)
+    resolver = MeshResolver(folder, package_map or {}, search_path, resolve_meshes)
     robot.geometry = tuple(
         _link_geometry(el, places[el.get("name")], source, resolver)
         for el in root.findall("link") if el.get("name") in places)
@@ -305,11 +305,19 @@ def _link_frames(base: str, chain: list[_UJoint], children: dict[str, list[str]]
     return places
 
 
-class _MeshResolver:
-    """Turn a URDF mesh path into an existing absolute path (or keep it, or refuse it)."""
+class MeshResolver:
+    """Turn a mesh path into an existing absolute path (or keep it, or refuse it).
+
+    Used by URDF import and robot files: ``package://NAME/rest`` is looked up in
+    ``package_map[NAME]/rest`` then ``FOLDER/NAME/rest`` for each search folder; a
+    relative path in ``folder`` (the description's folder) then in each search folder;
+    ``file://`` and absolute paths as they are.
+    """
 
     def __init__(self, folder: Path | None, package_map: Mapping[str, object],
-                 search_path: Sequence[object], strict: bool) -> None:
+                 search_path: Sequence[object], strict: bool,
+                 nowhere: str = "nowhere: give package_map= or search_path=") -> None:
+        self.nowhere = nowhere
         self.folder = folder
         self.package_map = {str(k): Path(str(v)) for k, v in package_map.items()}
         if isinstance(search_path, str | os.PathLike):
@@ -331,6 +339,12 @@ class _MeshResolver:
         return ([self.folder / p] if self.folder is not None else []) + [d / p for d in self.search]
 
     def __call__(self, name: str, where: str) -> str:
+        """The resolved absolute path of ``name`` (or ``name`` itself when not strict).
+
+        Raises:
+            RobotDefinitionError: strict, and no candidate is a file; the message starts
+                with ``where`` and lists every place looked in.
+        """
         tried = self.candidates(name)
         for p in tried:
             try:
@@ -339,8 +353,7 @@ class _MeshResolver:
             except (OSError, ValueError):  # a name too long, a loop of links: not a file
                 continue
         if self.strict:
-            looked = ", ".join(short_repr(str(p), 120) for p in tried) or (
-                "nowhere: give package_map= or search_path=")
+            looked = ", ".join(short_repr(str(p), 400) for p in tried) or self.nowhere
             raise RobotDefinitionError(
                 f"{where}: mesh {short_repr(name, 120)} does not resolve to a file; looked in "
                 f"{looked}")
@@ -348,7 +361,7 @@ class _MeshResolver:
 
 
 def _link_geometry(el: ET.Element, place: tuple[int, np.ndarray], source: str,
-                   resolve: _MeshResolver) -> LinkGeometry:
+                   resolve: MeshResolver) -> LinkGeometry:
     """The ``<visual>`` and ``<collision>`` shapes of one link, posed in its chain frame."""
     name = el.get("name")
     frame, T = place
@@ -381,7 +394,7 @@ def _link_geometry(el: ET.Element, place: tuple[int, np.ndarray], source: str,
     return LinkGeometry(name, frame, tuple(shapes["visual"]), tuple(shapes["collision"]))
 
 
-def _geometry(g: ET.Element, where: str, resolve: _MeshResolver):
+def _geometry(g: ET.Element, where: str, resolve: MeshResolver):
     """One URDF geometry element as a :mod:`~serialkin.model.geometry` object."""
     def num(attr: str) -> float:
         if g.get(attr) is None:

@@ -51,7 +51,9 @@ def scara(
         q3_range: (lower, upper) stroke of the prismatic joint [m].
 
     Returns:
-        A 4-joint standard-DH :class:`~serialkin.model.robot.Robot` named ``scara``.
+        A 4-joint standard-DH :class:`~serialkin.model.robot.Robot` named ``scara``, with
+        capsules on its column, arms and quill
+        (:func:`~serialkin.collision.robots.scara_collision_model`).
 
     Raises:
         InputError: a negative length.
@@ -69,7 +71,12 @@ def scara(
         DHLink(a=0.0, alpha=0.0, d=0.0, theta=0.0, type="R",
                qlim=(-2 * math.pi, 2 * math.pi), name="q4"),
     ]
-    return Robot.from_dh(rows, "standard", name="scara", source=SCARA_SOURCE)
+    from serialkin.collision.robots import scara_collision_model
+
+    robot = Robot.from_dh(rows, "standard", name="scara", source=SCARA_SOURCE)
+    robot.collision = scara_collision_model(float(d1), float(d2), l1, l2,
+                                            (float(q3_range[0]), float(q3_range[1])))
+    return robot
 
 
 def two_link(l1: float = 1.0, l2: float = 1.0) -> Robot:

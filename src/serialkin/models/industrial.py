@@ -1,7 +1,8 @@
 """Industrial and research arms from published DH tables.
 
 Each model names its source in ``robot.source``. Lengths in metres, angles in radians,
-joint limits from the manufacturer's data sheet or the cited paper.
+joint limits from the manufacturer's data sheet or the cited paper. Every model carries a
+capsule collision model (``robot.collision``, :mod:`serialkin.collision.robots`).
 """
 
 from __future__ import annotations
@@ -86,7 +87,11 @@ def puma560() -> Robot:
                  alpha=[h, 0.0, -h, h, -h, 0.0],
                  d=[26.45 * _INCH, 0.0, 0.15005, 0.4318, 0.0, 0.0],
                  theta=[0.0] * 6, qlim_deg=lim)
-    return Robot.from_dh(rows, "standard", name="puma560", source=PUMA560_SOURCE)
+    from serialkin.collision.robots import puma560_collision_model
+
+    robot = Robot.from_dh(rows, "standard", name="puma560", source=PUMA560_SOURCE)
+    robot.collision = puma560_collision_model()  # a fresh robot: no copy needed
+    return robot
 
 
 def stanford() -> Robot:
@@ -111,7 +116,11 @@ def stanford() -> Robot:
                  d=[0.412, 0.154, 0.0, 0.0, 0.0, 0.263],
                  theta=[0.0, 0.0, -h, 0.0, 0.0, 0.0],
                  qlim_deg=lim, types=["R", "R", "P", "R", "R", "R"])
-    return Robot.from_dh(rows, "standard", name="stanford", source=STANFORD_SOURCE)
+    from serialkin.collision.robots import stanford_collision_model
+
+    robot = Robot.from_dh(rows, "standard", name="stanford", source=STANFORD_SOURCE)
+    robot.collision = stanford_collision_model()
+    return robot
 
 
 def ur5() -> Robot:
@@ -176,4 +185,8 @@ def iiwa7() -> Robot:
                  alpha=[-h, h, h, -h, -h, h, 0.0],
                  d=[0.340, 0.0, 0.400, 0.0, 0.400, 0.0, 0.126],
                  theta=[0.0] * 7, qlim_deg=lim)
-    return Robot.from_dh(rows, "standard", name="iiwa7", source=IIWA7_SOURCE)
+    from serialkin.collision.robots import iiwa7_collision_model
+
+    robot = Robot.from_dh(rows, "standard", name="iiwa7", source=IIWA7_SOURCE)
+    robot.collision = iiwa7_collision_model()
+    return robot

@@ -54,7 +54,8 @@ def planar(
 
     Returns:
         A standard-DH :class:`~serialkin.model.robot.Robot` whose tool sits at the tip of
-        link ``n``.
+        link ``n``, with one collision capsule per link (radius 5 % of its length,
+        :func:`~serialkin.collision.robots.planar_collision_model`).
 
     Raises:
         InputError: n < 1 or above MAX_JOINTS, wrong number of lengths, negative or
@@ -76,4 +77,8 @@ def planar(
                qlim=(float(lim[i, 0]), float(lim[i, 1])), name=f"q{i + 1}")
         for i in range(n)
     ]
-    return Robot.from_dh(rows, "standard", name=name or f"planar{n}", source=PLANAR_SOURCE)
+    from serialkin.collision.robots import planar_collision_model
+
+    robot = Robot.from_dh(rows, "standard", name=name or f"planar{n}", source=PLANAR_SOURCE)
+    robot.collision = planar_collision_model(L)  # a fresh robot: no copy needed
+    return robot

@@ -16,14 +16,43 @@ Forward kinematics runs **in the page**, from the robot's compiled chain arrays
 so any robot (standard or modified DH, general joints, URDF) is drawn exactly as
 :meth:`Robot.fk` computes it. The page exposes ``window.serialkin`` with ``setJoint(i, v)``,
 ``setJoints(q)``, ``getJoints()``, ``endEffector()`` (the drawn tool frame's world position
-and matrix), ``linkOrigins()``, ``fk(q)``, ``setFrame(k)``, ``play()``, ``pause()`` for
-scripting and tests.
+and matrix), ``linkOrigins()``, ``fk(q)``, ``setFrame(k)``, ``play()``, ``pause()``,
+``drawn()`` (what is on screen: shapes, triangles, capsules, points) and ``clearance()``
+(the in-page self-collision check) for scripting and tests.
+
+**The robot's body.** A robot with link geometry (:attr:`Robot.geometry`, e.g. from a URDF)
+is drawn with its visual shapes, each fixed to its chain frame ``f`` at its origin, so a
+vertex ``p`` of a shape is drawn at ``fk_all(q)[f] · origin · p``. Boxes, cylinders,
+spheres and capsules become three.js geometries; mesh files are loaded with
+:func:`serialkin.model.mesh.load_mesh` (the ``mesh`` extra), decimated
+(:func:`serialkin.model.mesh.decimate`) so that all meshes together hold at most
+``mesh_budget`` triangles (each mesh gets a share proportional to its own triangle count;
+a mesh used by several links counts once), and embedded compactly: vertex positions
+quantised to 16 bits per coordinate over the mesh's bounding box (error at most half a step,
+``extent / 131070``, about 2 µm for a 0.3 m link) and triangle indices as 16- or 32-bit
+integers, both base64 of little-endian arrays; normals are computed in the page. A robot
+without geometry keeps the skeleton of cylinders.
+
+**Self-collision in the page.** With a collision model (:attr:`Robot.collision`, capsules
+and spheres per body, :mod:`serialkin.collision`) the page can draw the capsules (a toggle)
+and checks, after every slider move, the shape pairs that
+:func:`~serialkin.collision.queries.checked_shape_pairs` lists for the allowed-collision
+matrix: shape ``s`` with axis ends
+``a_s, b_s`` in frame ``f_s`` has world ends ``A_s = T_f a_s``, ``B_s = T_f b_s``, and a pair
+collides when ``dist(A_s B_s, A_t B_t) − r_s − r_t < 0`` (segment–segment distance, as
+:func:`serialkin.collision.self_clearance` computes it). The bodies of a colliding pair are
+drawn red (their capsules and the visual shapes of the links of the same name).
+
+**Point layer.** ``points`` (N, 3) [m] with RGB ``point_colors`` (N, 3) in [0, 1] are drawn
+as a point cloud with a toggle named by ``points_label`` (e.g. a reachability map):
+positions as float32, colours as 8-bit, base64.
 
 Lengths are in metres, angles in radians.
 """
 
 from __future__ import annotations
 
+import base64
 import html
 import json
 import re
@@ -35,18 +64,25 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from serialkin._checks import as_float_array
+from serialkin._checks import as_float_array, check_int, short_repr
 from serialkin._io import write_text_atomic
-from serialkin.errors import InputError
+from serialkin.errors import InputError, InputTypeError
 from serialkin.viz.plot import as_obstacle, robot_points, robot_scale
 
 if TYPE_CHECKING:
     from serialkin.model.robot import Robot
 
-__all__ = ["THREE_REVISION", "viewer_data", "viewer_html", "write_viewer"]
+__all__ = ["MESH_BUDGET", "THREE_REVISION", "viewer_data", "viewer_html", "write_viewer"]
 
 #: three.js release embedded in the page (``viz/assets/three.module.min.js``).
 THREE_REVISION = "170"
+#: Default largest number of triangles of all visual meshes embedded in a page together
+#: (about 12 bytes each in the file: the Panda's ten meshes in about 0.8 MB).
+MESH_BUDGET = 60_000
+#: Fewest triangles a decimated mesh keeps.
+_MIN_MESH_FACES = 16
+#: Colour of a visual shape without its own (RGBA in [0, 1]).
+_DEFAULT_RGBA = (0.86, 0.87, 0.89, 1.0)
 _ASSETS = ("three.module.min.js", "three.LICENSE", "viewer.js", "viewer.css", "viewer.html")
 
 
@@ -125,6 +161,214 @@ def _view(points: np.ndarray, planar: bool, scale: float) -> dict[str, Any]:
             "elevation": np.radians(22.0)}
 
 
+# ---------------------------------------------------------------------- geometry, collision, points
+def _b64(a: np.ndarray) -> str:
+    """Base64 text of an array's bytes (the caller chooses a little-endian dtype)."""
+    return base64.b64encode(np.ascontiguousarray(a).tobytes()).decode("ascii")
+
+
+def _welded(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Merge exactly equal vertices (mesh files repeat them per face corner); drop unused ones.
+
+    Returns (V', 3) vertices and (F, 3) faces indexing them; the triangles are unchanged.
+    """
+    used = np.unique(faces)
+    uniq, inverse = np.unique(vertices[used], axis=0, return_inverse=True)
+    remap = np.empty(vertices.shape[0], dtype=np.int64)
+    remap[used] = inverse.reshape(-1)
+    return uniq, remap[faces]
+
+
+def _encode_mesh(vertices: object, faces: object) -> dict[str, Any]:
+    """The compact page form of a triangle mesh (see the module docstring).
+
+    Positions are quantised over the bounding box ``[lo, lo + 65535 step]``:
+    ``p ≈ lo + step · u`` with ``u`` 16-bit integers, so the error per coordinate is at
+    most ``step / 2``; indices are uint16 when there are at most 65536 vertices, else uint32.
+
+    Args:
+        vertices: (V, 3) positions [m].
+        faces: (F, 3) vertex indices.
+
+    Returns:
+        ``{"lo": [3], "step": [3], "positions": base64 of (V, 3) <u2, "indices": base64 of
+        (F, 3) <u2 or <u4, "index_bytes": 2 or 4, "vertices": V, "faces": F}``.
+    """
+    v = as_float_array(vertices, "vertices", ndim=2)
+    f = np.asarray(faces)
+    if v.shape[1] != 3 or f.ndim != 2 or f.shape[1] != 3 or f.dtype.kind not in "iu":
+        raise InputError(f"expected vertices (V, 3) and integer faces (F, 3), got {v.shape} "
+                         f"and {f.shape}")
+    if f.size and (f.min() < 0 or f.max() >= v.shape[0]):
+        raise InputError(f"faces index vertices outside 0..{v.shape[0] - 1}")
+    lo = v.min(axis=0) if v.size else np.zeros(3)
+    span = (v.max(axis=0) - lo) if v.size else np.zeros(3)
+    step = np.where(span > 0, span / 65535.0, 1.0)
+    u = np.clip(np.rint((v - lo) / step), 0, 65535).astype("<u2")
+    wide = v.shape[0] > 65536
+    idx = f.astype("<u4" if wide else "<u2")
+    return {"lo": lo.tolist(), "step": step.tolist(), "positions": _b64(u),
+            "indices": _b64(idx), "index_bytes": 4 if wide else 2,
+            "vertices": int(v.shape[0]), "faces": int(f.shape[0])}
+
+
+def _face_shares(counts: list[int], budget: int) -> list[int]:
+    """Triangles each mesh keeps: all when they fit, else shares proportional to the counts."""
+    total = sum(counts)
+    if total <= budget:
+        return list(counts)
+    return [min(c, max(_MIN_MESH_FACES, int(c * budget / total))) for c in counts]
+
+
+def _primitive(g: object) -> dict[str, Any]:
+    """Kind and sizes of a box, cylinder, sphere or capsule for the page [m]."""
+    from serialkin.model.geometry import Box, Capsule, Cylinder, Sphere
+
+    if isinstance(g, Box):
+        return {"kind": "box", "size": list(g.size)}
+    if isinstance(g, Cylinder):
+        return {"kind": "cylinder", "radius": g.radius, "length": g.length}
+    if isinstance(g, Sphere):
+        return {"kind": "sphere", "radius": g.radius}
+    if isinstance(g, Capsule):
+        return {"kind": "capsule", "radius": g.radius, "length": g.length}
+    raise InputTypeError(f"unknown geometry {type(g).__name__}")
+
+
+def _visual_data(robot: Robot, meshes: bool, mesh_budget: int,
+                 body_index: dict[str, int]) -> tuple[list[dict], list[dict]]:
+    """The visual shapes (posed in their chain frames) and the encoded meshes they use.
+
+    Mesh files are loaded once per (file, scale); ``meshes=False`` leaves mesh shapes out
+    (primitives stay). Raises what :func:`serialkin.model.mesh.load_mesh` raises, with the
+    link named.
+    """
+    from serialkin.model.geometry import Mesh
+
+    shapes: list[dict] = []
+    files: dict[tuple, int] = {}
+    loaded: list[Any] = []
+    for lg in robot.geometry:
+        if lg.frame > robot.n:
+            raise InputError(f"link {short_repr(lg.link_name)} is fixed to frame {lg.frame}, "
+                             f"but robot {short_repr(robot.name)} has frames 0..{robot.n}")
+        for shape in lg.visual:
+            g = shape.geometry
+            entry: dict[str, Any] = {
+                "link": lg.link_name, "name": shape.name, "frame": lg.frame,
+                "origin": shape.origin.reshape(-1).tolist(),
+                "rgba": list(shape.rgba if shape.rgba is not None else _DEFAULT_RGBA),
+                "body": body_index.get(lg.link_name, -1),
+            }
+            if isinstance(g, Mesh):
+                if not meshes:
+                    continue
+                key = (g.filename, g.scale)
+                if key not in files:
+                    files[key] = len(loaded)
+                    loaded.append(_load_visual_mesh(lg.link_name, g))
+                entry.update(kind="mesh", mesh=files[key])
+            else:
+                entry.update(_primitive(g))
+            shapes.append(entry)
+    encoded = []
+    if loaded:
+        from serialkin.model.mesh import TriangleMesh, decimate
+
+        shares = _face_shares([m.faces.shape[0] for m in loaded], mesh_budget)
+        for m, share in zip(loaded, shares, strict=True):
+            if m.faces.shape[0] > share:
+                m = decimate(TriangleMesh(m.vertices, m.faces, m.source), max(4, share))
+            encoded.append(_encode_mesh(*_welded(m.vertices, m.faces)))
+    return shapes, encoded
+
+
+def _load_visual_mesh(link: str, g: Any) -> Any:
+    """Load one visual mesh file (scale applied), its vertices welded for decimation."""
+    from serialkin.errors import RobotDefinitionError
+    from serialkin.model.mesh import TriangleMesh, load_mesh
+
+    try:
+        m = load_mesh(g.filename, g.scale)
+    except RobotDefinitionError as exc:
+        hint = ""
+        if g.filename.startswith("package://") or not Path(g.filename).is_absolute():
+            hint = (" (the path was never resolved: load the URDF with package_map= or "
+                    "search_path=, or pass meshes=False)")
+        raise RobotDefinitionError(f"link {short_repr(link)} visual mesh: {exc}{hint}") from None
+    v, f = _welded(m.vertices, m.faces)
+    return TriangleMesh(v, f, m.source)
+
+
+def _collision_model(robot: Robot, collision: object) -> Any:
+    """The collision model drawn: the robot's (None), none (False) or the one given."""
+    if collision is False:
+        return None
+    if collision is None or collision is True:
+        model = robot.collision
+        if model is None and collision is True:
+            raise InputError(f"robot {short_repr(robot.name)} has no collision model "
+                             "(Robot.collision is None); pass collision=CollisionModel(...)")
+    else:
+        model = collision
+    if model is None:
+        return None
+    from serialkin.collision.model import CollisionModel
+
+    if not isinstance(model, CollisionModel):
+        raise InputTypeError(f"collision must be None, a bool or a CollisionModel, got "
+                             f"{type(model).__name__}")
+    if len(model.body_frames) and int(model.body_frames.max()) > robot.n:
+        i = int(np.argmax(model.body_frames > robot.n))
+        raise InputError(f"collision body {short_repr(model.body_names[i])} is fixed to frame "
+                         f"{int(model.body_frames[i])}, but robot {short_repr(robot.name)} "
+                         f"has frames 0..{robot.n}")
+    return model
+
+
+def _collision_data(model: Any, acm: object) -> dict[str, Any]:
+    """Capsules (frame, body, ends, radius) and the checked shape pairs for the page."""
+    from serialkin.collision.queries import checked_shape_pairs
+
+    pa, pb = checked_shape_pairs(model, acm)  # type: ignore[arg-type]
+    return {
+        "bodies": list(model.body_names),
+        "body_frames": model.body_frames.tolist(),
+        "frame": model.shape_frame.tolist(),
+        "body": model.shape_body.tolist(),
+        "a": model.a.tolist(),
+        "b": model.b.tolist(),
+        "radius": model.radius.tolist(),
+        "pairs": np.stack([pa, pb], axis=1).tolist() if len(pa) else [],
+        "source": model.source,
+    }
+
+
+def _points_data(points: object, point_colors: object, label: object) -> dict[str, Any] | None:
+    """The point layer: positions float32 and colours uint8, base64; None without points."""
+    if points is None:
+        if point_colors is not None:
+            raise InputError("point_colors given without points")
+        return None
+    P = as_float_array(points, "points", ndim=2)
+    if P.shape[1] != 3:
+        raise InputError(f"points must have shape (N, 3), got {P.shape}")
+    if point_colors is None:
+        C = np.tile([0.1, 0.45, 0.85], (P.shape[0], 1))
+    else:
+        C = as_float_array(point_colors, "point_colors", ndim=2)
+        if C.shape != P.shape:
+            raise InputError(f"point_colors must have shape {P.shape} (RGB per point), "
+                             f"got {C.shape}")
+        if C.size and (C.min() < 0.0 or C.max() > 1.0):
+            raise InputError(f"point_colors must be in [0, 1], got values in "
+                             f"[{C.min():.3g}, {C.max():.3g}]")
+    if not isinstance(label, str):
+        raise InputTypeError(f"points_label must be a string, got {short_repr(label)}")
+    return {"count": int(P.shape[0]), "label": label, "positions": _b64(P.astype("<f4")),
+            "colors": _b64(np.rint(C * 255).astype("u1"))}
+
+
 def viewer_data(
     robot: Robot,
     q: object = None,
@@ -132,6 +376,15 @@ def viewer_data(
     path_points: object = None,
     obstacles: Iterable[object] | None = None,
     title: str | None = None,
+    *,
+    meshes: bool = True,
+    mesh_budget: int = MESH_BUDGET,
+    collision: object = None,
+    acm: object = None,
+    show_collision: bool = False,
+    points: object = None,
+    point_colors: object = None,
+    points_label: str = "points",
 ) -> dict[str, Any]:
     """The JSON document the page is built from (see :func:`viewer_html` for arguments).
 
@@ -140,7 +393,12 @@ def viewer_data(
     (None where unlimited), ``slider_limits``, ``q``, ``trajectory`` (list of q or None),
     ``path_points`` (k, 3), ``obstacles`` (kind, center, radius, height, a, b),
     ``scale`` [m], ``sizes`` (link and joint radii drawn [m]), ``ground_z`` [m], ``view``
-    (camera), ``title``, ``version``.
+    (camera), ``title``, ``version``; ``shapes`` (visual shapes: link, name, frame, origin
+    as 16 row-major numbers, rgba, kind ``mesh|box|cylinder|sphere|capsule`` with its sizes
+    or its index into ``meshes``, body index or −1), ``meshes`` (encoded triangle meshes,
+    see the module docstring), ``collision`` (None, or bodies, body_frames, per shape
+    frame/body/a/b/radius, the checked shape ``pairs``, ``show``), ``points`` (None, or
+    count, label, base64 positions and colours).
     """
     from serialkin import __version__
 
@@ -148,6 +406,19 @@ def viewer_data(
     P = _path_points(path_points)
     q0 = _initial_q(robot, q, Q)
     obs = [as_obstacle(o, f"obstacles[{i}]") for i, o in enumerate(obstacles or ())]
+    mesh_budget = check_int(mesh_budget, "mesh_budget", minimum=4)
+    model = _collision_model(robot, collision)
+    if acm is not None and model is None:
+        raise InputError("acm given but there is no collision model to check")
+    cdata = None if model is None else _collision_data(model, acm)
+    if cdata is not None:
+        cdata["show"] = bool(show_collision)
+    elif show_collision:
+        raise InputError(f"show_collision=True but robot {short_repr(robot.name)} has no "
+                         "collision model (Robot.collision is None)")
+    bodies = {} if model is None else {nm: i for i, nm in enumerate(model.body_names)}
+    shapes, mesh_data = _visual_data(robot, bool(meshes), mesh_budget, bodies)
+    pdata = _points_data(points, point_colors, points_label)
     scale = robot_scale(robot)
     qs = q0[None] if Q is None else np.vstack([q0[None], Q])
     pts = robot_points(robot, qs).reshape(-1, 3)
@@ -158,6 +429,8 @@ def viewer_data(
     frame_pts.extend(o.extent_points() for o in obs)
     allpts = np.vstack(frame_pts)
     ground_z = float(allpts[:, 2].min()) - (0.002 * scale if planar else 0.0)
+    if pdata is not None and pdata["count"]:  # framed by the camera, not under the grid
+        allpts = np.vstack([allpts, as_float_array(points, "points", ndim=2)])
     qlim = [[float(v) if np.isfinite(v) else None for v in row] for row in robot.qlim]
     seg = np.linalg.norm(np.diff(robot_points(robot, q0), axis=0), axis=1)
     seg = seg[seg > 1e-9]
@@ -195,6 +468,10 @@ def viewer_data(
         "sizes": sizes,
         "ground_z": ground_z,
         "view": _view(allpts, planar, scale),
+        "shapes": shapes,
+        "meshes": mesh_data,
+        "collision": cdata,
+        "points": pdata,
     }
 
 
@@ -210,6 +487,15 @@ def viewer_html(
     path_points: object = None,
     obstacles: Iterable[object] | None = None,
     title: str | None = None,
+    *,
+    meshes: bool = True,
+    mesh_budget: int = MESH_BUDGET,
+    collision: object = None,
+    acm: object = None,
+    show_collision: bool = False,
+    points: object = None,
+    point_colors: object = None,
+    points_label: str = "points",
 ) -> str:
     """The interactive viewer page as an HTML string (self-contained, works offline).
 
@@ -224,16 +510,39 @@ def viewer_html(
         obstacles: obstacle objects or dicts (see :func:`serialkin.viz.plot.as_obstacle`):
             spheres, vertical cylinders, capsules.
         title: page title (default "serialkin viewer: <robot name>").
+        meshes: draw the visual mesh files of :attr:`Robot.geometry` (needs the ``mesh``
+            extra when there are any); False draws only the primitive shapes, or the
+            skeleton of cylinders when there are none.
+        mesh_budget: most triangles of all embedded meshes together (>= 4); larger
+            meshes are decimated (about 12 bytes of page per triangle).
+        collision: the capsule model checked and drawn: None = :attr:`Robot.collision`
+            (if any), a :class:`~serialkin.collision.model.CollisionModel`, or False
+            for none (True requires the robot's own).
+        acm: the :class:`~serialkin.collision.acm.AllowedCollisionMatrix` whose pairs are
+            skipped (default :func:`~serialkin.collision.acm.default_acm`).
+        show_collision: capsules visible when the page opens (a toggle in the page).
+        points: (N, 3) positions [m] drawn as a toggled point cloud.
+        point_colors: (N, 3) RGB in [0, 1] per point (default one blue).
+        points_label: the point layer's name in the page.
 
     Returns:
-        The HTML text (about 0.7 MB, most of it three.js).
+        The HTML text (about 0.7 MB of three.js, plus about 12 bytes per mesh triangle
+        and 20 per point).
 
     Raises:
         InputError: a configuration with the wrong number of joints or non-finite values,
-            a path of the wrong shape, a malformed obstacle.
+            a path of the wrong shape, a malformed obstacle, a collision model on frames
+            the robot does not have, points or colours of the wrong shape or range.
+        RobotDefinitionError: a visual mesh file that is missing or corrupt (the message
+            names the link and the file).
+        NotSupportedError: mesh files to draw but trimesh is not installed (the message
+            names the extra).
     """
     data = viewer_data(robot, q=q, trajectory=trajectory, path_points=path_points,
-                       obstacles=obstacles, title=title)
+                       obstacles=obstacles, title=title,
+                       meshes=meshes, mesh_budget=mesh_budget, collision=collision, acm=acm,
+                       show_collision=show_collision, points=points,
+                       point_colors=point_colors, points_label=points_label)
     kinds = "".join(robot.joint_types)
     subtitle = f"{robot.n} joints ({kinds})"
     if robot.convention:
@@ -265,17 +574,30 @@ def write_viewer(
     path_points: object = None,
     obstacles: Iterable[object] | None = None,
     title: str | None = None,
+    *,
+    meshes: bool = True,
+    mesh_budget: int = MESH_BUDGET,
+    collision: object = None,
+    acm: object = None,
+    show_collision: bool = False,
+    points: object = None,
+    point_colors: object = None,
+    points_label: str = "points",
 ) -> Path:
     """Write the viewer page (see :func:`viewer_html`) to ``path``, atomically.
 
     The file is written to a temporary file in the same folder and renamed, so an
-    interrupted run never leaves a truncated page. Parent folders are created.
+    interrupted run never leaves a truncated page. Parent folders are created. The
+    keyword arguments are those of :func:`viewer_html`.
 
     Returns:
         The path written.
     """
     text = viewer_html(robot, q=q, trajectory=trajectory, path_points=path_points,
-                       obstacles=obstacles, title=title)
+                       obstacles=obstacles, title=title,
+                       meshes=meshes, mesh_budget=mesh_budget, collision=collision, acm=acm,
+                       show_collision=show_collision, points=points,
+                       point_colors=point_colors, points_label=points_label)
     out = Path(path)
     write_text_atomic(out, text)
     return out

@@ -11,6 +11,14 @@
 // along (prismatic) the joint's unit axis. Link frame i is the pose right after M_i
 // times L[i]; frame 0 is L[0] (the base). Matrices are row-major arrays of 16 numbers
 // (float64), world z is up, lengths in metres, angles in radians.
+//
+// The robot's body: every visual shape is a child of its chain frame's group, placed at
+// its origin (row-major 4x4 in that frame), so it moves with the frame. Meshes arrive
+// quantised (uint16 per coordinate over the bounding box, p = lo + step * u) with uint16
+// or uint32 triangle indices, base64 of little-endian arrays. The self-collision check
+// runs after every change of q: for each checked capsule pair (s, t) the world axis ends
+// are T_f a and T_f b, and the pair collides when the segment-segment distance minus
+// both radii is below zero (as serialkin.collision.self_clearance computes it).
 
 const N = DATA.n;
 const F = DATA.F.map((m) => m.flat());
@@ -151,11 +159,15 @@ const Y = new THREE.Vector3(0, 1, 0);
 
 const robotGroup = new THREE.Group();
 scene.add(robotGroup);
+// the skeleton (links as cylinders, joints, base box): the whole robot when it has no
+// visual geometry, a toggle otherwise
+const skeletonGroup = new THREE.Group();
+robotGroup.add(skeletonGroup);
 const unitCyl = new THREE.CylinderGeometry(1, 1, 1, 20);
 const links = [];
 for (let i = 0; i <= N; i++) {
   const m = new THREE.Mesh(unitCyl, linkMat);
-  robotGroup.add(m);
+  skeletonGroup.add(m);
   links.push(m);
 }
 const jointMeshes = [];
@@ -165,17 +177,18 @@ for (let i = 0; i < N; i++) {
     ? new THREE.BoxGeometry(1.6 * rJoint, 3.2 * rJoint, 1.6 * rJoint)
     : new THREE.CylinderGeometry(rJoint, rJoint, 3.2 * rJoint, 24);
   const m = new THREE.Mesh(geom, prismatic ? jointMatP : jointMatR);
-  robotGroup.add(m);
+  skeletonGroup.add(m);
   jointMeshes.push(m);
 }
 const base = new THREE.Mesh(new THREE.BoxGeometry(4 * rJoint, 4 * rJoint, 1.5 * rJoint), baseMat);
 base.matrixAutoUpdate = false;
-robotGroup.add(base);
+skeletonGroup.add(base);
 
 // the end effector: a red ball on the tool frame, with its triad
 const ee = new THREE.Group();
 ee.matrixAutoUpdate = false;
-ee.add(new THREE.Mesh(new THREE.SphereGeometry(1.2 * rLink, 20, 14), eeMat));
+const eeBall = new THREE.Mesh(new THREE.SphereGeometry(1.2 * rLink, 20, 14), eeMat);
+ee.add(eeBall);
 ee.add(new THREE.AxesHelper(0.12 * S));
 robotGroup.add(ee);
 
@@ -202,6 +215,256 @@ function placeSegment(mesh, a, b, radius) {
   mesh.position.set((a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2);
   mesh.quaternion.setFromUnitVectors(Y, d.divideScalar(len));
   mesh.scale.set(radius, len, radius);
+}
+
+// ------------------------------------------------------------------ link geometry
+function b64bytes(text) {
+  // base64 text -> Uint8Array (its own buffer, offset 0: typed views of it are aligned)
+  const bin = atob(text);
+  const out = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; i++) out[i] = bin.charCodeAt(i);
+  return out;
+}
+
+function meshGeometry(m) {
+  // Decode one embedded mesh: positions lo + step * u (u uint16), indices uint16/uint32.
+  const u = new Uint16Array(b64bytes(m.positions).buffer);
+  const pos = new Float32Array(u.length);
+  for (let i = 0; i < u.length; i += 3) {
+    pos[i] = m.lo[0] + m.step[0] * u[i];
+    pos[i + 1] = m.lo[1] + m.step[1] * u[i + 1];
+    pos[i + 2] = m.lo[2] + m.step[2] * u[i + 2];
+  }
+  const ib = b64bytes(m.indices).buffer;
+  const idx = m.index_bytes === 4 ? new Uint32Array(ib) : new Uint16Array(ib);
+  const g = new THREE.BufferGeometry();
+  g.setAttribute("position", new THREE.BufferAttribute(pos, 3));
+  g.setIndex(new THREE.BufferAttribute(idx, 1));
+  g.computeVertexNormals();
+  return g;
+}
+
+// one group per chain frame that carries shapes; its matrix is the frame's world pose
+const frameGroups = new Map();
+function frameGroup(f) {
+  if (!frameGroups.has(f)) {
+    const g = new THREE.Group();
+    g.matrixAutoUpdate = false;
+    robotGroup.add(g);
+    frameGroups.set(f, g);
+  }
+  return frameGroups.get(f);
+}
+
+const hitMat = new THREE.MeshStandardMaterial({ color: 0xe02020, emissive: 0x700000, roughness: 0.5 });
+const ROT_Y_TO_Z = new THREE.Matrix4().makeRotationX(Math.PI / 2); // three's y axis onto z
+const meshGeometries = DATA.meshes.map(meshGeometry);
+const visualObjects = [];
+for (const sh of DATA.shapes) {
+  let geom;
+  let alongZ = false;
+  if (sh.kind === "mesh") geom = meshGeometries[sh.mesh];
+  else if (sh.kind === "box") geom = new THREE.BoxGeometry(...sh.size);
+  else if (sh.kind === "sphere") geom = new THREE.SphereGeometry(sh.radius, 32, 20);
+  else if (sh.kind === "cylinder") {
+    geom = new THREE.CylinderGeometry(sh.radius, sh.radius, sh.length, 32);
+    alongZ = true;
+  } else {
+    geom = new THREE.CapsuleGeometry(sh.radius, sh.length, 8, 24);
+    alongZ = true;
+  }
+  const [r, g, b, a] = sh.rgba;
+  const mat = new THREE.MeshStandardMaterial({
+    color: new THREE.Color(r, g, b), metalness: 0.05, roughness: 0.55,
+    transparent: a < 1, opacity: a,
+  });
+  const obj = new THREE.Mesh(geom, mat);
+  obj.matrixAutoUpdate = false;
+  obj.matrix.set(...sh.origin);
+  if (alongZ) obj.matrix.multiply(ROT_Y_TO_Z);
+  obj.userData = { kind: sh.kind, link: sh.link, body: sh.body, material: mat };
+  frameGroup(sh.frame).add(obj);
+  visualObjects.push(obj);
+}
+
+// collision capsules (a toggle) and the pairs checked in the page
+const COL = DATA.collision;
+const capsuleMat = new THREE.MeshStandardMaterial({
+  color: 0x20a090, transparent: true, opacity: 0.35, roughness: 0.7, depthWrite: false,
+});
+const capsuleHitMat = new THREE.MeshStandardMaterial({
+  color: 0xe02020, transparent: true, opacity: 0.6, roughness: 0.7, depthWrite: false,
+});
+const capsuleObjects = [];
+if (COL) {
+  for (let s = 0; s < COL.radius.length; s++) {
+    const a = COL.a[s], b = COL.b[s];
+    const len = Math.hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+    const m = new THREE.Mesh(new THREE.CapsuleGeometry(COL.radius[s], len, 6, 20), capsuleMat);
+    m.position.set((a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2);
+    if (len > 0) {
+      m.quaternion.setFromUnitVectors(Y, new THREE.Vector3(b[0] - a[0], b[1] - a[1], b[2] - a[2]).divideScalar(len));
+    }
+    m.visible = false;
+    frameGroup(COL.frame[s]).add(m);
+    capsuleObjects.push(m);
+  }
+}
+
+function segmentDistance(p1, q1, p2, q2) {
+  // Distance between segments p1q1 and p2q2: closest points by clamped parameters
+  // s, t in [0, 1] (Ericson, Real-Time Collision Detection, 5.1.9).
+  const d1 = [q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]];
+  const d2 = [q2[0] - p2[0], q2[1] - p2[1], q2[2] - p2[2]];
+  const r = [p1[0] - p2[0], p1[1] - p2[1], p1[2] - p2[2]];
+  const dot = (u, v) => u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+  const clamp = (x) => Math.min(1, Math.max(0, x));
+  const a = dot(d1, d1), e = dot(d2, d2), f = dot(d2, r);
+  const eps = 1e-24;
+  let s = 0, t = 0;
+  if (a <= eps && e <= eps) {
+    s = t = 0;
+  } else if (a <= eps) {
+    t = clamp(f / e);
+  } else {
+    const c = dot(d1, r);
+    if (e <= eps) {
+      s = clamp(-c / a);
+    } else {
+      const b = dot(d1, d2), denom = a * e - b * b;
+      s = denom > 0 ? clamp((b * f - c * e) / denom) : 0;
+      t = (b * s + f) / e;
+      if (t < 0) {
+        t = 0;
+        s = clamp(-c / a);
+      } else if (t > 1) {
+        t = 1;
+        s = clamp((b - c) / a);
+      }
+    }
+  }
+  return Math.hypot(r[0] + d1[0] * s - d2[0] * t, r[1] + d1[1] * s - d2[1] * t,
+    r[2] + d1[2] * s - d2[2] * t);
+}
+
+function transformPoint(T, p) {
+  return [
+    T[0] * p[0] + T[1] * p[1] + T[2] * p[2] + T[3],
+    T[4] * p[0] + T[5] * p[1] + T[6] * p[2] + T[7],
+    T[8] * p[0] + T[9] * p[1] + T[10] * p[2] + T[11],
+  ];
+}
+
+let collisionState = { distance: null, pair: null, colliding: [] };
+function checkCollisions() {
+  // Smallest signed distance over the checked pairs and every colliding body pair.
+  if (!COL) return;
+  const A = [], B = [];
+  for (let s = 0; s < COL.radius.length; s++) {
+    const T = current.frames[COL.frame[s]];
+    A.push(transformPoint(T, COL.a[s]));
+    B.push(transformPoint(T, COL.b[s]));
+  }
+  let best = Infinity, bestPair = null;
+  const hits = new Map(); // "i,j" body pair -> smallest distance
+  for (const [s, t] of COL.pairs) {
+    const d = segmentDistance(A[s], B[s], A[t], B[t]) - COL.radius[s] - COL.radius[t];
+    const i = Math.min(COL.body[s], COL.body[t]), j = Math.max(COL.body[s], COL.body[t]);
+    if (d < best) {
+      best = d;
+      bestPair = [i, j];
+    }
+    if (d < 0) {
+      const key = `${i},${j}`;
+      if (!hits.has(key) || d < hits.get(key)) hits.set(key, d);
+    }
+  }
+  const hitBodies = new Set();
+  const colliding = [];
+  for (const [key, d] of hits) {
+    const [i, j] = key.split(",").map(Number);
+    hitBodies.add(i);
+    hitBodies.add(j);
+    colliding.push([COL.bodies[i], COL.bodies[j], d]);
+  }
+  colliding.sort((x, y) => x[2] - y[2]);
+  for (let s = 0; s < capsuleObjects.length; s++) {
+    capsuleObjects[s].material = hitBodies.has(COL.body[s]) ? capsuleHitMat : capsuleMat;
+  }
+  for (const o of visualObjects) {
+    o.material = o.userData.body >= 0 && hitBodies.has(o.userData.body) ? hitMat : o.userData.material;
+  }
+  collisionState = {
+    distance: Number.isFinite(best) ? best : null,
+    pair: bestPair ? [COL.bodies[bestPair[0]], COL.bodies[bestPair[1]]] : null,
+    colliding,
+  };
+  const box = $("sk-collision");
+  if (colliding.length) {
+    const shown = colliding.slice(0, 6).map((c) => `${c[0]} – ${c[1]} (${fmt(c[2])} m)`);
+    if (colliding.length > 6) shown.push(`… and ${colliding.length - 6} more pairs`);
+    box.textContent = `colliding (${colliding.length}):\n` + shown.join("\n");
+    box.classList.add("sk-hit");
+  } else {
+    box.textContent = bestPair
+      ? `clear: ${fmt(best)} m\nclosest ${COL.bodies[bestPair[0]]} – ${COL.bodies[bestPair[1]]}`
+      : "no pairs to check";
+    box.classList.remove("sk-hit");
+  }
+}
+
+// the point layer (a toggle)
+let pointCloud = null;
+if (DATA.points && DATA.points.count > 0) {
+  const pos = new Float32Array(b64bytes(DATA.points.positions).buffer);
+  const rgb = b64bytes(DATA.points.colors);
+  const g = new THREE.BufferGeometry();
+  g.setAttribute("position", new THREE.BufferAttribute(pos, 3));
+  g.setAttribute("color", new THREE.BufferAttribute(rgb, 3, true));
+  pointCloud = new THREE.Points(g, new THREE.PointsMaterial({ size: 0.012 * S, vertexColors: true }));
+  scene.add(pointCloud);
+}
+
+function shownOnScreen(obj) {
+  for (let o = obj; o; o = o.parent) if (!o.visible) return false;
+  return true;
+}
+
+function drawn() {
+  // What is on screen now: visual shapes (meshes and primitives), their triangles,
+  // collision capsules, points, whether the skeleton is shown, and what is drawn red
+  // for a collision (links of the visual shapes, number of capsules; shown or not).
+  const vis = visualObjects.filter(shownOnScreen);
+  const tri = (o) => (o.geometry.index ? o.geometry.index.count : o.geometry.attributes.position.count) / 3;
+  return {
+    shapes: vis.length,
+    meshes: vis.filter((o) => o.userData.kind === "mesh").length,
+    primitives: vis.filter((o) => o.userData.kind !== "mesh").length,
+    triangles: vis.filter((o) => o.userData.kind === "mesh").reduce((acc, o) => acc + tri(o), 0),
+    capsules: capsuleObjects.filter(shownOnScreen).length,
+    points: pointCloud && shownOnScreen(pointCloud) ? DATA.points.count : 0,
+    skeleton: shownOnScreen(skeletonGroup),
+    highlighted: visualObjects.filter((o) => o.material === hitMat).map((o) => o.userData.link),
+    capsulesHit: capsuleObjects.filter((o) => o.material === capsuleHitMat).length,
+  };
+}
+
+function shapePoses() {
+  // World matrix (row-major 4x4) of every visual shape as drawn, in DATA.shapes order
+  // (cylinders and capsules include the turn of three.js's y axis onto the shape's z).
+  return visualObjects.map((o) => {
+    o.updateMatrixWorld(true);
+    return rows4(o.matrixWorld.clone().transpose().elements);
+  });
+}
+
+function clearance() {
+  // The in-page self-collision check for the current q (null distance: no model).
+  return {
+    distance: collisionState.distance,
+    pair: collisionState.pair,
+    colliding: collisionState.colliding.map((c) => c.slice()),
+  };
 }
 
 // ------------------------------------------------------------------ path, trace, obstacles
@@ -279,7 +542,9 @@ function updateRobot() {
   setMatrix(base, current.frames[0]);
   setMatrix(ee, current.tool);
   for (let i = 0; i <= N; i++) setMatrix(triads[i], current.frames[i]);
+  for (const [f, g] of frameGroups) setMatrix(g, current.frames[f]);
   scene.updateMatrixWorld(true);
+  checkCollisions();
   updateReadout();
 }
 
@@ -549,6 +814,22 @@ function bindToggles() {
   bind("sk-show-trace", (on) => (traceGroup.visible = on));
   bind("sk-show-obstacles", (on) => (obstacleGroup.visible = on));
   bind("sk-show-grid", (on) => (grid.visible = worldAxes.visible = on));
+  const offer = (id, present, checked, fn) => {
+    const box = $(id);
+    box.closest("label").hidden = !present;
+    box.checked = checked;
+    bind(id, fn);
+  };
+  const hasVisual = visualObjects.length > 0;
+  offer("sk-show-visual", hasVisual, true, (on) => visualObjects.forEach((o) => (o.visible = on)));
+  offer("sk-show-skeleton", hasVisual, !hasVisual, (on) => {
+    skeletonGroup.visible = on;
+    eeBall.visible = on;
+  });
+  offer("sk-show-collision", !!COL, !!(COL && COL.show), (on) => capsuleObjects.forEach((o) => (o.visible = on)));
+  offer("sk-show-points", !!pointCloud, true, (on) => pointCloud && (pointCloud.visible = on));
+  if (pointCloud) $("sk-points-label").textContent = `${DATA.points.label} (${DATA.points.count})`;
+  $("sk-collision-section").hidden = !COL;
   $("sk-reset-view").addEventListener("click", resetView);
   $("sk-home").addEventListener("click", () => setJoints(DATA.q.slice()));
 }
@@ -582,5 +863,10 @@ window.serialkin = {
   frameCount: TRAJ.length,
   resetView,
   render,
+  drawn,
+  clearance,
+  shapePoses,
 };
+// time from the start of navigation to a drawn, scriptable page [ms] (benchmarks read it)
+state.readyMs = performance.now();
 document.body.dataset.ready = "true";
