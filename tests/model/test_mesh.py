@@ -207,3 +207,23 @@ def test_import_serialkin_does_not_import_trimesh() -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
     assert out.stdout.strip() == "False"
+
+
+def test_decimate_keeps_the_surface_of_a_mesh_with_repeated_vertices():
+    """Decimating a per-corner (STL-like) sphere keeps its area within 10 % (vertices welded first)."""
+    pytest.importorskip("trimesh")
+    pytest.importorskip("fast_simplification")
+    from serialkin.model.geometry import Sphere
+    from serialkin.model.mesh import TriangleMesh, decimate, primitive_mesh
+
+    sphere = primitive_mesh(Sphere(0.1), sections=48)
+    corners = sphere.vertices[sphere.faces.reshape(-1)]  # every corner its own vertex
+    soup = TriangleMesh(corners, np.arange(corners.shape[0]).reshape(-1, 3), "soup")
+
+    def area(m):
+        a, b, c = (m.vertices[m.faces[:, k]] for k in range(3))
+        return 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum()
+
+    small = decimate(soup, 400)
+    assert small.faces.shape[0] <= 400
+    assert abs(area(small) / area(sphere) - 1) < 0.1

@@ -34,7 +34,7 @@ import numpy as np
 from serialkin._checks import check_choice, check_int, short_repr
 from serialkin.errors import InputTypeError, NotSupportedError, RobotDefinitionError
 
-__all__ = ["MESH_SUFFIXES", "LinkMesh", "TriangleMesh", "clear_mesh_cache", "decimate",
+__all__ = ["MESH_SUFFIXES", "LinkMesh", "TriangleMesh", "clear_mesh_cache", "decimate", "welded",
            "link_meshes", "load_mesh", "primitive_mesh"]
 
 #: File suffixes :func:`load_mesh` reads (lower case) and the trimesh file type of each.
@@ -223,8 +223,26 @@ def clear_mesh_cache() -> None:
         _cache.clear()
 
 
+def welded(mesh: TriangleMesh) -> TriangleMesh:
+    """The same triangles over merged vertices: exactly equal positions become one vertex.
+
+    Mesh files (STL always, COLLADA often) repeat a vertex for every face corner; edge
+    collapse needs the shared vertices to see the surface as connected (without welding,
+    decimating the Panda's link0 to 3,000 triangles kept 9 % of its area). Unused vertices
+    are dropped.
+
+    Returns:
+        a TriangleMesh with (V', 3) unique vertices and (F, 3) faces indexing them.
+    """
+    used = np.unique(mesh.faces)
+    uniq, inverse = np.unique(mesh.vertices[used], axis=0, return_inverse=True)
+    remap = np.empty(mesh.vertices.shape[0], dtype=np.int64)
+    remap[used] = inverse.reshape(-1)
+    return TriangleMesh(uniq, remap[mesh.faces], mesh.source)
+
+
 def decimate(mesh: TriangleMesh, max_faces: int) -> TriangleMesh:
-    """A mesh of at most ``max_faces`` triangles, by quadric edge collapse.
+    """A mesh of at most ``max_faces`` triangles, by quadric edge collapse of the welded mesh.
 
     Returns ``mesh`` itself when it already has at most ``max_faces`` faces. Uses trimesh's
     ``simplify_quadric_decimation`` (Garland & Heckbert 1997 quadric error metric, in
@@ -245,6 +263,7 @@ def decimate(mesh: TriangleMesh, max_faces: int) -> TriangleMesh:
     except ImportError:
         raise NotSupportedError(
             'mesh decimation needs fast-simplification: pip install "serialkin[mesh]"') from None
+    mesh = welded(mesh)
     tm = trimesh.Trimesh(mesh.vertices.copy(), mesh.faces.copy(), process=False)
     out = tm.simplify_quadric_decimation(face_count=max_faces)
     faces = np.asarray(out.faces, dtype=np.int64)

@@ -167,18 +167,6 @@ def _b64(a: np.ndarray) -> str:
     return base64.b64encode(np.ascontiguousarray(a).tobytes()).decode("ascii")
 
 
-def _welded(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Merge exactly equal vertices (mesh files repeat them per face corner); drop unused ones.
-
-    Returns (V', 3) vertices and (F, 3) faces indexing them; the triangles are unchanged.
-    """
-    used = np.unique(faces)
-    uniq, inverse = np.unique(vertices[used], axis=0, return_inverse=True)
-    remap = np.empty(vertices.shape[0], dtype=np.int64)
-    remap[used] = inverse.reshape(-1)
-    return uniq, remap[faces]
-
-
 def _encode_mesh(vertices: object, faces: object) -> dict[str, Any]:
     """The compact page form of a triangle mesh (see the module docstring).
 
@@ -273,20 +261,21 @@ def _visual_data(robot: Robot, meshes: bool, mesh_budget: int,
             shapes.append(entry)
     encoded = []
     if loaded:
-        from serialkin.model.mesh import TriangleMesh, decimate
+        from serialkin.model.mesh import TriangleMesh, decimate, welded
 
         shares = _face_shares([m.faces.shape[0] for m in loaded], mesh_budget)
         for m, share in zip(loaded, shares, strict=True):
             if m.faces.shape[0] > share:
                 m = decimate(TriangleMesh(m.vertices, m.faces, m.source), max(4, share))
-            encoded.append(_encode_mesh(*_welded(m.vertices, m.faces)))
+            m = welded(TriangleMesh(m.vertices, m.faces, m.source))
+            encoded.append(_encode_mesh(m.vertices, m.faces))
     return shapes, encoded
 
 
 def _load_visual_mesh(link: str, g: Any) -> Any:
     """Load one visual mesh file (scale applied), its vertices welded for decimation."""
     from serialkin.errors import RobotDefinitionError
-    from serialkin.model.mesh import TriangleMesh, load_mesh
+    from serialkin.model.mesh import load_mesh, welded
 
     try:
         m = load_mesh(g.filename, g.scale)
@@ -296,8 +285,7 @@ def _load_visual_mesh(link: str, g: Any) -> Any:
             hint = (" (the path was never resolved: load the URDF with package_map= or "
                     "search_path=, or pass meshes=False)")
         raise RobotDefinitionError(f"link {short_repr(link)} visual mesh: {exc}{hint}") from None
-    v, f = _welded(m.vertices, m.faces)
-    return TriangleMesh(v, f, m.source)
+    return welded(m)
 
 
 def _collision_model(robot: Robot, collision: object) -> Any:
