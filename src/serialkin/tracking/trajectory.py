@@ -25,7 +25,7 @@ import numpy as np
 from serialkin._io import write_bytes_atomic
 from serialkin.errors import InputError
 
-__all__ = ["PathFailure", "Trajectory"]
+__all__ = ["JointJump", "PathFailure", "Trajectory"]
 
 
 @dataclass(frozen=True)
@@ -39,6 +39,25 @@ class PathFailure:
     def __str__(self) -> str:
         t = ", ".join(f"{v:.4g}" for v in self.target)
         return f"path point {self.index} ({t}) not reached: error {self.error:.4g} m"
+
+
+@dataclass(frozen=True)
+class JointJump:
+    """A joint that moved by more than the allowed step between path points k − 1 and k.
+
+    Attributes:
+        index: path point k (point 0 is compared with the start configuration).
+        joint: index of the joint that moved most (0-based).
+        size: its signed change [rad or m].
+    """
+
+    index: int
+    joint: int
+    size: float
+
+    def __str__(self) -> str:
+        return (f"joint {self.joint + 1} jumped by {self.size:.4g} between path points "
+                f"{self.index - 1} and {self.index} (a branch flip or wrap)")
 
 
 @dataclass
@@ -63,6 +82,7 @@ class Trajectory:
             the arrays then hold the points computed so far, the failing one included.
         path_length: number of points of the full path.
         solver: description of the solver used.
+        jumps: points where a joint moved by more than the tracker's ``max_joint_step``.
     """
 
     q: np.ndarray
@@ -82,6 +102,7 @@ class Trajectory:
     stopped: bool = False
     path_length: int = 0
     solver: str = ""
+    jumps: list[JointJump] = field(default_factory=list)
 
     # ------------------------------------------------------------------ summaries
     def __len__(self) -> int:
@@ -125,6 +146,8 @@ class Trajectory:
             lines.append(f"min joint-limit margin {np.degrees(self.min_limit_margin):.4g} deg")
         for f in self.failures:
             lines.append(str(f))
+        for jmp in self.jumps:
+            lines.append(str(jmp))
         if self.stopped:
             lines.append("tracking stopped at the first unreachable point")
         return "; ".join(lines)

@@ -1,0 +1,194 @@
+"""Path tracking through the differential-IK QP: :class:`QPResolver`.
+
+For each path target the resolver iterates QP steps (``q ← q + Δq``, dt = 1) from the
+previous configuration until the task error is below ``tol``, the budget is spent, or
+the step vanishes (the constraints block the task: the result says so). Every step keeps
+the hard constraints:
+
+* joint limits (:class:`~serialkin.diffik.constraints.PositionLimit`, gain 1: a step goes
+  at most to the limit; the solver's feasibility tolerance, 1e-6, is removed by clipping
+  q to its limits after the step);
+* a per-iteration joint step ``max_step`` (a velocity limit with dt = 1);
+* optionally a bound on how far any joint may move between consecutive path points
+  (``max_joint_step``, a :class:`~serialkin.diffik.constraints.StepBox` around the
+  previous point's q): the tracker then never jumps by more, and a target it cannot
+  reach within that bound is reported as not reached;
+* collision avoidance against the obstacles (velocity damper with safety distance
+  ``safety`` and gain ``collision_gain``).
+
+The frame task is the path's task (its rows of the pose error); a posture task of weight
+``posture_weight`` pulls towards the configuration at the start of the point (the
+minimum-motion regulariser), and ``damping`` is the Tikhonov term μ.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from serialkin._checks import MAX_ITERATIONS, check_int, check_positive, short_repr
+from serialkin.diffik.constraints import (
+    CollisionAvoidance,
+    PositionLimit,
+    StepBox,
+    VelocityLimit,
+)
+from serialkin.diffik.qp import DiffIK
+from serialkin.diffik.tasks import FrameTask, PostureTask
+from serialkin.errors import InputError
+from serialkin.redundancy.obstacles import Capsule, Circle, Sphere, check_obstacles
+
+__all__ = ["QPResolver", "QPSolveStats"]
+
+
+@dataclass(frozen=True)
+class QPSolveStats:
+    """Outcome of one target: final q (n,), iterations, task error [m], reason ('' if met)."""
+
+    q: np.ndarray
+    iterations: int
+    error: float
+    converged: bool
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class QPResolver:
+    """Settings of QP path tracking (see the module docstring).
+
+    Attributes:
+        task: the path's task rows ('planar', 'position', 'pose', ...).
+        obstacles: obstacles of :mod:`serialkin.redundancy.obstacles`.
+        link_radius: link capsule radius [m].
+        safety: d_s, clearance kept from obstacles [m].
+        collision_gain: fraction of ``d − d_s`` the clearance may lose per step, (0, 1].
+        self_collision: also keep non-adjacent links apart (segments two or more apart).
+        posture_weight: weight of the pull towards the point's start configuration.
+        damping: μ, Tikhonov damping of the QP [cost/rad²].
+        max_step: largest change of any joint per iteration [rad or m].
+        max_joint_step: largest change of any joint between consecutive path points
+            (None: unbounded; the tracker still reports jumps above its own threshold).
+        tol: convergence tolerance on the task error [m].
+        max_iter: iteration budget per target.
+        solver: 'daqp' or 'qpsolvers:<name>'.
+    """
+
+    task: str | Sequence[int] = "planar"
+    obstacles: tuple = field(default_factory=tuple)
+    link_radius: float = 0.0
+    safety: float = 0.002
+    collision_gain: float = 0.5
+    self_collision: bool = False
+    posture_weight: float = 1e-4
+    damping: float = 1e-6
+    max_step: float = 0.1
+    max_joint_step: float | None = None
+    tol: float = 1e-5
+    max_iter: int = 200
+    solver: str = "daqp"
+
+    def __post_init__(self) -> None:
+        from serialkin.model.tasks import task_rows
+
+        task_rows(self.task)
+        if isinstance(self.obstacles, (str, bytes, Mapping)) or not isinstance(
+                self.obstacles, Iterable):
+            raise InputError("obstacles must be a list of Circle, Sphere or Capsule, got "
+                             f"{type(self.obstacles).__name__} {short_repr(self.obstacles)}")
+        obs = tuple(self.obstacles)
+        for i, o in enumerate(obs):
+            if not isinstance(o, (Circle, Sphere, Capsule)):
+                raise InputError(f"obstacles[{i}] must be a Circle, Sphere or Capsule, got "
+                                 f"{type(o).__name__}")
+        object.__setattr__(self, "obstacles", obs)
+        for name in ("link_radius", "safety", "posture_weight", "damping"):
+            object.__setattr__(self, name, check_positive(getattr(self, name), name,
+                                                          allow_zero=True))
+        for name in ("max_step", "tol"):
+            object.__setattr__(self, name, check_positive(getattr(self, name), name))
+        object.__setattr__(self, "collision_gain",
+                           check_positive(self.collision_gain, "collision_gain", maximum=1.0))
+        if self.max_joint_step is not None:
+            object.__setattr__(self, "max_joint_step",
+                               check_positive(self.max_joint_step, "max_joint_step"))
+        check_int(self.max_iter, "max_iter", minimum=1, maximum=MAX_ITERATIONS)
+        if not isinstance(self.self_collision, bool):
+            raise InputError(f"self_collision must be true or false, got "
+                             f"{short_repr(self.self_collision)}")
+
+    def with_options(self, **changes: object) -> QPResolver:
+        """A copy with some settings changed (validated again)."""
+        return replace(self, **changes)
+
+    def prepare(self, robot) -> _QPState:
+        """Buffers and checks for one robot (obstacles overlapping the base raise)."""
+        check_obstacles(robot, self.obstacles, link_radius=self.link_radius)
+        return _QPState(self, robot)
+
+
+class _QPState:
+    """One robot's QP (tasks and constraints built once; targets and references move)."""
+
+    def __init__(self, res: QPResolver, robot) -> None:
+        from serialkin.model.tasks import task_rows
+
+        self.res = res
+        self.robot = robot
+        self.rows = task_rows(res.task)
+        n = robot.n
+        self.frame = FrameTask(np.eye(4), task=res.task)
+        self.posture = PostureTask(np.zeros(n), weight=res.posture_weight)
+        cons: list = [PositionLimit(), VelocityLimit(res.max_step)]
+        self.box = None
+        if res.max_joint_step is not None:
+            self.box = StepBox(np.zeros(n), res.max_joint_step)
+            cons.append(self.box)
+        self.collision = None
+        if res.obstacles or res.self_collision:
+            self.collision = CollisionAvoidance(
+                res.obstacles, link_radius=res.link_radius, safety=res.safety,
+                gain=res.collision_gain, self_pairs="auto" if res.self_collision else ())
+            cons.append(self.collision)
+        tasks = [self.frame] + ([self.posture] if res.posture_weight > 0 else [])
+        self.ik = DiffIK(robot, tasks, cons, damping=res.damping, solver=res.solver)
+        self.lo = np.asarray(robot.qlim[:, 0], dtype=float)
+        self.hi = np.asarray(robot.qlim[:, 1], dtype=float)
+
+    def _error(self, q: np.ndarray) -> float:
+        self.ik.ws.update(q)
+        _, e, _ = self.frame.rows(self.ik.ws, q)
+        return float(np.sqrt(e @ e))
+
+    def solve(self, target: np.ndarray, q: np.ndarray) -> QPSolveStats:
+        """Iterate QP steps towards ``target`` (4, 4) from q (n,) (q is not modified)."""
+        res = self.res
+        q = np.array(q, dtype=float)
+        self.frame.set_target(target)
+        self.posture._ref[:] = q
+        if self.box is not None:
+            self.box.reference = q.copy()
+        err = self._error(q)
+        best_q, best = q, err
+        it = since_best = 0
+        reason = ""
+        while best >= res.tol and it < res.max_iter and since_best < 10:
+            step = self.ik.step(q)
+            it += 1
+            if not step.success:
+                reason = step.reason
+                break
+            q = np.clip(q + step.dq, self.lo, self.hi)
+            err = self._error(q)
+            if err < best * (1.0 - 1e-9):
+                best_q, best, since_best = q, err, 0
+            else:
+                since_best += 1
+            if np.max(np.abs(step.dq)) < 1e-12:
+                break
+        if best >= res.tol and not reason and it < res.max_iter:
+            reason = ("no progress towards the target: the constraints (limits, obstacles, "
+                      "max_joint_step) block the task or the target is out of reach")
+        q, err = best_q, best
+        return QPSolveStats(q, it, err, err < res.tol, reason)
