@@ -31,7 +31,7 @@ from serialkin.diffik.constraints import Constraint
 from serialkin.diffik.tasks import Task, Workspace
 from serialkin.errors import InputError, InputTypeError
 
-__all__ = ["DAQP_EXIT", "DiffIK", "StepResult", "solve_step"]
+__all__ = ["DAQP_EXIT", "DiffIK", "StepResult", "check_solver", "solve_step"]
 
 #: DAQP exit flags (https://darnstrom.github.io/daqp/parameters) and their meaning.
 DAQP_EXIT = {
@@ -84,6 +84,24 @@ def _solve_qpsolvers(name, H, c, G, h, lb, ub):
     return x, float(0.5 * x @ H @ x + c @ x), 1
 
 
+def check_solver(solver: object) -> str:
+    """Validate a solver name: 'daqp' or 'qpsolvers:<name>' of an installed qpsolvers solver.
+
+    Raises:
+        InputError: anything else (the message lists the installed qpsolvers solvers).
+    """
+    if not isinstance(solver, str) or not (solver == "daqp" or solver.startswith("qpsolvers:")):
+        raise InputError(f"solver must be 'daqp' or 'qpsolvers:<name>', got {solver!r}")
+    if solver.startswith("qpsolvers:"):
+        import qpsolvers
+
+        name = solver.split(":", 1)[1]
+        if name not in qpsolvers.available_solvers:
+            raise InputError(f"qpsolvers has no solver {name!r} installed; available: "
+                             f"{', '.join(qpsolvers.available_solvers)}")
+    return solver
+
+
 class DiffIK:
     """Tasks, constraints and solver settings of the differential-IK QP for one robot.
 
@@ -116,17 +134,7 @@ class DiffIK:
                 raise InputTypeError(f"constraints[{i}] must be a serialkin.diffik constraint, "
                                      f"got {type(k).__name__}")
         self.damping = check_positive(damping, "damping", allow_zero=True)
-        if not isinstance(solver, str) or not (solver == "daqp"
-                                               or solver.startswith("qpsolvers:")):
-            raise InputError(f"solver must be 'daqp' or 'qpsolvers:<name>', got {solver!r}")
-        if solver.startswith("qpsolvers:"):
-            import qpsolvers
-
-            name = solver.split(":", 1)[1]
-            if name not in qpsolvers.available_solvers:
-                raise InputError(f"qpsolvers has no solver {name!r} installed; available: "
-                                 f"{', '.join(qpsolvers.available_solvers)}")
-        self.solver = solver
+        self.solver = check_solver(solver)
         self.ws = Workspace(robot)
         self._eye = np.eye(robot.n)
 

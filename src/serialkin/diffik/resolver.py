@@ -7,7 +7,7 @@ the hard constraints:
 
 * joint limits (:class:`~serialkin.diffik.constraints.PositionLimit`, gain 1: a step goes
   at most to the limit; the solver's feasibility tolerance, 1e-6, is removed by clipping
-  q to its limits after the step);
+  q to its limits, and to the ``max_joint_step`` box, after the step);
 * a per-iteration joint step ``max_step`` (a velocity limit with dt = 1);
 * optionally a bound on how far any joint may move between consecutive path points
   (``max_joint_step``, a :class:`~serialkin.diffik.constraints.StepBox` around the
@@ -35,7 +35,7 @@ from serialkin.diffik.constraints import (
     StepBox,
     VelocityLimit,
 )
-from serialkin.diffik.qp import DiffIK
+from serialkin.diffik.qp import DiffIK, check_solver
 from serialkin.diffik.tasks import FrameTask, PostureTask
 from serialkin.errors import InputError
 from serialkin.redundancy.obstacles import Capsule, Circle, Sphere, check_obstacles
@@ -114,6 +114,7 @@ class QPResolver:
             object.__setattr__(self, "max_joint_step",
                                check_positive(self.max_joint_step, "max_joint_step"))
         check_int(self.max_iter, "max_iter", minimum=1, maximum=MAX_ITERATIONS)
+        check_solver(self.solver)
         if not isinstance(self.self_collision, bool):
             raise InputError(f"self_collision must be true or false, got "
                              f"{short_repr(self.self_collision)}")
@@ -167,8 +168,11 @@ class _QPState:
         q = np.array(q, dtype=float)
         self.frame.set_target(target)
         self.posture._ref[:] = q
+        lo, hi = self.lo, self.hi
         if self.box is not None:
             self.box.reference = q.copy()
+            lo = np.maximum(lo, q - res.max_joint_step)
+            hi = np.minimum(hi, q + res.max_joint_step)
         err = self._error(q)
         best_q, best = q, err
         it = since_best = 0
@@ -179,7 +183,7 @@ class _QPState:
             if not step.success:
                 reason = step.reason
                 break
-            q = np.clip(q + step.dq, self.lo, self.hi)
+            q = np.clip(q + step.dq, lo, hi)  # removes the solver's 1e-6 tolerance
             err = self._error(q)
             if err < best * (1.0 - 1e-9):
                 best_q, best, since_best = q, err, 0

@@ -324,7 +324,7 @@ def joint_jumps(q_start: np.ndarray, Q: np.ndarray, threshold: float) -> list[Jo
     prev = np.vstack([q_start[None, :], Q[:-1]])
     d = np.abs(Q - prev)
     out = []
-    for k in np.flatnonzero(d.max(axis=1) > threshold):
+    for k in np.flatnonzero(d.max(axis=1) > threshold * (1.0 + 1e-9) + 1e-12):  # float noise
         j = int(np.argmax(d[k]))
         out.append(JointJump(int(k), j, float(Q[k, j] - prev[k, j])))
     return out

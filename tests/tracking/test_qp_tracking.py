@@ -1,0 +1,109 @@
+"""Path tracking through the differential-IK QP: hard limits and clearance (20-link scenario)."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+
+from serialkin.diffik.resolver import QPResolver
+from serialkin.errors import InputError
+from serialkin.redundancy import Circle
+from serialkin.tracking import Path, load_scenario, planar_arm, scenario_from_dict, track
+
+
+def _circle_clearance(robot, Q, obstacles):
+    """Independent clearance: segment-to-centre distances in numpy, minus the radius (p, k)."""
+    out = np.empty((len(Q), len(obstacles)))
+    for k, q in enumerate(Q):
+        P = robot.fk_all(q)[:, :2, 3]
+        a, b = P[:-1], P[1:]
+        for j, o in enumerate(obstacles):
+            d = b - a
+            t = np.clip(np.einsum("ij,ij->i", o.center - a, d) / np.einsum("ij,ij->i", d, d),
+                        0.0, 1.0)
+            closest = a + t[:, None] * d
+            out[k, j] = np.linalg.norm(closest - o.center, axis=1).min() - o.radius
+    return out
+
+
+@pytest.fixture(scope="module")
+def scenario():
+    return load_scenario("twenty_link_obstacles")
+
+
+@pytest.fixture(scope="module")
+def qp_run(scenario):
+    res = QPResolver(task=scenario.path.task, obstacles=scenario.obstacles)
+    return track(scenario.robot, scenario.path, res, q0=scenario.q0,
+                 tolerance=scenario.tolerance, max_joint_step=0.2)
+
+
+def test_qp_tracking_never_leaves_a_limit_or_enters_an_obstacle(scenario, qp_run):
+    """20-link scenario by QP: every point within the joint limits and outside every obstacle."""
+    tr = qp_run
+    lim = scenario.robot.qlim
+    assert len(tr) == len(scenario.path)
+    assert np.all(tr.q >= lim[:, 0]) and np.all(tr.q <= lim[:, 1])
+    clear = _circle_clearance(scenario.robot, tr.q, scenario.obstacles)
+    assert clear.min() > 0.0
+    np.testing.assert_allclose(clear, tr.clearance, atol=1e-9)
+
+
+def test_qp_tracking_reaches_the_path_without_jumps(scenario, qp_run):
+    """Every point is reached within the scenario's tolerance and no joint jumps by > 0.2 rad."""
+    assert qp_run.complete, qp_run.summary()
+    assert qp_run.jumps == []
+    step = np.abs(np.diff(np.vstack([scenario.q0, qp_run.q]), axis=0))
+    assert step.max() <= 0.2 + 1e-9
+
+
+def test_weighted_run_needs_its_obstacle_task_the_qp_constraint_holds(scenario, qp_run):
+    """Eq 48 without its (soft) obstacle task enters obstacles; the QP's hard rows never do."""
+    weak = scenario.solver.with_options(obstacle_weight=0.0)
+    soft = track(scenario.robot, scenario.path, weak, q0=scenario.q0,
+                 obstacles=scenario.obstacles)
+    assert _circle_clearance(scenario.robot, soft.q, scenario.obstacles).min() < 0.0
+    assert qp_run.min_clearance > 0.0
+
+
+def test_joint_jumps_are_reported_never_silent():
+    """DLS tracking with a tiny max_joint_step lists every larger move as a JointJump."""
+    arm = planar_arm(4, 0.1)
+    path = Path.from_points([[0.3, 0.1], [0.1, 0.3], [-0.2, 0.1]])
+    tr = track(arm, path, q0=np.full(4, 0.3), max_joint_step=0.05)
+    assert tr.jumps and all(abs(j.size) > 0.05 for j in tr.jumps)
+    assert "jumped" in tr.summary()
+    capped = track(arm, path, "qp", q0=np.full(4, 0.3), max_joint_step=0.05)
+    assert capped.jumps == []
+    assert np.abs(np.diff(np.vstack([np.full(4, 0.3), capped.q]), axis=0)).max() <= 0.05 + 1e-9
+    assert not capped.reached.all()  # the far points cannot be reached within 0.05 rad
+
+
+def test_target_inside_an_obstacle_is_not_reached_and_not_entered():
+    """A path point inside an obstacle is reported unreached; the arm stops outside it."""
+    arm = planar_arm(6, 0.1)
+    obs = Circle([0.3, 0.25], 0.05, influence=0.03)
+    path = Path.from_points([[0.35, 0.1], [0.3, 0.25]])
+    tr = track(arm, path, "qp", q0=np.full(6, 0.2), obstacles=(obs,))
+    assert tr.reached.tolist() == [True, False]
+    assert tr.min_clearance > 0.0
+    assert tr.errors[1] >= 0.05 - 0.003  # stays at least the radius (minus safety) away
+
+
+def test_scenario_file_selects_the_qp(scenario):
+    """A scenario with solver: {method: qp, ...} tracks through the QP with its settings."""
+    data = copy.deepcopy(scenario.data)
+    data["solver"] = {"method": "qp", "safety": 0.003, "max_joint_step": 0.2, "max_iter": 100}
+    data["path"]["waypoints"] = data["path"]["waypoints"][:3]
+    sc = scenario_from_dict(data)
+    assert isinstance(sc.solver, QPResolver) and sc.solver.safety == 0.003
+    tr = sc.run()
+    assert tr.complete and "QP" in tr.solver
+    data["solver"] = {"method": "qp", "backend": "qpsolvers:nonexistent"}
+    with pytest.raises(InputError, match="nonexistent"):
+        scenario_from_dict(data)
+    data["solver"] = {"method": "qp", "weight": 1.0}
+    with pytest.raises(InputError, match="weight"):
+        scenario_from_dict(data)
