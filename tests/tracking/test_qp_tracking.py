@@ -107,3 +107,14 @@ def test_scenario_file_selects_the_qp(scenario):
     data["solver"] = {"method": "qp", "weight": 1.0}
     with pytest.raises(InputError, match="weight"):
         scenario_from_dict(data)
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".npz"])
+def test_jumps_survive_a_file_round_trip(tmp_path, suffix):
+    """Reported joint jumps are saved with the trajectory and read back unchanged."""
+    arm = planar_arm(4, 0.1)
+    path = Path.from_points([[0.3, 0.1], [0.1, 0.3]])
+    tr = track(arm, path, q0=np.full(4, 0.3), max_joint_step=0.05)
+    assert tr.jumps
+    back = type(tr).load(tr.save(tmp_path / f"t{suffix}"))
+    assert back.jumps == tr.jumps

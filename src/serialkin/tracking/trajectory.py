@@ -159,7 +159,8 @@ class Trajectory:
                 "obstacle_names": list(self.obstacle_names),
                 "failures": [[f.index, f.error, list(f.target)] for f in self.failures],
                 "stopped": self.stopped, "path_length": self.path_length,
-                "solver": self.solver}
+                "solver": self.solver,
+                "jumps": [[j.index, j.joint, j.size] for j in self.jumps]}
 
     def save(self, path: str | os.PathLike[str]) -> FsPath:
         """Write to ``.csv`` or ``.npz`` (chosen by the extension), atomically."""
@@ -254,6 +255,12 @@ class Trajectory:
             failures.append(PathFailure(idx.integer(hi=2**62), err.number(allow_inf=True),
                                         tuple(tgt.array(what="a list of numbers", ndim=1,
                                                         max_items=16))))
+        jumps = []
+        if meta["jumps"].present:  # files before the jump report have none
+            for f in meta["jumps"].items(max_len=arrays["q"].shape[0]):
+                idx, joint, size = f.items(min_len=3, max_len=3, what="[index, joint, size]")
+                jumps.append(JointJump(idx.integer(hi=2**62), joint.integer(hi=n - 1),
+                                       size.number()))
         stopped = meta["stopped"].value
         if not isinstance(stopped, bool):
             raise meta["stopped"].expected("true or false")
@@ -266,7 +273,7 @@ class Trajectory:
             tolerance=meta["tolerance"].number(lo=0.0, lo_open=True),
             joint_names=joint_names, obstacle_names=obstacle_names, failures=failures,
             stopped=stopped, path_length=meta["path_length"].integer(hi=2**62),
-            solver=meta["solver"].string(nonempty=False, max_len=10_000))
+            solver=meta["solver"].string(nonempty=False, max_len=10_000), jumps=jumps)
 
 
 #: Largest trajectory file read, and largest total size of the arrays it unpacks to [bytes].
