@@ -118,3 +118,22 @@ def test_jumps_survive_a_file_round_trip(tmp_path, suffix):
     assert tr.jumps
     back = type(tr).load(tr.save(tmp_path / f"t{suffix}"))
     assert back.jumps == tr.jumps
+
+
+def test_chapter_side_by_side_reports_both_runs(tmp_path, scenario, qp_run):
+    """The report's comparison: eq 48 and QP rows with their numbers, a table and a figure."""
+    pytest.importorskip("matplotlib")
+    from serialkin.chapter.report import ReportContext
+    from serialkin.chapter.sections import redundancy
+
+    ctx = ReportContext(outdir=tmp_path, quiet=True)
+    weighted, wt = redundancy.timed_run(ctx, scenario, repeat=1)
+    rows = redundancy.side_by_side(ctx, scenario, weighted, wt, repeat=1)
+    w, q = rows
+    assert q.min_clearance == pytest.approx(qp_run.min_clearance)
+    assert q.worst_margin >= 0.0 and q.min_clearance > 0.0 and q.unreached == 0
+    assert w.min_clearance == pytest.approx(weighted.min_clearance)
+    assert q.per_point > 0 and w.per_point > 0
+    sec = redundancy._qp_part(ctx, scenario, rows)
+    assert "QP with hard constraints" in sec.html and "<table" in sec.html
+    assert (tmp_path / "figures" / "twenty_link_qp_vs_eq48.png").read_bytes()[:4] == b"\x89PNG"
