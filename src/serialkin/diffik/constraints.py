@@ -110,8 +110,14 @@ class VelocityLimit(Constraint):
 
     def box(self, ws, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``∓ vmax · dt``."""
-        b = np.broadcast_to(self.vmax * self.dt, q.shape)
-        return -b, b
+        b = getattr(self, "_b", None)
+        if b is None or b.shape != q.shape:
+            if self.vmax.ndim and self.vmax.shape != q.shape:
+                raise InputError(f"vmax has {self.vmax.size} values but the robot has "
+                                 f"{q.size} joints")
+            b = np.ascontiguousarray(np.broadcast_to(self.vmax * self.dt, q.shape))
+            self._b, self._mb = b, -b
+        return self._mb, b
 
 
 @dataclass

@@ -65,11 +65,12 @@ class StepResult:
 def _solve_daqp(H, c, G, h, lb, ub):
     import daqp
 
-    n = lb.size
-    A = G if G.shape[0] else np.zeros((0, n))
-    bu = np.concatenate([ub, h])
-    bl = np.concatenate([lb, np.full(h.size, -_BIG)])
-    x, fval, flag, _ = daqp.solve(H, c, A, bu, bl, np.zeros(bu.size, dtype=np.int32))
+    if h.size:
+        bu = np.concatenate([ub, h])
+        bl = np.concatenate([lb, np.full(h.size, -_BIG)])
+    else:
+        bu, bl = ub, lb
+    x, fval, flag, _ = daqp.solve(H, c, G, bu, bl)
     return np.asarray(x, dtype=float), float(fval), int(flag)
 
 
@@ -137,6 +138,8 @@ class DiffIK:
         self.solver = check_solver(solver)
         self.ws = Workspace(robot)
         self._eye = np.eye(robot.n)
+        self._lb = np.empty(robot.n)
+        self._ub = np.empty(robot.n)
 
     def problem(self, q: np.ndarray) -> tuple[np.ndarray, ...]:
         """The QP at q: ``(H (n, n), c (n,), G (r, n), h (r,), lb (n,), ub (n,))``."""
@@ -149,8 +152,10 @@ class DiffIK:
             WJ = J * w[:, None]
             H = H + J.T @ WJ
             c -= t.gain * (WJ.T @ e)
-        lb = np.full(n, -np.inf)
-        ub = np.full(n, np.inf)
+        lb = self._lb
+        ub = self._ub
+        lb.fill(-np.inf)
+        ub.fill(np.inf)
         Gs, hs = [], []
         for k in self.constraints:
             if k.is_box:
@@ -173,16 +178,14 @@ class DiffIK:
             raise InputError(f"q must be {self.robot.n} finite values, got shape {qv.shape}")
         H, c, G, h, lb, ub = self.problem(qv)
         n = qv.size
-        bad = np.flatnonzero(lb > ub + 1e-12)
-        if bad.size:
-            j = int(bad[0])
+        if np.any(lb > ub + 1e-12):
+            j = int(np.flatnonzero(lb > ub + 1e-12)[0])
             name = self.robot.joint_names[j] if self.robot.joint_names else f"joint {j + 1}"
             return StepResult(np.zeros(n), False,
                               f"conflicting bounds on {name}: the constraints need "
                               f"Δq ≥ {lb[j]:.4g} and Δq ≤ {ub[j]:.4g}", 0.0, h.size)
-        lb = np.minimum(lb, ub)  # bounds within 1e-12 of each other
-        lb = np.where(np.isfinite(lb), lb, -_BIG)
-        ub = np.where(np.isfinite(ub), ub, _BIG)
+        lb = np.clip(np.minimum(lb, ub), -_BIG, _BIG)  # bounds within 1e-12 of each other
+        ub = np.clip(ub, -_BIG, _BIG)
         try:
             if self.solver == "daqp":
                 x, fval, flag = _solve_daqp(H, c, G, h, lb, ub)
