@@ -52,8 +52,8 @@ def _serialkin(robot, T, ref, vmax, solver):
 
 
 def _pink(robot, T, ref, vmax):
-    import pinocchio as pin
     import pink
+    import pinocchio as pin
     from pink.limits import ConfigurationLimit
     from pink.limits import VelocityLimit as PinkVelocityLimit
     from pink.tasks import FrameTask as PinkFrameTask
