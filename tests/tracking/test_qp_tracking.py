@@ -137,3 +137,26 @@ def test_chapter_side_by_side_reports_both_runs(tmp_path, scenario, qp_run):
     sec = redundancy._qp_part(ctx, scenario, rows)
     assert "QP with hard constraints" in sec.html and "<table" in sec.html
     assert (tmp_path / "figures" / "twenty_link_qp_vs_eq48.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cli_track_with_the_qp(tmp_path):
+    """`serialkin track --solver qp` runs the QP; --max-joint-step bounds it (exit 1, reported)."""
+    import json
+
+    from click.testing import CliRunner
+
+    from serialkin.cli.main import cli
+
+    args = ["track", "six_link_circle", "--solver", "qp", "--no-figures", "--no-animation",
+            "--json", "--out", str(tmp_path)]
+    r = CliRunner().invoke(cli, args)
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert "QP" in out["solver"] and out["success"] and out["jumps"] == []
+    capped = CliRunner().invoke(cli, [*args, "--max-joint-step", "0.05"])
+    assert capped.exit_code == 1  # the first points need larger moves from q0 = 0
+    out = json.loads(capped.output[:capped.output.rindex("}") + 1])
+    assert out["jumps"] == [] and out["failures"] and out["failures"][0]["index"] == 0
+    bad = CliRunner().invoke(cli, ["track", "six_link_circle", "--max-joint-step", "-1",
+                                   "--out", str(tmp_path)])
+    assert bad.exit_code == 2 and "max-joint-step" in bad.output

@@ -175,7 +175,7 @@ class _QPState:
             hi = np.minimum(hi, q + res.max_joint_step)
         err = self._error(q)
         best_q, best = q, err
-        it = since_best = 0
+        it = since_best = kicks = 0
         reason = ""
         while best >= res.tol and it < res.max_iter and since_best < 10:
             step = self.ik.step(q)
@@ -190,7 +190,15 @@ class _QPState:
             else:
                 since_best += 1
             if np.max(np.abs(step.dq)) < 1e-12:
-                break
+                if kicks >= 3:
+                    break
+                # exactly singular with the error in the lost direction (the stretched arm
+                # and a target behind it): Jᵀe = 0, the step vanishes; bend every joint by
+                # a small fixed angle (inside the limits and the step box) to leave it, as
+                # the DLS tracker does
+                kicks += 1
+                q = np.clip(q + 1e-3, lo, hi)
+                since_best = 0
         if best >= res.tol and not reason and it < res.max_iter:
             reason = ("no progress towards the target: the constraints (limits, obstacles, "
                       "max_joint_step) block the task or the target is out of reach")
