@@ -15,6 +15,7 @@ from serialkin.diffik.constraints import (
     VelocityLimit,
 )
 from serialkin.diffik.qp import DiffIK, StepResult, solve_step
+from serialkin.diffik.resolver import QPResolver, QPSolveStats
 from serialkin.diffik.tasks import CustomTask, FrameTask, ManipulabilityTask, PostureTask, Task
 
 __all__ = [
@@ -26,6 +27,8 @@ __all__ = [
     "ManipulabilityTask",
     "PositionLimit",
     "PostureTask",
+    "QPResolver",
+    "QPSolveStats",
     "StepBox",
     "StepResult",
     "Task",

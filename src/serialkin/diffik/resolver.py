@@ -162,6 +162,14 @@ class _QPState:
         _, e, _ = self.frame.rows(self.ik.ws, q)
         return float(np.sqrt(e @ e))
 
+    def _singular(self, q: np.ndarray) -> bool:
+        """The frame task sees no descent direction (Jᵀ W e ≈ 0) while its error remains."""
+        self.ik.ws.update(q)
+        J, e, w = self.frame.rows(self.ik.ws, q)
+        g = J.T @ (w * e)
+        scale = float(np.linalg.norm(J)) * float(np.linalg.norm(e)) + 1e-300
+        return float(np.linalg.norm(g)) < 1e-9 * scale
+
     def solve(self, target: np.ndarray, q: np.ndarray) -> QPSolveStats:
         """Iterate QP steps towards ``target`` (4, 4) from q (n,) (q is not modified)."""
         res = self.res
@@ -190,7 +198,7 @@ class _QPState:
             else:
                 since_best += 1
             if np.max(np.abs(step.dq)) < 1e-12:
-                if kicks >= 3:
+                if kicks >= 3 or not self._singular(q):
                     break
                 # exactly singular with the error in the lost direction (the stretched arm
                 # and a target behind it): Jᵀe = 0, the step vanishes; bend every joint by
