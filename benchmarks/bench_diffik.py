@@ -117,6 +117,8 @@ def qp_step_table(quick: bool) -> None:
     vmax = np.linspace(0.8, 2.0, robot.n)
     makers = {
         "serialkin (DAQP direct)": lambda: _serialkin(robot, T, ref, vmax, "daqp"),
+        "serialkin (compiled active set)": lambda: _serialkin(robot, T, ref, vmax,
+                                                              "compiled"),
         "serialkin (qpsolvers: daqp)": lambda: _serialkin(robot, T, ref, vmax,
                                                           "qpsolvers:daqp"),
         "pink": lambda: _pink(robot, T, ref, vmax),
@@ -160,29 +162,37 @@ def tracking_table(quick: bool) -> None:
     from serialkin.tracking import load_scenario, track
 
     sc = load_scenario("twenty_link_obstacles")
-    res = QPResolver(task=sc.path.task, obstacles=sc.obstacles, max_joint_step=0.2)
     out = {}
+    runs = {}
+    for name, solver in (("QP, DAQP (hard constraints)", "daqp"),
+                         ("QP, compiled active set", "compiled")):
+        res = QPResolver(task=sc.path.task, obstacles=sc.obstacles, max_joint_step=0.2,
+                         solver=solver)
 
-    def qp():
-        out["qp"] = track(sc.robot, sc.path, res, q0=sc.q0, tolerance=sc.tolerance)
+        def qp(res=res, name=name):
+            out[name] = track(sc.robot, sc.path, res, q0=sc.q0, tolerance=sc.tolerance)
+
+        runs[name] = qp
 
     def eq48():
-        out["eq48"] = sc.run()
+        out["eq 48 (weighted, compiled)"] = sc.run()
 
+    runs["eq 48 (weighted, compiled)"] = eq48
     rep = 3 if quick else 7
-    t_qp = wall_s(qp, rep)
-    t_48 = wall_s(eq48, rep)
+    times = {k: wall_s(f, rep) for k, f in runs.items()}
     p = len(sc.path)
     print(f"\n(2) 20-link scenario twenty_link_obstacles ({p} points), whole path, "
           f"median [spread] of {rep} warm runs")
     print(f"{'solver':<34}{'ms per point':>22}{'µs per iteration':>20}{'min clearance':>16}"
           f"{'worst margin':>14}")
-    for name, t, tr in (("QP (hard constraints)", t_qp, out["qp"]),
-                        ("eq 48 (weighted, compiled)", t_48, out["eq48"])):
+    for name, t in times.items():
+        tr = out[name]
         its = int(tr.iterations.sum())
         per = Stat(t.values / p * 1e3)
         print(f"{name:<34}{per.fmt(3):>22}{t.median / its * 1e6:>20.1f}"
               f"{tr.min_clearance * 1e3:>13.2f} mm{np.degrees(tr.min_limit_margin):>12.2f} °")
+    t_qp = times["QP, DAQP (hard constraints)"]
+    t_48 = times["eq 48 (weighted, compiled)"]
     record("13.3", "QP tracking 20-link: ms per path point", t_qp.median / p * 1e3, "ms",
            "report", True)
     print(f"QP / eq 48 time per point: {t_qp.median / t_48.median:.1f}x")

@@ -217,3 +217,29 @@ def test_bad_input_raises_library_errors(panda):
     bad = CustomTask(lambda x: (np.eye(3), np.zeros(3)), name="mine")
     with pytest.raises(InputError, match="mine"):
         solve_step(panda, np.zeros(7), [bad])
+
+
+@pytest.mark.parametrize("seed", [30, 31, 32])
+def test_compiled_solver_agrees_with_daqp_with_collision_rows(arm, seed):
+    """solver='compiled' gives DAQP's step on a QP with limits, a velocity box and distance rows."""
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(-0.5, 0.5, arm.n)
+    obs = [Circle([0.4, 0.3], 0.05, influence=0.3), Circle([0.2, -0.2], 0.04, influence=0.3)]
+    target = arm.fk(q)
+    target[:2, 3] = [0.3, 0.45]
+    tasks = [FrameTask(target, task="planar"), PostureTask(q, weight=1e-3)]
+    cons = [PositionLimit(np.tile([-1.0, 1.0], (arm.n, 1))), VelocityLimit(0.1),
+            CollisionAvoidance(obs, safety=0.01, gain=0.5)]
+    a = solve_step(arm, q, tasks, cons)
+    b = solve_step(arm, q, tasks, cons, solver="compiled")
+    assert a.success and b.success and a.active > 0
+    np.testing.assert_allclose(b.dq, a.dq, atol=1e-7)
+
+
+def test_compiled_solver_reports_infeasibility(arm):
+    """The compiled solver finds the infeasible collision QP infeasible too (a result)."""
+    q = np.zeros(arm.n)
+    obs = Circle([0.45, 0.04], 0.03, influence=0.05)
+    con = CollisionAvoidance([obs], safety=0.05, influence=0.1, gain=1.0)
+    res = solve_step(arm, q, [PostureTask(q)], [con, VelocityLimit(1e-4)], solver="compiled")
+    assert not res.success and "infeasible" in res.reason

@@ -9,8 +9,9 @@ At a configuration q the step ``Δq`` (n,) solves
 
 (tasks: :mod:`serialkin.diffik.tasks`; constraints: :mod:`serialkin.diffik.constraints`;
 μ the Tikhonov damping). The QP is solved by DAQP (a dual active-set solver in C,
-Arnström et al. 2022) called directly (``solver='daqp'``, the default), or by any solver
-of qpsolvers (``solver='qpsolvers:<name>'``, e.g. 'qpsolvers:daqp', 'qpsolvers:osqp').
+Arnström et al. 2022) called directly (``solver='daqp'``, the default), by the compiled
+dual active-set solver of :mod:`serialkin.diffik.active_set` (``solver='compiled'``), or
+by any solver of qpsolvers (``solver='qpsolvers:<name>'``, e.g. 'qpsolvers:osqp').
 
 Failure is a result, never an exception from the solver: a lower bound above an upper
 bound (e.g. a joint outside its limits further than its velocity limit lets it come back)
@@ -74,6 +75,14 @@ def _solve_daqp(H, c, G, h, lb, ub):
     return np.asarray(x, dtype=float), float(fval), int(flag)
 
 
+def _solve_compiled(H, c, G, h, lb, ub):
+    from serialkin.diffik.active_set import solve_bounded
+
+    x = np.empty(lb.size)
+    flag, _ = solve_bounded(H, c, G, h, lb, ub, x, 50 * (lb.size + h.size) + 100)
+    return x, float(0.5 * x @ H @ x + c @ x), int(flag)
+
+
 def _solve_qpsolvers(name, H, c, G, h, lb, ub):
     import qpsolvers
 
@@ -86,13 +95,15 @@ def _solve_qpsolvers(name, H, c, G, h, lb, ub):
 
 
 def check_solver(solver: object) -> str:
-    """Validate a solver name: 'daqp' or 'qpsolvers:<name>' of an installed qpsolvers solver.
+    """Validate a solver name: 'daqp', 'compiled' or 'qpsolvers:<name>' (an installed one).
 
     Raises:
         InputError: anything else (the message lists the installed qpsolvers solvers).
     """
-    if not isinstance(solver, str) or not (solver == "daqp" or solver.startswith("qpsolvers:")):
-        raise InputError(f"solver must be 'daqp' or 'qpsolvers:<name>', got {solver!r}")
+    if not isinstance(solver, str) or not (solver in ("daqp", "compiled")
+                                           or solver.startswith("qpsolvers:")):
+        raise InputError(f"solver must be 'daqp', 'compiled' or 'qpsolvers:<name>', got "
+                         f"{solver!r}")
     if solver.startswith("qpsolvers:"):
         import qpsolvers
 
@@ -112,7 +123,7 @@ class DiffIK:
         constraints: sequence of :class:`~serialkin.diffik.constraints.Constraint`.
         damping: μ ≥ 0, Tikhonov damping added to H [cost/rad²] (makes H positive definite
             when the tasks leave joints free).
-        solver: 'daqp' (direct call) or 'qpsolvers:<name>'.
+        solver: 'daqp' (direct call), 'compiled' or 'qpsolvers:<name>'.
 
     Raises:
         InputError: no task, negative damping, unknown solver.
@@ -189,6 +200,8 @@ class DiffIK:
         try:
             if self.solver == "daqp":
                 x, fval, flag = _solve_daqp(H, c, G, h, lb, ub)
+            elif self.solver == "compiled":
+                x, fval, flag = _solve_compiled(H, c, G, h, lb, ub)
             else:
                 x, fval, flag = _solve_qpsolvers(self.solver.split(":", 1)[1], H, c, G, h,
                                                  lb, ub)

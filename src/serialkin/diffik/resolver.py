@@ -72,7 +72,7 @@ class QPResolver:
             (None: unbounded; the tracker still reports jumps above its own threshold).
         tol: convergence tolerance on the task error [m].
         max_iter: iteration budget per target.
-        solver: 'daqp' or 'qpsolvers:<name>'.
+        solver: 'daqp', 'compiled' or 'qpsolvers:<name>'.
     """
 
     task: str | Sequence[int] = "planar"
