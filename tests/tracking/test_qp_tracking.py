@@ -51,6 +51,15 @@ def test_qp_tracking_never_leaves_a_limit_or_enters_an_obstacle(scenario, qp_run
     np.testing.assert_allclose(clear, tr.clearance, atol=1e-9)
 
 
+def test_compiled_loop_and_daqp_loop_give_the_same_trajectory(scenario, qp_run):
+    """The compiled per-target loop (default) and the Python loop around DAQP agree."""
+    res = QPResolver(task=scenario.path.task, obstacles=scenario.obstacles, solver="daqp")
+    tr = track(scenario.robot, scenario.path, res, q0=scenario.q0,
+               tolerance=scenario.tolerance, max_joint_step=0.2)
+    assert tr.iterations.tolist() == qp_run.iterations.tolist()
+    np.testing.assert_allclose(tr.q, qp_run.q, atol=1e-6)
+
+
 def test_qp_tracking_reaches_the_path_without_jumps(scenario, qp_run):
     """Every point is reached within the scenario's tolerance and no joint jumps by > 0.2 rad."""
     assert qp_run.complete, qp_run.summary()
@@ -160,3 +169,33 @@ def test_cli_track_with_the_qp(tmp_path):
     bad = CliRunner().invoke(cli, ["track", "six_link_circle", "--max-joint-step", "-1",
                                    "--out", str(tmp_path)])
     assert bad.exit_code == 2 and "max-joint-step" in bad.output
+
+
+def _self_distance(arm, Q):
+    """Smallest distance between link segments two or more apart, minus two radii of 1 cm."""
+    from serialkin.spatial.segments import closest_segment_segment
+
+    worst = np.inf
+    for q in Q:
+        P = arm.fk_all(q)[:, :3, 3]
+        for a in range(arm.n):
+            for b in range(a + 2, arm.n):
+                s, t = closest_segment_segment(P[a], P[a + 1], P[b], P[b + 1])
+                d = np.linalg.norm(P[a] + s * (P[a + 1] - P[a]) - P[b] - t * (P[b + 1] - P[b]))
+                worst = min(worst, d - 0.02)
+    return worst
+
+
+def test_self_collision_tracking_keeps_links_apart_in_both_loops():
+    """Folding a 6-link arm to its base: links cross without self-collision rows, never with."""
+    arm = planar_arm(6, 0.1)
+    path = Path.polyline([[0.5, 0.1], [0.05, 0.0], [0.0, 0.0]], 0.02)
+    free = track(arm, path, QPResolver(task="planar", link_radius=0.01), q0=np.full(6, 0.1))
+    assert _self_distance(arm, free.q) < 0.0
+    runs = []
+    for solver in ("compiled", "daqp"):
+        res = QPResolver(task="planar", self_collision=True, link_radius=0.01, safety=0.005,
+                         solver=solver)
+        runs.append(track(arm, path, res, q0=np.full(6, 0.1)))
+        assert _self_distance(arm, runs[-1].q) > 0.0
+    np.testing.assert_allclose(runs[0].q, runs[1].q, atol=1e-6)

@@ -16,6 +16,11 @@ the hard constraints:
 * collision avoidance against the obstacles (velocity damper with safety distance
   ``safety`` and gain ``collision_gain``).
 
+With ``solver='compiled'`` (the default) the iterations of one target run in one
+compiled loop (:func:`serialkin.diffik.compiled.qp_point_into`); with 'daqp' or a
+qpsolvers solver they run in Python around :class:`~serialkin.diffik.DiffIK`. Both give
+the same iterates (to the solvers' tolerances; the tests compare them).
+
 The frame task is the path's task (its rows of the pose error); a posture task of weight
 ``posture_weight`` pulls towards the configuration at the start of the point (the
 minimum-motion regulariser), and ``damping`` is the Tikhonov term μ.
@@ -72,7 +77,10 @@ class QPResolver:
             (None: unbounded; the tracker still reports jumps above its own threshold).
         tol: convergence tolerance on the task error [m].
         max_iter: iteration budget per target.
-        solver: 'daqp', 'compiled' or 'qpsolvers:<name>'.
+        solver: 'compiled' (default: every iteration of a target in one compiled loop
+            with the dual active-set solver of :mod:`serialkin.diffik.active_set`;
+            measured 5× faster than DAQP called from Python per iteration), 'daqp' or
+            'qpsolvers:<name>' (the Python loop of :class:`~serialkin.diffik.DiffIK`).
     """
 
     task: str | Sequence[int] = "planar"
@@ -87,7 +95,7 @@ class QPResolver:
     max_joint_step: float | None = None
     tol: float = 1e-5
     max_iter: int = 200
-    solver: str = "daqp"
+    solver: str = "compiled"
 
     def __post_init__(self) -> None:
         from serialkin.model.tasks import task_rows
@@ -129,6 +137,10 @@ class QPResolver:
         return _QPState(self, robot)
 
 
+_NO_PROGRESS = ("no progress towards the target: the constraints (limits, obstacles, "
+                "max_joint_step) block the task or the target is out of reach")
+
+
 class _QPState:
     """One robot's QP (tasks and constraints built once; targets and references move)."""
 
@@ -154,8 +166,27 @@ class _QPState:
             cons.append(self.collision)
         tasks = [self.frame] + ([self.posture] if res.posture_weight > 0 else [])
         self.ik = DiffIK(robot, tasks, cons, damping=res.damping, solver=res.solver)
-        self.lo = np.asarray(robot.qlim[:, 0], dtype=float)
-        self.hi = np.asarray(robot.qlim[:, 1], dtype=float)
+        self.lo = np.ascontiguousarray(robot.qlim[:, 0], dtype=float)
+        self.hi = np.ascontiguousarray(robot.qlim[:, 1], dtype=float)
+        if res.solver == "compiled":
+            self._prepare_compiled()
+
+    def _prepare_compiled(self) -> None:
+        """Arguments of :func:`serialkin.diffik.compiled.qp_point_into` for this robot."""
+        res, robot = self.res, self.robot
+        col = self.collision or CollisionAvoidance((), safety=res.safety,
+                                                   gain=res.collision_gain)
+        _, g, pairs, G, h, PAIRS, DIST = col._state(robot)
+        cfg = np.array([res.posture_weight, res.damping, res.max_step,
+                        -1.0 if res.max_joint_step is None else res.max_joint_step, res.tol,
+                        float(res.max_iter), res.link_radius, res.safety, res.collision_gain,
+                        col._self_influence])
+        c = robot.chain
+        self._kernel_args = (
+            np.ascontiguousarray(self.rows), c.F, c.L, c.meta, self.lo, self.hi, cfg,
+            g.has_tool, col._enc, np.ascontiguousarray(col._influence, dtype=float), g.link,
+            pairs, g.frames, g.P0, g.P1, g.Tee, g.T, g.SC, g.B, g.D, g.C, g.Jbuf, g.pbuf, G, h,
+            PAIRS, DIST)
 
     def _error(self, q: np.ndarray) -> float:
         self.ik.ws.update(q)
@@ -170,8 +201,28 @@ class _QPState:
         scale = float(np.linalg.norm(J)) * float(np.linalg.norm(e)) + 1e-300
         return float(np.linalg.norm(g)) < 1e-9 * scale
 
+    def _solve_compiled(self, target: np.ndarray, q: np.ndarray) -> QPSolveStats:
+        from serialkin.diffik.compiled import CONFLICT, NO_PROGRESS, qp_point_into
+        from serialkin.diffik.qp import DAQP_EXIT
+
+        a = self._kernel_args
+        out = np.empty(q.size)
+        it, err, code = qp_point_into(np.ascontiguousarray(q, dtype=float),
+                                      np.ascontiguousarray(target, dtype=float), a[0], *a[1:],
+                                      out)
+        reason = ""
+        if code == NO_PROGRESS:
+            reason = _NO_PROGRESS
+        elif code == CONFLICT:
+            reason = "conflicting bounds: a joint outside its limits beyond max_step"
+        elif code < 0:
+            reason = f"QP {DAQP_EXIT.get(int(code), f'exit flag {code}')}"
+        return QPSolveStats(out, int(it), float(err), err < self.res.tol, reason)
+
     def solve(self, target: np.ndarray, q: np.ndarray) -> QPSolveStats:
         """Iterate QP steps towards ``target`` (4, 4) from q (n,) (q is not modified)."""
+        if self.res.solver == "compiled":
+            return self._solve_compiled(target, q)
         res = self.res
         q = np.array(q, dtype=float)
         self.frame.set_target(target)
@@ -208,7 +259,6 @@ class _QPState:
                 q = np.clip(q + 1e-3, lo, hi)
                 since_best = 0
         if best >= res.tol and not reason and it < res.max_iter:
-            reason = ("no progress towards the target: the constraints (limits, obstacles, "
-                      "max_joint_step) block the task or the target is out of reach")
+            reason = _NO_PROGRESS
         q, err = best_q, best
         return QPSolveStats(q, it, err, err < res.tol, reason)

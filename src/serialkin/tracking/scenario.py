@@ -32,7 +32,8 @@ Schema (fields marked * are required)::
       max_joint_step [rad]   (dls / IK: report larger joint jumps between points;
                               qp: a hard bound, points beyond it are reported unreached)
       safety [m], collision_gain, self_collision, posture_weight, damping, max_step,
-      max_joint_step, tol, max_iter, link_radius, backend (daqp | qpsolvers:<name>)  (qp)
+      max_joint_step, tol, max_iter, link_radius,
+      backend (compiled | daqp | qpsolvers:<name>)  (qp)
       weight, obstacle_weight, joint_limit_weight, limit_buffer, singularity_damping,
       manipulability_threshold, repulsive_gain, gain, max_task_step, link_radius (multitask)
     tolerance: float [m]            (default 0.005)
