@@ -885,7 +885,8 @@ def _qp_part(ctx: ReportContext, sc: Scenario, rows: list[SideBySide]) -> Sectio
         + ctx.imath(r"\nabla d\,\Delta\mathbf{q} \ge -\xi\,\frac{d - d_s}{d_i - d_s}")
         + f", safety distance d_s = {res.safety * 1e3:g} mm, "
         + ctx.imath(r"\xi = " + f"{res.collision_gain:g}" + r"\,(d_i - d_s)")
-        + "), solved by DAQP (a dual active-set solver in C).</p>",
+        + "), solved by a dual active-set method (Goldfarb–Idnani) compiled into the "
+        "tracking loop.</p>",
     ]
     table = [(r.label, f"{len(r.trajectory) - r.unreached}/{len(sc.path)}", _mm(r.max_error),
               _mm(r.min_clearance), f"{r.worst_margin * DEG:.2f}",
@@ -911,9 +912,12 @@ def _qp_part(ctx: ReportContext, sc: Scenario, rows: list[SideBySide]) -> Sectio
         "the QP runs joints right up to their limits (margin 0° is allowed, beyond is "
         "impossible). The guarantee is the difference: the QP's limits hold by "
         "construction for any path and any weights, eq 48's only as long as its weights "
-        f"win. The QP costs about {ratio:.2g}× more time per path point (a QP solve per "
-        "iteration from Python against eq 48's compiled loop), at "
-        f"{q.per_point * 1e3:.2g} ms per point; timings are wall-clock medians on a shared "
+        f"win. Time per path point: {q.per_point * 1e3:.2g} ms for the QP against "
+        f"{w.per_point * 1e3:.2g} ms for eq 48 ({ratio:.2g}×; both run their iterations in "
+        "compiled loops, the QP with a dual active-set solver compiled with numba, which "
+        "measured 5× faster here than calling DAQP from Python each iteration; the QP "
+        f"needs {int(q.trajectory.iterations.sum())} iterations against eq 48's "
+        f"{int(w.trajectory.iterations.sum())}); timings are wall-clock medians on a shared "
         "machine.</p>")
     phases = _phases(sc)
     steps = np.arange(len(w.trajectory))
