@@ -22,6 +22,7 @@ which keeps every hard constraint that held before).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -159,10 +160,7 @@ class DiffIK:
         H = self.damping * self._eye
         c = np.zeros(n)
         for t in self.tasks:
-            J, e, w = t.rows(self.ws, q)
-            WJ = J * w[:, None]
-            H = H + J.T @ WJ
-            c -= t.gain * (WJ.T @ e)
+            t.accumulate(self.ws, q, H, c)
         lb = self._lb
         ub = self._ub
         lb.fill(-np.inf)
@@ -185,7 +183,7 @@ class DiffIK:
     def step(self, q: object) -> StepResult:
         """Solve the QP at q (n,); see the module docstring for failures."""
         qv = np.ascontiguousarray(q, dtype=float)
-        if qv.shape != (self.robot.n,) or not np.all(np.isfinite(qv)):
+        if qv.shape != (self.robot.n,) or not math.isfinite(float(qv @ qv)):
             raise InputError(f"q must be {self.robot.n} finite values, got shape {qv.shape}")
         H, c, G, h, lb, ub = self.problem(qv)
         n = qv.size
@@ -195,8 +193,8 @@ class DiffIK:
             return StepResult(np.zeros(n), False,
                               f"conflicting bounds on {name}: the constraints need "
                               f"Δq ≥ {lb[j]:.4g} and Δq ≤ {ub[j]:.4g}", 0.0, h.size)
-        lb = np.clip(np.minimum(lb, ub), -_BIG, _BIG)  # bounds within 1e-12 of each other
-        ub = np.clip(ub, -_BIG, _BIG)
+        lb = np.maximum(np.minimum(lb, ub), -_BIG)  # bounds within 1e-12 of each other
+        ub = np.minimum(ub, _BIG)
         try:
             if self.solver == "daqp":
                 x, fval, flag = _solve_daqp(H, c, G, h, lb, ub)

@@ -73,6 +73,13 @@ class Task:
         """Task Jacobian, error and row weights at q (``ws`` holds the tool J and pose)."""
         raise NotImplementedError  # pragma: no cover
 
+    def accumulate(self, ws: Workspace, q: np.ndarray, H: np.ndarray, c: np.ndarray) -> None:
+        """Add the task to the QP: ``H += Jᵀ W J``, ``c −= gain Jᵀ W e`` (in place)."""
+        J, e, w = self.rows(ws, q)
+        WJ = J * w[:, None]
+        H += J.T @ WJ
+        c -= self.gain * (WJ.T @ e)
+
     def error_norm(self, ws: Workspace, q: np.ndarray) -> float:
         """‖e‖ of the task at q (after ``ws.update(q)``)."""
         return float(np.linalg.norm(self.rows(ws, q)[1]))
@@ -143,6 +150,14 @@ class PostureTask(Task):
         self._w = _weights(self.weight, ref.size)
         self._eye = np.eye(ref.size)
         self.gain = check_positive(self.gain, "gain", maximum=1.0)
+
+    def accumulate(self, ws: Workspace, q: np.ndarray, H: np.ndarray, c: np.ndarray) -> None:
+        """``H += diag(w)``, ``c −= gain · w (q_ref − q)`` (J = I, without forming it)."""
+        if self._ref.size != q.size:
+            raise InputError(f"PostureTask reference has {self._ref.size} values but the "
+                             f"robot has {q.size} joints")
+        H.flat[::q.size + 1] += self._w
+        c -= self.gain * self._w * (self._ref - q)
 
     def rows(self, ws: Workspace, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Identity rows and ``q_ref − q``."""
