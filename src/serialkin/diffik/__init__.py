@@ -14,6 +14,7 @@ from serialkin.diffik.constraints import (
     StepBox,
     VelocityLimit,
 )
+from serialkin.diffik.model_collision import ModelCollisionAvoidance
 from serialkin.diffik.qp import DiffIK, StepResult, solve_step
 from serialkin.diffik.resolver import QPResolver, QPSolveStats
 from serialkin.diffik.tasks import CustomTask, FrameTask, ManipulabilityTask, PostureTask, Task
@@ -25,6 +26,7 @@ __all__ = [
     "DiffIK",
     "FrameTask",
     "ManipulabilityTask",
+    "ModelCollisionAvoidance",
     "PositionLimit",
     "PostureTask",
     "QPResolver",
