@@ -199,3 +199,17 @@ def test_self_collision_tracking_keeps_links_apart_in_both_loops():
         runs.append(track(arm, path, res, q0=np.full(6, 0.1)))
         assert _self_distance(arm, runs[-1].q) > 0.0
     np.testing.assert_allclose(runs[0].q, runs[1].q, atol=1e-6)
+
+
+def test_margin_larger_than_the_free_space_is_reported(tmp_path):
+    """A safety distance no configuration can keep: infeasible QPs are named, never silent."""
+    arm = planar_arm(6, 0.1)
+    obs = Circle([0.3, 0.2], 0.05, influence=0.05)
+    path = Path.from_points([arm.fk(np.full(6, 0.2))[:2, 3], [0.45, 0.1]])
+    res = QPResolver(task="planar", obstacles=(obs,), safety=0.5, max_step=0.01)
+    tr = track(arm, path, res, q0=np.full(6, 0.2))
+    text = tr.summary()
+    assert "infeasible" in text
+    assert tr.notes or any("infeasible" in f.reason for f in tr.failures)
+    back = type(tr).load(tr.save(tmp_path / "t.npz"))
+    assert back.notes == tr.notes and back.failures == tr.failures

@@ -227,6 +227,7 @@ def track(
     ITER = np.zeros(p, dtype=np.int64)
     ERR = np.zeros(p)
     TIMES = np.zeros(p)
+    reasons: dict[int, str] = {}  # why a solver stopped early at a point (QP)
     targets = np.ascontiguousarray(path.targets)
 
     if isinstance(solver, str) and solver == "dls":
@@ -283,12 +284,15 @@ def track(
             Q[k] = q
             ITER[k] = res.iterations
             ERR[k] = res.error
+            reason = getattr(res, "reason", "")
+            if reason:
+                reasons[k] = reason
             count = k + 1
             if stop and res.error > accept:
                 break
     return _assemble(robot, path, Q[:count], ITER[:count], ERR[:count], TIMES[:count],
                      obstacles, link_radius, accept, label,
-                     stop and count > 0 and ERR[count - 1] > accept, q_start, jump)
+                     stop and count > 0 and ERR[count - 1] > accept, q_start, jump, reasons)
 
 
 class _IKStats:
@@ -331,7 +335,7 @@ def joint_jumps(q_start: np.ndarray, Q: np.ndarray, threshold: float) -> list[Jo
 
 
 def _assemble(robot, path: Path, Q, ITER, ERR, TIMES, obstacles, link_radius, accept, label,
-              stopped, q_start=None, jump=None) -> Trajectory:
+              stopped, q_start=None, jump=None, reasons=None) -> Trajectory:
     count = Q.shape[0]
     poses = np.empty((count, 4, 4))
     for k in range(count):  # serial: the parallel batch kernel costs ms of thread start-up
@@ -346,12 +350,22 @@ def _assemble(robot, path: Path, Q, ITER, ERR, TIMES, obstacles, link_radius, ac
         clear = np.zeros((count, len(obstacles)))
     margin = limit_margins(Q, np.asarray(robot.qlim, dtype=float))
     reached = ERR <= accept
-    failures = [PathFailure(int(k), float(ERR[k]), tuple(float(v) for v in path.points[k]))
+    reasons = reasons or {}
+    failures = [PathFailure(int(k), float(ERR[k]), tuple(float(v) for v in path.points[k]),
+                            reasons.get(int(k), ""))
                 for k in np.flatnonzero(~reached)]
+    # solver failures at points that were still reached (e.g. an infeasible QP at a point
+    # the robot already sat on): one note per distinct reason, never silent
+    notes: dict[str, list[int]] = {}
+    for k, why in sorted(reasons.items()):
+        if reached[k] and not why.startswith("no progress"):
+            notes.setdefault(why, []).append(k)
+    note_text = [f"{why} at {len(ks)} reached path point(s), first at point {ks[0]}"
+                 for why, ks in notes.items()]
     return Trajectory(
         q=Q, poses=poses, targets=np.array(path.targets[:count]), errors=ERR,
         iterations=ITER, reached=reached, clearance=clear, limit_margin=margin, times=TIMES,
         task=path.task, tolerance=accept, joint_names=tuple(robot.joint_names),
         obstacle_names=tuple(o.name or f"obstacle{i + 1}" for i, o in enumerate(obstacles)),
         failures=failures, stopped=bool(stopped), path_length=len(path), solver=label,
-        jumps=[] if jump is None else joint_jumps(q_start, Q, jump))
+        jumps=[] if jump is None else joint_jumps(q_start, Q, jump), notes=note_text)
