@@ -156,6 +156,9 @@ def test_collision_damper_limits_the_approach(arm):
         q = q + res.dq
         C1, _ = con.distances(arm, q)
         assert C1.min() > 0.0  # never enters
+        near = C0 < 0.01 + obs.influence  # the constrained pairs
+        allowed = C0 - 0.5 * (C0 - 0.01)  # damper: lose at most half the excess over d_s
+        assert np.all(C1[near] >= allowed[near] - 1e-3)  # up to second order (steps 0.05 rad)
     assert C1.min() == pytest.approx(0.01, abs=2e-3)  # settles at the safety distance
 
 
