@@ -65,15 +65,26 @@ class StepResult:
 
 
 def _solve_daqp(H, c, G, h, lb, ub):
-    import daqp
-
+    daqp = _daqp()
     if h.size:
         bu = np.concatenate([ub, h])
         bl = np.concatenate([lb, np.full(h.size, -_BIG)])
     else:
         bu, bl = ub, lb
     x, fval, flag, _ = daqp.solve(H, c, G, bu, bl)
-    return np.asarray(x, dtype=float), float(fval), int(flag)
+    return x, fval, flag
+
+
+_DAQP = []
+
+
+def _daqp():
+    """The daqp module, imported once (lazily: ``import serialkin`` does not load it)."""
+    if not _DAQP:
+        import daqp
+
+        _DAQP.append(daqp)
+    return _DAQP[0]
 
 
 def _solve_compiled(H, c, G, h, lb, ub):
@@ -152,13 +163,20 @@ class DiffIK:
         self._eye = np.eye(robot.n)
         self._lb = np.empty(robot.n)
         self._ub = np.empty(robot.n)
+        self._H = np.empty((robot.n, robot.n))
+        self._c = np.empty(robot.n)
+        self._no_rows = (np.zeros((0, robot.n)), np.zeros(0))
 
     def problem(self, q: np.ndarray) -> tuple[np.ndarray, ...]:
-        """The QP at q: ``(H (n, n), c (n,), G (r, n), h (r,), lb (n,), ub (n,))``."""
-        n = self.robot.n
+        """The QP at q: ``(H (n, n), c (n,), G (r, n), h (r,), lb (n,), ub (n,))``.
+
+        The arrays are this object's buffers, overwritten by the next call: copy what you
+        keep.
+        """
         self.ws.update(q)
-        H = self.damping * self._eye
-        c = np.zeros(n)
+        H = np.multiply(self._eye, self.damping, out=self._H)
+        c = self._c
+        c.fill(0.0)
         for t in self.tasks:
             t.accumulate(self.ws, q, H, c)
         lb = self._lb
@@ -176,8 +194,10 @@ class DiffIK:
                 if h.size:
                     Gs.append(G)
                     hs.append(h)
-        G = np.vstack(Gs) if Gs else np.zeros((0, n))
-        h = np.concatenate(hs) if hs else np.zeros(0)
+        if not Gs:
+            return H, c, *self._no_rows, lb, ub
+        G = Gs[0] if len(Gs) == 1 else np.vstack(Gs)
+        h = hs[0] if len(hs) == 1 else np.concatenate(hs)
         return H, c, G, h, lb, ub
 
     def step(self, q: object) -> StepResult:
@@ -205,13 +225,13 @@ class DiffIK:
                                                  lb, ub)
         except Exception as exc:  # noqa: BLE001 - a solver's internal error becomes a result
             return StepResult(np.zeros(n), False, f"QP solver failed: {exc}", 0.0, h.size)
-        if flag not in (1, 2) or x is None or not np.all(np.isfinite(x)):
+        if flag not in (1, 2) or x is None or not math.isfinite(float(x @ x)):
             what = DAQP_EXIT.get(flag, f"exit flag {flag}")
             hint = (" (the constraints conflict: e.g. a link already closer to an obstacle "
                     "than the safety distance with no way out within the limits)"
                     if flag == -1 and h.size else "")
             return StepResult(np.zeros(n), False, f"QP {what}{hint}", 0.0, h.size)
-        return StepResult(x, True, "", fval, h.size)
+        return StepResult(np.array(x, dtype=float), True, "", float(fval), h.size)
 
 
 def solve_step(robot, q: object, tasks: Sequence[Task], constraints: Sequence[Constraint] = (),

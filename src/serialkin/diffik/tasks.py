@@ -111,7 +111,9 @@ class FrameTask(Task):
 
     def __post_init__(self) -> None:
         self._rows = task_rows(self.task)
+        self._all = self._rows.tolist() == [0, 1, 2, 3, 4, 5]
         self._w = _weights(self.weight, self._rows.size)
+        self._unit = bool(np.all(self._w == 1.0))
         self.gain = check_positive(self.gain, "gain", maximum=1.0)
         self.set_target(self.target)
 
@@ -122,7 +124,20 @@ class FrameTask(Task):
     def rows(self, ws: Workspace, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Rows of the geometric Jacobian and of the pose error (see the class docstring)."""
         pose_error_into(ws.T, self.target, ws.e6)
+        if self._all:
+            return ws.J, ws.e6, self._w
         return ws.J[self._rows], ws.e6[self._rows], self._w
+
+    def accumulate(self, ws: Workspace, q: np.ndarray, H: np.ndarray, c: np.ndarray) -> None:
+        """``H += Jᵀ W J``, ``c −= gain Jᵀ W e`` (unit weights: no weighting pass)."""
+        J, e, w = self.rows(ws, q)
+        if self._unit:
+            H += J.T @ J
+            c -= self.gain * (e @ J)
+        else:
+            WJ = J * w[:, None]
+            H += J.T @ WJ
+            c -= self.gain * (e @ WJ)
 
 
 @dataclass
