@@ -246,3 +246,25 @@ def test_compiled_solver_reports_infeasibility(arm):
     con = CollisionAvoidance([obs], safety=0.05, influence=0.1, gain=1.0)
     res = solve_step(arm, q, [PostureTask(q)], [con, VelocityLimit(1e-4)], solver="compiled")
     assert not res.success and "infeasible" in res.reason
+
+
+def test_resolver_and_tracker_reject_bad_settings(arm):
+    """QPResolver and track(solver='qp') name the bad setting (library errors, nothing run)."""
+    from serialkin.diffik import QPResolver
+    from serialkin.tracking import Path, track
+
+    for kwargs, word in (({"max_step": -1.0}, "max_step"), ({"obstacles": "abc"}, "obstacles"),
+                         ({"solver": "cvx"}, "solver"), ({"collision_gain": 2.0}, "collision_gain"),
+                         ({"max_joint_step": float("nan")}, "max_joint_step"),
+                         ({"task": "sideways"}, "sideways"), ({"max_iter": 0}, "max_iter")):
+        with pytest.raises((InputError, InputTypeError), match=word):
+            QPResolver(**kwargs)
+    path = Path.from_points([[0.3, 0.1]])
+    with pytest.raises(InputError, match="max_joint_step"):
+        track(arm, path, "qp", max_joint_step=float("inf"))
+    with pytest.raises(InputError, match="task"):
+        track(arm, path, QPResolver(task="position"))
+    with pytest.raises(InputError, match="target"):
+        FrameTask(np.eye(3))
+    with pytest.raises(InputError, match="q must be"):
+        DiffIK(arm, [PostureTask(np.zeros(arm.n))]).step(np.full(arm.n, np.nan))
