@@ -213,3 +213,25 @@ def test_margin_larger_than_the_free_space_is_reported(tmp_path):
     assert tr.notes or any("infeasible" in f.reason for f in tr.failures)
     back = type(tr).load(tr.save(tmp_path / "t.npz"))
     assert back.notes == tr.notes and back.failures == tr.failures
+
+
+def test_panda_tracking_with_its_capsule_model_and_a_scene():
+    """A Panda path over a box on a table: no capsule enters the scene or another body."""
+    import serialkin as sk
+    from serialkin.collision import Box, HalfSpace, scene_clearance, self_clearance
+
+    panda = sk.models.get("panda")
+    box = Box([0.5, 0.0, 0.1], [0.1, 0.15, 0.1])
+    scene = (box, HalfSpace([0, 0, 1], -0.12))
+    q0 = np.array([0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8])
+    start = panda.fk(q0)[:3, 3]
+    path = Path.polyline([start, [0.5, 0.0, 0.22], [0.5, 0.2, 0.3]], 0.01)
+    res = QPResolver(task="position", scene=scene, self_collision=True, safety=0.005,
+                     max_step=0.02, max_iter=100)
+    tr = track(panda, path, res, q0=q0)
+    sc = scene_clearance(panda, panda.collision, tr.q, scene).distance
+    sf = self_clearance(panda, panda.collision, tr.q).distance
+    assert sc.min() > 0.0 and sf.min() > 0.0
+    lim = panda.qlim
+    assert np.all(tr.q >= lim[:, 0]) and np.all(tr.q <= lim[:, 1])
+    assert tr.reached[0] and tr.reached[-1]

@@ -15,7 +15,9 @@ for overlapping shapes alike), so ``∇d = uᵀ J_p(w₁)`` for a scene pair and
 ``∇d = uᵀ (J_p(w₁) − J_p(w₂))`` for a self pair, with ``J_p`` the point Jacobian of the
 witness point held on its link frame (the compiled kernel family). Rows as in
 :class:`~serialkin.diffik.constraints.CollisionAvoidance`:
-``∇d · Δq ≥ −gain (d − d_s)`` when ``d < d_i``.
+``∇d · Δq ≥ −gain (d − d_s)`` when ``d < d_i``. A capsule against a scene shape also gets
+the rows of its two end spheres: lying flat on a face it has a whole segment of closest
+points, and a single row at one of them would let the other end sink as it tilts.
 """
 
 from __future__ import annotations
@@ -98,7 +100,9 @@ def model_rows_into(q, F, L, meta, shape_frame, A, B, rad, scene, pa, pb, influe
     """Velocity-damper rows of every robot-shape/scene-shape pair and checked self pair.
 
     ``DIST`` (m·k + P,) receives every pair's signed distance (scene pairs shape-major,
-    then the self pairs); ``WHO[r]`` the pair index of row r. Returns the number of rows.
+    then the self pairs); ``WHO[r]`` the pair index of row r (``−1 − index`` for the rows of
+    a capsule's end spheres against the scene). G, h, WHO hold up to 3·m·k + P rows.
+    Returns the number of rows.
     """
     n = q.shape[0]
     K.fk_all_into(q, F, L, meta, frames)
@@ -121,22 +125,36 @@ def model_rows_into(q, F, L, meta, shape_frame, A, B, rad, scene, pa, pb, influe
     k = scene.shape[0]
     for s in range(m):
         for o in range(k):
-            d, w1, w2 = _scene_pair(W0[s].copy(), W1[s].copy(), rad[s], scene, o)
-            DIST[idx] = d
-            if d < influence and abs(d) > 1e-12:
-                for r in range(3):
-                    u[r] = (w1[r] - w2[r]) / d
-                for c in range(n):
-                    g[c] = 0.0
-                _add_gradient(q, F, L, meta, frames, shape_frame[s], w1, u, 1.0, Jbuf, pbuf, g)
-                if _negligible(g):  # a shape that does not move (on the base): no row
-                    idx += 1
-                    continue
-                for c in range(n):
-                    G[rows, c] = -g[c]
-                h[rows] = gain * (d - safety)
-                WHO[rows] = idx
-                rows += 1
+            # the closest pair, then (for a capsule) each end as a sphere: a capsule lying
+            # flat on a face has a whole segment of closest points, and one row at one of
+            # them lets the other end sink when the capsule tilts
+            for part in range(3):
+                if part == 0:
+                    d, w1, w2 = _scene_pair(W0[s].copy(), W1[s].copy(), rad[s], scene, o)
+                    DIST[idx] = d
+                else:
+                    end = W0[s].copy() if part == 1 else W1[s].copy()
+                    same = True
+                    for r in range(3):
+                        if W0[s, r] != W1[s, r]:
+                            same = False
+                    if same:
+                        break
+                    d, w1, w2 = _scene_pair(end, end.copy(), rad[s], scene, o)
+                if d < influence and abs(d) > 1e-12:
+                    for r in range(3):
+                        u[r] = (w1[r] - w2[r]) / d
+                    for c in range(n):
+                        g[c] = 0.0
+                    _add_gradient(q, F, L, meta, frames, shape_frame[s], w1, u, 1.0, Jbuf,
+                                  pbuf, g)
+                    if _negligible(g):  # a shape that does not move (on the base): no row
+                        continue
+                    for c in range(n):
+                        G[rows, c] = -g[c]
+                    h[rows] = gain * (d - safety)
+                    WHO[rows] = idx if part == 0 else -1 - idx
+                    rows += 1
             idx += 1
     for p in range(pa.shape[0]):
         i = pa[p]
@@ -220,10 +238,11 @@ class ModelCollisionAvoidance(Constraint):
         else:
             pa = pb = np.zeros(0, dtype=np.int64)
         total = model.a.shape[0] * self._scene.shape[0] + pa.size
+        rows = 3 * model.a.shape[0] * self._scene.shape[0] + pa.size
         st = (robot, model, np.ascontiguousarray(model.shape_frame, dtype=np.int64),
               np.ascontiguousarray(pa, dtype=np.int64), np.ascontiguousarray(pb, dtype=np.int64),
-              np.empty((robot.n + 1, 4, 4)), np.empty((total, robot.n)), np.empty(total),
-              np.empty(total), np.empty(total, dtype=np.int64))
+              np.empty((robot.n + 1, 4, 4)), np.empty((rows, robot.n)), np.empty(rows),
+              np.empty(total), np.empty(rows, dtype=np.int64))
         self._cache = {id(robot): st}
         self._check_base(robot, model, st)
         return st

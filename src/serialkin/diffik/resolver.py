@@ -69,7 +69,13 @@ class QPResolver:
         link_radius: link capsule radius [m].
         safety: d_s, clearance kept from obstacles [m].
         collision_gain: fraction of ``d − d_s`` the clearance may lose per step, (0, 1].
-        self_collision: also keep non-adjacent links apart (segments two or more apart).
+        self_collision: also keep non-adjacent links apart (segments two or more apart; with
+            ``scene`` the checked body pairs of the capsule model).
+        scene: scene shapes for the robot's capsule model ``robot.collision``
+            (:class:`~serialkin.diffik.model_collision.ModelCollisionAvoidance`): spheres,
+            capsules, z-cylinders, boxes, half-spaces of :mod:`serialkin.collision`, in the
+            world frame. Non-empty: the capsule model is used (the iterations then run in
+            Python around :class:`~serialkin.diffik.DiffIK`, with the chosen solver).
         posture_weight: weight of the pull towards the point's start configuration.
         damping: μ, Tikhonov damping of the QP [cost/rad²].
         max_step: largest change of any joint per iteration [rad or m].
@@ -85,6 +91,7 @@ class QPResolver:
 
     task: str | Sequence[int] = "planar"
     obstacles: tuple = field(default_factory=tuple)
+    scene: tuple = field(default_factory=tuple)
     link_radius: float = 0.0
     safety: float = 0.002
     collision_gain: float = 0.5
@@ -111,6 +118,13 @@ class QPResolver:
                 raise InputError(f"obstacles[{i}] must be a Circle, Sphere or Capsule, got "
                                  f"{type(o).__name__}")
         object.__setattr__(self, "obstacles", obs)
+        from serialkin.collision.shapes import encode_scene
+
+        if isinstance(self.scene, (str, bytes, Mapping)) or not isinstance(self.scene, Iterable):
+            raise InputError(f"scene must be a list of scene shapes, got "
+                             f"{type(self.scene).__name__}")
+        object.__setattr__(self, "scene", tuple(self.scene))
+        encode_scene(self.scene)
         for name in ("link_radius", "safety", "posture_weight", "damping"):
             object.__setattr__(self, name, check_positive(getattr(self, name), name,
                                                           allow_zero=True))
@@ -159,7 +173,16 @@ class _QPState:
             self.box = StepBox(np.zeros(n), res.max_joint_step)
             cons.append(self.box)
         self.collision = None
-        if res.obstacles or res.self_collision:
+        self.model_collision = None
+        if res.scene:
+            from serialkin.diffik.model_collision import ModelCollisionAvoidance
+
+            self.model_collision = ModelCollisionAvoidance(
+                res.scene, self_collision=res.self_collision, safety=res.safety,
+                influence=res.safety + 0.03, gain=res.collision_gain)
+            self.model_collision._state(robot)  # no model, or the scene through the base
+            cons.append(self.model_collision)
+        if res.obstacles or (res.self_collision and not res.scene):
             self.collision = CollisionAvoidance(
                 res.obstacles, link_radius=res.link_radius, safety=res.safety,
                 gain=res.collision_gain, self_pairs="auto" if res.self_collision else ())
@@ -168,7 +191,8 @@ class _QPState:
         self.ik = DiffIK(robot, tasks, cons, damping=res.damping, solver=res.solver)
         self.lo = np.ascontiguousarray(robot.qlim[:, 0], dtype=float)
         self.hi = np.ascontiguousarray(robot.qlim[:, 1], dtype=float)
-        if res.solver == "compiled":
+        self.in_kernel = res.solver == "compiled" and self.model_collision is None
+        if self.in_kernel:
             self._prepare_compiled()
 
     def _prepare_compiled(self) -> None:
@@ -221,7 +245,7 @@ class _QPState:
 
     def solve(self, target: np.ndarray, q: np.ndarray) -> QPSolveStats:
         """Iterate QP steps towards ``target`` (4, 4) from q (n,) (q is not modified)."""
-        if self.res.solver == "compiled":
+        if self.in_kernel:
             return self._solve_compiled(target, q)
         res = self.res
         q = np.array(q, dtype=float)
