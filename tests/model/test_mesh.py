@@ -210,7 +210,7 @@ def test_import_serialkin_does_not_import_trimesh() -> None:
 
 
 def test_decimate_keeps_the_surface_of_a_mesh_with_repeated_vertices():
-    """Decimating a per-corner (STL-like) sphere keeps its area within 10 % (vertices welded first)."""
+    """Decimating a per-corner (STL-like) sphere keeps its area within 10 % (welded first)."""
     pytest.importorskip("trimesh")
     pytest.importorskip("fast_simplification")
     from serialkin.model.geometry import Sphere

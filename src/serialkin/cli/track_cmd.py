@@ -38,11 +38,14 @@ _TRACK_HELP = command_help(
     "tracking error, clearance in one figure) and each of them alone (<name>_motion.png, "
     "_joints.png, _error.png, _clearance.png with obstacles), <name>.gif (and .mp4 with "
     "--mp4 when ffmpeg is present) and, with --viewer, <name>.html (the interactive "
-    "viewer). Exit code 1 when a path point is not reached within the tolerance; 2 on bad "
-    "input.",
+    "viewer). --solver qp replaces the scenario's solver by the differential-IK quadratic "
+    "program with hard joint limits and collision constraints (serialkin.diffik); "
+    "--max-joint-step reports (and with qp forbids) larger joint jumps between path points. "
+    "Exit code 1 when a path point is not reached within the tolerance; 2 on bad input.",
     ["serialkin track six_link_circle --out out/track",
      "serialkin track twenty_link_obstacles --format npz --viewer",
      "serialkin track my_scenario.yaml --no-animation --json",
+     "serialkin track twenty_link_obstacles --solver qp --max-joint-step 0.2",
      "serialkin track --list"],
 )
 
@@ -61,14 +64,21 @@ _TRACK_HELP = command_help(
 @click.option("--max-frames", type=int, default=150, show_default=True,
               help="At most this many animation frames (evenly spread).")
 @click.option("--viewer", is_flag=True, help="Also write the interactive viewer page.")
+@click.option("--solver", "solver", type=click.Choice(["scenario", "qp"]), default="scenario",
+              show_default=True,
+              help="The scenario's own solver, or the QP with hard constraints.")
+@click.option("--max-joint-step", type=float, default=None,
+              help="Report joint jumps between path points above this [rad]; a hard bound "
+                   "with --solver qp.")
 @click.option("--list", "list_only", is_flag=True, help="List the shipped scenarios.")
 @json_option
 @quiet_option
 @memory_budget_option
 @handle_errors
 def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_animation: bool,
-              mp4: bool, fps: float, max_frames: int, viewer: bool, list_only: bool,
-              as_json: bool, quiet: bool) -> None:
+              mp4: bool, fps: float, max_frames: int, viewer: bool, solver: str,
+              max_joint_step: float | None, list_only: bool, as_json: bool,
+              quiet: bool) -> None:
     """Track a scenario's path and write trajectory, figures and animation."""
     from serialkin.tracking import list_scenarios, load_scenario
 
@@ -85,8 +95,10 @@ def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_ani
     # every option is checked before anything is computed or written
     fps = check_positive(fps, "--fps")
     max_frames = check_int(max_frames, "--max-frames", minimum=1, maximum=MAX_FRAMES)
+    if max_joint_step is not None:
+        max_joint_step = check_positive(max_joint_step, "--max-joint-step")
     check_out_folder(out)
-    sc = load_scenario(scenario)
+    sc = _with_solver(load_scenario(scenario), solver, max_joint_step)
     stem = Path(scenario).stem if Path(scenario).suffix else scenario
     show = not quiet and not as_json and sys.stderr.isatty()
     if show:
@@ -168,8 +180,26 @@ def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_ani
             click.echo(f"  wrote {v}")
     for f in traj.failures:
         click.echo(str(f), err=True)
+    for j in traj.jumps:
+        click.echo(str(j), err=True)
     if not traj.complete:
         raise SystemExit(EXIT_NOT_REACHED)
+
+
+def _with_solver(sc: Any, solver: str, max_joint_step: float | None) -> Any:
+    """The scenario with --solver and --max-joint-step applied."""
+    from dataclasses import replace
+
+    from serialkin.diffik.resolver import QPResolver
+
+    if solver == "qp" and not isinstance(sc.solver, QPResolver):
+        sc = replace(sc, solver=QPResolver(task=sc.path.task, obstacles=sc.obstacles,
+                                           link_radius=sc.link_radius), options={})
+    if max_joint_step is not None:
+        if isinstance(sc.solver, QPResolver):
+            sc = replace(sc, solver=sc.solver.with_options(max_joint_step=max_joint_step))
+        sc = replace(sc, options={**sc.options, "max_joint_step": max_joint_step})
+    return sc
 
 
 def _summary(sc: Any, traj: Any, files: dict[str, str]) -> dict[str, Any]:
@@ -189,5 +219,6 @@ def _summary(sc: Any, traj: Any, files: dict[str, str]) -> dict[str, Any]:
         "stopped": traj.stopped,
         "failures": [{"index": f.index, "error": f.error, "target": list(f.target)}
                      for f in traj.failures],
+        "jumps": [{"index": j.index, "joint": j.joint, "size": j.size} for j in traj.jumps],
         "files": dict(files),
     }

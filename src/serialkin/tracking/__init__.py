@@ -18,10 +18,11 @@ from serialkin.tracking.scenario import (
     scenario_from_dict,
 )
 from serialkin.tracking.tracker import track
-from serialkin.tracking.trajectory import PathFailure, Trajectory
+from serialkin.tracking.trajectory import JointJump, PathFailure, Trajectory
 
 __all__ = [
     "Path",
+    "JointJump",
     "PathFailure",
     "Scenario",
     "ScenarioError",

@@ -27,8 +27,13 @@ Schema (fields marked * are required)::
       task: planar | position | planar_pose   # optional
     obstacles: [{type: circle|cylinder|sphere|capsule, center|a,b, radius, influence, name}]
     solver:
-      method: dls | multitask | <IK method name>          (default dls)
+      method: dls | multitask | qp | <IK method name>     (default dls)
       damping, tol, max_iter, max_step                     (dls / IK)
+      max_joint_step [rad]   (dls / IK: report larger joint jumps between points;
+                              qp: a hard bound, points beyond it are reported unreached)
+      safety [m], collision_gain, self_collision, posture_weight, damping, max_step,
+      max_joint_step, tol, max_iter, link_radius,
+      backend (compiled | daqp | qpsolvers:<name>)  (qp)
       weight, obstacle_weight, joint_limit_weight, limit_buffer, singularity_damping,
       manipulability_threshold, repulsive_gain, gain, max_task_step, link_radius (multitask)
     tolerance: float [m]            (default 0.005)
@@ -100,7 +105,9 @@ def planar_arm(links: int, length: float, *, name: str | None = None,
 
 _ROOT_FIELDS = {"name", "description", "robot", "q0", "q0_deg", "path", "obstacles", "solver",
                 "tolerance", "on_unreachable"}
-_DLS_FIELDS = {"damping", "tol", "max_iter", "max_step"}
+_DLS_FIELDS = {"damping", "tol", "max_iter", "max_step", "max_joint_step"}
+_QP_FIELDS = {"safety", "collision_gain", "self_collision", "posture_weight", "damping",
+              "max_step", "max_joint_step", "tol", "max_iter", "link_radius", "backend"}
 _MT_FIELDS = {"weight", "obstacle_weight", "joint_limit_weight", "limit_buffer", "damping",
               "singularity_damping", "manipulability_threshold", "repulsive_gain", "gain",
               "max_task_step", "max_step", "tol", "max_iter", "link_radius"}
@@ -124,7 +131,7 @@ class Scenario:
         path: the :class:`~serialkin.tracking.path.Path`.
         q0: (n,) start configuration [rad / m].
         obstacles: obstacles.
-        solver: 'dls', an IK method name, or a ``MultiTaskResolver``.
+        solver: 'dls', an IK method name, a ``MultiTaskResolver`` or a ``QPResolver``.
         options: keyword options for :func:`~serialkin.tracking.tracker.track`.
         tolerance: acceptance tolerance [m].
         on_unreachable: 'continue' or 'stop'.
@@ -292,9 +299,11 @@ def _solver(f: Field, path: Path, obstacles: tuple) -> tuple[Any, dict[str, Any]
     from serialkin.ik.registry import available_methods
 
     s = f.mapping() if f.present else Field({}, f.path, f.origin, f.error)
-    others = [m for m in available_methods() if m not in ("dls", "multitask")]
-    method = s["method"].string(choices=("dls", "multitask", *others),
+    others = [m for m in available_methods() if m not in ("dls", "multitask", "qp")]
+    method = s["method"].string(choices=("dls", "multitask", "qp", *others),
                                 default="dls")
+    if method == "qp":
+        return _qp_solver(s, path, obstacles)
     if method == "multitask":
         s.mapping(_MT_FIELDS | {"method"})
         kw: dict[str, Any] = {k: s[k].number(lo=0.0) for k in sorted(_MT_FIELDS - {"max_iter"})
@@ -308,7 +317,8 @@ def _solver(f: Field, path: Path, obstacles: tuple) -> tuple[Any, dict[str, Any]
         return resolver, {}, kw.get("link_radius", 0.0)
     s.mapping(_DLS_FIELDS | {"method", "options"})
     options: dict[str, Any] = {k: s[k].number(lo=0.0, lo_open=True)
-                               for k in ("damping", "tol", "max_step") if s[k].present}
+                               for k in ("damping", "tol", "max_step", "max_joint_step")
+                               if s[k].present}
     if s["max_iter"].present:
         options["max_iter"] = s["max_iter"].integer(lo=1, hi=MAX_ITERATIONS)
     if method != "dls":
@@ -317,6 +327,28 @@ def _solver(f: Field, path: Path, obstacles: tuple) -> tuple[Any, dict[str, Any]
     elif s["options"].present:
         raise s["options"].fail("is for IK methods; the 'dls' tracker has no options")
     return method, options, 0.0
+
+
+def _qp_solver(s: Field, path: Path, obstacles: tuple) -> tuple[Any, dict[str, Any], float]:
+    """The ``solver`` mapping of ``method: qp``: a :class:`~serialkin.diffik.QPResolver`."""
+    from serialkin.diffik.resolver import QPResolver
+
+    s.mapping(_QP_FIELDS | {"method"})
+    kw: dict[str, Any] = {k: s[k].number(lo=0.0) for k in sorted(
+        _QP_FIELDS - {"max_iter", "self_collision", "backend"}) if s[k].present}
+    if s["max_iter"].present:
+        kw["max_iter"] = s["max_iter"].integer(lo=1, hi=MAX_ITERATIONS)
+    if s["self_collision"].present:
+        if not isinstance(s["self_collision"].value, bool):
+            raise s["self_collision"].expected("true or false")
+        kw["self_collision"] = s["self_collision"].value
+    if s["backend"].present:
+        kw["solver"] = s["backend"].string(max_len=100)
+    try:
+        resolver = QPResolver(task=path.task, obstacles=obstacles, **kw)
+    except (InputError, InputTypeError) as exc:
+        raise s.fail(f"is invalid: {exc}") from exc
+    return resolver, {}, kw.get("link_radius", 0.0)
 
 
 def scenario_from_dict(data: object, source: str = "<dict>",

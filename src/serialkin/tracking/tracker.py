@@ -9,12 +9,21 @@ error is below ``tol`` or the iteration budget is spent ("CYCLE WHILE 2"). Solve
   corrected). The whole path runs in one compiled loop over the kernel family.
 * ``'multitask'`` or a :class:`~serialkin.redundancy.multitask.MultiTaskResolver` — the
   weighted multi-task resolution of eq 48 (obstacles, joint limits, singularities).
+* ``'qp'`` or a :class:`~serialkin.diffik.resolver.QPResolver` — differential IK as a
+  quadratic program with hard joint limits and collision constraints
+  (:mod:`serialkin.diffik`).
 * any other name — an IK method of :func:`serialkin.ik.solve` (``robot.ik``), warm
   started from the previous configuration.
 
 A point whose final error exceeds ``tolerance`` is reported (:class:`PathFailure`: index,
 error, target); tracking continues from the best configuration found or stops there, as
 chosen with ``on_unreachable``; everything computed so far is kept in the trajectory.
+
+Joint jumps: with ``max_joint_step`` set, every pair of consecutive points where some joint
+moved by more than that (a branch flip, a wrap) is reported in ``Trajectory.jumps``
+(:class:`~serialkin.tracking.trajectory.JointJump`), never silently; the QP solver
+additionally enforces the bound as a hard constraint, so it reports a point it cannot
+reach within the bound as not reached instead of jumping.
 """
 
 from __future__ import annotations
@@ -27,6 +36,7 @@ import numpy as np
 from numba import njit
 
 from serialkin._checks import MAX_ITERATIONS, check_choice, check_int, check_positive
+from serialkin.diffik.resolver import QPResolver
 from serialkin.errors import InputError, InputTypeError
 from serialkin.kinematics import kernels as K
 from serialkin.kinematics.dls import dls_step_into, weigh_rows_into
@@ -37,9 +47,9 @@ from serialkin.redundancy.objectives import task_rows
 from serialkin.redundancy.obstacles import _Geometry, check_obstacles, encode_obstacles
 from serialkin.spatial.kernels import pose_error_into
 from serialkin.tracking.path import Path
-from serialkin.tracking.trajectory import PathFailure, Trajectory
+from serialkin.tracking.trajectory import JointJump, PathFailure, Trajectory
 
-__all__ = ["ON_UNREACHABLE", "dls_track", "limit_margins", "track"]
+__all__ = ["ON_UNREACHABLE", "dls_track", "joint_jumps", "limit_margins", "track"]
 
 ON_UNREACHABLE = ("continue", "stop")
 
@@ -141,7 +151,7 @@ def _ik_target(path: Path, k: int) -> np.ndarray:
 def track(
     robot,
     path: Path,
-    solver: str | MultiTaskResolver = "dls",
+    solver: str | MultiTaskResolver | QPResolver = "dls",
     *,
     q0: object = None,
     obstacles: tuple = (),
@@ -153,6 +163,7 @@ def track(
     max_iter: int = 500,
     max_step: float = 0.5,
     ik_options: Mapping[str, Any] | None = None,
+    max_joint_step: float | None = None,
 ) -> Trajectory:
     """Track a path and record the trajectory.
 
@@ -161,8 +172,10 @@ def track(
         path: a :class:`~serialkin.tracking.path.Path`.
         solver: 'dls' (eq 46 corrected, compiled; joints projected onto their limits
             after every step), 'multitask' (eq 48 with default
-            weights and the given obstacles), a ``MultiTaskResolver``, or an IK method
-            name of :func:`serialkin.ik.solve`.
+            weights and the given obstacles), a ``MultiTaskResolver``, 'qp' (the
+            differential-IK QP with hard limits and collision constraints, default
+            settings, the given obstacles), a ``QPResolver``, or an IK method name of
+            :func:`serialkin.ik.solve`.
         q0: start configuration (n,); default zeros (the chapter's q0 = 0).
         obstacles: obstacles for clearance reporting (and for ``'multitask'``); a
             resolver's own obstacles are used when this is empty.
@@ -175,6 +188,9 @@ def track(
         max_iter: iteration budget per point (DLS and IK; a resolver keeps its own).
         max_step: cap on the joint step per DLS iteration [rad].
         ik_options: extra keyword arguments for ``robot.ik`` (IK methods only).
+        max_joint_step: report every point where a joint moved by more than this since
+            the previous point [rad or m] (``Trajectory.jumps``); with ``'qp'`` it is also
+            a hard bound of the QP. None: no check.
 
     Returns:
         :class:`~serialkin.tracking.trajectory.Trajectory`.
@@ -198,7 +214,8 @@ def track(
     if q_start.shape != (robot.n,):
         raise InputError(f"q0 must have shape ({robot.n},), got {q_start.shape}")
     rows = task_rows(path.task)
-    if isinstance(solver, MultiTaskResolver) and not obstacles:
+    jump = None if max_joint_step is None else check_positive(max_joint_step, "max_joint_step")
+    if isinstance(solver, (MultiTaskResolver, QPResolver)) and not obstacles:
         obstacles = solver.obstacles
     obstacles = tuple(obstacles)
     encode_obstacles(obstacles)
@@ -210,6 +227,7 @@ def track(
     ITER = np.zeros(p, dtype=np.int64)
     ERR = np.zeros(p)
     TIMES = np.zeros(p)
+    reasons: dict[int, str] = {}  # why a solver stopped early at a point (QP)
     targets = np.ascontiguousarray(path.targets)
 
     if isinstance(solver, str) and solver == "dls":
@@ -227,7 +245,19 @@ def track(
         if isinstance(solver, str) and solver == "multitask":
             solver = MultiTaskResolver(task=path.task, obstacles=obstacles,
                                        link_radius=link_radius, max_iter=budget, tol=conv)
-        if isinstance(solver, MultiTaskResolver):
+        if isinstance(solver, str) and solver == "qp":
+            solver = QPResolver(task=path.task, obstacles=obstacles, link_radius=link_radius,
+                                max_iter=budget, tol=conv, max_joint_step=jump)
+        if isinstance(solver, QPResolver):
+            if list(task_rows(solver.task)) != list(rows):
+                raise InputError(f"the resolver's task {solver.task!r} does not match the "
+                                 f"path's task {path.task!r}")
+            if jump is not None and solver.max_joint_step is None:
+                solver = solver.with_options(max_joint_step=jump)
+            label = "differential-IK QP (hard limits and collision constraints)"
+            qstate = solver.prepare(robot)
+            step = lambda k, q: qstate.solve(targets[k], q)  # noqa: E731
+        elif isinstance(solver, MultiTaskResolver):
             if list(task_rows(solver.task)) != list(rows):
                 raise InputError(f"the resolver's task {solver.task!r} does not match the "
                                  f"path's task {path.task!r}")
@@ -241,8 +271,9 @@ def track(
             opts.setdefault("tol", conv)
             step = _ik_step(robot, path, solver, opts)
         else:
-            raise InputTypeError("solver must be 'dls', 'multitask', an IK method name or a "
-                                 f"MultiTaskResolver, got {type(solver).__name__}")
+            raise InputTypeError("solver must be 'dls', 'multitask', 'qp', an IK method name, "
+                                 f"a MultiTaskResolver or a QPResolver, got "
+                                 f"{type(solver).__name__}")
         q = q_start.copy()
         count = 0
         for k in range(p):
@@ -253,12 +284,15 @@ def track(
             Q[k] = q
             ITER[k] = res.iterations
             ERR[k] = res.error
+            reason = getattr(res, "reason", "")
+            if reason:
+                reasons[k] = reason
             count = k + 1
             if stop and res.error > accept:
                 break
     return _assemble(robot, path, Q[:count], ITER[:count], ERR[:count], TIMES[:count],
                      obstacles, link_radius, accept, label,
-                     stop and count > 0 and ERR[count - 1] > accept)
+                     stop and count > 0 and ERR[count - 1] > accept, q_start, jump, reasons)
 
 
 class _IKStats:
@@ -283,8 +317,25 @@ def _ik_step(robot, path: Path, method: str, opts: dict):
     return step
 
 
+def joint_jumps(q_start: np.ndarray, Q: np.ndarray, threshold: float) -> list[JointJump]:
+    """Every point k where some joint moved by more than ``threshold`` since point k − 1.
+
+    Point 0 is compared with the start configuration. Returns one
+    :class:`~serialkin.tracking.trajectory.JointJump` per such point (its largest move).
+    """
+    if not Q.shape[0]:
+        return []
+    prev = np.vstack([q_start[None, :], Q[:-1]])
+    d = np.abs(Q - prev)
+    out = []
+    for k in np.flatnonzero(d.max(axis=1) > threshold * (1.0 + 1e-9) + 1e-12):  # float noise
+        j = int(np.argmax(d[k]))
+        out.append(JointJump(int(k), j, float(Q[k, j] - prev[k, j])))
+    return out
+
+
 def _assemble(robot, path: Path, Q, ITER, ERR, TIMES, obstacles, link_radius, accept, label,
-              stopped) -> Trajectory:
+              stopped, q_start=None, jump=None, reasons=None) -> Trajectory:
     count = Q.shape[0]
     poses = np.empty((count, 4, 4))
     for k in range(count):  # serial: the parallel batch kernel costs ms of thread start-up
@@ -299,11 +350,22 @@ def _assemble(robot, path: Path, Q, ITER, ERR, TIMES, obstacles, link_radius, ac
         clear = np.zeros((count, len(obstacles)))
     margin = limit_margins(Q, np.asarray(robot.qlim, dtype=float))
     reached = ERR <= accept
-    failures = [PathFailure(int(k), float(ERR[k]), tuple(float(v) for v in path.points[k]))
+    reasons = reasons or {}
+    failures = [PathFailure(int(k), float(ERR[k]), tuple(float(v) for v in path.points[k]),
+                            reasons.get(int(k), ""))
                 for k in np.flatnonzero(~reached)]
+    # solver failures at points that were still reached (e.g. an infeasible QP at a point
+    # the robot already sat on): one note per distinct reason, never silent
+    notes: dict[str, list[int]] = {}
+    for k, why in sorted(reasons.items()):
+        if reached[k] and not why.startswith("no progress"):
+            notes.setdefault(why, []).append(k)
+    note_text = [f"{why} at {len(ks)} reached path point(s), first at point {ks[0]}"
+                 for why, ks in notes.items()]
     return Trajectory(
         q=Q, poses=poses, targets=np.array(path.targets[:count]), errors=ERR,
         iterations=ITER, reached=reached, clearance=clear, limit_margin=margin, times=TIMES,
         task=path.task, tolerance=accept, joint_names=tuple(robot.joint_names),
         obstacle_names=tuple(o.name or f"obstacle{i + 1}" for i, o in enumerate(obstacles)),
-        failures=failures, stopped=bool(stopped), path_length=len(path), solver=label)
+        failures=failures, stopped=bool(stopped), path_length=len(path), solver=label,
+        jumps=[] if jump is None else joint_jumps(q_start, Q, jump), notes=note_text)

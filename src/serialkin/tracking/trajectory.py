@@ -25,20 +25,45 @@ import numpy as np
 from serialkin._io import write_bytes_atomic
 from serialkin.errors import InputError
 
-__all__ = ["PathFailure", "Trajectory"]
+__all__ = ["JointJump", "PathFailure", "Trajectory"]
 
 
 @dataclass(frozen=True)
 class PathFailure:
-    """A path point that was not reached: its index, its final error [m] and its target."""
+    """A path point that was not reached: index, final error [m], target, and the solver's reason.
+
+    ``reason`` is empty unless the solver says why it stopped (the QP tracker does: blocked
+    by constraints, infeasible QP, ...).
+    """
 
     index: int
     error: float
     target: tuple[float, ...]
+    reason: str = ""
 
     def __str__(self) -> str:
         t = ", ".join(f"{v:.4g}" for v in self.target)
-        return f"path point {self.index} ({t}) not reached: error {self.error:.4g} m"
+        why = f" ({self.reason})" if self.reason else ""
+        return f"path point {self.index} ({t}) not reached: error {self.error:.4g} m{why}"
+
+
+@dataclass(frozen=True)
+class JointJump:
+    """A joint that moved by more than the allowed step between path points k − 1 and k.
+
+    Attributes:
+        index: path point k (point 0 is compared with the start configuration).
+        joint: index of the joint that moved most (0-based).
+        size: its signed change [rad or m].
+    """
+
+    index: int
+    joint: int
+    size: float
+
+    def __str__(self) -> str:
+        return (f"joint {self.joint + 1} jumped by {self.size:.4g} between path points "
+                f"{self.index - 1} and {self.index} (a branch flip or wrap)")
 
 
 @dataclass
@@ -63,6 +88,9 @@ class Trajectory:
             the arrays then hold the points computed so far, the failing one included.
         path_length: number of points of the full path.
         solver: description of the solver used.
+        jumps: points where a joint moved by more than the tracker's ``max_joint_step``.
+        notes: solver failures at points that were nevertheless reached (e.g. an infeasible
+            QP: a safety margin larger than the free space), one line per distinct reason.
     """
 
     q: np.ndarray
@@ -82,6 +110,8 @@ class Trajectory:
     stopped: bool = False
     path_length: int = 0
     solver: str = ""
+    jumps: list[JointJump] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
 
     # ------------------------------------------------------------------ summaries
     def __len__(self) -> int:
@@ -125,6 +155,9 @@ class Trajectory:
             lines.append(f"min joint-limit margin {np.degrees(self.min_limit_margin):.4g} deg")
         for f in self.failures:
             lines.append(str(f))
+        for jmp in self.jumps:
+            lines.append(str(jmp))
+        lines.extend(self.notes)
         if self.stopped:
             lines.append("tracking stopped at the first unreachable point")
         return "; ".join(lines)
@@ -134,9 +167,12 @@ class Trajectory:
         return {"task": self.task, "tolerance": self.tolerance,
                 "joint_names": list(self.joint_names),
                 "obstacle_names": list(self.obstacle_names),
-                "failures": [[f.index, f.error, list(f.target)] for f in self.failures],
+                "failures": [[f.index, f.error, list(f.target), f.reason]
+                             for f in self.failures],
                 "stopped": self.stopped, "path_length": self.path_length,
-                "solver": self.solver}
+                "solver": self.solver,
+                "jumps": [[j.index, j.joint, j.size] for j in self.jumps],
+                "notes": list(self.notes)}
 
     def save(self, path: str | os.PathLike[str]) -> FsPath:
         """Write to ``.csv`` or ``.npz`` (chosen by the extension), atomically."""
@@ -227,10 +263,22 @@ class Trajectory:
                                for f in meta["obstacle_names"].items(max_len=k))
         failures = []
         for f in meta["failures"].items(max_len=arrays["q"].shape[0]):
-            idx, err, tgt = f.items(min_len=3, max_len=3, what="[index, error, target]")
+            parts = f.items(min_len=3, max_len=4, what="[index, error, target, reason?]")
+            idx, err, tgt = parts[:3]
+            why = parts[3].string(nonempty=False, max_len=10_000) if len(parts) == 4 else ""
             failures.append(PathFailure(idx.integer(hi=2**62), err.number(allow_inf=True),
                                         tuple(tgt.array(what="a list of numbers", ndim=1,
-                                                        max_items=16))))
+                                                        max_items=16)), why))
+        notes = []
+        if meta["notes"].present:
+            notes = [f.string(nonempty=False, max_len=10_000)
+                     for f in meta["notes"].items(max_len=1000)]
+        jumps = []
+        if meta["jumps"].present:  # files before the jump report have none
+            for f in meta["jumps"].items(max_len=arrays["q"].shape[0]):
+                idx, joint, size = f.items(min_len=3, max_len=3, what="[index, joint, size]")
+                jumps.append(JointJump(idx.integer(hi=2**62), joint.integer(hi=n - 1),
+                                       size.number()))
         stopped = meta["stopped"].value
         if not isinstance(stopped, bool):
             raise meta["stopped"].expected("true or false")
@@ -243,7 +291,8 @@ class Trajectory:
             tolerance=meta["tolerance"].number(lo=0.0, lo_open=True),
             joint_names=joint_names, obstacle_names=obstacle_names, failures=failures,
             stopped=stopped, path_length=meta["path_length"].integer(hi=2**62),
-            solver=meta["solver"].string(nonempty=False, max_len=10_000))
+            solver=meta["solver"].string(nonempty=False, max_len=10_000), jumps=jumps,
+            notes=notes)
 
 
 #: Largest trajectory file read, and largest total size of the arrays it unpacks to [bytes].
