@@ -2,7 +2,8 @@
 
 The site is built once per test session with ``mkdocs build --strict`` (a warning of MkDocs,
 mkdocstrings or griffe fails the build), exactly as ``make docs`` does, into a temporary folder.
-Python blocks fenced as ```` ```python ```` on the hand-written guide pages are run; fragments
+Python blocks fenced as ```` ```python ```` on the hand-written guide pages are run, page by
+page in one namespace (as a reader pastes them one after the other); fragments
 that are not meant to run (excerpts of the library's source) are fenced as ```` ```py ````.
 """
 
@@ -175,7 +176,7 @@ _BLOCK = re.compile(r"^```python\n(.*?)^```", re.S | re.M)
 
 @pytest.mark.parametrize("page", GUIDE_PAGES, ids=[p.name for p in GUIDE_PAGES])
 def test_guide_snippets_run(page, tmp_path, monkeypatch):
-    """Every ```python block of a guide page runs as pasted (from a scratch folder)."""
+    """The ```python blocks of a guide page run as pasted, in order, as one session."""
     blocks = _BLOCK.findall(page.read_text(encoding="utf-8"))
     if not blocks:
         assert "```python" not in page.read_text(encoding="utf-8")
@@ -185,8 +186,8 @@ def test_guide_snippets_run(page, tmp_path, monkeypatch):
     matplotlib.use("Agg")
     (tmp_path / "examples").symlink_to(ROOT / "examples")  # pages quote examples/ paths
     monkeypatch.chdir(tmp_path)
+    namespace = {"__name__": "__main__"}  # later blocks may use earlier blocks' names
     for i, block in enumerate(blocks):
-        namespace = {"__name__": "__main__"}
         try:
             exec(compile(block, f"{page.name} block {i + 1}", "exec"), namespace)  # noqa: S102
         except Exception as exc:  # noqa: BLE001 - report which block of which page
