@@ -35,6 +35,14 @@ class IKResult:
         reason: '' on success, else a sentence saying why the solve failed.
         restarts: how many times the solver restarted from a new random configuration.
         method: name of the method that produced the result.
+        clearance: smallest signed distance of the returned q [m] over the checked pairs
+            (self pairs not allowed by the collision matrix, robot shapes against the
+            scene): negative when shapes overlap; +inf when nothing is checked (no
+            ``scene`` nor ``self_collision``). With collision checking a success has
+            ``clearance >= margin``.
+        closest_pair: the two names realising ``clearance``: two body names, or a body
+            name and the scene shape (its name, else ``scene[i]``); ``('', '')`` when
+            nothing is checked. A batch holds an (N, 2) str array.
     """
 
     q: np.ndarray
@@ -45,10 +53,13 @@ class IKResult:
     reason: str | np.ndarray
     restarts: int | np.ndarray
     method: str
+    clearance: float | np.ndarray = np.inf
+    closest_pair: tuple[str, str] | np.ndarray = ("", "")
 
     @classmethod
     def make(cls, q: np.ndarray, success: bool, iterations: int, position_error: float,
-             orientation_error: float, reason: str, restarts: int, method: str) -> IKResult:
+             orientation_error: float, reason: str, restarts: int, method: str,
+             clearance: float = np.inf, closest_pair: tuple[str, str] = ("", "")) -> IKResult:
         """The result with these fields, built without the frozen ``__init__``'s overhead.
 
         For the solvers' hot path (about 1 µs less per call); the fields are trusted.
@@ -56,7 +67,8 @@ class IKResult:
         r = _NEW(cls)
         r.__dict__.update(q=q, success=success, iterations=iterations,
                           position_error=position_error, orientation_error=orientation_error,
-                          reason=reason, restarts=restarts, method=method)
+                          reason=reason, restarts=restarts, method=method,
+                          clearance=clearance, closest_pair=closest_pair)
         return r
 
     @property
@@ -81,6 +93,10 @@ class IKResult:
             reason=str(np.asarray(self.reason)[k]),
             restarts=int(np.asarray(self.restarts)[k]),
             method=self.method,
+            clearance=float(np.asarray(self.clearance)[k]) if np.ndim(self.clearance)
+            else float(self.clearance),
+            closest_pair=(tuple(str(x) for x in np.asarray(self.closest_pair)[k])
+                          if np.ndim(self.closest_pair) == 2 else tuple(self.closest_pair)),
         )
 
     def __repr__(self) -> str:
