@@ -20,6 +20,7 @@ configurations (the link frames of one chunk are held in memory).
 
 from __future__ import annotations
 
+import math
 import weakref
 from dataclasses import dataclass
 
@@ -152,6 +153,22 @@ def _shape_scene(W0, W1, s, r, scene, o):
     return segment_distance((a0[0], a0[1], 0.0), (a1[0], a1[1], 0.0), c, c) - r - scene[o, 3]
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _box_bound(W0, W1, s, r, scene, o):
+    """A lower bound of the signed distance of capsule s to scene row o (−inf unless a box).
+
+    For a box, ``dist(axis, centre) − r − |h|`` (the box lies inside the sphere of radius
+    ``|h|`` about its centre): much cheaper than the exact golden-section distance, so
+    that boxes farther than the best pair found so far are skipped.
+    """
+    if int(scene[o, 0]) != 2:
+        return -np.inf
+    c = (scene[o, 1], scene[o, 2], scene[o, 3])
+    hr = math.sqrt(scene[o, 13] ** 2 + scene[o, 14] ** 2 + scene[o, 15] ** 2)
+    return segment_distance((W0[s, 0], W0[s, 1], W0[s, 2]), (W1[s, 0], W1[s, 1], W1[s, 2]),
+                            c, c) - r - hr
+
+
 @njit(cache=True, nogil=True)
 def scene_clearance_range(frames, shape_frame, A, B, rad, shape_body, scene, out_d, out_p,
                           start, stop):
@@ -166,6 +183,8 @@ def scene_clearance_range(frames, shape_frame, A, B, rad, shape_body, scene, out
         bo = -1
         for s in range(m):
             for o in range(scene.shape[0]):
+                if _box_bound(W0, W1, s, rad[s], scene, o) >= best:
+                    continue
                 d = _shape_scene(W0, W1, s, rad[s], scene, o)
                 if d < best:
                     best = d
@@ -243,6 +262,8 @@ def clearance_at(frames, shape_frame, A, B, rad, shape_body, pa, pb, scene, W0, 
             pair[4] = j
     for s in range(A.shape[0]):
         for o in range(scene.shape[0]):
+            if _box_bound(W0, W1, s, rad[s], scene, o) >= best:
+                continue
             d = _shape_scene(W0, W1, s, rad[s], scene, o)
             if d < best:
                 best = d
