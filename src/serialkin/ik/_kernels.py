@@ -413,6 +413,53 @@ def _limit_step(dq, max_step):
             dq[j] *= max_step / big
 
 
+@njit(cache=True, inline="always")
+def _workspace(n):
+    """The loop's arrays for n joints, carved from one allocation (views, C-contiguous).
+
+    Returns ``(J (6, n), T (4, 4), e (6,), dq (n,), q (n,), be (6,), sw (6,), ws)`` with
+    ``ws`` the step kernels' scratch tuple (``W_*``). One allocation instead of seventeen
+    (each costs about 50 ns with reference counting).
+    """
+    size = 6 * n + 16 + 6 + n + n + 6 + 6 + (6 * n + 6 + n * n + n + 36 + 6 + n + n + 16 + 6)
+    buf = np.empty(size)
+    o = 0
+    J = buf[o:o + 6 * n].reshape((6, n))
+    o += 6 * n
+    T = buf[o:o + 16].reshape((4, 4))
+    o += 16
+    e = buf[o:o + 6]
+    o += 6
+    dq = buf[o:o + n]
+    o += n
+    q = buf[o:o + n]
+    o += n
+    be = buf[o:o + 6]
+    o += 6
+    sw = buf[o:o + 6]
+    o += 6
+    Jw = buf[o:o + 6 * n].reshape((6, n))
+    o += 6 * n
+    r = buf[o:o + 6]
+    o += 6
+    A = buf[o:o + n * n].reshape((n, n))
+    o += n * n
+    g = buf[o:o + n]
+    o += n
+    M6 = buf[o:o + 36].reshape((6, 6))
+    o += 36
+    y6 = buf[o:o + 6]
+    o += 6
+    free = buf[o:o + n]
+    o += n
+    qn = buf[o:o + n]
+    o += n
+    Tn = buf[o:o + 16].reshape((4, 4))
+    o += 16
+    en = buf[o:o + 6]
+    return J, T, e, dq, q, be, sw, (Jw, r, A, g, M6, y6, free, qn, Tn, en)
+
+
 # ---------------------------------------------------------------- the shared loop
 # The three functions below are templates: compile_method copies them with the method's
 # step kernel (and the copies that call it) bound as globals, then compiles the copies.
@@ -557,15 +604,7 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     respect = cfg[C_RESPECT] > 0.5
     use_q0 = cfg[C_USE_Q0] > 0.5
     window = int(cfg[C_WINDOW])
-    J = np.empty((6, n))
-    T = np.empty((4, 4))
-    e = np.empty(6)
-    dq = np.empty(n)
-    q = np.empty(n)
-    be = np.empty(6)
-    sw = np.empty(6)
-    ws = (np.empty((6, n)), np.empty(6), np.empty((n, n)), np.empty(n), np.empty((6, 6)),
-          np.empty(6), np.empty(n), np.empty(n), np.empty((4, 4)), np.empty(6))
+    J, T, e, dq, q, be, sw, ws = _workspace(n)
     for i in range(6):
         sw[i] = math.sqrt(w[i])
     state = np.empty(1, dtype=np.uint64)
@@ -753,15 +792,7 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
     margin = ccfg[K_MARGIN]
     pushes = int(ccfg[K_PUSHES])
     m = A.shape[0]
-    J = np.empty((6, n))
-    T = np.empty((4, 4))
-    e = np.empty(6)
-    dq = np.empty(n)
-    q = np.empty(n)
-    be = np.empty(6)
-    sw = np.empty(6)
-    ws = (np.empty((6, n)), np.empty(6), np.empty((n, n)), np.empty(n), np.empty((6, 6)),
-          np.empty(6), np.empty(n), np.empty(n), np.empty((4, 4)), np.empty(6))
+    J, T, e, dq, q, be, sw, ws = _workspace(n)
     frames = np.empty((n + 1, 4, 4))
     W0 = np.empty((m, 3))
     W1 = np.empty((m, 3))

@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import MAX_ITERATIONS, check_int, short_repr
+from serialkin._checks import MAX_ITERATIONS, ROTATION_TOL, check_int, short_repr
 from serialkin.errors import InputError, InputTypeError
 from serialkin.ik import _kernels as K
 from serialkin.ik.registry import MethodSpec, available_methods, get_method
@@ -47,6 +47,7 @@ from serialkin.ik.target import (
     check_q0,
     check_tol,
     parse_target,
+    pose_and_q0_valid,
     robot_arrays,
 )
 from serialkin.kinematics import kernels as FK
@@ -403,6 +404,13 @@ def solve(
             outside the Jacobian family. A failed solve is not an error: it returns
             ``success=False`` with a ``reason``.
     """
+    if (type(target) is np.ndarray and type(method) is str and not options and mask is None
+            and tol is None and max_iter is None and restarts is None and respect_limits is True
+            and scene is None and self_collision is False and acm is None
+            and type(margin) is float and margin == 0.0):
+        res = _fast(robot, target, method, q0, seed)
+        if res is not None:
+            return res
     spec = get_method(method)
     if not isinstance(robot, Robot):
         raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
@@ -442,6 +450,83 @@ def solve(
                                bool(respect_limits), opts)
     return _solve_python(robot, tgt, spec, q0a, tol_v, iters, nrest, stream,
                          bool(respect_limits), opts)
+
+
+#: Fast-path entries per (id(robot), method): see :func:`_fast`.
+_FAST: dict[tuple[int, str], tuple] = {}
+
+
+def _fast_entry(robot: object, method: str) -> tuple | None:
+    """The prepared arrays of the fast path for ``robot`` and ``method`` (None: not eligible)."""
+    import weakref
+
+    if not isinstance(robot, Robot) or method not in available_methods():
+        return None
+    spec = get_method(method)
+    if (spec.kernel is None or "pose" not in spec.targets
+            or (spec.max_joints is not None and robot.n > spec.max_joints)):
+        return None
+    a = robot_arrays(robot)
+    T = np.eye(4)
+    tgt = Target(T, DEFAULT_WEIGHTS["pose"], "pose")
+    cfgs = tuple(_kernel_config(spec, tgt, DEFAULT_TOL, spec.max_iter, spec.restarts, True,
+                                use, spec.options) for use in (False, True))
+    zeros = np.zeros(robot.n)
+    entry = (weakref.ref(robot), spec, robot.chain.F, robot.chain.meta, a.box, a.lo, a.hi,
+             cfgs, zeros, robot.n)
+    if len(_FAST) > 256:
+        _FAST.clear()
+    _FAST[(id(robot), method)] = entry
+    return entry
+
+
+def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
+          seed: object) -> IKResult | None:
+    """:func:`solve` for the common call, or None when the call is not that one.
+
+    The common call: one C-contiguous, writeable float64 (4, 4) pose, ``q0`` None or such
+    an (n,) array, ``seed`` None or an int, every other argument at its default, a
+    compiled method. The checks are those of the ordinary path in one compiled call
+    (:func:`~serialkin.ik.target.pose_and_q0_valid`); when they fail, None, and the
+    ordinary path raises its precise error. The answer is the ordinary path's, bit for
+    bit (same kernel, configuration and seed).
+    """
+    if target.shape != (4, 4) or target.dtype != np.float64:
+        return None
+    flags = target.flags
+    if not (flags.c_contiguous and flags.writeable):
+        return None
+    ent = _FAST.get((id(robot), method))
+    if ent is None or ent[0]() is not robot or ent[1] is not get_method(method):
+        ent = _fast_entry(robot, method)
+        if ent is None:
+            return None
+    _, spec, F, meta, box, lo, hi, cfgs, zeros, n = ent
+    if q0 is None:
+        q0k = zeros
+        cfg = cfgs[0]
+    elif (type(q0) is np.ndarray and q0.shape == (n,) and q0.dtype == np.float64
+          and q0.flags.c_contiguous and q0.flags.writeable):
+        q0k = q0
+        cfg = cfgs[1]
+    else:
+        return None
+    if type(seed) is int:
+        s = seed & _MASK64
+    elif seed is None:
+        s = int.from_bytes(os.urandom(8), "little")
+    else:
+        return None
+    if not pose_and_q0_valid(target, q0k, lo, hi, ROTATION_TOL, q0 is not None):
+        return None
+    q = np.empty(n)
+    info = np.empty(K.N_INFO)
+    spec.kernel.solve_one(F, meta, target, box, q0k, cfg, np.uint64(s), q, info)
+    if info[K.I_SUCCESS] > 0.5 and info[K.I_INSIDE] > 0.5:
+        return IKResult.make(q, True, int(info[K.I_ITERATIONS]), float(info[K.I_POS_ERR]),
+                             float(info[K.I_ORI_ERR]), "", int(info[K.I_RESTARTS]), spec.name)
+    tgt = Target(target, DEFAULT_WEIGHTS["pose"], "pose")
+    return _result_single(robot, tgt, spec, q, info, DEFAULT_TOL, True)
 
 
 def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | None,
