@@ -109,6 +109,9 @@ class IKResult:
             )
         q = np.array2string(np.asarray(self.q), precision=4, separator=", ")
         tail = "" if self.success else f", reason={self.reason!r}"
+        if np.isfinite(self.clearance):
+            tail = f", clearance={self.clearance:.3g} m ({self.closest_pair[0]}, " \
+                   f"{self.closest_pair[1]}){tail}"
         return (
             f"IKResult(method={self.method!r}, success={bool(self.success)}, q={q}, "
             f"iterations={self.iterations}, restarts={self.restarts}, "
