@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 _NEW = object.__new__
+_SET = object.__setattr__
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,10 +66,11 @@ class IKResult:
         For the solvers' hot path (about 1 µs less per call); the fields are trusted.
         """
         r = _NEW(cls)
-        r.__dict__.update(q=q, success=success, iterations=iterations,
-                          position_error=position_error, orientation_error=orientation_error,
-                          reason=reason, restarts=restarts, method=method,
-                          clearance=clearance, closest_pair=closest_pair)
+        _SET(r, "__dict__", {
+            "q": q, "success": success, "iterations": iterations,
+            "position_error": position_error, "orientation_error": orientation_error,
+            "reason": reason, "restarts": restarts, "method": method,
+            "clearance": clearance, "closest_pair": closest_pair})
         return r
 
     @property

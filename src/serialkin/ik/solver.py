@@ -522,9 +522,10 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
     q = np.empty(n)
     info = np.empty(K.N_INFO)
     spec.kernel.solve_one(F, meta, target, box, q0k, cfg, np.uint64(s), q, info)
-    if info[K.I_SUCCESS] > 0.5 and info[K.I_INSIDE] > 0.5:
-        return IKResult.make(q, True, int(info[K.I_ITERATIONS]), float(info[K.I_POS_ERR]),
-                             float(info[K.I_ORI_ERR]), "", int(info[K.I_RESTARTS]), spec.name)
+    i = info.tolist()  # one conversion instead of a numpy scalar per field
+    if i[K.I_SUCCESS] > 0.5 and i[K.I_INSIDE] > 0.5:
+        return IKResult.make(q, True, int(i[K.I_ITERATIONS]), i[K.I_POS_ERR], i[K.I_ORI_ERR],
+                             "", int(i[K.I_RESTARTS]), spec.name)
     tgt = Target(target, DEFAULT_WEIGHTS["pose"], "pose")
     return _result_single(robot, tgt, spec, q, info, DEFAULT_TOL, True)
 
