@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from serialkin import models
 from serialkin.collision import Box, HalfSpace, default_acm, scene_clearance, self_clearance
 from serialkin.collision.queries import checked_shape_pairs
 from serialkin.errors import InputError, InputTypeError
+from serialkin.ik import _kernels as K
 from serialkin.ik import solver
 from serialkin.redundancy.obstacles import Sphere
 
@@ -234,3 +237,22 @@ def test_nearest_representative_single_and_batch():
                     other = q + sgn * 2 * np.pi
                     inside = (other >= -2 * np.pi) & (other <= 2 * np.pi)
                     assert not np.any(inside & (np.abs(other - q0[k]) < np.abs(q - q0[k])))
+
+
+@settings(max_examples=200, deadline=None)
+@given(q=st.floats(-2 * np.pi, 2 * np.pi), ref=st.floats(-20.0, 20.0),
+       lo=st.floats(-9.0, 0.0), width=st.floats(0.0, 18.0))
+def test_nearest_into_property(q, ref, lo, width):
+    """nearest_into keeps the angle mod 2π and inside [lo, hi], and no in-range shift is nearer."""
+    hi = lo + width
+    q = min(max(q, lo), hi)
+    out = np.array([q])
+    K.nearest_into(out, np.array([ref]), np.array([lo]), np.array([hi]), np.array([1.0]), True)
+    x = out[0]
+    assert lo <= x <= hi
+    k = (x - q) / (2 * np.pi)
+    assert abs(k - round(k)) < 1e-9
+    for j in range(-4, 5):
+        other = q + 2 * np.pi * j
+        if lo <= other <= hi:
+            assert abs(x - ref) <= abs(other - ref) + 1e-9

@@ -205,28 +205,27 @@ def normalize_into(q, lo, hi, revolute):
 def nearest_into(q, ref, lo, hi, revolute, bounded):
     """Move each revolute q_i (in place) to its 2π-representative nearest ``ref_i`` in range.
 
-    Among ``q_i + 2πk`` (same pose) the one nearest ``ref_i`` is taken when it lies in
-    [lo_i, hi_i] (or always when ``bounded`` is False), else the nearer in-range
-    neighbour of it when that is nearer than q_i, else q_i is kept; this only matters for
-    ranges wider than 2π (the UR5's ±2π) and unlimited joints. Prismatic joints are
-    untouched. ``ref`` (n,) is the initial guess q0.
+    Among ``q_i + 2πk`` (same pose) with k such that the value stays in [lo_i, hi_i]
+    (any k when ``bounded`` is False), the one nearest ``ref_i``: since ``|q_i + 2πk −
+    ref_i|`` is convex in k, that is ``k = round((ref_i − q_i)/2π)`` clamped to
+    ``[⌈(lo_i − q_i)/2π⌉, ⌊(hi_i − q_i)/2π⌋]``. This only matters for ranges wider than 2π
+    (the UR5's ±2π) and unlimited joints. Prismatic joints are untouched; ``ref`` (n,) is
+    the initial guess q0.
     """
     for i in range(q.shape[0]):
-        if revolute[i] == 0 or not math.isfinite(ref[i]):
+        if revolute[i] == 0 or not math.isfinite(ref[i]) or not math.isfinite(q[i]):
             continue
-        c = q[i] + TWO_PI * math.floor((ref[i] - q[i]) / TWO_PI + 0.5)
-        if not bounded or (c >= lo[i] and c <= hi[i]):
-            q[i] = c
-            continue
-        a = c - TWO_PI
-        b = c + TWO_PI
-        a_in = a >= lo[i] and a <= hi[i]
-        b_in = b >= lo[i] and b <= hi[i]
-        if a_in and (not b_in or abs(a - ref[i]) <= abs(b - ref[i])):
-            if abs(a - ref[i]) < abs(q[i] - ref[i]):
-                q[i] = a
-        elif b_in and abs(b - ref[i]) < abs(q[i] - ref[i]):
-            q[i] = b
+        k = math.floor((ref[i] - q[i]) / TWO_PI + 0.5)
+        if bounded:
+            if math.isfinite(lo[i]):
+                kmin = math.ceil((lo[i] - q[i]) / TWO_PI)
+                k = max(k, kmin)
+            if math.isfinite(hi[i]):
+                kmax = math.floor((hi[i] - q[i]) / TWO_PI)
+                k = min(k, kmax)
+        x = q[i] + TWO_PI * k
+        if not bounded or (x >= lo[i] and x <= hi[i]):
+            q[i] = x
 
 
 # ---------------------------------------------------------------- small dense algebra
