@@ -210,6 +210,10 @@ def test_bad_collision_input(panda):
         panda.ik(T, self_collision="yes")
     with pytest.raises(InputTypeError, match="acm"):
         panda.ik(T, self_collision=True, acm="none")
+    with pytest.raises(InputError, match="self_collision=True"):
+        panda.ik(T, scene=SCENE, acm=default_acm(panda.collision))
+    with pytest.raises(InputTypeError, match="margin"):
+        panda.ik(T, scene=SCENE, margin=np.array([0.1, 0.2]))
     bare = panda.with_collision(None)
     with pytest.raises(InputError, match="with_collision"):
         bare.ik(T, scene=SCENE)

@@ -437,7 +437,8 @@ def solve(
         raise InputTypeError(f"respect_limits must be True or False, got {respect_limits!r}")
     opts = _options(spec, options)
     coll = None
-    if scene is not None or self_collision is not False or margin != 0.0 or acm is not None:
+    if (scene is not None or self_collision is not False or acm is not None
+            or not (type(margin) is float and margin == 0.0)):
         coll = _collision_setup(robot, spec, scene, self_collision, margin, acm)
     n_targets = tgt.T.shape[0] if tgt.batch else None
     q0a = None if q0 is None else check_q0(robot, q0, n_targets, bool(respect_limits))
@@ -589,6 +590,9 @@ def _collision_setup(robot: Robot, spec: MethodSpec, scene: object, self_collisi
     if acm is not None and not isinstance(acm, AllowedCollisionMatrix):
         raise InputTypeError(f"acm must be an AllowedCollisionMatrix or None, got "
                              f"{type(acm).__name__}")
+    if acm is not None and not self_collision:
+        raise InputError("acm lists the body pairs a self-collision check skips; it needs "
+                         "self_collision=True")
     if scene is not None and not isinstance(scene, (list, tuple)):
         scene = [scene]
     enc = np.zeros((0, 16)) if scene is None else encode_scene(scene)
