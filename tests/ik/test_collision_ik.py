@@ -188,13 +188,17 @@ def test_margin_larger_than_free_space_fails(panda):
     assert res.iterations <= 4 * 100 * (solver.PUSHES + 1) + 100
 
 
-@pytest.mark.parametrize("method", ["lm", "dls"])
-def test_jacobian_family_methods(method, panda):
-    """Jacobian-family methods solve collision-aware targets, and successes are free."""
-    Q = free_configurations(panda, 16, seed=13)
-    res = panda.ik(panda.fk(Q), method=method, scene=SCENE, self_collision=True, seed=2)
-    assert res.success.mean() >= 0.75
-    assert (res.clearance[res.success] >= 0).all()
+def test_another_jacobian_method(panda):
+    """Another Jacobian-family method (dls, single calls) also returns free solutions only.
+
+    Every compiled method runs the same collision-aware loop around its step kernel; one
+    more besides lm is compiled here (compilation takes seconds per method).
+    """
+    Q = free_configurations(panda, 8, seed=13)
+    results = [panda.ik(T, method="dls", scene=SCENE, self_collision=True, seed=2)
+               for T in panda.fk(Q)]
+    assert np.mean([r.success for r in results]) >= 0.75
+    assert all(r.clearance >= 0 for r in results if r.success)
 
 
 def test_bad_collision_input(panda):
