@@ -29,6 +29,7 @@ GOALS = {
     "12.1": "Panda self_clearance batched on one core <= 2 us per configuration",
     "12.2": "URDF with meshes (Panda, UR5): cold load and capsule fit <= 2 s each",
     "12.5": "viewer with meshes: Panda page <= 5 MB, opens in headless Chromium < 2 s",
+    "13.1": "collision-aware IK Panda (table + 2 obstacles) batched <= 100 us at >= 95 %",
     "13.2": "differential-IK QP step <= half of pink's and mink's (Panda, same task set)",
     "13.3": "QP tracking of the 20-link scenario: time per path point (reported)",
     "15.1": "UR5 2.5 cm x 50-orientation reach map < 1 h on 2 cores; Dask 1->2 workers >= 0.85",

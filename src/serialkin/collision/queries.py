@@ -20,6 +20,7 @@ configurations (the link frames of one chunk are held in memory).
 
 from __future__ import annotations
 
+import math
 import weakref
 from dataclasses import dataclass
 
@@ -34,7 +35,8 @@ from serialkin.collision.shapes import encode_scene
 from serialkin.errors import InputError
 from serialkin.kinematics import parallel
 
-__all__ = ["CHUNK", "Clearance", "body_pair_distances", "checked_shape_pairs",
+__all__ = ["CHUNK", "PAIR_NONE", "PAIR_SCENE", "PAIR_SELF", "Clearance", "body_pair_distances",
+           "checked_shape_pairs", "clearance_at", "pair_distance_at", "scene_point_distance",
            "in_collision", "scene_clearance", "self_clearance"]
 
 #: Configurations whose link frames are computed at once (8 frames × 128 B each for a 7-axis arm).
@@ -151,6 +153,22 @@ def _shape_scene(W0, W1, s, r, scene, o):
     return segment_distance((a0[0], a0[1], 0.0), (a1[0], a1[1], 0.0), c, c) - r - scene[o, 3]
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _box_bound(W0, W1, s, r, scene, o):
+    """A lower bound of the signed distance of capsule s to scene row o (−inf unless a box).
+
+    For a box, ``dist(axis, centre) − r − |h|`` (the box lies inside the sphere of radius
+    ``|h|`` about its centre): much cheaper than the exact golden-section distance, so
+    that boxes farther than the best pair found so far are skipped.
+    """
+    if int(scene[o, 0]) != 2:
+        return -np.inf
+    c = (scene[o, 1], scene[o, 2], scene[o, 3])
+    hr = math.sqrt(scene[o, 13] ** 2 + scene[o, 14] ** 2 + scene[o, 15] ** 2)
+    return segment_distance((W0[s, 0], W0[s, 1], W0[s, 2]), (W1[s, 0], W1[s, 1], W1[s, 2]),
+                            c, c) - r - hr
+
+
 @njit(cache=True, nogil=True)
 def scene_clearance_range(frames, shape_frame, A, B, rad, shape_body, scene, out_d, out_p,
                           start, stop):
@@ -165,6 +183,8 @@ def scene_clearance_range(frames, shape_frame, A, B, rad, shape_body, scene, out
         bo = -1
         for s in range(m):
             for o in range(scene.shape[0]):
+                if _box_bound(W0, W1, s, rad[s], scene, o) >= best:
+                    continue
                 d = _shape_scene(W0, W1, s, rad[s], scene, o)
                 if d < best:
                     best = d
@@ -173,6 +193,107 @@ def scene_clearance_range(frames, shape_frame, A, B, rad, shape_body, scene, out
         out_d[k] = best
         out_p[k, 0] = bs
         out_p[k, 1] = bo
+
+
+@njit(cache=True, nogil=True)
+def scene_point_distance(p, scene, o):
+    """Signed distance [m] of the point ``p`` (3,) to scene row ``o`` (negative inside)."""
+    W = p.reshape(1, 3)
+    return _shape_scene(W, W, 0, 0.0, scene, o)
+
+
+# ---------------------------------------------------------------- one configuration
+#: Kinds of closest pair written by :func:`clearance_at` into ``pair[0]``.
+PAIR_NONE = 0  # nothing checked (distance +inf)
+PAIR_SELF = 1  # pair = (PAIR_SELF, body i, body j), i < j
+PAIR_SCENE = 2  # pair = (PAIR_SCENE, body, scene index)
+
+
+@njit(cache=True, nogil=True)
+def clearance_at(frames, shape_frame, A, B, rad, shape_body, pa, pb, scene, W0, W1, pair):
+    """Smallest signed distance [m] of one configuration, self pairs and scene together.
+
+    For the link frames ``frames`` (n+1, 4, 4) of one configuration (``fk_all``):
+    ``min(min over checked shape pairs (pa[p], pb[p]) of dist(axis_i, axis_j) − r_i − r_j,
+    min over shapes s and scene rows o of sd(s, o))``, the per-pair distances of
+    :func:`self_clearance_range` and :func:`scene_clearance_range`. The compiled IK loop
+    calls it once per candidate solution (no allocation: ``W0``, ``W1`` are (m, 3)
+    buffers).
+
+    Args:
+        frames: (n+1, 4, 4) link frames.
+        shape_frame: (m,) int, the link frame of each shape of the collision model.
+        A: (m, 3) first axis end of each shape in its frame [m].
+        B: (m, 3) second axis end [m].
+        rad: (m,) radii [m].
+        shape_body: (m,) int, the body of each shape.
+        pa: (P,) first shape of each checked pair (:func:`checked_shape_pairs`; empty: no
+            self check).
+        pb: (P,) second shape of each checked pair.
+        scene: (k, 16) encoded scene (:func:`~serialkin.collision.shapes.encode_scene`;
+            k = 0: no scene).
+        W0: (m, 3) buffer (world first ends).
+        W1: (m, 3) buffer (world second ends).
+        pair: (5,) float output: kind (:data:`PAIR_NONE`, :data:`PAIR_SELF`,
+            :data:`PAIR_SCENE`), the two indices (bodies, or body and scene row), then
+            the shape indices (two shapes, or shape and scene row) for
+            :func:`pair_distance_at`.
+
+    Returns:
+        The clearance [m]; +inf when nothing is checked.
+    """
+    _to_world(frames, shape_frame, A, B, W0, W1)
+    best = np.inf
+    for k in range(5):
+        pair[k] = -1.0
+    pair[0] = PAIR_NONE
+    for p in range(pa.shape[0]):
+        i = pa[p]
+        j = pb[p]
+        d = _pair(W0, W1, i, j) - rad[i] - rad[j]
+        if d < best:
+            best = d
+            bi = shape_body[i]
+            bj = shape_body[j]
+            pair[0] = PAIR_SELF
+            pair[1] = min(bi, bj)
+            pair[2] = max(bi, bj)
+            pair[3] = i
+            pair[4] = j
+    for s in range(A.shape[0]):
+        for o in range(scene.shape[0]):
+            if _box_bound(W0, W1, s, rad[s], scene, o) >= best:
+                continue
+            d = _shape_scene(W0, W1, s, rad[s], scene, o)
+            if d < best:
+                best = d
+                pair[0] = PAIR_SCENE
+                pair[1] = shape_body[s]
+                pair[2] = o
+                pair[3] = s
+                pair[4] = o
+    return best
+
+
+@njit(cache=True, nogil=True)
+def pair_distance_at(frames, shape_frame, A, B, rad, scene, pair, W0, W1):
+    """Signed distance [m] of the one pair ``pair`` (as written by :func:`clearance_at`).
+
+    Only the pair's shapes are placed in the world (``W0``, ``W1`` (m, 3) buffers), so a
+    gradient by finite differences costs one ``fk_all`` and one distance per step.
+    """
+    s = int(pair[3])
+    t = int(pair[4])
+    for k in (s, t) if pair[0] == PAIR_SELF else (s, s):
+        f = shape_frame[k]
+        for r in range(3):
+            W0[k, r] = (frames[f, r, 0] * A[k, 0] + frames[f, r, 1] * A[k, 1]
+                        + frames[f, r, 2] * A[k, 2] + frames[f, r, 3])
+            W1[k, r] = (frames[f, r, 0] * B[k, 0] + frames[f, r, 1] * B[k, 1]
+                        + frames[f, r, 2] * B[k, 2] + frames[f, r, 3])
+    if pair[0] == PAIR_SELF:
+        return _pair(W0, W1, s, t) - rad[s] - rad[t]
+    return _shape_scene(W0, W1, s, rad[s], scene, t)
 
 
 # ---------------------------------------------------------------- Python front ends

@@ -77,8 +77,9 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from serialkin.kinematics.dls import spd_solve_into
-from serialkin.kinematics.kernels import fk_into, jacobian_into
+from serialkin.collision.queries import PAIR_NONE, clearance_at, pair_distance_at
+from serialkin.kinematics.dls import dls_step_into, spd_solve_into
+from serialkin.kinematics.kernels import fk_all_into, fk_into, jacobian_into
 from serialkin.model.limits import inside as interval_inside
 from serialkin.model.limits import normalize as interval_normalize
 from serialkin.model.limits import project as interval_project
@@ -123,7 +124,20 @@ I_ORI_ERR = 3
 I_RESTARTS = 4
 I_COST = 5
 I_INSIDE = 6  # 1: the returned q lies inside the joint limits (within LIMIT_TOL)
-N_INFO = 7
+I_CLEARANCE = 7  # clearance of the returned q [m] (+inf when nothing is checked)
+I_PAIR = 8  # 5 slots: the closest pair (collision.queries.clearance_at's ``pair``)
+N_INFO = 13
+
+#: Layout of the collision options ``ccfg`` (float64) of the collision-aware solves.
+K_MARGIN = 0  # required clearance [m], >= 0
+K_PUSHES = 1  # push-out steps allowed per attempt that reaches the target in collision
+N_CCFG = 2
+
+#: Push-out step: clearance asked beyond the margin [m], cap on max |Δq_i| [rad or m],
+#: forward-difference step of the clearance gradient [rad or m].
+PUSH_EXTRA = 0.01
+PUSH_MAX = 0.5
+PUSH_H = 1e-6
 
 #: Tolerance of the final "q inside the joint limits" test of a success [rad or m].
 LIMIT_TOL = 1e-12
@@ -185,6 +199,33 @@ def normalize_into(q, lo, hi, revolute):
     """
     for i in range(q.shape[0]):
         q[i] = interval_normalize(q[i], lo[i], hi[i], revolute[i] != 0)
+
+
+@njit(cache=True)
+def nearest_into(q, ref, lo, hi, revolute, bounded):
+    """Move each revolute q_i (in place) to its 2π-representative nearest ``ref_i`` in range.
+
+    Among ``q_i + 2πk`` (same pose) with k such that the value stays in [lo_i, hi_i]
+    (any k when ``bounded`` is False), the one nearest ``ref_i``: since ``|q_i + 2πk −
+    ref_i|`` is convex in k, that is ``k = round((ref_i − q_i)/2π)`` clamped to
+    ``[⌈(lo_i − q_i)/2π⌉, ⌊(hi_i − q_i)/2π⌋]``. This only matters for ranges wider than 2π
+    (the UR5's ±2π) and unlimited joints. Prismatic joints are untouched; ``ref`` (n,) is
+    the initial guess q0.
+    """
+    for i in range(q.shape[0]):
+        if revolute[i] == 0 or not math.isfinite(ref[i]) or not math.isfinite(q[i]):
+            continue
+        k = math.floor((ref[i] - q[i]) / TWO_PI + 0.5)
+        if bounded:
+            if math.isfinite(lo[i]):
+                kmin = math.ceil((lo[i] - q[i]) / TWO_PI)
+                k = max(k, kmin)
+            if math.isfinite(hi[i]):
+                kmax = math.floor((hi[i] - q[i]) / TWO_PI)
+                k = min(k, kmax)
+        x = q[i] + TWO_PI * k
+        if not bounded or (x >= lo[i] and x <= hi[i]):
+            q[i] = x
 
 
 # ---------------------------------------------------------------- small dense algebra
@@ -371,6 +412,53 @@ def _limit_step(dq, max_step):
             dq[j] *= max_step / big
 
 
+@njit(cache=True, inline="always")
+def _workspace(n):
+    """The loop's arrays for n joints, carved from one allocation (views, C-contiguous).
+
+    Returns ``(J (6, n), T (4, 4), e (6,), dq (n,), q (n,), be (6,), sw (6,), ws)`` with
+    ``ws`` the step kernels' scratch tuple (``W_*``). One allocation instead of seventeen
+    (each costs about 50 ns with reference counting).
+    """
+    size = 6 * n + 16 + 6 + n + n + 6 + 6 + (6 * n + 6 + n * n + n + 36 + 6 + n + n + 16 + 6)
+    buf = np.empty(size)
+    o = 0
+    J = buf[o:o + 6 * n].reshape((6, n))
+    o += 6 * n
+    T = buf[o:o + 16].reshape((4, 4))
+    o += 16
+    e = buf[o:o + 6]
+    o += 6
+    dq = buf[o:o + n]
+    o += n
+    q = buf[o:o + n]
+    o += n
+    be = buf[o:o + 6]
+    o += 6
+    sw = buf[o:o + 6]
+    o += 6
+    Jw = buf[o:o + 6 * n].reshape((6, n))
+    o += 6 * n
+    r = buf[o:o + 6]
+    o += 6
+    A = buf[o:o + n * n].reshape((n, n))
+    o += n * n
+    g = buf[o:o + n]
+    o += n
+    M6 = buf[o:o + 36].reshape((6, 6))
+    o += 36
+    y6 = buf[o:o + 6]
+    o += 6
+    free = buf[o:o + n]
+    o += n
+    qn = buf[o:o + n]
+    o += n
+    Tn = buf[o:o + 16].reshape((4, 4))
+    o += 16
+    en = buf[o:o + 6]
+    return J, T, e, dq, q, be, sw, (Jw, r, A, g, M6, y6, free, qn, Tn, en)
+
+
 # ---------------------------------------------------------------- the shared loop
 # The three functions below are templates: compile_method copies them with the method's
 # step kernel (and the copies that call it) bound as globals, then compiles the copies.
@@ -515,15 +603,7 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     respect = cfg[C_RESPECT] > 0.5
     use_q0 = cfg[C_USE_Q0] > 0.5
     window = int(cfg[C_WINDOW])
-    J = np.empty((6, n))
-    T = np.empty((4, 4))
-    e = np.empty(6)
-    dq = np.empty(n)
-    q = np.empty(n)
-    be = np.empty(6)
-    sw = np.empty(6)
-    ws = (np.empty((6, n)), np.empty(6), np.empty((n, n)), np.empty(n), np.empty((6, 6)),
-          np.empty(6), np.empty(n), np.empty(n), np.empty((4, 4)), np.empty(6))
+    J, T, e, dq, q, be, sw, ws = _workspace(n)
     for i in range(6):
         sw[i] = math.sqrt(w[i])
     state = np.empty(1, dtype=np.uint64)
@@ -577,6 +657,8 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
             be[:] = e
             success = ok
     normalize_into(q_out, lo, hi, revolute)
+    if use_q0:
+        nearest_into(q_out, q0, lo, hi, revolute, respect)
     pe, oe = task_errors(be, w)
     info[I_SUCCESS] = 1.0 if success else 0.0
     info[I_ITERATIONS] = total
@@ -585,6 +667,10 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     info[I_RESTARTS] = used
     info[I_COST] = best_cost
     info[I_INSIDE] = 1.0 if inside_limits(q_out, lo, hi, LIMIT_TOL) else 0.0
+    info[I_CLEARANCE] = np.inf
+    for k in range(5):
+        info[I_PAIR + k] = -1.0
+    info[I_PAIR] = PAIR_NONE
 
 
 def _solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
@@ -601,6 +687,233 @@ def _solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
         solve_one(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k])  # noqa: F821
 
 
+# ---------------------------------------------------------------- collision-aware solves
+@njit(cache=True)
+def _clearance(q, F, L, meta, frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1, pair):
+    """Clearance [m] of configuration q and its closest pair.
+
+    ``pair`` (5,) as :func:`serialkin.collision.queries.clearance_at` writes it.
+    """
+    fk_all_into(q, F, L, meta, frames)
+    return clearance_at(frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1, pair)
+
+
+@njit(cache=True)
+def _push_out(q, d, margin, J, sw, lo, hi, revolute, respect, F, L, meta, frames, sf, A, B,
+              rad, sb, pa, pb, scene, W0, W1, pair, g, qn, Jw, M6, y6, v6, dq):
+    """One push-out step from q (n,), which reaches the target with clearance ``d < margin``.
+
+    q is moved in place. Returns False when the clearance does not depend on q (nothing
+    to push).
+
+    The gradient ``g = ∂d/∂q`` of the closest pair's distance (``pair``, as left by the
+    last :func:`_clearance`; forward differences, step :data:`PUSH_H`) is
+    projected onto the null space of the weighted task Jacobian ``Jw = diag(√w) J``:
+    ``u = g − Jwᵀ (Jw Jwᵀ + λ² I)⁻¹ Jw g`` (the DLS step of :mod:`serialkin.kinematics.dls`,
+    λ² = 1e-8), so that a redundant arm moves its body away without moving the tool; when
+    the null space carries less than 5 % of the gradient (a 6-axis arm) the plain
+    gradient is used and the loop re-converges to the target afterwards. The step
+    ``Δq = s u`` asks the linearised clearance ``d + s gᵀu`` to reach
+    ``margin + PUSH_EXTRA``, with max |Δq_i| ≤ :data:`PUSH_MAX`; q is then projected onto
+    the joint ranges when ``respect``.
+    """
+    n = q.shape[0]
+    gg = 0.0
+    for j in range(n):
+        for k in range(n):
+            qn[k] = q[k]
+        qn[j] += PUSH_H
+        fk_all_into(qn, F, L, meta, frames)
+        g[j] = (pair_distance_at(frames, sf, A, B, rad, scene, pair, W0, W1) - d) / PUSH_H
+        gg += g[j] * g[j]
+    if not gg > 1e-12 or not math.isfinite(gg):
+        return False
+    for i in range(6):
+        s = 0.0
+        for j in range(n):
+            Jw[i, j] = sw[i] * J[i, j]
+            s += Jw[i, j] * g[j]
+        v6[i] = s
+    gain = 0.0
+    if dls_step_into(Jw, v6, 1e-8, 1e-9, M6, y6, dq):
+        for j in range(n):
+            dq[j] = g[j] - dq[j]
+            gain += dq[j] * g[j]
+    if not gain > 1e-3 * gg:
+        for j in range(n):
+            dq[j] = g[j]
+        gain = gg
+    s = (margin - d + PUSH_EXTRA) / gain
+    big = 0.0
+    for j in range(n):
+        dq[j] *= s
+        big = max(big, abs(dq[j]))
+    if big > PUSH_MAX:
+        for j in range(n):
+            dq[j] *= PUSH_MAX / big
+    for j in range(n):
+        q[j] += dq[j]
+    if respect:
+        project_into(q, lo, hi, revolute)
+    return True
+
+
+def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, pa, pb, scene,
+                         ccfg, q_out, info):
+    """``solve_one`` whose success also asks for a clearance ≥ ``ccfg[K_MARGIN]``.
+
+    Every attempt that reaches the target is checked (:func:`_clearance`: the checked self
+    pairs ``pa, pb`` and the encoded ``scene``); while it collides, up to
+    ``ccfg[K_PUSHES]`` push-out steps (:func:`_push_out`) each followed by the attempt loop
+    again (which brings the tool back onto the target); then the next restart. The
+    returned q is the first collision-free solution; else the solution with the largest
+    clearance; else (no attempt reached the target) the lowest-cost attempt, polished as
+    in ``solve_one``. ``info[I_CLEARANCE]`` and ``info[I_PAIR:I_PAIR + 3]`` describe the
+    returned q; ``info[I_SUCCESS]`` is 1 only when it reaches the target and its clearance
+    is ≥ the margin. Arguments as ``solve_one`` plus the collision model's flat arrays
+    (``sf`` shape frames, ``A``, ``B``, ``rad``, ``sb`` shape bodies), the checked pairs,
+    the scene (k, 16) and ``ccfg`` (:data:`N_CCFG`,).
+    """
+    n = meta.shape[0]
+    w = cfg[C_WEIGHTS:C_WEIGHTS + 6]
+    p = cfg[N_LOOP:]
+    lo = box[B_LO]
+    hi = box[B_HI]
+    slo = box[B_SLO]
+    shi = box[B_SHI]
+    revolute = box[B_REVOLUTE]
+    tol = cfg[C_TOL]
+    max_iter = int(cfg[C_MAX_ITER])
+    restarts = int(cfg[C_RESTARTS])
+    respect = cfg[C_RESPECT] > 0.5
+    use_q0 = cfg[C_USE_Q0] > 0.5
+    window = int(cfg[C_WINDOW])
+    margin = ccfg[K_MARGIN]
+    pushes = int(ccfg[K_PUSHES])
+    m = A.shape[0]
+    J, T, e, dq, q, be, sw, ws = _workspace(n)
+    frames = np.empty((n + 1, 4, 4))
+    W0 = np.empty((m, 3))
+    W1 = np.empty((m, 3))
+    pair = np.empty(5)
+    g = np.empty(n)
+    qn = np.empty(n)
+    Jw = np.empty((6, n))
+    M6 = np.empty((6, 6))
+    y6 = np.empty(6)
+    v6 = np.empty(6)
+    hit_q = np.empty(n)
+    hit_e = np.empty(6)
+    hit_d = -np.inf
+    have_hit = False
+    for i in range(6):
+        sw[i] = math.sqrt(w[i])
+    state = np.empty(1, dtype=np.uint64)
+    state[0] = seed
+    total = 0
+    success = False
+    used = 0
+    if use_q0:
+        q_out[:] = q0
+    else:
+        state_copy = np.empty(1, dtype=np.uint64)
+        state_copy[0] = seed
+        random_q_into(state_copy, slo, shi, q_out)
+    if respect:
+        project_into(q_out, lo, hi, revolute)
+    fk_into(q_out, F, meta, T)
+    pose_error_into(T, Tt, be)
+    best_cost = task_cost(be, w)
+    for attempt in range(restarts + 1):
+        used = attempt
+        if attempt == 0 and use_q0:
+            q[:] = q0
+        else:
+            random_q_into(state, slo, shi, q)
+        if respect:
+            project_into(q, lo, hi, revolute)
+        its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
+                                     respect, p, window, tol, max_iter, q, J, T, e, dq, ws)
+        total += its
+        finite = math.isfinite(cost)
+        for i in range(n):
+            if not math.isfinite(q[i]):
+                finite = False
+        if not finite:
+            continue
+        if not ok:
+            if not have_hit and cost < best_cost:
+                best_cost = cost
+                q_out[:] = q
+                be[:] = e
+            continue
+        d = _clearance(q, F, L, meta, frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1, pair)
+        for push in range(pushes + 1):
+            if d >= margin:
+                break
+            if d > hit_d:
+                hit_d = d
+                hit_q[:] = q
+                hit_e[:] = e
+                have_hit = True
+            if push == pushes or not _push_out(
+                    q, d, margin, J, sw, lo, hi, revolute, respect, F, L, meta, frames, sf,
+                    A, B, rad, sb, pa, pb, scene, W0, W1, pair, g, qn, Jw, M6, y6, v6, dq):
+                break
+            its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
+                                         respect, p, window, tol, max_iter, q, J, T, e, dq, ws)
+            total += its
+            if not ok or not math.isfinite(cost):
+                ok = False
+                break
+            d = _clearance(q, F, L, meta, frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1,
+                           pair)
+        if ok and d >= margin:
+            success = True
+            best_cost = cost
+            q_out[:] = q
+            be[:] = e
+            break
+    if not success and have_hit:
+        q_out[:] = hit_q
+        be[:] = hit_e
+        best_cost = task_cost(be, w)
+    elif not success and cfg[C_POLISH] > 0.5:
+        q[:] = q_out
+        its, ok, cost = _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
+                                q, J, T, e, ws[W_JW], ws[W_R], ws[W_A], ws[W_G], dq,
+                                ws[W_QN], np.empty((6, n)), ws[W_TN], ws[W_EN])
+        total += its
+        if ok or cost < best_cost:
+            best_cost = cost
+            q_out[:] = q
+            be[:] = e
+            success = ok
+    normalize_into(q_out, lo, hi, revolute)
+    if use_q0:
+        nearest_into(q_out, q0, lo, hi, revolute, respect)
+    d = _clearance(q_out, F, L, meta, frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1, pair)
+    pe, oe = task_errors(be, w)
+    info[I_SUCCESS] = 1.0 if success and d >= margin else 0.0
+    info[I_ITERATIONS] = total
+    info[I_POS_ERR] = pe
+    info[I_ORI_ERR] = oe
+    info[I_RESTARTS] = used
+    info[I_COST] = best_cost
+    info[I_INSIDE] = 1.0 if inside_limits(q_out, lo, hi, LIMIT_TOL) else 0.0
+    info[I_CLEARANCE] = d
+    for k in range(5):
+        info[I_PAIR + k] = pair[k]
+
+
+def _solve_chunk_collision(F, L, meta, Tt, box, Q0, cfg, seed, sf, A, B, rad, sb, pa, pb, scene,
+                           ccfg, Q_out, info, start, stop):
+    """``solve_one_collision`` for targets ``start..stop-1`` (as ``solve_chunk``), GIL released."""
+    for k in range(start, stop):
+        solve_one_collision(F, L, meta, Tt[k], box, Q0[k], cfg, seed, sf, A, B,  # noqa: F821
+                            rad, sb, pa, pb, scene, ccfg, Q_out[k], info[k])
+
+
 @dataclass(frozen=True, eq=False)
 class CompiledMethod:
     """A compiled IK method: its step kernel inside the shared loop.
@@ -612,12 +925,16 @@ class CompiledMethod:
         solve_one: ``solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info)``.
         solve_chunk: ``solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start,
             stop)``, GIL released.
+        solve_one_collision, solve_chunk_collision: the same with the collision check
+            (:func:`_solve_one_collision`), compiled at their first call.
     """
 
     step: object
     params: tuple[tuple[str, bool], ...]
     solve_one: object
     solve_chunk: object
+    solve_one_collision: object = None
+    solve_chunk_collision: object = None
 
 
 _SOURCE = Path(__file__).read_bytes()
@@ -659,4 +976,8 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
                                                      step=step))
     one = njit(cache=True)(_bind(_solve_one, name, tag, attempt_loop=attempt))
     chunk = njit(cache=True, nogil=True)(_bind(_solve_chunk, name, tag, solve_one=one))
-    return CompiledMethod(step=step, params=tuple(params), solve_one=one, solve_chunk=chunk)
+    one_c = njit(cache=True)(_bind(_solve_one_collision, name, tag, attempt_loop=attempt))
+    chunk_c = njit(cache=True, nogil=True)(_bind(_solve_chunk_collision, name, tag,
+                                                 solve_one_collision=one_c))
+    return CompiledMethod(step=step, params=tuple(params), solve_one=one, solve_chunk=chunk,
+                          solve_one_collision=one_c, solve_chunk_collision=chunk_c)

@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import MAX_ITERATIONS, check_int, short_repr
+from serialkin._checks import MAX_ITERATIONS, ROTATION_TOL, check_int, short_repr
 from serialkin.errors import InputError, InputTypeError
 from serialkin.ik import _kernels as K
 from serialkin.ik.registry import MethodSpec, available_methods, get_method
@@ -47,6 +47,7 @@ from serialkin.ik.target import (
     check_q0,
     check_tol,
     parse_target,
+    pose_and_q0_valid,
     robot_arrays,
 )
 from serialkin.kinematics import kernels as FK
@@ -352,6 +353,10 @@ def solve(
     restarts: int | None = None,
     seed: None | int | np.random.Generator = None,
     respect_limits: bool = True,
+    scene: object = None,
+    self_collision: bool = False,
+    margin: float = 0.0,
+    acm: object = None,
     **options: Any,
 ) -> IKResult:
     """Inverse kinematics of ``robot`` for ``target`` by ``method``.
@@ -374,16 +379,38 @@ def solve(
             :data:`MAX_RESTARTS` (10⁵).
         seed: None, int or numpy Generator for the random starts.
         respect_limits: keep q inside the joint limits (each method documents how).
+        scene: obstacles in the world frame — one or a sequence of
+            :class:`~serialkin.collision.shapes.Box`, :class:`~serialkin.collision.shapes.HalfSpace`
+            and the :mod:`serialkin.redundancy.obstacles` shapes (``Sphere``, ``Capsule``,
+            ``Circle``) — that a solution must clear by ``margin`` (needs
+            ``robot.collision``; Jacobian-family methods).
+        self_collision: also ask for a self-collision-free solution (the robot's shape
+            pairs not allowed by ``acm``).
+        margin: clearance a solution must keep [m], ≥ 0 (0: touching is allowed).
+        acm: :class:`~serialkin.collision.acm.AllowedCollisionMatrix` of body pairs never
+            checked (default :func:`~serialkin.collision.acm.default_acm` of the model).
         **options: method-specific options (see ``METHODS[name].options``).
 
     Returns:
-        :class:`IKResult`; for a batch target, with arrays.
+        :class:`IKResult`; for a batch target, with arrays. With ``scene`` or
+        ``self_collision``, a success also has ``clearance >= margin``, and the solver
+        keeps searching (push-out steps along the clearance gradient, restarts) until it
+        finds one or its budget ends (see :func:`serialkin.ik._kernels._solve_one_collision`).
 
     Raises:
         InputError: a malformed target, mask, tolerance or q0, an unknown method (the
-            message lists the available ones) or an unknown option. A failed solve is
-            not an error: it returns ``success=False`` with a ``reason``.
+            message lists the available ones) or an unknown option; a negative margin, a
+            scene or collision check on a robot without a collision model, or on a method
+            outside the Jacobian family. A failed solve is not an error: it returns
+            ``success=False`` with a ``reason``.
     """
+    if (type(target) is np.ndarray and type(method) is str and not options and mask is None
+            and tol is None and max_iter is None and restarts is None and respect_limits is True
+            and scene is None and self_collision is False and acm is None
+            and type(margin) is float and margin == 0.0):
+        res = _fast(robot, target, method, q0, seed)
+        if res is not None:
+            return res
     spec = get_method(method)
     if not isinstance(robot, Robot):
         raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
@@ -409,14 +436,99 @@ def solve(
     if not isinstance(respect_limits, (bool, np.bool_)):
         raise InputTypeError(f"respect_limits must be True or False, got {respect_limits!r}")
     opts = _options(spec, options)
+    coll = None
+    if (scene is not None or self_collision is not False or acm is not None
+            or not (type(margin) is float and margin == 0.0)):
+        coll = _collision_setup(robot, spec, scene, self_collision, margin, acm)
     n_targets = tgt.T.shape[0] if tgt.batch else None
     q0a = None if q0 is None else check_q0(robot, q0, n_targets, bool(respect_limits))
     stream = _stream_seed(seed)
+    if coll is not None and coll.active:
+        return _solve_collision(robot, tgt, spec, q0a, tol_v, iters, nrest, stream,
+                                bool(respect_limits), opts, coll)
     if spec.kernel is not None:
         return _solve_compiled(robot, tgt, spec, q0a, tol_v, iters, nrest, stream,
                                bool(respect_limits), opts)
     return _solve_python(robot, tgt, spec, q0a, tol_v, iters, nrest, stream,
                          bool(respect_limits), opts)
+
+
+#: Fast-path entries per (id(robot), method): see :func:`_fast`.
+_FAST: dict[tuple[int, str], tuple] = {}
+
+
+def _fast_entry(robot: object, method: str) -> tuple | None:
+    """The prepared arrays of the fast path for ``robot`` and ``method`` (None: not eligible)."""
+    import weakref
+
+    if not isinstance(robot, Robot) or method not in available_methods():
+        return None
+    spec = get_method(method)
+    if (spec.kernel is None or "pose" not in spec.targets
+            or (spec.max_joints is not None and robot.n > spec.max_joints)):
+        return None
+    a = robot_arrays(robot)
+    T = np.eye(4)
+    tgt = Target(T, DEFAULT_WEIGHTS["pose"], "pose")
+    cfgs = tuple(_kernel_config(spec, tgt, DEFAULT_TOL, spec.max_iter, spec.restarts, True,
+                                use, spec.options) for use in (False, True))
+    zeros = np.zeros(robot.n)
+    entry = (weakref.ref(robot), spec, robot.chain.F, robot.chain.meta, a.box, a.lo, a.hi,
+             cfgs, zeros, robot.n)
+    if len(_FAST) > 256:
+        _FAST.clear()
+    _FAST[(id(robot), method)] = entry
+    return entry
+
+
+def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
+          seed: object) -> IKResult | None:
+    """:func:`solve` for the common call, or None when the call is not that one.
+
+    The common call: one C-contiguous, writeable float64 (4, 4) pose, ``q0`` None or such
+    an (n,) array, ``seed`` None or an int, every other argument at its default, a
+    compiled method. The checks are those of the ordinary path in one compiled call
+    (:func:`~serialkin.ik.target.pose_and_q0_valid`); when they fail, None, and the
+    ordinary path raises its precise error. The answer is the ordinary path's, bit for
+    bit (same kernel, configuration and seed).
+    """
+    if target.shape != (4, 4) or target.dtype != np.float64:
+        return None
+    flags = target.flags
+    if not (flags.c_contiguous and flags.writeable):
+        return None
+    ent = _FAST.get((id(robot), method))
+    if ent is None or ent[0]() is not robot or ent[1] is not get_method(method):
+        ent = _fast_entry(robot, method)
+        if ent is None:
+            return None
+    _, spec, F, meta, box, lo, hi, cfgs, zeros, n = ent
+    if q0 is None:
+        q0k = zeros
+        cfg = cfgs[0]
+    elif (type(q0) is np.ndarray and q0.shape == (n,) and q0.dtype == np.float64
+          and q0.flags.c_contiguous and q0.flags.writeable):
+        q0k = q0
+        cfg = cfgs[1]
+    else:
+        return None
+    if type(seed) is int:
+        s = seed & _MASK64
+    elif seed is None:
+        s = int.from_bytes(os.urandom(8), "little")
+    else:
+        return None
+    if not pose_and_q0_valid(target, q0k, lo, hi, ROTATION_TOL, q0 is not None):
+        return None
+    q = np.empty(n)
+    info = np.empty(K.N_INFO)
+    spec.kernel.solve_one(F, meta, target, box, q0k, cfg, np.uint64(s), q, info)
+    i = info.tolist()  # one conversion instead of a numpy scalar per field
+    if i[K.I_SUCCESS] > 0.5 and i[K.I_INSIDE] > 0.5:
+        return IKResult.make(q, True, int(i[K.I_ITERATIONS]), i[K.I_POS_ERR], i[K.I_ORI_ERR],
+                             "", int(i[K.I_RESTARTS]), spec.name)
+    tgt = Target(target, DEFAULT_WEIGHTS["pose"], "pose")
+    return _result_single(robot, tgt, spec, q, info, DEFAULT_TOL, True)
 
 
 def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | None,
@@ -442,6 +554,159 @@ def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray 
     Q0 = np.zeros((N, n)) if q0 is None else np.array(q0, dtype=np.float64, order="C")
     _run_chunks(spec.kernel.solve_chunk, F, meta, Tt, box, Q0, cfg, seed64, Q, info)
     return _result_batch(robot, tgt, spec, Q, info, tol, respect)
+
+
+@dataclass(frozen=True, eq=False)
+class _Collision:
+    """The collision check of one solve: the model's flat arrays, pairs, scene, names."""
+
+    active: bool
+    arrays: tuple = ()
+    ccfg: np.ndarray | None = None
+    body_names: tuple[str, ...] = ()
+    scene_names: tuple[str, ...] = ()
+    scene: np.ndarray | None = None
+    margin: float = 0.0
+
+
+#: Push-out steps per attempt that reaches the target in collision.
+PUSHES = 2
+
+
+def _collision_setup(robot: Robot, spec: MethodSpec, scene: object, self_collision: object,
+                     margin: object, acm: object) -> _Collision:
+    """Validate the collision arguments of :func:`solve` and pack them for the kernels."""
+    from serialkin._checks import check_real
+    from serialkin.collision.acm import AllowedCollisionMatrix
+    from serialkin.collision.queries import checked_shape_pairs
+    from serialkin.collision.shapes import encode_scene
+
+    if not isinstance(self_collision, (bool, np.bool_)):
+        raise InputTypeError(f"self_collision must be True or False, got {self_collision!r}")
+    margin_v = check_real(margin, "margin", unit="m")
+    if margin_v < 0.0:
+        raise InputError(f"margin must be >= 0 m (the clearance a solution keeps), got "
+                         f"{margin_v!r}")
+    if acm is not None and not isinstance(acm, AllowedCollisionMatrix):
+        raise InputTypeError(f"acm must be an AllowedCollisionMatrix or None, got "
+                             f"{type(acm).__name__}")
+    if acm is not None and not self_collision:
+        raise InputError("acm lists the body pairs a self-collision check skips; it needs "
+                         "self_collision=True")
+    if scene is not None and not isinstance(scene, (list, tuple)):
+        scene = [scene]
+    enc = np.zeros((0, 16)) if scene is None else encode_scene(scene)
+    if not (self_collision or enc.shape[0]):
+        return _Collision(active=False)
+    model = robot.collision
+    if model is None:
+        raise InputError(
+            f"robot {short_repr(robot.name)} has no collision model, so scene / "
+            "self_collision cannot be checked; attach one with robot.with_collision(model) "
+            "(e.g. serialkin.collision.panda_collision_model() for a Panda, or a "
+            "CollisionModel.from_dicts(...) of your capsules)")
+    if spec.kernel is None:
+        compiled = [m for m in available_methods() if get_method(m).kernel is not None]
+        raise InputError(
+            f"collision-aware IK (scene / self_collision) runs in the compiled loop of the "
+            f"Jacobian-family methods; method {spec.name!r} is not one of them: use one of "
+            f"{', '.join(compiled)}")
+    if self_collision:
+        pa, pb = checked_shape_pairs(model, acm)
+    else:
+        pa = pb = np.zeros(0, dtype=np.int64)
+    arrays = (np.ascontiguousarray(model.shape_frame), model.a, model.b, model.radius,
+              model.shape_body, pa, pb, enc)
+    names = tuple((getattr(s, "name", "") or f"scene[{i}]") for i, s in enumerate(scene or ()))
+    ccfg = np.empty(K.N_CCFG)
+    ccfg[K.K_MARGIN] = margin_v
+    ccfg[K.K_PUSHES] = PUSHES
+    return _Collision(active=True, arrays=arrays, ccfg=ccfg, body_names=model.body_names,
+                      scene_names=names, scene=enc, margin=margin_v)
+
+
+def _pair_names(coll: _Collision, info: np.ndarray) -> tuple[str, str]:
+    """The closest pair of ``info`` (N_INFO,) as names."""
+    from serialkin.collision.queries import PAIR_SCENE, PAIR_SELF
+
+    kind, i, j = int(info[K.I_PAIR]), int(info[K.I_PAIR + 1]), int(info[K.I_PAIR + 2])
+    if kind == PAIR_SELF:
+        return coll.body_names[i], coll.body_names[j]
+    if kind == PAIR_SCENE:
+        return coll.body_names[i], coll.scene_names[j]
+    return "", ""
+
+
+def _collision_reason(robot: Robot, coll: _Collision, tgt_T: np.ndarray, q: np.ndarray,
+                      info: np.ndarray, pair: tuple[str, str], tol: float, kind: str,
+                      respect: bool, weights: np.ndarray) -> str:
+    """Why a collision-aware solve failed (the sentence of ``IKResult.reason``)."""
+    from serialkin.collision.queries import scene_point_distance
+
+    pe, oe = float(info[K.I_POS_ERR]), float(info[K.I_ORI_ERR])
+    its, used = int(info[K.I_ITERATIONS]), int(info[K.I_RESTARTS])
+    d = float(info[K.I_CLEARANCE])
+    if not (pe <= tol and oe <= tol):
+        return failure_reason(pe, oe, tol, used + 1, its, kind,
+                              failure_hint(robot, q, weights, respect, tgt_T))
+    where = ""
+    if coll.scene is not None and coll.scene.shape[0] and weights[:3].all():
+        p = np.ascontiguousarray(tgt_T[:3, 3], dtype=np.float64)
+        for o in range(coll.scene.shape[0]):
+            if scene_point_distance(p, coll.scene, o) < 0.0:
+                where = (f"; the target position lies inside obstacle {coll.scene_names[o]!r}, "
+                         "so no collision-free solution exists")
+                break
+    where = where or ("; the margin may be larger than the free space around the target, or "
+                      "more restarts are needed")
+    return (f"every attempt that reached the target collided ({used + 1} attempt(s), "
+            f"{its} iterations): best clearance {d:.3g} m < margin {coll.margin:g} m, "
+            f"closest pair {pair[0]!r}–{pair[1]!r}{where}")
+
+
+def _solve_collision(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | None,
+                     tol: float, max_iter: int, restarts: int, seed: int, respect: bool,
+                     opts: Mapping[str, Any], coll: _Collision) -> IKResult:
+    """The compiled collision-aware solve (single target or batch on every core)."""
+    box = robot_arrays(robot).box
+    cfg = _kernel_config(spec, tgt, tol, max_iter, restarts, respect, q0 is not None, opts)
+    F, L, meta = robot.chain.F, robot.chain.L, robot.chain.meta
+    n = robot.n
+    seed64 = np.uint64(seed)
+    Tt = np.array(tgt.T, dtype=np.float64, order="C")
+    if not tgt.batch:
+        q = np.empty(n)
+        info = np.empty(K.N_INFO)
+        q0k = np.zeros(n) if q0 is None else np.array(q0, dtype=np.float64)
+        spec.kernel.solve_one_collision(F, L, meta, Tt, box, q0k, cfg, seed64, *coll.arrays,
+                                        coll.ccfg, q, info)
+        ok = bool(info[K.I_SUCCESS] > 0.5 and (not respect or info[K.I_INSIDE] > 0.5))
+        pair = _pair_names(coll, info)
+        reason = "" if ok else _collision_reason(robot, coll, Tt, q, info, pair, tol, tgt.kind,
+                                                 respect, tgt.weights)
+        return IKResult.make(q, ok, int(info[K.I_ITERATIONS]), float(info[K.I_POS_ERR]),
+                             float(info[K.I_ORI_ERR]), reason, int(info[K.I_RESTARTS]),
+                             spec.name, float(info[K.I_CLEARANCE]), pair)
+    N = Tt.shape[0]
+    Q = np.empty((N, n))
+    info = np.empty((N, K.N_INFO))
+    Q0 = np.zeros((N, n)) if q0 is None else np.array(q0, dtype=np.float64, order="C")
+    parallel.run(spec.kernel.solve_chunk_collision,
+                 (F, L, meta, Tt, box, Q0, cfg, seed64, *coll.arrays, coll.ccfg, Q, info),
+                 N, grain=4)
+    ok = info[:, K.I_SUCCESS] > 0.5
+    if respect and ok.any():
+        ok &= robot.within_limits(Q, LIMIT_TOL)
+    pairs = np.array([_pair_names(coll, info[k]) for k in range(N)], dtype=str).reshape(N, 2)
+    reasons = np.array(
+        ["" if ok[k] else _collision_reason(robot, coll, Tt[k], Q[k], info[k], tuple(pairs[k]),
+                                            tol, tgt.kind, respect, tgt.weights)
+         for k in range(N)], dtype=object).astype(str)
+    return IKResult(q=Q, success=ok, iterations=info[:, K.I_ITERATIONS].astype(np.int64),
+                    position_error=info[:, K.I_POS_ERR].copy(),
+                    orientation_error=info[:, K.I_ORI_ERR].copy(), reason=reasons,
+                    restarts=info[:, K.I_RESTARTS].astype(np.int64), method=spec.name,
+                    clearance=info[:, K.I_CLEARANCE].copy(), closest_pair=pairs)
 
 
 def _run_chunks(solve_chunk: Any, F: np.ndarray, meta: np.ndarray, Tt: np.ndarray, box: np.ndarray,

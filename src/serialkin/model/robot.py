@@ -726,7 +726,11 @@ class Robot:
 
     # ------------------------------------------------------------------ inverse kinematics
     def ik(self, target: object, method: str = "lm", **options: Any) -> IKResult:
-        """Inverse kinematics by any method (see :func:`serialkin.ik.solve`)."""
+        """Inverse kinematics by any method (see :func:`serialkin.ik.solve`).
+
+        ``scene=[...]``, ``self_collision=True`` and ``margin`` (m) ask for a solution
+        that is also collision-free (needs :attr:`collision`; see docs/ik.md).
+        """
         from serialkin.ik import solve
 
         return solve(self, target, method=method, **options)

@@ -1,0 +1,53 @@
+"""The fast path of ``robot.ik`` for one (4, 4) pose gives the ordinary path's answer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from serialkin import models
+from serialkin.errors import InputError
+from serialkin.ik import solver
+
+
+def _same(a, b):
+    """True when two single results agree field by field (q bit for bit)."""
+    return (np.array_equal(a.q, b.q) and a.success == b.success
+            and a.iterations == b.iterations and a.restarts == b.restarts
+            and a.position_error == b.position_error
+            and a.orientation_error == b.orientation_error and a.reason == b.reason
+            and a.method == b.method)
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda"])
+def test_fast_equals_ordinary(name):
+    """A writeable pose (fast path) and a read-only copy (ordinary path) give one answer."""
+    robot = models.get(name)
+    Q = robot.random_q(6, seed=4)
+    Q0 = robot.random_q(6, seed=5)
+    for k in range(6):
+        T = np.ascontiguousarray(robot.fk(Q[k]))
+        frozen = T.copy()
+        frozen.setflags(write=False)
+        for q0 in (None, Q0[k]):
+            fast = robot.ik(T, q0=q0, seed=k)
+            slow = robot.ik(frozen, q0=q0, seed=k)
+            assert _same(fast, slow)
+            assert solver._fast(robot, T, "lm", q0, k) is not None
+
+
+def test_fast_path_declines_what_it_does_not_check():
+    """Bad poses and q0 outside the limits fall back to the ordinary path's errors."""
+    ur5 = models.ur5()
+    T = ur5.fk(np.zeros(6))
+    bad = T.copy()
+    bad[0, 0] = 2.0
+    assert solver._fast(ur5, bad, "lm", None, 0) is None
+    with pytest.raises(InputError, match="target"):
+        ur5.ik(bad)
+    q0 = np.full(6, 7.0)
+    assert solver._fast(ur5, T, "lm", q0, 0) is None
+    with pytest.raises(InputError, match="q0 is outside the joint limits"):
+        ur5.ik(T, q0=q0)
+    assert solver._fast(ur5, T, "ccd", None, 0) is None
+    assert solver._fast(ur5, T, "lm", None, np.random.default_rng(0)) is None
