@@ -79,6 +79,22 @@ def _fast() -> tuple[Any, Any, Any, Any]:
     return _FK1, _JAC1, _HESS1, _JDOT1
 
 
+_SOLVE: Any = None
+
+
+def _ik_solve() -> Any:
+    """Resolve (once) :func:`serialkin.ik.solve` for :meth:`Robot.ik`.
+
+    ``ik`` sits above ``model`` in the layers, so it is imported on first use rather than
+    at import time, and not again on every call (that cost 0.5 µs per solve).
+    """
+    global _SOLVE
+    from serialkin.ik.solver import solve
+
+    _SOLVE = solve
+    return solve
+
+
 def _out_array(out: object, shape: tuple[int, ...]) -> np.ndarray:
     """``out`` when it is a writeable C-contiguous float64 array of ``shape``, else raise."""
     if not (type(out) is np.ndarray and out.dtype is _F64 and out.shape == shape
@@ -731,9 +747,7 @@ class Robot:
         ``scene=[...]``, ``self_collision=True`` and ``margin`` (m) ask for a solution
         that is also collision-free (needs :attr:`collision`; see docs/ik.md).
         """
-        from serialkin.ik import solve
-
-        return solve(self, target, method=method, **options)
+        return (_SOLVE or _ik_solve())(self, target, method, **options)
 
     def ik_all(self, target: object, **options: Any) -> np.ndarray:
         """Every closed-form IK solution inside the limits (see ``serialkin.ik.analytic``)."""
