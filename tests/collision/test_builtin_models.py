@@ -125,3 +125,40 @@ def test_shipped_capsules_contain_the_collision_meshes(name, rel, tip, offsets) 
         assert inside.all(), lm.link_name
         checked += 1
     assert checked == (9 if name == "panda" else 7)
+
+
+def test_ur5_self_collision_works_out_of_the_box():
+    """The zoo UR5 default ACM allows its always-overlapping shoulder pair; random q mostly free."""
+    import dataclasses
+
+    from serialkin.collision import AllowedCollisionMatrix, default_acm, sampled_acm, self_clearance
+
+    robot = models.get("ur5")
+    sampled = sampled_acm(robot, robot.collision, samples=2000, seed=1)
+    assert default_acm(robot.collision).checked_pairs() == sampled.checked_pairs()
+    Q = robot.random_q(500, seed=2)  # joints over ±2π: the wrist often folds into the arm
+    free = (self_clearance(robot, robot.collision, Q).distance > 0).mean()
+    strict = AllowedCollisionMatrix(robot.collision.body_names,
+                                    default_acm(dataclasses.replace(robot.collision,
+                                                                    allowed=())).allowed)
+    free_strict = (self_clearance(robot, robot.collision, Q, acm=strict).distance > 0).mean()
+    assert free_strict == 0 and free > 0.3
+
+
+def test_allowed_pairs_round_trip_through_dicts_and_robot_files(tmp_path):
+    """A model's allowed pairs survive to_dicts/from_dicts and a robot file; unknown names fail."""
+    from serialkin.collision.model import CollisionModel
+    from serialkin.errors import InputError
+    from serialkin.model.robotfile import load_robot_file, save_robot_file
+
+    robot = models.get("ur5")
+    model = robot.collision
+    assert model.allowed == (("base_link", "upper_arm_link"),)
+    assert CollisionModel.from_dicts(model.to_dicts()).allowed == model.allowed
+    path = tmp_path / "ur5.yaml"
+    save_robot_file(robot, path)
+    assert load_robot_file(path).collision.allowed == model.allowed
+    bad = model.to_dicts()
+    bad[0]["allowed"] = ["no_such_body"]
+    with pytest.raises(InputError, match="no_such_body"):
+        CollisionModel.from_dicts(bad)

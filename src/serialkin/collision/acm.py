@@ -75,14 +75,15 @@ class AllowedCollisionMatrix:
 
 
 def default_acm(model: CollisionModel) -> AllowedCollisionMatrix:
-    """Allow bodies on the same frame and on adjacent frames.
+    """Allow bodies on the same frame and on adjacent frames, and the model's ``allowed`` pairs.
 
     Frames ``i < j`` are adjacent when no body is fixed to a frame strictly between them
     (for a model with bodies on every frame: ``|frame_i − frame_j| ≤ 1``).
     """
     f = model.body_frames
     rank = np.searchsorted(np.unique(f), f)  # index of each body's frame among used frames
-    return AllowedCollisionMatrix(model.body_names, np.abs(rank[:, None] - rank[None, :]) <= 1)
+    acm = AllowedCollisionMatrix(model.body_names, np.abs(rank[:, None] - rank[None, :]) <= 1)
+    return acm.allow(model.allowed) if model.allowed else acm
 
 
 def acm_from_srdf(model: CollisionModel, srdf: Srdf | str | os.PathLike[str],

@@ -43,6 +43,9 @@ class CollisionModel:
         b: (m, 3) second end [m] (``a = b`` for a sphere).
         radius: (m,) radius [m], ≥ 0.
         source: where the numbers come from.
+        allowed: body-name pairs whose contact is always allowed (never checked) beyond the
+            adjacent ones of :func:`~serialkin.collision.acm.default_acm`, e.g. pairs whose
+            capsules overlap in every configuration; stored sorted, each pair sorted.
 
     Raises:
         InputError: inconsistent lengths, a negative or non-finite radius or point, an
@@ -57,6 +60,7 @@ class CollisionModel:
     b: np.ndarray
     radius: np.ndarray
     source: str = ""
+    allowed: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         names = tuple(self.body_names)
@@ -90,6 +94,18 @@ class CollisionModel:
             i = int(np.argmax(r < 0))
             raise InputError(f"radius[{i}] (a shape of body {names[sb[i]]!r}) must be >= 0, "
                              f"got {r[i]}")
+        pairs = set()
+        for i, pair in enumerate(self.allowed):
+            if isinstance(pair, (str, bytes)) or len(pair) != 2:
+                raise InputError(f"allowed[{i}] must be a pair of body names, got "
+                                 f"{short_repr(pair)}")
+            for x in pair:
+                if x not in names:
+                    raise InputError(f"allowed[{i}] names an unknown body {short_repr(x)}; "
+                                     f"bodies: {', '.join(names)}")
+            if pair[0] != pair[1]:
+                pairs.add(tuple(sorted(pair)))
+        object.__setattr__(self, "allowed", tuple(sorted(pairs)))
         for k, v in (("body_names", names), ("body_frames", frames), ("shape_body", sb),
                      ("a", pts["a"]), ("b", pts["b"]), ("radius", np.ascontiguousarray(r))):
             if isinstance(v, np.ndarray):
@@ -113,6 +129,9 @@ class CollisionModel:
     def from_dicts(cls, bodies: Sequence[Mapping], source: str = "") -> CollisionModel:
         """Build from the dictionary form of the module docstring.
 
+        A body may list ``allowed``: names of other bodies it may always touch (see
+        :attr:`allowed`).
+
         Raises:
             InputError / InputTypeError: a missing or malformed entry; the message names
                 it, e.g. ``bodies[2].capsules[0].radius``.
@@ -120,14 +139,20 @@ class CollisionModel:
         if isinstance(bodies, (str, bytes, Mapping)) or not isinstance(bodies, Sequence):
             raise InputTypeError(f"bodies must be a list of mappings, got {short_repr(bodies)}")
         names, frames, sb, A, B, R = [], [], [], [], [], []
+        allowed: list[tuple[str, str]] = []
         for i, body in enumerate(bodies):
             where = f"bodies[{i}]"
             if not isinstance(body, Mapping):
                 raise InputTypeError(f"{where} must be a mapping, got {short_repr(body)}")
-            unknown = set(body) - {"name", "frame", "capsules", "spheres"}
+            unknown = set(body) - {"name", "frame", "capsules", "spheres", "allowed"}
             if unknown:
                 raise InputError(f"{where} has unknown keys {sorted(map(str, unknown))}; "
-                                 "expected name, frame, capsules, spheres")
+                                 "expected name, frame, capsules, spheres, allowed")
+            others = body.get("allowed", [])
+            if isinstance(others, (str, bytes)) or not isinstance(others, Sequence):
+                raise InputTypeError(f"{where}.allowed must be a list of body names, got "
+                                     f"{short_repr(others)}")
+            allowed += [(body.get("name"), other) for other in others]
             for key in ("name", "frame"):
                 if key not in body:
                     raise InputError(f"{where}.{key} is missing")
@@ -160,7 +185,7 @@ class CollisionModel:
         return cls(tuple(names), np.array(frames, dtype=np.int64), np.array(sb, dtype=np.int64),
                    np.reshape(np.array(A, dtype=float), (-1, 3)),
                    np.reshape(np.array(B, dtype=float), (-1, 3)), np.array(R, dtype=float),
-                   source)
+                   source, tuple(allowed))
 
     def to_dicts(self) -> list[dict]:
         """The dictionary form (inverse of :meth:`from_dicts`)."""
@@ -172,6 +197,9 @@ class CollisionModel:
                 out[bi]["spheres"].append({"center": a, "radius": r})
             else:
                 out[bi]["capsules"].append({"a": a, "b": b, "radius": r})
+        index = {nm: i for i, nm in enumerate(self.body_names)}
+        for a, b in self.allowed:
+            out[index[a]].setdefault("allowed", []).append(b)
         return out
 
 

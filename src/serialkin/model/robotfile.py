@@ -262,11 +262,15 @@ def _collision_field(f: Field, n: int, length_unit: str, source: str) -> Any:
     lin = LENGTH_UNITS[length_unit]
     b = _bound(MAX_LENGTH, lin)
     names, frames, owner, A, B, R = [], [], [], [], [], []
+    allowed: list[tuple[Field, str, str]] = []
     for i, body in enumerate(f.items(max_len=MAX_SHAPES,
                                      what="a list of {name, frame, capsules, spheres}")):
-        body.mapping({"name", "frame", "capsules", "spheres"}, ("name", "frame"),
-                     what="a mapping {name, frame, capsules, spheres}")
+        body.mapping({"name", "frame", "capsules", "spheres", "allowed"}, ("name", "frame"),
+                     what="a mapping {name, frame, capsules, spheres, allowed}")
         name = body["name"].string(max_len=1000)
+        if body["allowed"].present:
+            allowed += [(item, name, item.string(max_len=1000)) for item in
+                        body["allowed"].items(max_len=MAX_SHAPES, what="a list of body names")]
         if name in names:
             raise body["name"].fail(f"must name each body once, got {short_repr(name)} twice")
         names.append(name)
@@ -282,10 +286,14 @@ def _collision_field(f: Field, n: int, length_unit: str, source: str) -> Any:
                 A.append(pts[0])
                 B.append(pts[-1])
                 R.append(_size(s["radius"], length_unit, lin))
+    for item, _, other in allowed:
+        if other not in names:
+            raise item.fail(f"must name a body of this list ({', '.join(names)}), got "
+                            f"{short_repr(other)}")
     return CollisionModel(tuple(names), np.array(frames, dtype=np.int64),
                           np.array(owner, dtype=np.int64), np.reshape(np.array(A), (-1, 3)),
                           np.reshape(np.array(B), (-1, 3)), np.array(R, dtype=float),
-                          source=source)
+                          source=source, allowed=tuple((a, b) for _, a, b in allowed))
 
 
 def robot_from_dict(data: object, origin: str = "<robot description>",
