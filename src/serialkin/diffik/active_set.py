@@ -29,6 +29,8 @@ import math
 import numpy as np
 from numba import njit
 
+from serialkin.kinematics.dls import chol_factor_into, lower_solve_into, lower_t_solve_into
+
 __all__ = ["INFEASIBLE", "ITERATION_LIMIT", "NOT_CONVEX", "OPTIMAL", "dual_active_set",
            "solve_bounded"]
 
@@ -37,28 +39,6 @@ OPTIMAL = 1
 INFEASIBLE = -1
 ITERATION_LIMIT = -4
 NOT_CONVEX = -5
-
-
-@njit(cache=True)
-def _forward(L, v, out):
-    """Solve L out = v (L lower triangular)."""
-    n = L.shape[0]
-    for i in range(n):
-        s = v[i]
-        for k in range(i):
-            s -= L[i, k] * out[k]
-        out[i] = s / L[i, i]
-
-
-@njit(cache=True)
-def _backward_t(L, v, out):
-    """Solve Lᵀ out = v (L lower triangular)."""
-    n = L.shape[0]
-    for i in range(n - 1, -1, -1):
-        s = v[i]
-        for k in range(i + 1, n):
-            s -= L[k, i] * out[k]
-        out[i] = s / L[i, i]
 
 
 @njit(cache=True)
@@ -71,14 +51,14 @@ def _factor_active(L, A, active, q, J1, R):
     for j in range(q):
         for i in range(n):
             tmp[i] = A[active[j], i]
-        _forward(L, tmp, col)
+        lower_solve_into(L, tmp, col, n)
         for i in range(n):
             M[i, j] = col[i]
     Q1, R1 = np.linalg.qr(M)
     for j in range(q):
         for i in range(n):
             tmp[i] = Q1[i, j]
-        _backward_t(L, tmp, col)
+        lower_t_solve_into(L, tmp, col, n)
         for i in range(n):
             J1[i, j] = col[i]
         for i in range(q):
@@ -104,23 +84,17 @@ def dual_active_set(H, c, A, b, x, max_iter):
     n = H.shape[0]
     m = A.shape[0]
     L = np.zeros((n, n))
-    for i in range(n):  # Cholesky H = L Lᵀ
+    for i in range(n):
         for j in range(i + 1):
-            s = H[i, j]
-            for k in range(j):
-                s -= L[i, k] * L[j, k]
-            if i == j:
-                if s <= 0.0:
-                    return NOT_CONVEX, 0
-                L[i, i] = math.sqrt(s)
-            else:
-                L[i, j] = s / L[j, j]
+            L[i, j] = H[i, j]
+    if not chol_factor_into(L, n):  # H = L Lᵀ, lower triangle; the upper stays zero
+        return NOT_CONVEX, 0
     y = np.empty(n)
     tmp = np.empty(n)
     for i in range(n):
         tmp[i] = -c[i]
-    _forward(L, tmp, y)
-    _backward_t(L, y, x)  # unconstrained minimum
+    lower_solve_into(L, tmp, y, n)
+    lower_t_solve_into(L, y, x, n)  # unconstrained minimum
     norms = np.empty(m)
     for i in range(m):
         s = 0.0
@@ -160,8 +134,8 @@ def dual_active_set(H, c, A, b, x, max_iter):
         u_plus = 0.0
         for k in range(n):
             np_[k] = A[p, k]
-        _forward(L, np_, y)
-        _backward_t(L, y, hinv_n)  # H⁻¹ n⁺
+        lower_solve_into(L, np_, y, n)
+        lower_t_solve_into(L, y, hinv_n, n)  # H⁻¹ n⁺
         while True:  # step 2: add p (possibly after dropping others)
             it += 1
             if it > max_iter:

@@ -75,18 +75,30 @@ def chol_factor_into(A, m):
 
 
 @njit(cache=True)
-def chol_solve_into(L, b, x, m):
-    """Solve ``L Lᵀ x = b`` (m,) with the factor L of :func:`chol_factor_into`; x may alias b."""
+def lower_solve_into(L, b, x, m):
+    """Forward substitution: solve ``L x = b`` (m,), L lower triangular; x may alias b."""
     for i in range(m):
         t = b[i]
         for k in range(i):
             t -= L[i, k] * x[k]
         x[i] = t / L[i, i]
+
+
+@njit(cache=True)
+def lower_t_solve_into(L, b, x, m):
+    """Back substitution: solve ``Lᵀ x = b`` (m,), L lower triangular; x may alias b."""
     for i in range(m - 1, -1, -1):
-        t = x[i]
+        t = b[i]
         for k in range(i + 1, m):
             t -= L[k, i] * x[k]
         x[i] = t / L[i, i]
+
+
+@njit(cache=True)
+def chol_solve_into(L, b, x, m):
+    """Solve ``L Lᵀ x = b`` (m,) with the factor L of :func:`chol_factor_into`; x may alias b."""
+    lower_solve_into(L, b, x, m)
+    lower_t_solve_into(L, x, x, m)
 
 
 @njit(cache=True)
