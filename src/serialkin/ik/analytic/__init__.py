@@ -512,7 +512,7 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
             iiwa); the rest is solved as above and the locked values are put back in
             the rows. Sweeping the value samples the self-motion manifold.
         near_tol: tolerance of the nearly-ideal test [rad; m per m of size]; 0 disables it.
-        grid: nodes per searched joint of the general 6R search (default 40).
+        grid: nodes per searched joint of the general 6R search (default 48).
         reference: (n,) configuration: rows are shifted by 2π towards it (inside the
             limits) and sorted nearest first (single targets; see
             :func:`sort_by_reference`); without it rows are sorted lexicographically.

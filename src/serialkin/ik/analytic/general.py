@@ -27,7 +27,7 @@ solution is refined on the robot's own chain (so the method is exact to 1e-12 fo
 joint description, base and tool), and it degrades gracefully near special geometry
 where the eliminant's 24×24 companion matrix loses accuracy. Its cost is the grid
 (``grid``² nodes × one quartic), and two solutions closer together than about one grid
-cell can merge into one basin: the default grid of 40 found all 16 solutions of the
+cell can merge into one basin: the default grid of 48 found all 16 solutions of the
 published 16-solution arms (tests); ``grid`` can be raised.
 """
 
@@ -54,7 +54,7 @@ from serialkin.ik.analytic.subproblems import (
 #: Most solutions of a 6R arm.
 MAX_SOLUTIONS = 16
 #: Default number of grid nodes per searched joint.
-DEFAULT_GRID = 40
+DEFAULT_GRID = 48
 
 
 @njit(cache=True)
@@ -127,6 +127,7 @@ def general_candidates(T, W, P, M, aux, arm, grid, F, meta, tol_p, tol_r, out):
                 Q[i5, i6, b, 3] = sp1_dir(w4, u4, mv(X, u4))
     k = 0
     q = np.empty(6)
+    accept = 2.0 * h  # residuals this small start Newton even when not a local minimum
     for i5 in range(N):
         for i6 in range(N):
             for b in range(nb[i5, i6]):
@@ -150,12 +151,19 @@ def general_candidates(T, W, P, M, aux, arm, grid, F, meta, tol_p, tol_r, out):
                             break
                     if not local:
                         break
-                if not local:
+                if not local and r > accept:
                     continue
                 for j in range(4):
                     q[j] = Q[i5, i6, b, j]
                 q[4] = -math.pi + h * i5
                 q[5] = -math.pi + h * i6
+                near = False  # inside the basin of a solution already found: skip
+                for s in range(k):
+                    if _wrapped_dist(q, out[s], 6) < 0.5 * h:
+                        near = True
+                        break
+                if near:
+                    continue
                 if not newton_refine(q, T, F, meta, tol_p, tol_r, MAX_NEWTON):
                     continue
                 dup = False
