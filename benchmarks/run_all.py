@@ -27,6 +27,7 @@ GOALS = {
     "11.2": "parallel batches never slower than serial; 6-DOF batch FK >= 40 M/s",
     "11.3": "IK lm single <= 8 us at 100 % success; batch <= 4 us per target",
     "12.1": "Panda self_clearance batched on one core <= 2 us per configuration",
+    "14.1": "ik_all decomposable arms <= 10 us single, <= 3 us batched; general 6R <= 200 us",
 }
 
 

@@ -471,10 +471,15 @@ def _as_poses(a: np.ndarray) -> np.ndarray:
     if not transforms_valid(T, ROTATION_TOL):
         for k in range(T.shape[0]):
             check_transform(T[k], f"target[{k}]")
-    U, _, Vt = np.linalg.svd(T[:, :3, :3])
-    T = T.copy()
-    T[:, :3, :3] = U @ Vt
-    T[:, 3] = (0.0, 0.0, 0.0, 1.0)
+    R = T[:, :3, :3]
+    gram = np.einsum("kij,kil->kjl", R, R) - np.eye(3)
+    off = (np.abs(gram).max(axis=(1, 2)) > 1e-13) | np.any(T[:, 3] != (0.0, 0.0, 0.0, 1.0),
+                                                          axis=1)
+    if off.any():  # nearest rotations (polar decomposition) where needed, exact last rows
+        T = T.copy()
+        U, _, Vt = np.linalg.svd(T[off, :3, :3])
+        T[off, :3, :3] = U @ Vt
+        T[off, 3] = (0.0, 0.0, 0.0, 1.0)
     return T
 
 
