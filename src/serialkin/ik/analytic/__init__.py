@@ -19,9 +19,14 @@ class                       structure                                           
 ``ur``                      6R, axes 2 ∥ 3 ∥ 4, axes 5 and 6 intersect            8
 ==========================  ====================================================  =====
 
-Other robots raise :class:`~serialkin.errors.NoClosedFormError`, whose message says
-which structural test failed and points to the numerical solvers
-(``robot.ik(target, method="lm")``).
+Beyond these exact classes (see ``docs/ik-analytic.md``): a 6-joint arm within
+``near_tol`` of a class (a calibrated robot) is solved on the idealised class and every
+branch refined by Newton's method on the true model (:mod:`~serialkin.ik.analytic.refine`);
+any other 6R arm by the 2-D search of :mod:`~serialkin.ik.analytic.general` (up to 16
+solutions); ``free={index: value}`` locks joints (7R arms); a batch of targets
+(..., 4, 4) returns an :class:`AllSolutions`. Other robots raise
+:class:`~serialkin.errors.NoClosedFormError`, whose message says which structural test
+failed and points to the numerical solvers (``robot.ik(target, method="lm")``).
 
 Semantics:
 
@@ -37,8 +42,8 @@ Semantics:
   set is a continuum; one representative per branch is returned (the free angle set
   to 0). At a stretched elbow the two elbow branches merge into one solution.
 * The kernels are compiled by numba on first use (cached on disk afterwards); a call
-  then takes about 10-15 µs for a 6R arm, all solutions included
-  (``benchmarks/bench_ik_all.py``).
+  then takes about 10-15 µs for a 6R arm of an exact class, all solutions included,
+  and milliseconds for the general search (``benchmarks/bench_ik_all.py``).
 """
 
 from __future__ import annotations
