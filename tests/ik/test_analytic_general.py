@@ -250,3 +250,20 @@ def test_wrist_singular_target_of_nearly_ideal_arm_is_finite():
     res = ik_all(robot, T, report=True)
     assert np.all(np.isfinite(res.q))
     assert _fk_error(robot, res.q, T) < 1e-10
+
+
+def test_continuous_family_flag():
+    """A wrist-singular target (Puma, q5 = 0) flags its row; a regular target flags none."""
+    robot = models.puma560()
+    q = np.array([0.2, -0.5, 0.3, 0.3, 0.0, 0.4])
+    T = robot.fk(q)
+    res = ik_all(robot, T, report=True)
+    row = int(np.argmin(_wrapped(res.q, q)))
+    assert res.continuous[row]
+    axes = robot.joint_axes(res.q[row])[1]  # axes 4 and 6 collinear: q4 + δ, q6 ∓ δ keeps T
+    moved = res.q[row] + np.array([0, 0, 0, 0.3, 0, -0.3 * np.sign(axes[3] @ axes[5])])
+    assert np.abs(robot.fk(moved) - T).max() < 1e-10
+    regular = ik_all(robot, robot.fk(np.array([0.2, -0.5, 0.3, 0.3, 0.6, 0.4])), report=True)
+    assert not regular.continuous.any()
+    batch = ik_all(robot, np.stack([T, T]), report=True)
+    assert batch.continuous.shape == batch.q.shape[:2] and batch.continuous[0].any()

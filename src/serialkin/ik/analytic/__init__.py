@@ -60,6 +60,7 @@ import numpy as np
 from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
 from serialkin.errors import InputError, NoClosedFormError
 from serialkin.ik.analytic.dispatch import GENERAL, MAX_ROWS, PLANAR, SCARA, UR, WRIST
+from serialkin.ik.analytic.singular import continuous_family
 from serialkin.ik.analytic.structure import (
     CLASSES,
     NUMERICAL_HINT,
@@ -320,6 +321,10 @@ class AllSolutions:
             the tolerance of ``kind``: solved for the idealised axes, every branch refined
             on the true model) or ``'general'`` (the 2-D search of
             :mod:`serialkin.ik.analytic.general`).
+        continuous: (..., k_max) bool, with ``report=True``: solution j of target i lies
+            on a continuous family of solutions (a singular target: the row is one
+            representative, :func:`~serialkin.ik.analytic.singular.continuous_family`);
+            None when not computed.
     """
 
     q: np.ndarray
@@ -328,6 +333,7 @@ class AllSolutions:
     converged: np.ndarray
     kind: str
     mode: str
+    continuous: np.ndarray | None = None
 
     def solutions(self, index: int | tuple[int, ...]) -> np.ndarray:
         """The (count, n) solutions of one target (an index into the batch dimensions)."""
@@ -528,7 +534,9 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
             :func:`sort_by_reference`); without it rows are sorted lexicographically.
         weights: (n,) weights of the distance to ``reference``.
         norm: 'l2' (weighted Euclidean) or 'linf' (weighted max) distance.
-        report: return an :class:`AllSolutions` for a single target too.
+        report: return an :class:`AllSolutions` for a single target too, with the
+            per-branch convergence and, per solution, whether it lies on a continuous
+            family (a singular target).
         **options: none other are accepted (an unknown name raises InputError).
 
     Returns:
@@ -553,9 +561,9 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         res = ik_all(reduced, target, tol=tol, all_turns=all_turns, near_tol=near_tol,
                      grid=grid, report=report)
         if isinstance(res, AllSolutions):
-            full = AllSolutions(_insert_locked(res.q, idx, vals, robot.n), res.count,
-                                res.branches, res.converged, res.kind, res.mode)
-            return full
+            return AllSolutions(_insert_locked(res.q, idx, vals, robot.n), res.count,
+                                res.branches, res.converged, res.kind, res.mode,
+                                res.continuous)
         full_rows = _insert_locked(res, idx, vals, robot.n)
         if reference is not None:
             full_rows = sort_by_reference(robot, full_rows, reference, weights=weights,
@@ -579,9 +587,16 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         kmax = int(counts.max(initial=0))
         branches = conv[:, 0]
         converged = conv[:, 1:].astype(bool)
+        cont = None
+        if report:
+            cont = np.zeros((T.shape[0], kmax), dtype=bool)
+            for i in range(T.shape[0]):
+                for j in range(int(counts[i])):
+                    cont[i, j] = continuous_family(robot, T[i], out[i, j])
+            cont = cont.reshape(lead + (kmax,))
         return AllSolutions(out[:, :kmax].reshape(lead + (kmax, p.n)), counts.reshape(lead),
                             branches.reshape(lead), converged.reshape(lead + (MAX_ROWS,)),
-                            p.s.kind, p.mode)
+                            p.s.kind, p.mode, cont)
     T, check_rot = _parse_target(p, robot, a)
     from serialkin.ik.analytic.dispatch import solve_into
 
@@ -596,6 +611,8 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
     if reference is not None:
         sols = sort_by_reference(robot, sols, reference, weights=weights, norm=norm)
     if report:
+        cont = np.array([check_rot and p.n == 6 and continuous_family(robot, T, row)
+                         for row in sols], dtype=bool)
         return AllSolutions(sols.copy(), np.array(sols.shape[0]), np.array(conv[0]),
-                            conv[1:].astype(bool), p.s.kind, p.mode)
+                            conv[1:].astype(bool), p.s.kind, p.mode, cont)
     return sols
