@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from serialkin import Robot, models
 from serialkin.errors import InputError, NoClosedFormError
@@ -267,3 +269,22 @@ def test_continuous_family_flag():
     assert not regular.continuous.any()
     batch = ik_all(robot, np.stack([T, T]), report=True)
     assert batch.continuous.shape == batch.q.shape[:2] and batch.continuous[0].any()
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.lists(st.tuples(st.floats(0.0, 0.6), st.floats(-3.1, 3.1), st.floats(-0.4, 0.4)),
+                min_size=6, max_size=6),
+       st.integers(0, 2**31 - 1))
+def test_any_dh_table_round_trip(rows, seed):
+    """For any 6R DH table, the generating q is among the rows and every row meets FK."""
+    robot = Robot.from_dh([DHLink(a=a, alpha=al, d=d) for a, al, d in rows])
+    q = np.random.default_rng(seed).uniform(-np.pi, np.pi, 6)
+    T = robot.fk(q)
+    try:
+        sols = ik_all(robot, T)
+    except NoClosedFormError:  # degenerate tables (e.g. axes 1-3 all parallel) may refuse
+        return
+    assert len(sols) <= 16 and np.all(np.isfinite(sols))
+    assert _fk_error(robot, sols, T) < 1e-9 * max(1.0, float(np.abs(T[:3, 3]).max()))
+    if np.linalg.svd(robot.jacobian(q), compute_uv=False)[-1] > 1e-3:  # regular q: found
+        assert _wrapped(sols, q).min() < 1e-7

@@ -45,7 +45,6 @@ from serialkin.ik.analytic.subproblems import (
     inv_rigid,
     mm,
     mv,
-    rotation,
     screw,
     sp1_dir,
     transform_point,
@@ -55,6 +54,19 @@ from serialkin.ik.analytic.subproblems import (
 MAX_SOLUTIONS = 16
 #: Default number of grid nodes per searched joint.
 DEFAULT_GRID = 48
+
+
+@njit(cache=True)
+def rotate(w, theta, v):
+    """``Rot(w, θ)·v`` (3,) by Rodrigues' formula, w a unit axis, v a vector."""
+    c = math.cos(theta)
+    s = math.sin(theta)
+    wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2]
+    out = np.empty(3)
+    out[0] = v[0] * c + (w[1] * v[2] - w[2] * v[1]) * s + w[0] * wv * (1.0 - c)
+    out[1] = v[1] * c + (w[2] * v[0] - w[0] * v[2]) * s + w[1] * wv * (1.0 - c)
+    out[2] = v[2] * c + (w[0] * v[1] - w[1] * v[0]) * s + w[2] * wv * (1.0 - c)
+    return out
 
 
 @njit(cache=True)
@@ -104,27 +116,31 @@ def general_candidates(T, W, P, M, aux, arm, grid, F, meta, tol_p, tol_r, out):
     Q = np.zeros((N, N, 4, 4))
     arm3 = np.empty((4, 3))
     h = TWO_PI / N
+    E5 = np.empty((N, 4, 4))  # exp(−ξ5 q5) and T·M⁻¹·exp(−ξ6 q6) on the grid
+    A6 = np.empty((N, 4, 4))
+    for i in range(N):
+        E5[i] = screw(w5, r5, -(-math.pi + h * i), False)
+        A6[i] = mm(TMinv, screw(w6, r6, -(-math.pi + h * i), False))
+    w1 = W[0].copy()
+    w2 = W[1].copy()
+    w3 = W[2].copy()
     for i5 in range(N):
-        q5 = -math.pi + h * i5
-        E5 = screw(w5, r5, -q5, False)
         for i6 in range(N):
-            q6 = -math.pi + h * i6
-            G = mm(mm(TMinv, screw(w6, r6, -q6, False)), E5)
+            G = mm(A6[i6], E5[i5])
             pw = transform_point(G, c)
             m = arm_positions(pw, W, P, aux, arm, False, arm3)
             nb[i5, i6] = m
+            gw = mv(G, w4)  # R_G w4 and R_G u4, then turned back by joints 1-3
+            gu = mv(G, u4)
             for b in range(m):
-                R123 = mm(mm(rotation(W[0].copy(), arm3[b, 0]), rotation(W[1].copy(),
-                                                                           arm3[b, 1])),
-                          rotation(W[2].copy(), arm3[b, 2]))
-                X = mm(R123.T, G[:3, :3].copy())
-                xw = mv(X, w4)
+                xw = rotate(w3, -arm3[b, 2], rotate(w2, -arm3[b, 1], rotate(w1, -arm3[b, 0], gw)))
+                xu = rotate(w3, -arm3[b, 2], rotate(w2, -arm3[b, 1], rotate(w1, -arm3[b, 0], gu)))
                 res[i5, i6, b] = math.sqrt((xw[0] - w4[0]) ** 2 + (xw[1] - w4[1]) ** 2
                                            + (xw[2] - w4[2]) ** 2)
                 Q[i5, i6, b, 0] = arm3[b, 0]
                 Q[i5, i6, b, 1] = arm3[b, 1]
                 Q[i5, i6, b, 2] = arm3[b, 2]
-                Q[i5, i6, b, 3] = sp1_dir(w4, u4, mv(X, u4))
+                Q[i5, i6, b, 3] = sp1_dir(w4, u4, xu)
     k = 0
     q = np.empty(6)
     accept = 2.0 * h  # residuals this small start Newton even when not a local minimum
