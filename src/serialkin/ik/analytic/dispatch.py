@@ -77,7 +77,8 @@ def solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mi
     elif code == UR:
         k = ur_candidates(T, W, P, M, aux, cand)
     else:
-        k = general_candidates(T, W, P, M, aux, arm, grid, F, meta, newton_p, newton_r, cand)
+        k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, grid, F, meta, newton_p,
+                               newton_r, cand)
     conv[0] = k
     if refine and code != GENERAL:
         ok = np.zeros(k, dtype=np.bool_)

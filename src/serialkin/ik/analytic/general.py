@@ -80,7 +80,7 @@ def _wrapped_dist(a, b, n):
 
 
 @njit(cache=True)
-def general_candidates(T, W, P, M, aux, arm, grid, F, meta, tol_p, tol_r, out):
+def general_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r, out):
     """Every solution of a general 6R arm found by the (q5, q6) search, into ``out`` (16, 6).
 
     Args:
@@ -92,6 +92,8 @@ def general_candidates(T, W, P, M, aux, arm, grid, F, meta, tol_p, tol_r, out):
             then as for :func:`~serialkin.ik.analytic.spherical_wrist.arm_positions`),
             and ``aux[-1]`` a unit vector ⟂ w4.
         arm: arm code for ``arm_positions`` (0 planar 2 ∥ 3, 1 axes 1, 2 meet, 2 other).
+        reverse: W, P, M describe the reversed chain (joint j is joint 7 − j, tool pose
+            M⁻¹), searched for ``T⁻¹``; rows are returned in the robot's joint order.
         grid: nodes per searched joint (N; N² nodes).
         F: (7, 4, 4) chain transforms.
         meta: (6, 5) chain joint data.
@@ -110,7 +112,8 @@ def general_candidates(T, W, P, M, aux, arm, grid, F, meta, tol_p, tol_r, out):
     r5 = P[4].copy()
     w6 = W[5].copy()
     r6 = P[5].copy()
-    TMinv = mm(T, inv_rigid(M))
+    Ts = inv_rigid(T) if reverse else T
+    TMinv = mm(Ts, inv_rigid(M))
     nb = np.zeros((N, N), dtype=np.int64)
     res = np.full((N, N, 4), np.inf)
     Q = np.zeros((N, N, 4, 4))
@@ -143,6 +146,7 @@ def general_candidates(T, W, P, M, aux, arm, grid, F, meta, tol_p, tol_r, out):
                 Q[i5, i6, b, 3] = sp1_dir(w4, u4, xu)
     k = 0
     q = np.empty(6)
+    qs = np.empty(6)
     accept = 2.0 * h  # residuals this small start Newton even when not a local minimum
     for i5 in range(N):
         for i6 in range(N):
@@ -170,9 +174,11 @@ def general_candidates(T, W, P, M, aux, arm, grid, F, meta, tol_p, tol_r, out):
                 if not local and r > accept:
                     continue
                 for j in range(4):
-                    q[j] = Q[i5, i6, b, j]
-                q[4] = -math.pi + h * i5
-                q[5] = -math.pi + h * i6
+                    qs[j] = Q[i5, i6, b, j]
+                qs[4] = -math.pi + h * i5
+                qs[5] = -math.pi + h * i6
+                for j in range(6):
+                    q[j] = qs[5 - j] if reverse else qs[j]
                 near = False  # inside the basin of a solution already found: skip
                 for s in range(k):
                     if _wrapped_dist(q, out[s], 6) < 0.5 * h:

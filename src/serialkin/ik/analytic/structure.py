@@ -349,12 +349,19 @@ def general_structure(robot: Robot) -> Structure:
 
     The 3R arm of joints 1-3 must place a point ``c`` of axis 4 in closed form; ``c`` is
     taken on axis 4 as far from axis 3 as the candidates ``P4 + t·w4`` (t = 0, ±size/2)
-    allow, and the arm is classified like the arm of a spherical-wrist robot. ``order``
-    holds the arm code (:data:`ARM_CODES`); ``aux`` ends with a unit vector ⟂ w4.
+    allow, and the arm is classified like the arm of a spherical-wrist robot. When joints
+    1-3 cannot (e.g. axes 1, 2, 3 parallel), the chain is reversed:
+    ``T⁻¹ = M⁻¹·e6⁻¹···e1⁻¹`` is a chain whose joint j is joint 7 − j about the line
+    ``(−R_Mᵀ w, M⁻¹ p)`` with tool pose ``M⁻¹``, and joints 6-4 place a point of axis 3.
+    When both ends can, the reversed chain is taken only when it is clearly better
+    conditioned (Pieper's quartic divides by the common normal a1 of axes 1 and 2: the
+    score min(1, 10·a1/size) is below 0.5 forward and at least 0.5 reversed).
+    ``order`` holds the arm code (:data:`ARM_CODES`) and 1 when reversed; ``aux`` ends
+    with a unit vector ⟂ w4 (of the chain searched); W, P, M are that chain's.
 
     Raises:
-        NoClosedFormError: not a 6R arm, or its first three joints cannot place a point
-            in closed form (e.g. axes 1, 2, 3 all parallel).
+        NoClosedFormError: not a 6R arm, or neither end's three joints can place a point
+            in closed form (e.g. coaxial joints: infinitely many solutions).
     """
     W, P, M = joint_lines(robot)
     rev = robot.revolute
@@ -364,14 +371,32 @@ def general_structure(robot: Robot) -> Structure:
     scale = max(1.0, float(np.max(np.linalg.norm(np.vstack([P, M[:3, 3]]) - P[0], axis=1))))
     ltol = 1e-6 * scale
     reasons: list[str] = []
-    options = sorted(((_point_line_distance(P[3] + t * W[3], P[2], W[2]), t)
-                      for t in (0.0, 0.5 * scale, -0.5 * scale)), reverse=True)
-    for _, t in options:
-        c = P[3] + t * W[3]
-        arm = _wrist_arm(W, P, M, rev, scale, ltol, types, c, reasons, 1e-6)
-        if arm is not None:
-            aux = np.vstack([arm.aux[:-1], _unit_perp(W[3])])
-            return Structure("general_6r", W, P, M, rev, aux,
-                             np.array([ARM_CODES[arm.kind]], dtype=np.int64), False, scale)
+    Minv = np.linalg.inv(M)
+    Wr = -(W[::-1] @ M[:3, :3])
+    Pr = P[::-1] @ Minv[:3, :3].T + Minv[:3, 3]
+    found = []
+    for reversed_, (Wc, Pc, Mc) in ((0, (W, P, M)), (1, (Wr, Pr, Minv))):
+        options = sorted(((_point_line_distance(Pc[3] + t * Wc[3], Pc[2], Wc[2]), t)
+                          for t in (0.0, 0.5 * scale, -0.5 * scale)), reverse=True)
+        for _, t in options:
+            c = Pc[3] + t * Wc[3]
+            arm = _wrist_arm(Wc, Pc, Mc, rev, scale, ltol, types, c, reasons, 1e-6)
+            if arm is not None:
+                # conditioning: Pieper's quartic divides by the common normal a1 of axes 1, 2
+                score = 1.0 if arm.kind != "pieper_general" else \
+                    min(1.0, 10.0 * float(np.linalg.norm(arm.aux[2] - arm.aux[1])) / scale)
+                aux = np.vstack([arm.aux[:-1], _unit_perp(Wc[3])])
+                found.append((score, -reversed_, Structure(
+                    "general_6r", np.ascontiguousarray(Wc), np.ascontiguousarray(Pc),
+                    np.ascontiguousarray(Mc), rev, aux,
+                    np.array([ARM_CODES[arm.kind], reversed_], dtype=np.int64), False,
+                    scale)))
+                break
+    if found:  # the reversed chain only when clearly better conditioned
+        best = found[0]
+        if len(found) == 2 and found[0][0] < 0.5 <= found[1][0]:
+            best = found[1]
+        return best[2]
     raise _fail(robot, "no closed form for the 3R arm of joints 1-3 placing a point of axis "
-                       "4: " + "; ".join(dict.fromkeys(reasons)))
+                       "4, nor for joints 6-4 placing a point of axis 3: "
+                       + "; ".join(dict.fromkeys(reasons)))
