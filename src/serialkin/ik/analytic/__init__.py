@@ -191,7 +191,9 @@ def _prepared(robot: Robot, near_tol: float = 0.0) -> _Prepared:
         if p is None:
             try:
                 p = _Prepared(robot, general_structure(robot), "general")
-            except NoClosedFormError:
+            except NoClosedFormError as general_error:
+                if robot.joint_types == ("R",) * 6:
+                    raise general_error from None
                 raise exact_error from None
     cache[near_tol] = p
     return p

@@ -79,6 +79,9 @@ def solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mi
     else:
         k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, grid, F, meta, newton_p,
                                newton_r, cand)
+        if k % 2 == 1:  # real solutions of a 6R come in even numbers: search finer once
+            k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, 2 * grid, F, meta,
+                                   newton_p, newton_r, cand)
     conv[0] = k
     if refine and code != GENERAL:
         ok = np.zeros(k, dtype=np.bool_)

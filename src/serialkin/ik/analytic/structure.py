@@ -370,6 +370,11 @@ def general_structure(robot: Robot) -> Structure:
         raise _fail(robot, f"the general solver needs six revolute joints, got {types}")
     scale = max(1.0, float(np.max(np.linalg.norm(np.vstack([P, M[:3, 3]]) - P[0], axis=1))))
     ltol = 1e-6 * scale
+    for i in range(5):  # coaxial neighbours turn as one joint: a continuum of solutions
+        if _sin_angle(W[i], W[i + 1]) < 1e-9 and \
+                _point_line_distance(P[i + 1], P[i], W[i]) < 1e-9 * scale:
+            raise _fail(robot, f"axes {i + 1} and {i + 2} coincide: the arm is redundant "
+                               "(infinitely many solutions)")
     reasons: list[str] = []
     Minv = np.linalg.inv(M)
     Wr = -(W[::-1] @ M[:3, :3])
