@@ -192,9 +192,9 @@ def _prepared(robot: Robot, near_tol: float = 0.0) -> _Prepared:
             try:
                 p = _Prepared(robot, general_structure(robot), "general")
             except NoClosedFormError as general_error:
-                if robot.joint_types == ("R",) * 6:
-                    raise general_error from None
-                raise exact_error from None
+                why = str(general_error).split("): ", 1)[-1].split(". Closed forms")[0]
+                raise NoClosedFormError(f"{exact_error} The general 6R search does not apply "
+                                        f"either: {why}.") from None
     cache[near_tol] = p
     return p
 
