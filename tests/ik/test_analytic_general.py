@@ -313,3 +313,25 @@ def test_reversed_chain_when_the_front_cannot():
     assert _fk_error(robot, res.q, T) < 1e-10 and _wrapped(res.q, q).min() < 1e-8
     for f in _newton_set(robot, T, 200, np.random.default_rng(1)):
         assert _wrapped(res.q, f).min() < 1e-6
+
+
+def test_batch_with_reference_and_locked_joint():
+    """Batches sort each target's rows by the reference; free= keeps zero padding in batches."""
+    robot = models.ur5()
+    q = np.array([[0.3, -1.0, 1.2, -0.5, 0.8, 0.2], [-0.4, -1.3, 0.9, 0.5, -0.7, 1.0]])
+    res = ik_all(robot, robot.fk(q), reference=q[0])
+    for i in range(2):
+        rows = res.solutions(i)
+        dist = np.sqrt(((rows - q[0]) ** 2).sum(1))
+        assert np.all(np.diff(dist) >= -1e-12)
+    np.testing.assert_allclose(res.solutions(0)[0], q[0], atol=1e-8)
+    with pytest.raises(InputError, match="all_turns"):
+        ik_all(robot, robot.fk(q), all_turns=True)
+    iiwa = models.iiwa7()
+    q7 = np.array([[0.3, 0.5, 0.2, -1.0, 0.4, 0.6, 0.1], [0.3, -0.5, 0.7, -1.2, -0.4, 0.6, 0.3]])
+    locked = ik_all(iiwa, iiwa.fk(q7), free={2: 0.2})
+    assert locked.q.shape[-1] == 7
+    for i in range(2):
+        k = int(locked.count[i])
+        assert np.all(locked.q[i, :k, 2] == 0.2) and np.all(locked.q[i, k:] == 0.0)
+        assert _fk_error(iiwa, locked.solutions(i), iiwa.fk(q7[i])) < 1e-10

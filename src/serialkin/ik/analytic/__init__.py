@@ -410,7 +410,8 @@ def _insert_locked(sols: np.ndarray, idx: np.ndarray, vals: np.ndarray, n: int) 
 
 
 def sort_by_reference(robot: Robot, sols: np.ndarray, reference: object, *,
-                      weights: object = None, norm: str = "l2") -> np.ndarray:
+                      weights: object = None, norm: str = "l2",
+                      return_order: bool = False) -> Any:
     """Solutions ordered by distance to a reference configuration, nearest first.
 
     Each revolute joint of each row is first moved by the multiple of 2π that brings it
@@ -425,9 +426,11 @@ def sort_by_reference(robot: Robot, sols: np.ndarray, reference: object, *,
         reference: (n,) reference configuration [rad / m].
         weights: (n,) non-negative weights (default ones).
         norm: 'l2' or 'linf'.
+        return_order: also return the permutation applied to ``sols``.
 
     Returns:
-        (k, n) the shifted rows, nearest first (stable for ties).
+        (k, n) the shifted rows, nearest first (stable for ties); with ``return_order``
+        also the (k,) indices of ``sols`` in that order.
     """
     from serialkin._checks import check_choice
 
@@ -439,7 +442,7 @@ def sort_by_reference(robot: Robot, sols: np.ndarray, reference: object, *,
                          f"{np.asarray(weights)!r}")
     q = np.array(sols, dtype=float).reshape(-1, robot.n)
     if q.shape[0] == 0:
-        return q
+        return (q, np.zeros(0, dtype=np.int64)) if return_order else q
     rev = robot.revolute
     lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
     for j in np.flatnonzero(rev):
@@ -455,7 +458,28 @@ def sort_by_reference(robot: Robot, sols: np.ndarray, reference: object, *,
         q[:, j] = np.where(ok, shifted, q[:, j])
     d = q - ref
     dist = np.sqrt((w * d * d).sum(axis=1)) if norm == "l2" else (w * np.abs(d)).max(axis=1)
-    return q[np.argsort(dist, kind="stable")]
+    order = np.argsort(dist, kind="stable")
+    if return_order:
+        return q[order], order
+    return q[order]
+
+
+def _sort_batch(robot: Robot, res: AllSolutions, reference: object, weights: object,
+                norm: str) -> AllSolutions:
+    """``res`` with each target's rows sorted by :func:`sort_by_reference` (flags too)."""
+    k_max, n = res.q.shape[-2], res.q.shape[-1]
+    q = res.q.reshape(-1, k_max, n).copy()
+    counts = np.asarray(res.count).reshape(-1)
+    cont = None if res.continuous is None else res.continuous.reshape(-1, k_max).copy()
+    for i in range(q.shape[0]):
+        k = int(counts[i])
+        if k:
+            q[i, :k], order = sort_by_reference(robot, q[i, :k], reference, weights=weights,
+                                                norm=norm, return_order=True)
+            if cont is not None:
+                cont[i, :k] = cont[i, :k][order]
+    return replace(res, q=q.reshape(res.q.shape),
+                   continuous=None if cont is None else cont.reshape(res.continuous.shape))
 
 
 def _solve_batch(p: _Prepared, robot: Robot, T: np.ndarray, tol: float,
@@ -532,7 +556,7 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         near_tol: tolerance of the nearly-ideal test [rad; m per m of size]; 0 disables it.
         grid: nodes per searched joint of the general 6R search (default 48).
         reference: (n,) configuration: rows are shifted by 2π towards it (inside the
-            limits) and sorted nearest first (single targets; see
+            limits) and sorted nearest first (per target in a batch; see
             :func:`sort_by_reference`); without it rows are sorted lexicographically.
         weights: (n,) weights of the distance to ``reference``.
         norm: 'l2' (weighted Euclidean) or 'linf' (weighted max) distance.
@@ -563,9 +587,12 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         res = ik_all(reduced, target, tol=tol, all_turns=all_turns, near_tol=near_tol,
                      grid=grid, report=report)
         if isinstance(res, AllSolutions):
-            return AllSolutions(_insert_locked(res.q, idx, vals, robot.n), res.count,
-                                res.branches, res.converged, res.kind, res.mode,
-                                res.continuous)
+            q = _insert_locked(res.q, idx, vals, robot.n)
+            q[np.arange(q.shape[-2]) >= np.asarray(res.count)[..., None]] = 0.0  # padding
+            full = replace(res, q=q)
+            if reference is not None:
+                full = _sort_batch(robot, full, reference, weights, norm)
+            return full
         full_rows = _insert_locked(res, idx, vals, robot.n)
         if reference is not None:
             full_rows = sort_by_reference(robot, full_rows, reference, weights=weights,
@@ -583,6 +610,9 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
     grid = int(grid)
     a = target if type(target) is np.ndarray else as_float_array(target, "target")
     if a.ndim >= 3 and a.shape[-2:] == (4, 4):
+        if all_turns:
+            raise InputError("all_turns applies to one target; for a batch, call ik_all per "
+                             "target with all_turns=True")
         lead = a.shape[:-2]
         T = _as_poses(a.reshape(-1, 4, 4))
         out, counts, conv = _solve_batch(p, robot, T, tol, grid)
@@ -596,9 +626,12 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
                 for j in range(int(counts[i])):
                     cont[i, j] = continuous_family(robot, T[i], out[i, j])
             cont = cont.reshape(lead + (kmax,))
-        return AllSolutions(out[:, :kmax].reshape(lead + (kmax, p.n)), counts.reshape(lead),
-                            branches.reshape(lead), converged.reshape(lead + (MAX_ROWS,)),
-                            p.s.kind, p.mode, cont)
+        res = AllSolutions(out[:, :kmax].reshape(lead + (kmax, p.n)), counts.reshape(lead),
+                           branches.reshape(lead), converged.reshape(lead + (MAX_ROWS,)),
+                           p.s.kind, p.mode, cont)
+        if reference is not None:
+            res = _sort_batch(robot, res, reference, weights, norm)
+        return res
     T, check_rot = _parse_target(p, robot, a)
     from serialkin.ik.analytic.dispatch import solve_into
 
