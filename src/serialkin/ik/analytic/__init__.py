@@ -464,6 +464,38 @@ def sort_by_reference(robot: Robot, sols: np.ndarray, reference: object, *,
     return q[order]
 
 
+def _with_general(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
+                  grid: int) -> np.ndarray:
+    """``sols`` of a nearly ideal arm merged with the general search's (when it applies).
+
+    Called when a refined branch did not converge (e.g. near a singularity of the true
+    arm), so that the solution it stood for is still found.
+    """
+    from serialkin.ik.analytic.dispatch import solve_into
+
+    cache = _PREPARED.setdefault(robot, {})
+    g = cache.get(-1.0)
+    if g is None:
+        try:
+            g = _Prepared(robot, general_structure(robot), "general")
+        except NoClosedFormError:
+            return sols
+        cache[-1.0] = g
+    out = np.empty((MAX_ROWS, g.n))
+    conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
+    k = solve_into(g.code, g.arm, g.prismatic3, T, g.W, g.P, g.M, g.aux, g.order, g.revolute,
+                   g.qlim, g.mid, g.F, g.meta, True, False, grid, tol * g.s.scale, tol,
+                   REFINE_TOL * g.s.scale, REFINE_TOL, out, conv)
+    rows = [r for r in sols]
+    for r in out[:k]:
+        d = np.abs((np.array(rows) - r + np.pi) % (2 * np.pi) - np.pi).max(axis=1) \
+            if rows else np.array([np.inf])
+        if d.min() > 1e-7:
+            rows.append(r)
+    merged = np.array(rows, dtype=float).reshape(-1, robot.n)
+    return merged[np.lexsort(merged.T[::-1])] if len(merged) else merged
+
+
 def _sort_batch(robot: Robot, res: AllSolutions, reference: object, weights: object,
                 norm: str) -> AllSolutions:
     """``res`` with each target's rows sorted by :func:`sort_by_reference` (flags too)."""
@@ -626,6 +658,13 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
                 for j in range(int(counts[i])):
                     cont[i, j] = continuous_family(robot, T[i], out[i, j])
             cont = cont.reshape(lead + (kmax,))
+        if p.mode == "near":  # a branch that did not converge: the general search as well
+            for i in range(T.shape[0]):
+                if not conv[i, 1:conv[i, 0] + 1].all():
+                    rows = _with_general(robot, T[i], out[i, :counts[i]], tol, grid)
+                    counts[i] = min(len(rows), MAX_ROWS)
+                    out[i, :counts[i]] = rows[:MAX_ROWS]
+            kmax = int(counts.max(initial=0))
         res = AllSolutions(out[:, :kmax].reshape(lead + (kmax, p.n)), counts.reshape(lead),
                            branches.reshape(lead), converged.reshape(lead + (MAX_ROWS,)),
                            p.s.kind, p.mode, cont)
@@ -641,6 +680,8 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
                    p.qlim, p.mid, p.F, p.meta, check_rot, p.refine, grid, tol * p.s.scale, tol,
                    REFINE_TOL * p.s.scale, REFINE_TOL, out, conv)
     sols = out[:k]
+    if p.mode == "near" and not conv[1:conv[0] + 1].all():
+        sols = _with_general(robot, T, sols, tol, grid)
     if all_turns and k:
         sols = _expand_turns(sols, p.revolute, p.qlim)
     if reference is not None:
