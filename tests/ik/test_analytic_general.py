@@ -335,3 +335,16 @@ def test_batch_with_reference_and_locked_joint():
         k = int(locked.count[i])
         assert np.all(locked.q[i, :k, 2] == 0.2) and np.all(locked.q[i, k:] == 0.0)
         assert _fk_error(iiwa, locked.solutions(i), iiwa.fk(q7[i])) < 1e-10
+
+
+def test_general_search_completes_a_partial_set():
+    """The fallback of nearly ideal arms merges the general search's rows without duplicates."""
+    from serialkin.ik.analytic import _with_general
+
+    robot = models.ur5()
+    T = robot.fk(np.array([0.3, -1.0, 1.2, -0.5, 0.8, 0.2]))
+    full = ik_all(robot, T)
+    merged = _with_general(robot, T, full[:3], 1e-8, 48)
+    assert len(merged) == len(full) == 8
+    for row in full:
+        assert _wrapped(merged, row).min() < 1e-8
