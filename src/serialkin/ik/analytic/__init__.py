@@ -468,8 +468,10 @@ def _with_general(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
                   grid: int) -> np.ndarray:
     """``sols`` of a nearly ideal arm merged with the general search's (when it applies).
 
-    Called when a refined branch did not converge (e.g. near a singularity of the true
-    arm), so that the solution it stood for is still found.
+    Called when an odd number of refined branches converged: real solutions of a 6R come
+    in pairs, so one was lost (e.g. near a singularity of the true arm). Branches that
+    fail in pairs are usually solutions the idealised arm has and the true arm has not
+    (a target near the workspace boundary), and trigger nothing.
     """
     from serialkin.ik.analytic.dispatch import solve_into
 
@@ -658,9 +660,9 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
                 for j in range(int(counts[i])):
                     cont[i, j] = continuous_family(robot, T[i], out[i, j])
             cont = cont.reshape(lead + (kmax,))
-        if p.mode == "near":  # a branch that did not converge: the general search as well
+        if p.mode == "near":  # an odd number of converged branches: general search too
             for i in range(T.shape[0]):
-                if not conv[i, 1:conv[i, 0] + 1].all():
+                if conv[i, 1:conv[i, 0] + 1].sum() % 2 == 1:
                     rows = _with_general(robot, T[i], out[i, :counts[i]], tol, grid)
                     counts[i] = min(len(rows), MAX_ROWS)
                     out[i, :counts[i]] = rows[:MAX_ROWS]
@@ -680,7 +682,7 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
                    p.qlim, p.mid, p.F, p.meta, check_rot, p.refine, grid, tol * p.s.scale, tol,
                    REFINE_TOL * p.s.scale, REFINE_TOL, out, conv)
     sols = out[:k]
-    if p.mode == "near" and not conv[1:conv[0] + 1].all():
+    if p.mode == "near" and conv[1:conv[0] + 1].sum() % 2 == 1:
         sols = _with_general(robot, T, sols, tol, grid)
     if all_turns and k:
         sols = _expand_turns(sols, p.revolute, p.qlim)
