@@ -15,10 +15,11 @@ from typing import Any
 
 import numpy as np
 
+from serialkin.ik.analytic import NEAR_TOL
 from serialkin.model.robot import Robot
 
 #: Options of the method, with their defaults (passed on to ``ik_all``).
-OPTIONS: dict[str, Any] = {"weights": None, "norm": "l2", "near_tol": 0.05, "grid": None}
+OPTIONS: dict[str, Any] = {"weights": None, "norm": "l2", "near_tol": NEAR_TOL, "grid": None}
 
 
 def analytic_solve(robot: Robot, problem: Any, q0: np.ndarray | None,
