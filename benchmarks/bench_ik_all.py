@@ -1,4 +1,11 @@
-"""Closed-form ``ik_all`` (all solutions): time per call on UR5 and Puma 560.
+"""``ik_all`` (all solutions): time per pose, single and batched; UR5, Puma 560, general arms.
+
+Per pose, single call and batched (all cores), for decomposable arms (UR5, Puma 560:
+goals <= 10 us single, <= 3 us batched), a UR5 with every axis perturbed by up to
+0.01 rad (nearly ideal: the idealised closed form refined by Newton) and a random
+general 6R arm (the 2-D search: goal <= 200 us, against Robotics Toolbox's
+Raghavan-Roth ``analytic_ik`` in the same run). IK-Geo's published native figures are
+printed beside them.
 
 Run by hand: ``.venv/bin/python benchmarks/bench_ik_all.py [--targets N] [--no-peers]``.
 
@@ -27,9 +34,15 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
+from _common import header, interleaved_us, latency_us, record  # noqa: E402
+
 from serialkin import Robot, models  # noqa: E402
 from serialkin.ik.analytic import classify, ik_all  # noqa: E402
 from serialkin.model.dh import DHLink  # noqa: E402
+
+#: IK-Geo's published native figures as quoted in issue 14 (Elias & Wen, IK-Geo,
+#: arXiv:2211.05737; C++, their machine): all solutions per pose, decomposable arms.
+IKGEO_US = {"decomposable arms, fastest": 1.7, "decomposable arms, slowest": 2.7}
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:
@@ -102,12 +115,95 @@ def bench_rtb(rtb_robot, name: str, n_targets: int, seed: int = 1) -> dict:
     return out
 
 
+def _perturbed(robot: Robot, rng: np.random.Generator, angle: float = 0.01) -> Robot:
+    """Every DH twist and offset moved by up to ``angle`` rad, lengths by up to 1 mm."""
+    rows = [DHLink(a=r.a + rng.uniform(-1e-3, 1e-3), alpha=r.alpha + rng.uniform(-angle, angle),
+                   d=r.d + rng.uniform(-1e-3, 1e-3), theta=r.theta + rng.uniform(-angle, angle))
+            for r in robot.dh]
+    return Robot.from_dh(rows, robot.convention, name=f"{robot.name} perturbed")
+
+
+def _general_arm(seed: int) -> Robot:
+    rng = np.random.default_rng(seed)
+    return Robot.from_dh([DHLink(a=rng.uniform(0.05, 0.5), alpha=rng.uniform(-3.0, 3.0),
+                                 d=rng.uniform(-0.3, 0.3)) for _ in range(6)], name="general")
+
+
+def bench_per_pose(n_batch: int, repeat: int) -> None:
+    """Per pose, single call and batched, for exact, nearly ideal and general arms (14.1)."""
+    print(f"\nper pose, single call and batched ({n_batch} targets, all cores via "
+          "parallel.run); median [spread] over repeated runs")
+    print(f"{'arm':18s} {'mode':8s} {'single us':>22s} {'batched us/pose':>22s} {'#sol':>5s}")
+    rng = np.random.default_rng(0)
+    arms = [(models.ur5(), 10.0, 3.0), (models.puma560(), 10.0, 3.0),
+            (_perturbed(models.ur5(), rng), None, None), (_general_arm(3), 200.0, None)]
+    for robot, goal_single, goal_batch in arms:
+        Q = robot.random_q(n_batch, seed=1)
+        T = np.ascontiguousarray(robot.fk(Q))
+        res = ik_all(robot, T)
+        T0 = np.ascontiguousarray(T[0])
+        few = 20 if res.mode == "general" else 2000
+        single = latency_us(lambda r=robot, t=T0: ik_all(r, t), few, repeat)
+        Tb = T[: max(8, n_batch // (50 if res.mode == "general" else 1))]
+        batched = latency_us(lambda r=robot, t=Tb: ik_all(r, t), 1, repeat)
+        per = batched.median / len(Tb)
+        print(f"{robot.name:18s} {res.mode:8s} {single.fmt(1):>22s} "
+              f"{per:22.2f} {res.count.mean():5.1f}")
+        if goal_single is not None:
+            record("14.1", f"ik_all single, {robot.name} ({res.mode}), all solutions",
+                   single.median, "us", f"<= {goal_single:g}", single.median <= goal_single)
+        if goal_batch is not None:
+            record("14.1", f"ik_all batched per pose, {robot.name} ({res.mode})", per, "us",
+                   f"<= {goal_batch:g}", per <= goal_batch)
+    print("IK-Geo published (native C++, their machine): "
+          + ", ".join(f"{k} {v:g} us" for k, v in IKGEO_US.items()))
+
+
+def bench_general_vs_rtb(repeat: int) -> None:
+    """General 6R: ours against Robotics Toolbox's Raghavan–Roth solver, same DH table."""
+    try:
+        import roboticstoolbox as rtb
+    except ImportError:
+        print("roboticstoolbox not installed: general-arm peer skipped")
+        return
+    ours = _general_arm(3)
+    links = [rtb.RevoluteDH(a=r.a, alpha=r.alpha, d=r.d) for r in ours.dh]
+    peer = rtb.DHRobot(links, name="general")
+    T = np.ascontiguousarray(ours.fk(ours.random_q(1, seed=2)[0]))
+    t0 = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            solver = peer.analytic_ik()
+            solver.solve(T, joint_limits=False)
+        except Exception as exc:  # noqa: BLE001 - a peer's failure is reported, not raised
+            print(f"Robotics Toolbox analytic_ik on the general arm failed: {exc}")
+            return
+    derive = time.perf_counter() - t0
+    times = interleaved_us({"ours": lambda: ik_all(ours, T),
+                            "rtb": lambda: solver.solve(T, joint_limits=False)}, 5, repeat)
+    b = np.atleast_2d(np.asarray(solver.solve(T, joint_limits=False).q, dtype=float))
+    a = ik_all(ours, T)
+    print(f"\ngeneral 6R vs Robotics Toolbox analytic_ik (Raghavan-Roth; derived in "
+          f"{derive:.1f} s): ours {times['ours'].fmt(0)} us ({len(a)} solutions), "
+          f"rtb {times['rtb'].fmt(0)} us ({len(b)} solutions), ratio rtb/ours "
+          f"{times['rtb'] / times['ours']:.2f}")
+    record("14.1", "ik_all general 6R, all solutions, single call", times["ours"].median, "us",
+           "<= 200", times["ours"].median <= 200.0)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--targets", type=int, default=1000)
     parser.add_argument("--peer-targets", type=int, default=100)
     parser.add_argument("--no-peers", action="store_true")
+    parser.add_argument("--batch", type=int, default=2000)
+    parser.add_argument("--repeat", type=int, default=7)
     args = parser.parse_args()
+    print(header())
+    bench_per_pose(args.batch, args.repeat)
+    if not args.no_peers:
+        bench_general_vs_rtb(args.repeat)
 
     print(f"serialkin ik_all, {args.targets} reachable targets per arm (limits on)")
     print(f"{'robot':10s} {'class':6s} {'median us':>10s} {'p10-p90 us':>12s} {'mean us':>9s} "

@@ -32,6 +32,7 @@ GOALS = {
     "13.1": "collision-aware IK Panda (table + 2 obstacles) batched <= 100 us at >= 95 %",
     "13.2": "differential-IK QP step <= half of pink's and mink's (Panda, same task set)",
     "13.3": "QP tracking of the 20-link scenario: time per path point (reported)",
+    "14.1": "ik_all decomposable arms <= 10 us single, <= 3 us batched; general 6R <= 200 us",
     "15.1": "UR5 2.5 cm x 50-orientation reach map < 1 h on 2 cores; Dask 1->2 workers >= 0.85",
     "16.1": "calibration fit <= 1 s (UR5 60 positions; Panda 200 poses)",
 }

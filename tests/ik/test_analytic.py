@@ -628,8 +628,6 @@ def test_recognition_ignores_the_name():
     (models.iiwa7(), ["redundant"]),
     (models.planar(4), ["redundant", "4 revolute"]),
     (models.planar(6), ["redundant", "6 revolute"]),
-    (Robot.from_dh([DHLink(a=0.3, alpha=0.4, d=0.1 * i) for i in range(6)], name="odd"),
-     ["do not meet in one point", "axes 2, 3, 4 are not parallel", "robot.ik"]),
 ])
 def test_unsupported_robot_raises_with_reason(robot, words):
     """Robots without a closed form raise NoClosedFormError saying why and pointing to robot.ik."""
@@ -661,12 +659,12 @@ def test_infinite_solution_targets_raise():
 @pytest.mark.parametrize("target, match", [
     (np.diag([1.0, 1.0, 2.0, 1.0]), "target"),
     (np.full((4, 4), np.nan), "target"),
-    (np.zeros((3, 4, 4)), "one target"),
+    (np.zeros((3, 4, 4)), "target"),
     (np.zeros(5), "must be a 4x4 pose"),
     ("pose", "target"),
 ])
 def test_bad_target(target, match):
-    """Non-rigid, NaN, batched, misshaped or non-numeric targets raise errors naming 'target'."""
+    """Non-rigid, NaN, misshaped or non-numeric targets (one or a batch) raise naming 'target'."""
     with pytest.raises((InputError, sk.errors.InputTypeError), match=match):
         ik_all(models.ur5(), target)
 

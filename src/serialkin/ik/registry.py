@@ -119,7 +119,7 @@ def _discover() -> None:
         if not info.ispkg and not info.name.startswith("_") and info.name not in _SKELETON:
             importlib.import_module(f"serialkin.ik.{info.name}")
     if "analytic" not in _REGISTRY:
-        from serialkin.ik.solver import register_analytic
+        from serialkin.ik.analytic.method import register_analytic
 
         register_analytic()
 

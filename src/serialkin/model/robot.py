@@ -749,8 +749,13 @@ class Robot:
         """
         return (_SOLVE or _ik_solve())(self, target, method, **options)
 
-    def ik_all(self, target: object, **options: Any) -> np.ndarray:
-        """Every closed-form IK solution inside the limits (see ``serialkin.ik.analytic``)."""
+    def ik_all(self, target: object, **options: Any) -> Any:
+        """Every IK solution inside the limits (see :func:`serialkin.ik.analytic.ik_all`).
+
+        One (4, 4) target gives a (k, n) array; a batch (..., 4, 4) an ``AllSolutions``
+        (padded rows and a count per target). Options: ``tol``, ``all_turns``, ``free``,
+        ``near_tol``, ``grid``, ``reference``, ``weights``, ``norm``, ``report``.
+        """
         from serialkin.ik.analytic import ik_all
 
         return ik_all(self, target, **options)

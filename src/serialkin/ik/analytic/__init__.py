@@ -19,9 +19,14 @@ class                       structure                                           
 ``ur``                      6R, axes 2 ∥ 3 ∥ 4, axes 5 and 6 intersect            8
 ==========================  ====================================================  =====
 
-Other robots raise :class:`~serialkin.errors.NoClosedFormError`, whose message says
-which structural test failed and points to the numerical solvers
-(``robot.ik(target, method="lm")``).
+Beyond these exact classes (see ``docs/ik-analytic.md``): a 6-joint arm within
+``near_tol`` of a class (a calibrated robot) is solved on the idealised class and every
+branch refined by Newton's method on the true model (:mod:`~serialkin.ik.analytic.refine`);
+any other 6R arm by the 2-D search of :mod:`~serialkin.ik.analytic.general` (up to 16
+solutions); ``free={index: value}`` locks joints (7R arms); a batch of targets
+(..., 4, 4) returns an :class:`AllSolutions`. Other robots raise
+:class:`~serialkin.errors.NoClosedFormError`, whose message says which structural test
+failed and points to the numerical solvers (``robot.ik(target, method="lm")``).
 
 Semantics:
 
@@ -37,8 +42,8 @@ Semantics:
   set is a continuum; one representative per branch is returned (the free angle set
   to 0). At a stretched elbow the two elbow branches merge into one solution.
 * The kernels are compiled by numba on first use (cached on disk afterwards); a call
-  then takes about 10-15 µs for a 6R arm, all solutions included
-  (``benchmarks/bench_ik_all.py``).
+  then takes about 10-15 µs for a 6R arm of an exact class, all solutions included,
+  and milliseconds for the general search (``benchmarks/bench_ik_all.py``).
 """
 
 from __future__ import annotations
@@ -46,17 +51,32 @@ from __future__ import annotations
 import itertools
 import math
 import weakref
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
 from serialkin.errors import InputError, NoClosedFormError
-from serialkin.ik.analytic.structure import CLASSES, NUMERICAL_HINT, Structure, analyse
+from serialkin.ik.analytic.dispatch import GENERAL, MAX_ROWS, PLANAR, SCARA, UR, WRIST
+from serialkin.ik.analytic.singular import continuous_family
+from serialkin.ik.analytic.structure import (
+    CLASSES,
+    NUMERICAL_HINT,
+    Structure,
+    analyse,
+    general_structure,
+)
 from serialkin.ik.analytic.subproblems import rigid_error
 from serialkin.model.robot import Robot
 
-__all__ = ["CLASSES", "classify", "ik_all", "structure_of"]
+#: Spherical-wrist classes: (arm code, joint 3 prismatic) for ``solve_spherical_wrist``.
+_WRIST_ARMS = {"puma": (0, False), "pieper_intersecting": (1, False), "stanford": (1, True),
+               "pieper_general": (2, False), "stanford_general": (2, True)}
+
+__all__ = ["CLASSES", "AllSolutions", "classify", "ik_all", "sort_by_reference",
+           "structure_of"]
 
 _STRUCTURES: weakref.WeakKeyDictionary[Robot, Structure | NoClosedFormError] = \
     weakref.WeakKeyDictionary()
@@ -65,8 +85,22 @@ _STRUCTURES: weakref.WeakKeyDictionary[Robot, Structure | NoClosedFormError] = \
 class _Prepared:
     """A robot's structure plus the contiguous arrays its kernel takes (cached per robot)."""
 
-    def __init__(self, robot: Robot, s: Structure) -> None:
+    def __init__(self, robot: Robot, s: Structure, mode: str = "exact") -> None:
         self.s = s
+        self.mode = mode  # "exact", "near" (idealised, refined) or "general" (search)
+        kind = s.kind
+        if kind in ("planar_2r", "planar_3r"):
+            self.code, self.arm, self.prismatic3 = PLANAR, 0, False
+        elif kind in ("scara", "scara_rrp"):
+            self.code, self.arm, self.prismatic3 = SCARA, 0, False
+        elif kind in _WRIST_ARMS:
+            self.code = WRIST
+            self.arm, self.prismatic3 = _WRIST_ARMS[kind]
+        elif kind == "ur":
+            self.code, self.arm, self.prismatic3 = UR, 0, False
+        else:  # general_6r
+            self.code, self.arm, self.prismatic3 = GENERAL, int(s.order[0]), False
+        self.refine = mode == "near"
         self.W = np.ascontiguousarray(s.W)
         self.P = np.ascontiguousarray(s.P)
         self.M = np.ascontiguousarray(s.M)
@@ -95,11 +129,8 @@ class _Prepared:
             a.setflags(write=False)
 
 
-_PREPARED: weakref.WeakKeyDictionary[Robot, _Prepared] = weakref.WeakKeyDictionary()
-
-#: Spherical-wrist classes: (arm code, joint 3 prismatic) for ``solve_spherical_wrist``.
-_WRIST_ARMS = {"puma": (0, False), "pieper_intersecting": (1, False), "stanford": (1, True),
-               "pieper_general": (2, False), "stanford_general": (2, True)}
+_PREPARED: weakref.WeakKeyDictionary[Robot, dict[float, _Prepared]] = \
+    weakref.WeakKeyDictionary()
 
 
 def structure_of(robot: Robot) -> Structure:
@@ -132,13 +163,39 @@ def classify(robot: Robot) -> str:
     return structure_of(robot).kind
 
 
-def _prepared(robot: Robot) -> _Prepared:
+def _prepared(robot: Robot, near_tol: float = 0.0) -> _Prepared:
+    """The robot's solver data, cached per robot and ``near_tol``.
+
+    Its exact class; else (6 joints) the class it is within ``near_tol`` of (solved on
+    the idealised axes, refined on the true chain); else (6R) the general search.
+    """
     if not isinstance(robot, Robot):
         raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
-    p = _PREPARED.get(robot)
-    if p is None:
+    cache = _PREPARED.get(robot)
+    if cache is None:
+        cache = _PREPARED[robot] = {}
+    p = cache.get(near_tol)
+    if p is not None:
+        return p
+    try:
         p = _Prepared(robot, structure_of(robot))
-        _PREPARED[robot] = p
+    except NoClosedFormError as exact_error:
+        if robot.n != 6:
+            raise
+        p = None
+        if near_tol > 0.0:
+            try:
+                p = _Prepared(robot, analyse(robot, near_tol, near_tol), "near")
+            except NoClosedFormError:
+                p = None
+        if p is None:
+            try:
+                p = _Prepared(robot, general_structure(robot), "general")
+            except NoClosedFormError as general_error:
+                why = str(general_error).split("): ", 1)[-1].split(". Closed forms")[0]
+                raise NoClosedFormError(f"{exact_error} The general 6R search does not apply "
+                                        f"either: {why}.") from None
+    cache[near_tol] = p
     return p
 
 
@@ -172,9 +229,6 @@ def _parse_target(p: _Prepared, robot: Robot, target: object) -> tuple[np.ndarra
     kind = p.s.kind
     if a.shape == (4, 4):
         return _as_pose(a), True
-    if a.ndim == 3 and a.shape[1:] == (4, 4):
-        raise InputError(f"ik_all takes one target, got a batch of shape {a.shape}; call it "
-                         "once per target (each may have a different number of solutions)")
     planar = kind in ("planar_2r", "planar_3r")
     if a.shape in ((2,), (3,)) and planar and p.s.planar_z:
         T = p.M.copy()
@@ -198,7 +252,7 @@ def _parse_target(p: _Prepared, robot: Robot, target: object) -> tuple[np.ndarra
         T[:3, 3] = a
         return T, False
     if a.shape == (3,) and kind in ("puma", "pieper_intersecting", "pieper_general", "stanford",
-                                    "stanford_general", "ur", "scara"):
+                                    "stanford_general", "ur", "scara", "general_6r"):
         raise NoClosedFormError(
             f"robot {robot.name!r} ({kind}) has infinitely many solutions for a position-only "
             f"target: the orientation is free. Give ik_all a 4x4 pose, or {NUMERICAL_HINT}")
@@ -241,69 +295,402 @@ def _expand_turns(sols: np.ndarray, revolute: np.ndarray, qlim: np.ndarray) -> n
     return out
 
 
-def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool = False,
-           **options: Any) -> np.ndarray:
-    """Every closed-form inverse-kinematics solution inside the joint limits (section 4.1).
+
+#: Default tolerance [rad, and × robot size in m] within which a 6-joint arm counts as
+#: nearly of a special class (solved on the ideal axes, every branch refined).
+NEAR_TOL = 0.05
+#: Newton refinement tolerance: position [m] per metre of robot size, rotation [rad].
+REFINE_TOL = 1e-12
+
+
+@dataclass(frozen=True, eq=False)
+class AllSolutions:
+    """Every IK solution of a batch of targets (``ik_all`` on (..., 4, 4) targets).
+
+    Attributes:
+        q: (..., k_max, n) joint values [rad / m]; row j of target i is a solution for
+            j < ``count[i]`` and zero padding after it (never NaN).
+        count: (...,) int, number of solutions of each target (0: unreachable, or only
+            outside the joint limits).
+        branches: (...,) int, candidate branches the solver produced (before the limit
+            filter and de-duplication).
+        converged: (..., 16) bool, per candidate branch whether its Newton refinement
+            on the true model converged to 1e-12 (always True for exact classes, where
+            no refinement is needed; False beyond ``branches``).
+        kind: the structure class solved (a key of :data:`CLASSES`, or
+            ``'general_6r'``).
+        mode: ``'exact'`` (closed form of the exact class), ``'near'`` (the arm is within
+            the tolerance of ``kind``: solved for the idealised axes, every branch refined
+            on the true model) or ``'general'`` (the 2-D search of
+            :mod:`serialkin.ik.analytic.general`).
+        continuous: (..., k_max) bool, with ``report=True``: solution j of target i lies
+            on a continuous family of solutions (a singular target: the row is one
+            representative, :func:`~serialkin.ik.analytic.singular.continuous_family`);
+            None when not computed.
+    """
+
+    q: np.ndarray
+    count: np.ndarray
+    branches: np.ndarray
+    converged: np.ndarray
+    kind: str
+    mode: str
+    continuous: np.ndarray | None = None
+
+    def solutions(self, index: int | tuple[int, ...]) -> np.ndarray:
+        """The (count, n) solutions of one target (an index into the batch dimensions)."""
+        return self.q[index][: int(self.count[index])]
+
+
+def _locked(robot: Robot, free: object) -> tuple[Robot, np.ndarray, np.ndarray]:
+    """The robot with the joints of ``free`` = {index: value} locked at those values.
+
+    Returns the reduced robot, the locked indices and their values. A locked joint's
+    motion is folded into the next joint's ``origin`` (or into the tool for the last).
+    """
+    if not isinstance(free, Mapping) or not free:
+        raise InputError("free must be a non-empty mapping {joint index: value}, got "
+                         f"{free!r}")
+    idx, vals = [], []
+    for key, value in free.items():
+        if isinstance(key, bool) or not isinstance(key, (int, np.integer)) \
+                or not 0 <= int(key) < robot.n:
+            raise InputError(f"free: joint index must be an int in 0..{robot.n - 1}, got "
+                             f"{key!r}")
+        v = float(np.asarray(value, dtype=float))
+        if not math.isfinite(v):
+            raise InputError(f"free[{key}] must be a finite joint value, got {value!r}")
+        idx.append(int(key))
+        vals.append(v)
+    order = np.argsort(idx)
+    idx_a = np.array(idx, dtype=np.int64)[order]
+    vals_a = np.array(vals)[order]
+    key = (tuple(idx_a.tolist()), tuple(vals_a.tolist()))
+    cache = _LOCKED.get(robot)
+    if cache is None:
+        cache = _LOCKED[robot] = {}
+    if key in cache:
+        return cache[key], idx_a, vals_a
+    joints = list(robot.joints)
+    tool = robot.tool
+    for i, v in sorted(zip(idx_a, vals_a), reverse=True):
+        j = joints[i]
+        m = np.eye(4)
+        if j.type == "R":
+            from serialkin.spatial.rotations import axis_angle_to_matrix
+
+            m[:3, :3] = axis_angle_to_matrix(j.axis, v + j.offset)
+        else:
+            m[:3, 3] = (v + j.offset) * j.axis
+        A = j.origin @ m @ j.post
+        if i + 1 < len(joints):
+            nxt = joints[i + 1]
+            joints[i + 1] = replace(nxt, origin=A @ nxt.origin)
+        else:
+            tool = A @ tool
+        del joints[i]
+    reduced = Robot.from_joints(joints, base=robot.base, tool=tool,
+                                name=f"{robot.name} (joint(s) {list(idx_a + 1)} locked)")
+    if len(cache) > 64:
+        cache.clear()
+    cache[key] = reduced
+    return reduced, idx_a, vals_a
+
+
+_LOCKED: weakref.WeakKeyDictionary[Robot, dict] = weakref.WeakKeyDictionary()
+
+
+def _insert_locked(sols: np.ndarray, idx: np.ndarray, vals: np.ndarray, n: int) -> np.ndarray:
+    """Put the locked joints' values back into rows of the reduced robot (..., n - len(idx))."""
+    out = np.zeros(sols.shape[:-1] + (n,))
+    keep = np.setdiff1d(np.arange(n), idx)
+    out[..., keep] = sols
+    out[..., idx] = vals
+    return out
+
+
+def sort_by_reference(robot: Robot, sols: np.ndarray, reference: object, *,
+                      weights: object = None, norm: str = "l2",
+                      return_order: bool = False) -> Any:
+    """Solutions ordered by distance to a reference configuration, nearest first.
+
+    Each revolute joint of each row is first moved by the multiple of 2π that brings it
+    nearest the reference while staying inside its limits (a joint with a range wider
+    than 2π has several representatives: the nearest is taken). The distance is
+    ``sqrt(Σ w_j d_j²)`` (``norm='l2'``) or ``max_j w_j |d_j|`` (``norm='linf'``),
+    ``d = q − reference`` after that shift.
 
     Args:
-        robot: a robot of a class in :data:`CLASSES` (recognised from its joint axes).
-        target: (4, 4) tool pose in the world frame (base and tool transforms included);
-            on a planar arm whose axes are along the world z axis also ``(x, y)`` [m]
-            (2R) or ``(x, y, φ)`` [m, m, rad], φ the heading ``atan2(R[1, 0], R[0, 0])`` of
-            the tool x axis; on such a SCARA ``(x, y, z, φ)``; on an R R P arm a position
+        robot: the robot (joint kinds and limits).
+        sols: (k, n) solutions, e.g. from :func:`ik_all`.
+        reference: (n,) reference configuration [rad / m].
+        weights: (n,) non-negative weights (default ones).
+        norm: 'l2' or 'linf'.
+        return_order: also return the permutation applied to ``sols``.
+
+    Returns:
+        (k, n) the shifted rows, nearest first (stable for ties); with ``return_order``
+        also the (k,) indices of ``sols`` in that order.
+    """
+    from serialkin._checks import check_choice
+
+    check_choice(norm, "norm", ("l2", "linf"))
+    ref = robot.check_q(reference).reshape(robot.n)
+    w = np.ones(robot.n) if weights is None else as_float_array(weights, "weights")
+    if w.shape != (robot.n,) or not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise InputError(f"weights must be {robot.n} finite non-negative numbers, got "
+                         f"{np.asarray(weights)!r}")
+    q = np.array(sols, dtype=float).reshape(-1, robot.n)
+    if q.shape[0] == 0:
+        return (q, np.zeros(0, dtype=np.int64)) if return_order else q
+    rev = robot.revolute
+    lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
+    for j in np.flatnonzero(rev):
+        turns = np.round((ref[j] - q[:, j]) / (2 * np.pi))
+        for _ in range(3):  # step back towards the original value while outside the limits
+            shifted = q[:, j] + 2 * np.pi * turns
+            bad = (shifted < lo[j] - 1e-12) | (shifted > hi[j] + 1e-12)
+            if not bad.any():
+                break
+            turns = np.where(bad, turns - np.sign(turns), turns)
+        shifted = q[:, j] + 2 * np.pi * turns
+        ok = (shifted >= lo[j] - 1e-12) & (shifted <= hi[j] + 1e-12)
+        q[:, j] = np.where(ok, shifted, q[:, j])
+    d = q - ref
+    dist = np.sqrt((w * d * d).sum(axis=1)) if norm == "l2" else (w * np.abs(d)).max(axis=1)
+    order = np.argsort(dist, kind="stable")
+    if return_order:
+        return q[order], order
+    return q[order]
+
+
+def _with_general(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
+                  grid: int) -> np.ndarray:
+    """``sols`` of a nearly ideal arm merged with the general search's (when it applies).
+
+    Called when an odd number of refined branches converged: real solutions of a 6R come
+    in pairs, so one was lost (e.g. near a singularity of the true arm). Branches that
+    fail in pairs are usually solutions the idealised arm has and the true arm has not
+    (a target near the workspace boundary), and trigger nothing.
+    """
+    from serialkin.ik.analytic.dispatch import solve_into
+
+    cache = _PREPARED.setdefault(robot, {})
+    g = cache.get(-1.0)
+    if g is None:
+        try:
+            g = _Prepared(robot, general_structure(robot), "general")
+        except NoClosedFormError:
+            return sols
+        cache[-1.0] = g
+    out = np.empty((MAX_ROWS, g.n))
+    conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
+    k = solve_into(g.code, g.arm, g.prismatic3, T, g.W, g.P, g.M, g.aux, g.order, g.revolute,
+                   g.qlim, g.mid, g.F, g.meta, True, False, grid, tol * g.s.scale, tol,
+                   REFINE_TOL * g.s.scale, REFINE_TOL, out, conv)
+    rows = [r for r in sols]
+    for r in out[:k]:
+        d = np.abs((np.array(rows) - r + np.pi) % (2 * np.pi) - np.pi).max(axis=1) \
+            if rows else np.array([np.inf])
+        if d.min() > 1e-7:
+            rows.append(r)
+    merged = np.array(rows, dtype=float).reshape(-1, robot.n)
+    return merged[np.lexsort(merged.T[::-1])] if len(merged) else merged
+
+
+def _sort_batch(robot: Robot, res: AllSolutions, reference: object, weights: object,
+                norm: str) -> AllSolutions:
+    """``res`` with each target's rows sorted by :func:`sort_by_reference` (flags too)."""
+    k_max, n = res.q.shape[-2], res.q.shape[-1]
+    q = res.q.reshape(-1, k_max, n).copy()
+    counts = np.asarray(res.count).reshape(-1)
+    cont = None if res.continuous is None else res.continuous.reshape(-1, k_max).copy()
+    for i in range(q.shape[0]):
+        k = int(counts[i])
+        if k:
+            q[i, :k], order = sort_by_reference(robot, q[i, :k], reference, weights=weights,
+                                                norm=norm, return_order=True)
+            if cont is not None:
+                cont[i, :k] = cont[i, :k][order]
+    return replace(res, q=q.reshape(res.q.shape),
+                   continuous=None if cont is None else cont.reshape(res.continuous.shape))
+
+
+def _solve_batch(p: _Prepared, robot: Robot, T: np.ndarray, tol: float,
+                 grid: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Solve targets T (N, 4, 4) on every core; (out (N, 16, n), counts (N,), conv (N, 17))."""
+    from serialkin.ik.analytic.dispatch import solve_range
+    from serialkin.kinematics.parallel import run
+
+    N = T.shape[0]
+    out = np.zeros((N, MAX_ROWS, p.n))
+    counts = np.zeros(N, dtype=np.int64)
+    conv = np.zeros((N, MAX_ROWS + 1), dtype=np.int64)
+    args = (p.code, p.arm, p.prismatic3, T, p.W, p.P, p.M, p.aux, p.order, p.revolute,
+            p.qlim, p.mid, p.F, p.meta, p.refine, grid, tol * p.s.scale, tol,
+            REFINE_TOL * p.s.scale, REFINE_TOL, out, counts, conv)
+    grain = 4 if p.code == GENERAL else 64
+    run(solve_range, args, N, grain)
+    return out, counts, conv
+
+
+def _as_poses(a: np.ndarray) -> np.ndarray:
+    """(N, 4, 4) targets as exact rigid transforms (checked; rotations projected on SO(3))."""
+    from serialkin.spatial.kernels import transforms_valid
+
+    T = np.ascontiguousarray(a, dtype=float)
+    if not transforms_valid(T, ROTATION_TOL):
+        for k in range(T.shape[0]):
+            check_transform(T[k], f"target[{k}]")
+    R = T[:, :3, :3]
+    gram = np.einsum("kij,kil->kjl", R, R) - np.eye(3)
+    off = (np.abs(gram).max(axis=(1, 2)) > 1e-13) | np.any(T[:, 3] != (0.0, 0.0, 0.0, 1.0),
+                                                          axis=1)
+    if off.any():  # nearest rotations (polar decomposition) where needed, exact last rows
+        T = T.copy()
+        U, _, Vt = np.linalg.svd(T[off, :3, :3])
+        T[off, :3, :3] = U @ Vt
+        T[off, 3] = (0.0, 0.0, 0.0, 1.0)
+    return T
+
+
+def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool = False,
+           free: Mapping[int, float] | None = None, near_tol: float = NEAR_TOL,
+           grid: int | None = None, reference: object = None, weights: object = None,
+           norm: str = "l2", report: bool = False,
+           **options: Any) -> np.ndarray | AllSolutions:
+    """Every inverse-kinematics solution inside the joint limits (section 4.1).
+
+    Which solver runs is decided from the joint axes (never the name):
+
+    * a robot of a class in :data:`CLASSES`: its closed form (exact);
+    * a 6-joint arm within ``near_tol`` of such a class (axes parallel / meeting up to
+      ``near_tol`` rad, ``near_tol``·size m; e.g. a calibrated robot): the closed form of
+      the idealised arm gives one candidate per branch, each refined by Newton's method
+      on the true model to 1e-12 (``report=True`` says per branch whether it converged);
+    * any other 6R arm: the 2-D search of :mod:`serialkin.ik.analytic.general` (up to 16
+      solutions, each refined to 1e-12).
+
+    Args:
+        robot: the robot.
+        target: (4, 4) tool pose in the world frame (base and tool transforms included),
+            or a batch (..., 4, 4) (then an :class:`AllSolutions` is returned); on a
+            planar arm whose axes are along the world z axis also ``(x, y)`` [m] (2R) or
+            ``(x, y, φ)`` [m, m, rad], φ the heading ``atan2(R[1, 0], R[0, 0])`` of the
+            tool x axis; on such a SCARA ``(x, y, z, φ)``; on an R R P arm a position
             ``(x, y, z)`` [m]. A pose's rotation may deviate from orthonormal by up to
             1e-6 (``check_transform``); it is replaced by the nearest rotation first.
         tol: verification tolerance: each returned row reproduces the target within
             ``tol``·max(1, robot size) metres and ``tol`` in every rotation entry.
         all_turns: also list every 2π-equivalent of each revolute angle inside the limits
-            (e.g. joints with ±2π limits; joints without finite limits keep one value);
-            by default one representative, nearest the middle of the limits.
+            (single targets; joints without finite limits keep one value).
+        free: ``{joint index: value}`` locks joints (e.g. one joint of a 7R arm: Panda,
+            iiwa); the rest is solved as above and the locked values are put back in
+            the rows. Sweeping the value samples the self-motion manifold.
+        near_tol: tolerance of the nearly-ideal test [rad; m per m of size]; 0 disables it.
+        grid: nodes per searched joint of the general 6R search (default 32).
+        reference: (n,) configuration: rows are shifted by 2π towards it (inside the
+            limits) and sorted nearest first (per target in a batch; see
+            :func:`sort_by_reference`); without it rows are sorted lexicographically.
+        weights: (n,) weights of the distance to ``reference``.
+        norm: 'l2' (weighted Euclidean) or 'linf' (weighted max) distance.
+        report: return an :class:`AllSolutions` for a single target too, with the
+            per-branch convergence and, per solution, whether it lies on a continuous
+            family (a singular target).
         **options: none other are accepted (an unknown name raises InputError).
 
     Returns:
-        (k, n) array of joint values [rad / m], k >= 0 (k = 0: unreachable, or reachable
-        only outside the joint limits), rows unique and sorted lexicographically.
+        one target: (k, n) array of joint values [rad / m], k >= 0 (k = 0: unreachable,
+        or reachable only outside the joint limits), rows unique; a batch (or
+        ``report=True``): an :class:`AllSolutions`.
 
     Raises:
-        NoClosedFormError: the robot has no closed form here, or the target leaves
-            infinitely many solutions (e.g. a position-only target for a 6R arm).
+        NoClosedFormError: no solver applies (not 6 joints and of no class), or the target
+            leaves infinitely many solutions (a position-only target for a 6R arm).
         InputError: a target that is not a rigid transform / of an accepted shape, a
             non-positive ``tol`` or an unknown option.
     """
     if options:
         raise InputError(f"unknown option(s) for ik_all: {', '.join(sorted(options))}; "
-                         "accepted: tol, all_turns")
-    p = _prepared(robot)
+                         "accepted: tol, all_turns, free, near_tol, grid, reference, "
+                         "weights, norm, report")
+    if free is not None:
+        if not isinstance(robot, Robot):
+            raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+        reduced, idx, vals = _locked(robot, free)
+        res = ik_all(reduced, target, tol=tol, all_turns=all_turns, near_tol=near_tol,
+                     grid=grid, report=report)
+        if isinstance(res, AllSolutions):
+            q = _insert_locked(res.q, idx, vals, robot.n)
+            q[np.arange(q.shape[-2]) >= np.asarray(res.count)[..., None]] = 0.0  # padding
+            full = replace(res, q=q)
+            if reference is not None:
+                full = _sort_batch(robot, full, reference, weights, norm)
+            return full
+        full_rows = _insert_locked(res, idx, vals, robot.n)
+        if reference is not None:
+            full_rows = sort_by_reference(robot, full_rows, reference, weights=weights,
+                                          norm=norm)
+        return full_rows
+    near_tol = check_positive(near_tol, "near_tol", allow_zero=True)
+    p = _prepared(robot, near_tol)
     tol = check_positive(tol, "tol")
-    T, check_rot = _parse_target(p, robot, target)
-    tol_p = tol * p.s.scale
-    kind = p.s.kind
-    if kind in ("planar_2r", "planar_3r"):
-        from serialkin.ik.analytic.planar import solve_planar
+    if grid is None:
+        from serialkin.ik.analytic.general import DEFAULT_GRID
 
-        out = np.empty((2, p.n))
-        k = solve_planar(T, p.W, p.P, p.M, p.order, p.aux[0], p.aux[1], p.revolute, p.qlim,
-                         p.mid, p.F, p.meta, check_rot, tol_p, tol, out)
-    elif kind in ("scara", "scara_rrp"):
-        from serialkin.ik.analytic.scara import solve_scara
+        grid = DEFAULT_GRID
+    if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 4 <= grid <= 2000:
+        raise InputError(f"grid must be an int in 4..2000, got {grid!r}")
+    grid = int(grid)
+    a = target if type(target) is np.ndarray else as_float_array(target, "target")
+    if a.ndim >= 3 and a.shape[-2:] == (4, 4):
+        if all_turns:
+            raise InputError("all_turns applies to one target; for a batch, call ik_all per "
+                             "target with all_turns=True")
+        lead = a.shape[:-2]
+        T = _as_poses(a.reshape(-1, 4, 4))
+        out, counts, conv = _solve_batch(p, robot, T, tol, grid)
+        kmax = int(counts.max(initial=0))
+        branches = conv[:, 0]
+        converged = conv[:, 1:].astype(bool)
+        cont = None
+        if report:
+            cont = np.zeros((T.shape[0], kmax), dtype=bool)
+            for i in range(T.shape[0]):
+                for j in range(int(counts[i])):
+                    cont[i, j] = continuous_family(robot, T[i], out[i, j])
+            cont = cont.reshape(lead + (kmax,))
+        if p.mode == "near":  # an odd number of converged branches: general search too
+            for i in range(T.shape[0]):
+                if conv[i, 1:conv[i, 0] + 1].sum() % 2 == 1:
+                    rows = _with_general(robot, T[i], out[i, :counts[i]], tol, grid)
+                    counts[i] = min(len(rows), MAX_ROWS)
+                    out[i, :counts[i]] = rows[:MAX_ROWS]
+            kmax = int(counts.max(initial=0))
+        res = AllSolutions(out[:, :kmax].reshape(lead + (kmax, p.n)), counts.reshape(lead),
+                           branches.reshape(lead), converged.reshape(lead + (MAX_ROWS,)),
+                           p.s.kind, p.mode, cont)
+        if reference is not None:
+            res = _sort_batch(robot, res, reference, weights, norm)
+        return res
+    T, check_rot = _parse_target(p, robot, a)
+    from serialkin.ik.analytic.dispatch import solve_into
 
-        out = np.empty((2, p.n))
-        k = solve_scara(T, p.W, p.P, p.M, p.order, p.aux[0], p.aux[1], p.revolute, p.qlim,
-                        p.mid, p.F, p.meta, check_rot, tol_p, tol, out)
-    elif kind in _WRIST_ARMS:
-        from serialkin.ik.analytic.spherical_wrist import solve_spherical_wrist
-
-        out = np.empty((8, 6))
-        arm, prismatic3 = _WRIST_ARMS[kind]
-        k = solve_spherical_wrist(T, p.W, p.P, p.M, p.aux, arm, prismatic3,
-                                  p.revolute, p.qlim, p.mid, p.F, p.meta, tol_p, tol, out)
-    else:  # "ur"
-        from serialkin.ik.analytic.ur import solve_ur
-
-        out = np.empty((8, 6))
-        k = solve_ur(T, p.W, p.P, p.M, p.aux, p.revolute, p.qlim, p.mid, p.F, p.meta, tol_p,
-                     tol, out)
+    out = np.empty((MAX_ROWS, p.n))
+    conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
+    k = solve_into(p.code, p.arm, p.prismatic3, T, p.W, p.P, p.M, p.aux, p.order, p.revolute,
+                   p.qlim, p.mid, p.F, p.meta, check_rot, p.refine, grid, tol * p.s.scale, tol,
+                   REFINE_TOL * p.s.scale, REFINE_TOL, out, conv)
     sols = out[:k]
+    if p.mode == "near" and conv[1:conv[0] + 1].sum() % 2 == 1:
+        sols = _with_general(robot, T, sols, tol, grid)
     if all_turns and k:
         sols = _expand_turns(sols, p.revolute, p.qlim)
+    if reference is not None:
+        sols = sort_by_reference(robot, sols, reference, weights=weights, norm=norm)
+    if report:
+        cont = np.array([check_rot and p.n == 6 and continuous_family(robot, T, row)
+                         for row in sols], dtype=bool)
+        return AllSolutions(sols.copy(), np.array(sols.shape[0]), np.array(conv[0]),
+                            conv[1:].astype(bool), p.s.kind, p.mode, cont)
     return sols

@@ -111,15 +111,18 @@ def wrist_into(Rg, W, v, q1, q2, q3, prismatic3, out, k):
 
 
 @njit(cache=True)
-def puma_candidates(T, W, P, M, aux, out):
-    """Candidates for a ``puma``-class arm; aux = (c, w, e1 ⟂ w, v ⟂ w6). Returns the count."""
+def puma_positions(pw, W, P, aux, out):
+    """Arm joints (q1, q2, q3) of a ``puma``-class arm putting c on ``pw``.
+
+    aux = (c, w, e1 ⟂ w, ...).
+
+    Writes rows into ``out`` (4, 3) and returns their count.
+    """
     c = aux[0].copy()
     w = aux[1].copy()
     e1 = aux[2].copy()
-    v = aux[3].copy()
     w1 = W[0].copy()
     r1 = P[0].copy()
-    pw, Rg = target_point(T, M, c)
     q1s = np.empty(2)
     n1 = sp4(w1, w, pw - r1, dot3(w, c - r1), q1s)
     sol = np.empty((2, 2))
@@ -131,28 +134,30 @@ def puma_candidates(T, W, P, M, aux, out):
         x = transform_point(screw(w1, r1, -q1, False), pw)
         m = planar2r(w, e1, P[1].copy(), P[2].copy(), c, x, sol)
         for j in range(m):
-            k = wrist_into(Rg, W, v, q1, s2 * sol[j, 0], s3 * sol[j, 1], False, out, k)
+            out[k, 0] = q1
+            out[k, 1] = s2 * sol[j, 0]
+            out[k, 2] = s3 * sol[j, 1]
+            k += 1
     return k
 
 
 @njit(cache=True)
-def intersecting_candidates(T, W, P, M, aux, prismatic3, out):
-    """Candidates when axes 1 and 2 meet at o; aux = (c, o, v ⟂ w6). Returns the count.
+def intersecting_positions(pw, W, P, aux, prismatic3, out):
+    """Arm joints when axes 1 and 2 meet at o; aux = (c, o, ...). Rows into ``out`` (4, 3).
 
     Rotations about axes 1 and 2 keep the distance to ``o``, so joint 3 alone must give
     the wrist centre its target distance ``|p_w − o|``: subproblem 3 for a revolute
     joint 3 (``pieper_intersecting``), :func:`~serialkin.ik.analytic.subproblems.sp3_slide`
     for a prismatic one (``prismatic3``, ``stanford``). Up to two values of q3; q1, q2
     then carry the moved centre onto ``p_w`` (subproblem 2, two solutions each).
+    Returns the count.
     """
     c = aux[0].copy()
     o = aux[1].copy()
-    v = aux[2].copy()
     w1 = W[0].copy()
     w2 = W[1].copy()
     w3 = W[2].copy()
     r3 = P[2].copy()
-    pw, Rg = target_point(T, M, c)
     h = c - o
     g = pw - o
     q3s = np.empty(2)
@@ -170,7 +175,10 @@ def intersecting_candidates(T, W, P, M, aux, prismatic3, out):
             x = transform_point(screw(w3, r3, q3, False), c) - o
         m = sp2_dir(w1, w2, x, g, sol)
         for j in range(m):
-            k = wrist_into(Rg, W, v, sol[j, 0], sol[j, 1], q3, prismatic3, out, k)
+            out[k, 0] = sol[j, 0]
+            out[k, 1] = sol[j, 1]
+            out[k, 2] = q3
+            k += 1
     return k
 
 
@@ -186,8 +194,10 @@ def _general_residual(theta, c, w3, r3, r2, w2, a1, ca, sa, rho2, h):
 
 
 @njit(cache=True)
-def general_candidates(T, W, P, M, aux, prismatic3, out):
-    """Candidates for a ``pieper_general`` or ``stanford_general`` arm; aux = (c, r1, r2, n, m, v).
+def general_positions(pw, W, P, aux, prismatic3, out):
+    """Arm joints of a ``pieper_general`` / ``stanford_general`` arm; aux = (c, r1, r2, n, m, ...).
+
+    Writes rows (q1, q2, q3) putting c on ``pw`` into ``out`` (4, 3); returns the count.
 
     Axes 1 and 2 do not meet: r1, r2 are the feet of their common perpendicular, a1 = |r2 − r1|,
     n = (r2 − r1)/a1, m = w2 × n, and w1 = cα·w2 + sα·m. With u = exp(ξ3 q3)·c − r2 and
@@ -203,8 +213,7 @@ def general_candidates(T, W, P, M, aux, prismatic3, out):
     E is a trigonometric polynomial of degree 2 (:func:`_quartic_theta3`). Prismatic joint 3
     (``prismatic3``, ``stanford_general``): u = c + d·w3 − r2 is linear in the stroke d and
     E(d) a polynomial quartic (:func:`_quartic_stroke`). Up to 4 values of q3; then
-    θ2 = atan2(g2, g1) − atan2(m·u, n·u), θ1 by subproblem 1 and the wrist by
-    :func:`wrist_into`.
+    θ2 = atan2(g2, g1) − atan2(m·u, n·u) and θ1 by subproblem 1.
 
     When axes 1 and 2 are parallel (sα = 0) the second invariant reads w2·u = cα·w1·(p_w − r1)
     instead: θ3 by :func:`~serialkin.ik.analytic.subproblems.sp4` (two values) or d directly
@@ -215,12 +224,10 @@ def general_candidates(T, W, P, M, aux, prismatic3, out):
     r2 = aux[2].copy()
     n = aux[3].copy()
     m = aux[4].copy()
-    v = aux[5].copy()
     w1 = W[0].copy()
     w2 = W[1].copy()
     w3 = W[2].copy()
     r3 = P[2].copy()
-    pw, Rg = target_point(T, M, c)
     a1 = dot3(r2 - r1, n)
     ca = dot3(w1, w2)
     sa = dot3(w1, m)
@@ -259,9 +266,12 @@ def general_candidates(T, W, P, M, aux, prismatic3, out):
             th2 = math.atan2(gj, g1) - math.atan2(dot3(m, u), dot3(n, u))
             x = mv(rotation(w2, th2), u) + r2
             th1 = sp1_dir(w1, x - r1, pw - r1)
-            if k + 2 > out.shape[0]:
+            if k == out.shape[0]:
                 return k
-            k = wrist_into(Rg, W, v, th1, th2, th, prismatic3, out, k)
+            out[k, 0] = th1
+            out[k, 1] = th2
+            out[k, 2] = th
+            k += 1
     return k
 
 
@@ -364,6 +374,37 @@ def _quartic_stroke(h0, b, w2, a1, ca, sa, rho2, h, parallel, strokes):
 
 
 @njit(cache=True)
+def arm_positions(pw, W, P, aux, arm, prismatic3, out):
+    """Joints (q1, q2, q3) that put the point ``aux[0]`` (at q = 0) on ``pw`` (3,) [m].
+
+    ``arm`` 0: axes 2 ∥ 3 (:func:`puma_positions`); 1: axes 1, 2 meet
+    (:func:`intersecting_positions`); 2: otherwise (:func:`general_positions`). Rows into
+    ``out`` (4, 3); returns their count (0-4).
+    """
+    if arm == 0:
+        return puma_positions(pw, W, P, aux, out)
+    if arm == 1:
+        return intersecting_positions(pw, W, P, aux, prismatic3, out)
+    return general_positions(pw, W, P, aux, prismatic3, out)
+
+
+@njit(cache=True)
+def wrist_candidates(T, W, P, M, aux, arm, prismatic3, out):
+    """Candidate rows (8, 6) of a spherical-wrist arm: the arm joints, then the wrist.
+
+    ``aux[0]`` is the wrist centre c and ``aux[-1]`` a unit vector ⟂ w6; returns the count.
+    """
+    pw, Rg = target_point(T, M, aux[0].copy())
+    arm3 = np.empty((4, 3))
+    m = arm_positions(pw, W, P, aux, arm, prismatic3, arm3)
+    v = aux[aux.shape[0] - 1].copy()
+    k = 0
+    for i in range(m):
+        k = wrist_into(Rg, W, v, arm3[i, 0], arm3[i, 1], arm3[i, 2], prismatic3, out, k)
+    return k
+
+
+@njit(cache=True)
 def solve_spherical_wrist(T, W, P, M, aux, arm, prismatic3, revolute, qlim, mid, F, meta,
                           tol_p, tol_r, out):
     """Every solution of a spherical-wrist 6R / R R P arm inside the limits, sorted, into ``out``.
@@ -390,10 +431,5 @@ def solve_spherical_wrist(T, W, P, M, aux, arm, prismatic3, revolute, qlim, mid,
         number of solutions (0-8).
     """
     cand = np.zeros((MAX_SOLUTIONS, 6))
-    if arm == 0:
-        k = puma_candidates(T, W, P, M, aux, cand)
-    elif arm == 1:
-        k = intersecting_candidates(T, W, P, M, aux, prismatic3, cand)
-    else:
-        k = general_candidates(T, W, P, M, aux, prismatic3, cand)
+    k = wrist_candidates(T, W, P, M, aux, arm, prismatic3, cand)
     return finalize(cand, k, revolute, qlim, mid, F, meta, T, True, tol_p, tol_r, out)

@@ -117,12 +117,12 @@ def _sin_angle(w1: np.ndarray, w2: np.ndarray) -> float:
     return float(np.linalg.norm(np.cross(w1, w2)))
 
 
-def _line_distance(p1, w1, p2, w2) -> float:
+def _line_distance(p1, w1, p2, w2, atol: float = ANGLE_TOL) -> float:
     """Shortest distance between two lines [m]."""
     x = np.cross(w1, w2)
     nx = np.linalg.norm(x)
     d = p2 - p1
-    if nx < ANGLE_TOL:
+    if nx < atol:
         return float(np.linalg.norm(np.cross(d, w1)))
     return float(abs(d @ x) / nx)
 
@@ -168,11 +168,14 @@ def _fail(robot: Robot, why: str) -> NoClosedFormError:
     )
 
 
-def analyse(robot: Robot) -> Structure:
+def analyse(robot: Robot, angle_tol: float = ANGLE_TOL,
+            length_tol: float = LENGTH_TOL) -> Structure:
     """Recognise the robot's closed-form class from its joint lines.
 
     Args:
         robot: the robot.
+        angle_tol: two axes are parallel when the sine of their angle is below this.
+        length_tol: lines meet when closer than this times the robot's size [m/m].
 
     Returns:
         the :class:`Structure` with the class-specific data the solvers need.
@@ -185,23 +188,24 @@ def analyse(robot: Robot) -> Structure:
     n = robot.n
     rev = robot.revolute
     scale = max(1.0, float(np.max(np.linalg.norm(np.vstack([P, M[:3, 3]]) - P[0], axis=1))))
-    ltol = LENGTH_TOL * scale
+    ltol = length_tol * scale
+    atol = angle_tol
 
     def para(i: int, j: int) -> bool:
-        return _sin_angle(W[i], W[j]) < ANGLE_TOL
+        return _sin_angle(W[i], W[j]) < atol
 
     # ---------------------------------------------------------------- parallel family
     if all(para(0, j) for j in range(1, n)):
-        return _parallel_family(robot, W, P, M, rev, scale, ltol)
+        return _parallel_family(robot, W, P, M, rev, scale, ltol, atol)
     if n == 6:
-        return _six_dof(robot, W, P, M, rev, scale, ltol)
+        return _six_dof(robot, W, P, M, rev, scale, ltol, atol)
     if n > 6:
         raise _fail(robot, f"it has {n} joints, more than the 6 a pose needs: it is redundant "
                            "and has infinitely many solutions per target")
     raise _fail(robot, f"its {n} joints are not all parallel and it is not a 6-joint arm")
 
 
-def _parallel_family(robot, W, P, M, rev, scale, ltol) -> Structure:
+def _parallel_family(robot, W, P, M, rev, scale, ltol, atol) -> Structure:
     n = robot.n
     ir = [i for i in range(n) if rev[i]]
     ip = [i for i in range(n) if not rev[i]]
@@ -223,33 +227,34 @@ def _parallel_family(robot, W, P, M, rev, scale, ltol) -> Structure:
     e1 = _unit_perp(w)
     aux = np.array([w, e1])
     order = np.array(ir + [ip[0] if ip else -1], dtype=np.int64)
-    planar_z = abs(abs(w[2]) - 1.0) < ANGLE_TOL
+    planar_z = abs(abs(w[2]) - 1.0) < atol
     return Structure(kind, W, P, M, rev, aux, order, planar_z, scale)
 
 
-def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons) -> Structure | None:
+def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons,
+               atol=ANGLE_TOL) -> Structure | None:
     """The arm class in front of a spherical wrist, or None (a reason is appended)."""
     v = _unit_perp(W[5])
     none = np.zeros(0, np.int64)
     if types[:3] not in ("RRR", "RRP"):
         reasons.append(f"the arm joints are {types[:3]}; closed forms need RRR or RRP")
         return None
-    p12 = _sin_angle(W[0], W[1]) < ANGLE_TOL
+    p12 = _sin_angle(W[0], W[1]) < atol
     if types[:3] == "RRP":  # the wrist centre slides on the line (wrist, W[2])
         for k in (0, 1):
-            if _sin_angle(W[k], W[2]) < ANGLE_TOL and \
+            if _sin_angle(W[k], W[2]) < atol and \
                     _point_line_distance(wrist, P[k], W[k]) < ltol:
                 reasons.append(f"the wrist centre slides along axis {k + 1}, which then "
                                "cannot move it")
                 return None
     if types[:3] == "RRR":
-        if _sin_angle(W[0], W[2]) < ANGLE_TOL and _point_line_distance(P[2], P[0], W[0]) < ltol:
+        if _sin_angle(W[0], W[2]) < atol and _point_line_distance(P[2], P[0], W[0]) < ltol:
             reasons.append("axes 1 and 3 coincide")
             return None
         if _point_line_distance(wrist, P[2], W[2]) < ltol:
             reasons.append("the wrist centre lies on axis 3")
             return None
-        if _sin_angle(W[1], W[2]) < ANGLE_TOL:  # Puma class, or degenerate
+        if _sin_angle(W[1], W[2]) < atol:  # Puma class, or degenerate
             if p12:
                 reasons.append("axes 1, 2, 3 are all parallel: the wrist centre cannot leave "
                                "a plane")
@@ -259,11 +264,11 @@ def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons) -> Structure | 
                 aux = np.array([wrist, W[1], _unit_perp(W[1]), v])
                 return Structure("puma", W, P, M, rev, aux, none, False, scale)
             return None
-    d12 = _line_distance(P[0], W[0], P[1], W[1])
+    d12 = _line_distance(P[0], W[0], P[1], W[1], atol)
     if p12 and d12 < ltol:
         reasons.append("axes 1 and 2 coincide")
         return None
-    if p12 and types[:3] == "RRP" and abs(W[1] @ W[2]) < ANGLE_TOL:
+    if p12 and types[:3] == "RRP" and abs(W[1] @ W[2]) < atol:
         reasons.append("the arm is R R P with parallel axes 1 and 2 and a slide perpendicular "
                        "to them: the wrist centre cannot leave a plane")
         return None
@@ -289,17 +294,17 @@ def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons) -> Structure | 
     return Structure(kind, W, P, M, rev, aux, none, False, scale)
 
 
-def _six_dof(robot, W, P, M, rev, scale, ltol) -> Structure:
+def _six_dof(robot, W, P, M, rev, scale, ltol, atol) -> Structure:
     types = "".join(robot.joint_types)
     reasons = []
     # ------------------------------------------------ spherical wrist (axes 4, 5, 6)
     wrist = None
     if types[3:] != "RRR":
         reasons.append("joints 4-6 are not all revolute, so there is no spherical wrist")
-    elif _sin_angle(W[3], W[4]) < ANGLE_TOL or _sin_angle(W[4], W[5]) < ANGLE_TOL:
+    elif _sin_angle(W[3], W[4]) < atol or _sin_angle(W[4], W[5]) < atol:
         reasons.append("wrist axes 4/5 or 5/6 are parallel, so they do not form a spherical wrist")
     else:
-        d45 = _line_distance(P[3], W[3], P[4], W[4])
+        d45 = _line_distance(P[3], W[3], P[4], W[4], atol)
         c = _closest_point(P[3], W[3], P[4], W[4])
         d6 = _point_line_distance(c, P[5], W[5])
         if d45 < ltol and d6 < ltol:
@@ -308,19 +313,19 @@ def _six_dof(robot, W, P, M, rev, scale, ltol) -> Structure:
             reasons.append(f"axes 4, 5, 6 do not meet in one point (axes 4-5 {d45:.3g} m "
                            f"apart, axis 6 {d6:.3g} m from their meeting point)")
     if wrist is not None:
-        found = _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons)
+        found = _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons, atol)
         if found is not None:
             return found
     # ------------------------------------------------ three parallel axes (2, 3, 4)
     if types == "RRRRRR":
-        if _sin_angle(W[1], W[2]) < ANGLE_TOL and _sin_angle(W[1], W[3]) < ANGLE_TOL:
+        if _sin_angle(W[1], W[2]) < atol and _sin_angle(W[1], W[3]) < atol:
             w = W[1]
-            d56 = _line_distance(P[4], W[4], P[5], W[5])
-            if _sin_angle(W[0], w) < ANGLE_TOL:
+            d56 = _line_distance(P[4], W[4], P[5], W[5], atol)
+            if _sin_angle(W[0], w) < atol:
                 reasons.append("axis 1 is parallel to the parallel axes 2, 3, 4")
-            elif _sin_angle(W[4], w) < ANGLE_TOL:
+            elif _sin_angle(W[4], w) < atol:
                 reasons.append("axis 5 is parallel to the parallel axes 2, 3, 4")
-            elif _sin_angle(W[4], W[5]) < ANGLE_TOL or d56 >= ltol:
+            elif _sin_angle(W[4], W[5]) < atol or d56 >= ltol:
                 reasons.append(f"axes 2, 3, 4 are parallel but axes 5 and 6 do not intersect "
                                f"({d56:.3g} m apart)")
             elif _point_line_distance(P[2], P[1], w) < ltol or \
@@ -333,3 +338,70 @@ def _six_dof(robot, W, P, M, rev, scale, ltol) -> Structure:
         else:
             reasons.append("axes 2, 3, 4 are not parallel")
     raise _fail(robot, "; ".join(reasons))
+
+
+#: Arm codes of the 3R arm in front of axis 4 (as ``spherical_wrist.arm_positions``).
+ARM_CODES = {"puma": 0, "pieper_intersecting": 1, "pieper_general": 2}
+
+
+def general_structure(robot: Robot) -> Structure:
+    """The data of the general 6R search (:mod:`serialkin.ik.analytic.general`).
+
+    The 3R arm of joints 1-3 must place a point ``c`` of axis 4 in closed form; ``c`` is
+    taken on axis 4 as far from axis 3 as the candidates ``P4 + t·w4`` (t = 0, ±size/2)
+    allow, and the arm is classified like the arm of a spherical-wrist robot. When joints
+    1-3 cannot (e.g. axes 1, 2, 3 parallel), the chain is reversed:
+    ``T⁻¹ = M⁻¹·e6⁻¹···e1⁻¹`` is a chain whose joint j is joint 7 − j about the line
+    ``(−R_Mᵀ w, M⁻¹ p)`` with tool pose ``M⁻¹``, and joints 6-4 place a point of axis 3.
+    When both ends can, the reversed chain is taken only when it is clearly better
+    conditioned (Pieper's quartic divides by the common normal a1 of axes 1 and 2: the
+    score min(1, 10·a1/size) is below 0.5 forward and at least 0.5 reversed).
+    ``order`` holds the arm code (:data:`ARM_CODES`) and 1 when reversed; ``aux`` ends
+    with a unit vector ⟂ w4 (of the chain searched); W, P, M are that chain's.
+
+    Raises:
+        NoClosedFormError: not a 6R arm, or neither end's three joints can place a point
+            in closed form (e.g. coaxial joints: infinitely many solutions).
+    """
+    W, P, M = joint_lines(robot)
+    rev = robot.revolute
+    types = "".join(robot.joint_types)
+    if robot.n != 6 or types != "RRRRRR":
+        raise _fail(robot, f"the general solver needs six revolute joints, got {types}")
+    scale = max(1.0, float(np.max(np.linalg.norm(np.vstack([P, M[:3, 3]]) - P[0], axis=1))))
+    ltol = 1e-6 * scale
+    for i in range(5):  # coaxial neighbours turn as one joint: a continuum of solutions
+        if _sin_angle(W[i], W[i + 1]) < 1e-9 and \
+                _point_line_distance(P[i + 1], P[i], W[i]) < 1e-9 * scale:
+            raise _fail(robot, f"axes {i + 1} and {i + 2} coincide: the arm is redundant "
+                               "(infinitely many solutions)")
+    reasons: list[str] = []
+    Minv = np.linalg.inv(M)
+    Wr = -(W[::-1] @ M[:3, :3])
+    Pr = P[::-1] @ Minv[:3, :3].T + Minv[:3, 3]
+    found = []
+    for reversed_, (Wc, Pc, Mc) in ((0, (W, P, M)), (1, (Wr, Pr, Minv))):
+        options = sorted(((_point_line_distance(Pc[3] + t * Wc[3], Pc[2], Wc[2]), t)
+                          for t in (0.0, 0.5 * scale, -0.5 * scale)), reverse=True)
+        for _, t in options:
+            c = Pc[3] + t * Wc[3]
+            arm = _wrist_arm(Wc, Pc, Mc, rev, scale, ltol, types, c, reasons, 1e-6)
+            if arm is not None:
+                # conditioning: Pieper's quartic divides by the common normal a1 of axes 1, 2
+                score = 1.0 if arm.kind != "pieper_general" else \
+                    min(1.0, 10.0 * float(np.linalg.norm(arm.aux[2] - arm.aux[1])) / scale)
+                aux = np.vstack([arm.aux[:-1], _unit_perp(Wc[3])])
+                found.append((score, -reversed_, Structure(
+                    "general_6r", np.ascontiguousarray(Wc), np.ascontiguousarray(Pc),
+                    np.ascontiguousarray(Mc), rev, aux,
+                    np.array([ARM_CODES[arm.kind], reversed_], dtype=np.int64), False,
+                    scale)))
+                break
+    if found:  # the reversed chain only when clearly better conditioned
+        best = found[0]
+        if len(found) == 2 and found[0][0] < 0.5 <= found[1][0]:
+            best = found[1]
+        return best[2]
+    raise _fail(robot, "no closed form for the 3R arm of joints 1-3 placing a point of axis "
+                       "4, nor for joints 6-4 placing a point of axis 3: "
+                       + "; ".join(dict.fromkeys(reasons)))

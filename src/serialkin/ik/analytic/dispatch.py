@@ -1,0 +1,109 @@
+"""One compiled entry for every closed-form class, and its batch range kernel (numba).
+
+:func:`solve_into` solves one target for any recognised class (an integer ``code``),
+optionally refining every candidate branch on the true chain (nearly ideal arms, see
+:mod:`serialkin.ik.analytic.refine`); :func:`solve_range` runs it over targets
+``start..stop-1`` with the GIL released, for :func:`serialkin.kinematics.parallel.run`.
+Kernels trust their input.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from serialkin.ik.analytic.general import MAX_SOLUTIONS as GENERAL_MAX
+from serialkin.ik.analytic.general import general_candidates
+from serialkin.ik.analytic.planar import solve_planar
+from serialkin.ik.analytic.refine import refine_rows
+from serialkin.ik.analytic.scara import solve_scara
+from serialkin.ik.analytic.spherical_wrist import wrist_candidates
+from serialkin.ik.analytic.subproblems import finalize
+from serialkin.ik.analytic.ur import ur_candidates
+
+#: Class codes of :func:`solve_into`.
+PLANAR, SCARA, WRIST, UR, GENERAL = 0, 1, 2, 3, 4
+#: Rows of the output buffer (the most solutions of any class).
+MAX_ROWS = GENERAL_MAX
+
+
+@njit(cache=True)
+def solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mid, F, meta,
+               check_rot, refine, grid, tol_p, tol_r, newton_p, newton_r, out, conv):
+    """Every solution of one target into ``out`` (16, n); returns their count.
+
+    Args:
+        code: class code (:data:`PLANAR`, :data:`SCARA`, :data:`WRIST`, :data:`UR`,
+            :data:`GENERAL`).
+        arm: arm code of the spherical-wrist / general classes.
+        prismatic3: joint 3 slides (Stanford classes).
+        T: (4, 4) target pose (world).
+        W: (n, 3) joint directions at q = 0 (the structure's data, as P, M, aux, order).
+        P: (n, 3) joint points [m].
+        M: (4, 4) tool pose at q = 0.
+        aux: class data.
+        order: class joint indices.
+        revolute: (n,) joint kinds.
+        qlim: (n, 2) joint limits.
+        mid: (n,) wrapping centres.
+        F: (n+1, 4, 4) chain transforms (verification and refinement).
+        meta: (n, 5) chain joint data.
+        check_rot: verify the rotation too.
+        refine: Newton-refine every candidate branch on the chain (nearly ideal arms).
+        grid: search grid of the general class.
+        tol_p: verification tolerance [m].
+        tol_r: verification tolerance of the rotation entries.
+        newton_p: refinement tolerance [m].
+        newton_r: refinement tolerance [rad].
+        out: (16, n) output rows.
+        conv: (17,) int: ``conv[0]`` the number of candidate branches B, ``conv[1:B+1]``
+            1 when branch i converged (or needed no refinement), else 0.
+
+    Returns:
+        the number of solutions inside the limits (rows sorted lexicographically).
+    """
+    n = W.shape[0]
+    if code == PLANAR:
+        conv[0] = 0
+        return solve_planar(T, W, P, M, order, aux[0].copy(), aux[1].copy(), revolute, qlim,
+                            mid, F, meta, check_rot, tol_p, tol_r, out)
+    if code == SCARA:
+        conv[0] = 0
+        return solve_scara(T, W, P, M, order, aux[0].copy(), aux[1].copy(), revolute, qlim,
+                           mid, F, meta, check_rot, tol_p, tol_r, out)
+    cand = np.zeros((MAX_ROWS, n))
+    if code == WRIST:
+        k = wrist_candidates(T, W, P, M, aux, arm, prismatic3, cand)
+    elif code == UR:
+        k = ur_candidates(T, W, P, M, aux, cand)
+    else:
+        k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, grid, F, meta, newton_p,
+                               newton_r, cand)
+        if k % 2 == 1:  # real solutions of a 6R come in even numbers: search finer once
+            k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, 2 * grid, F, meta,
+                                   newton_p, newton_r, cand)
+    conv[0] = k
+    if refine and code != GENERAL:
+        ok = np.zeros(k, dtype=np.bool_)
+        refine_rows(cand, k, T, F, meta, newton_p, newton_r, ok)
+        for i in range(k):
+            conv[1 + i] = 1 if ok[i] else 0
+    else:
+        for i in range(k):
+            conv[1 + i] = 1
+    return finalize(cand, k, revolute, qlim, mid, F, meta, T, True, tol_p, tol_r, out)
+
+
+@njit(cache=True, nogil=True)
+def solve_range(code, arm, prismatic3, Ts, W, P, M, aux, order, revolute, qlim, mid, F, meta,
+                refine, grid, tol_p, tol_r, newton_p, newton_r, out, counts, conv, start,
+                stop):
+    """:func:`solve_into` for targets ``Ts[start:stop]`` (N, 4, 4), GIL released.
+
+    Writes ``out`` (N, 16, n), ``counts`` (N,) and ``conv`` (N, 17); the other arguments
+    as for :func:`solve_into` (rotations always verified).
+    """
+    for i in range(start, stop):
+        counts[i] = solve_into(code, arm, prismatic3, Ts[i], W, P, M, aux, order, revolute,
+                               qlim, mid, F, meta, True, refine, grid, tol_p, tol_r, newton_p,
+                               newton_r, out[i], conv[i])

@@ -1,0 +1,350 @@
+"""ik_all beyond the exact classes (batches, general 6R, nearly ideal arms, locked joints).
+
+Also selection by a reference configuration, singular and unreachable targets.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from serialkin import Robot, models
+from serialkin.errors import InputError, NoClosedFormError
+from serialkin.ik.analytic import AllSolutions, classify, ik_all, sort_by_reference
+from serialkin.ik.analytic.refine import newton_refine
+from serialkin.model.dh import DHLink
+
+
+def _wrapped(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Largest joint difference, revolute differences wrapped to [-π, π]."""
+    return np.abs((np.asarray(a) - b + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)
+
+
+def _fk_error(robot: Robot, sols: np.ndarray, T: np.ndarray) -> float:
+    """Worst |FK(q) − T| entry over the rows."""
+    if len(sols) == 0:
+        return 0.0
+    return float(np.abs(robot.fk(sols) - T).max())
+
+
+def _newton_set(robot: Robot, T: np.ndarray, seeds: int, rng: np.random.Generator) -> list:
+    """Distinct solutions Newton's method reaches from random starts (the independent check)."""
+    found: list[np.ndarray] = []
+    for _ in range(seeds):
+        q = rng.uniform(-np.pi, np.pi, robot.n)
+        if newton_refine(q, T, robot.chain.F, robot.chain.meta, 1e-11, 1e-11, 60):
+            if not any(_wrapped(q, f) < 1e-6 for f in found):
+                found.append(q)
+    return found
+
+
+def _random_arm(rng: np.random.Generator) -> Robot:
+    """A random 6R standard-DH arm (general: no special structure)."""
+    return Robot.from_dh([DHLink(a=rng.uniform(0.05, 0.5), alpha=rng.uniform(-3.0, 3.0),
+                                 d=rng.uniform(-0.3, 0.3)) for _ in range(6)], name="random")
+
+
+def _perturbed(robot: Robot, rng: np.random.Generator, angle: float = 0.01) -> Robot:
+    """Every DH twist and joint offset moved by up to ``angle`` rad, lengths by up to 1 mm."""
+    rows = [DHLink(a=r.a + rng.uniform(-1e-3, 1e-3), alpha=r.alpha + rng.uniform(-angle, angle),
+                   d=r.d + rng.uniform(-1e-3, 1e-3), theta=r.theta + rng.uniform(-angle, angle))
+            for r in robot.dh]
+    return Robot.from_dh(rows, robot.convention, base=robot.base, tool=robot.tool,
+                         name=f"{robot.name} (perturbed)")
+
+
+# ----------------------------------------------------------------------------- batches
+@pytest.mark.parametrize("name", ["ur5", "puma560"])
+def test_batch_equals_single_calls(name):
+    """A (2, 5, 4, 4) batch gives, per target, the single call's rows, zero-padded, with counts."""
+    robot = getattr(models, name)()
+    rng = np.random.default_rng(3)
+    q = rng.uniform(*robot.qlim.T, size=(2, 5, 6)) * 0.8
+    T = robot.fk(q)
+    res = ik_all(robot, T)
+    assert isinstance(res, AllSolutions)
+    assert res.count.shape == (2, 5) and res.q.shape[:2] == (2, 5) and res.q.shape[-1] == 6
+    assert res.mode == "exact" and res.kind == classify(robot)
+    for i in range(2):
+        for j in range(5):
+            single = ik_all(robot, T[i, j])
+            k = int(res.count[i, j])
+            assert k == len(single) >= 1
+            np.testing.assert_allclose(res.solutions((i, j)), single, atol=1e-12)
+            assert np.all(res.q[i, j, k:] == 0.0)
+            assert _wrapped(single, q[i, j]).min() < 1e-8
+
+
+def test_batch_unreachable_targets_count_zero():
+    """Unreachable targets in a batch get count 0 and zero rows, never NaN."""
+    robot = models.ur5()
+    T = np.repeat(robot.fk(np.zeros(6))[None], 3, axis=0)
+    T[1, :3, 3] = (5.0, 0.0, 0.0)
+    res = ik_all(robot, T)
+    assert res.count[1] == 0 and res.count[0] > 0 and res.count[2] > 0
+    assert np.all(np.isfinite(res.q))
+
+
+def test_batch_rejects_non_rigid_target():
+    """A non-rigid transform inside a batch raises an InputError naming its index."""
+    robot = models.ur5()
+    T = np.repeat(np.eye(4)[None], 2, axis=0)
+    T[1, 0, 0] = 2.0
+    with pytest.raises(InputError, match=r"target\[1\]"):
+        ik_all(robot, T)
+
+
+# ----------------------------------------------------------------------------- general 6R
+def test_general_arms_complete_and_exact():
+    """Random general 6R arms: rows meet FK to 1e-10; Newton from 200 seeds finds none missed."""
+    rng = np.random.default_rng(11)
+    for _ in range(4):
+        robot = _random_arm(rng)
+        with pytest.raises(NoClosedFormError):
+            classify(robot)
+        q = rng.uniform(-np.pi, np.pi, 6)
+        T = robot.fk(q)
+        res = ik_all(robot, T, report=True)
+        assert res.mode == "general" and res.kind == "general_6r"
+        sols = res.q
+        assert 1 <= len(sols) <= 16 and len(sols) % 2 == 0
+        assert _fk_error(robot, sols, T) < 1e-10
+        assert _wrapped(sols, q).min() < 1e-8
+        for f in _newton_set(robot, T, 200, rng):
+            assert _wrapped(sols, f).min() < 1e-6
+
+
+def test_fourteen_solution_arm():
+    """An arm with 14 real solutions for a pose gives all 14 (Newton from 300 seeds agrees)."""
+    a = [0.82, 0.447, 0.3452, 0.0421, 0.9922, 0.4346]
+    alpha = [-0.9003, 2.4162, -2.0018, 2.1241, -0.9509, 2.4511]
+    d = [-0.1558, 0.4385, 0.8134, -0.0544, -0.1974, 0.3604]
+    robot = Robot.from_dh([DHLink(a=a[i], alpha=alpha[i], d=d[i]) for i in range(6)])
+    q = np.array([-2.4066, 2.4268, 2.5359, 0.3229, 1.7934, -0.4422])
+    T = robot.fk(q)
+    sols = ik_all(robot, T)
+    assert len(sols) == 14
+    assert _fk_error(robot, sols, T) < 1e-10
+    assert np.all(_wrapped(sols[:, None], sols[None]) + 10 * np.eye(14) > 1e-6)  # distinct
+    for f in _newton_set(robot, T, 300, np.random.default_rng(0)):
+        assert _wrapped(sols, f).min() < 1e-6
+
+
+def test_general_arm_batch_matches_single():
+    """The general solver gives the same rows one target at a time and in a batch."""
+    rng = np.random.default_rng(5)
+    robot = _random_arm(rng)
+    T = robot.fk(rng.uniform(-np.pi, np.pi, (3, 6)))
+    res = ik_all(robot, T)
+    for i in range(3):
+        np.testing.assert_allclose(res.solutions(i), ik_all(robot, T[i]), atol=1e-10)
+
+
+def test_general_arm_unreachable_gives_no_rows():
+    """A target beyond the reach of a general arm gives zero rows, not NaN or an error."""
+    robot = _random_arm(np.random.default_rng(2))
+    T = np.eye(4)
+    T[:3, 3] = (10.0, 0.0, 0.0)
+    sols = ik_all(robot, T)
+    assert sols.shape == (0, 6)
+
+
+# ----------------------------------------------------------------------------- nearly ideal
+@pytest.mark.parametrize("name", ["ur5", "puma560"])
+def test_perturbed_arm_keeps_all_eight(name):
+    """Axes perturbed by up to 0.01 rad: all 8 solutions, every branch refined to FK 1e-10."""
+    ideal = getattr(models, name)().with_limits(np.tile([-np.inf, np.inf], (6, 1)))
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        robot = _perturbed(ideal, rng)
+        q = rng.uniform(-2.5, 2.5, 6)
+        T = robot.fk(q)
+        if len(ik_all(ideal, T)) != 8:
+            continue
+        res = ik_all(robot, T, report=True)
+        assert res.mode == "near" and res.kind == classify(ideal)
+        assert int(res.count) == 8
+        assert np.all(res.converged[: int(res.branches)])
+        assert _fk_error(robot, res.q, T) < 1e-10
+        assert _wrapped(res.q, q).min() < 1e-8
+        general = ik_all(robot, T, near_tol=0.0)  # the general search agrees
+        for row in res.q:
+            assert _wrapped(general, row).min() < 1e-8
+
+
+# ----------------------------------------------------------------------------- locked joints
+@pytest.mark.parametrize("name, index", [("panda", 2), ("iiwa7", 2), ("iiwa7", 0)])
+def test_locked_joint_of_7r_arm(name, index):
+    """free={i: v}: every row keeps q_i = v, meets FK to 1e-10 and the generating q is found."""
+    robot = getattr(models, name)().with_limits(np.tile([-np.inf, np.inf], (7, 1)))
+    rng = np.random.default_rng(4)
+    q = rng.uniform(-1.5, 1.5, 7)
+    T = robot.fk(q)
+    sols = ik_all(robot, T, free={index: q[index]})
+    assert sols.shape[1] == 7 and len(sols) >= 1
+    assert np.all(sols[:, index] == q[index])
+    assert _fk_error(robot, sols, T) < 1e-10
+    assert _wrapped(sols, q).min() < 1e-8
+
+
+def test_locked_joint_bad_input():
+    """The free= option must map valid joint indices to finite values."""
+    robot = models.panda()
+    T = robot.fk(np.zeros(7))
+    for bad in ({9: 0.0}, {0: np.nan}, [0.0], {}):
+        with pytest.raises(InputError, match="free"):
+            ik_all(robot, T, free=bad)
+
+
+# ----------------------------------------------------------------------------- selection
+def test_reference_sorting_l2_and_linf():
+    """Rows come nearest-first to the reference (weighted L2 or L∞), inside the limits."""
+    robot = models.ur5()
+    rng = np.random.default_rng(8)
+    q = rng.uniform(-2.0, 2.0, 6)
+    T = robot.fk(q)
+    ref = q + 0.01
+    w = np.array([1.0, 2.0, 1.0, 0.5, 0.5, 0.1])
+    for norm in ("l2", "linf"):
+        rows = ik_all(robot, T, reference=ref, weights=w, norm=norm)
+        d = rows - ref
+        dist = np.sqrt((w * d * d).sum(1)) if norm == "l2" else (w * np.abs(d)).max(1)
+        assert np.all(np.diff(dist) >= -1e-12)
+        np.testing.assert_allclose(rows[0], q, atol=1e-8)
+        assert _fk_error(robot, rows, T) < 1e-10
+        assert np.all(robot.within_limits(rows))
+    with pytest.raises(InputError, match="norm"):
+        sort_by_reference(robot, rows, ref, norm="l1")
+
+
+def test_wide_range_joint_takes_the_turn_nearest_the_reference():
+    """With ±2π limits, a reference near +2π moves joint 1 to its +2π representative."""
+    robot = models.ur5()
+    q = np.array([-0.3, -1.0, 1.2, -0.5, 0.8, 0.2])
+    T = robot.fk(q)
+    ref = q.copy()
+    ref[0] += 2 * np.pi
+    rows = ik_all(robot, T, reference=ref)
+    np.testing.assert_allclose(rows[0], ref, atol=1e-8)
+
+
+@pytest.mark.parametrize("make", [models.ur5, models.puma560, None])
+def test_analytic_method_returns_nearest_to_q0(make):
+    """robot.ik(method='analytic', q0=...) returns the solution nearest q0 (exact and general)."""
+    robot = make() if make else _random_arm(np.random.default_rng(21))
+    rng = np.random.default_rng(9)
+    q = rng.uniform(*(0.7 * robot.sampling_limits()).T)
+    T = robot.fk(q)
+    res = robot.ik(T, method="analytic", q0=q + 0.02)
+    assert res.success
+    np.testing.assert_allclose(res.q, q, atol=1e-8)
+
+
+# ----------------------------------------------------------------------------- singular
+def test_wrist_singular_target_of_nearly_ideal_arm_is_finite():
+    """A wrist-singular target (q5 = 0) on a perturbed UR5 gives finite rows that meet FK."""
+    ideal = models.ur5()
+    robot = _perturbed(ideal, np.random.default_rng(0), 0.002)
+    q = np.array([0.2, -1.0, 1.0, 0.3, 0.0, 0.4])
+    T = robot.fk(q)
+    res = ik_all(robot, T, report=True)
+    assert np.all(np.isfinite(res.q))
+    assert _fk_error(robot, res.q, T) < 1e-10
+
+
+def test_continuous_family_flag():
+    """A wrist-singular target (Puma, q5 = 0) flags its row; a regular target flags none."""
+    robot = models.puma560()
+    q = np.array([0.2, -0.5, 0.3, 0.3, 0.0, 0.4])
+    T = robot.fk(q)
+    res = ik_all(robot, T, report=True)
+    row = int(np.argmin(_wrapped(res.q, q)))
+    assert res.continuous[row]
+    axes = robot.joint_axes(res.q[row])[1]  # axes 4 and 6 collinear: q4 + δ, q6 ∓ δ keeps T
+    moved = res.q[row] + np.array([0, 0, 0, 0.3, 0, -0.3 * np.sign(axes[3] @ axes[5])])
+    assert np.abs(robot.fk(moved) - T).max() < 1e-10
+    regular = ik_all(robot, robot.fk(np.array([0.2, -0.5, 0.3, 0.3, 0.6, 0.4])), report=True)
+    assert not regular.continuous.any()
+    batch = ik_all(robot, np.stack([T, T]), report=True)
+    assert batch.continuous.shape == batch.q.shape[:2] and batch.continuous[0].any()
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.lists(st.tuples(st.floats(0.0, 0.6), st.floats(-3.1, 3.1), st.floats(-0.4, 0.4)),
+                min_size=6, max_size=6),
+       st.integers(0, 2**31 - 1))
+def test_any_dh_table_round_trip(rows, seed):
+    """For any 6R DH table, the generating q is among the rows and every row meets FK."""
+    robot = Robot.from_dh([DHLink(a=a, alpha=al, d=d) for a, al, d in rows])
+    q = np.random.default_rng(seed).uniform(-np.pi, np.pi, 6)
+    T = robot.fk(q)
+    try:
+        sols = ik_all(robot, T, grid=96)
+    except NoClosedFormError:  # degenerate tables (e.g. coaxial joints) refuse
+        return
+    assert len(sols) <= 16 and np.all(np.isfinite(sols))
+    assert _fk_error(robot, sols, T) < 1e-9 * max(1.0, float(np.abs(T[:3, 3]).max()))
+    if np.linalg.svd(robot.jacobian(q), compute_uv=False)[-1] > 1e-2:  # regular q: found
+        assert len(sols) and _wrapped(sols, q).min() < 1e-7
+
+
+def test_coaxial_joints_refuse_with_reason():
+    """A 6R arm with coaxial joints 1, 2 (infinitely many solutions) raises NoClosedFormError."""
+    rows = [DHLink(a=0.0, alpha=0.0, d=0.1)] + [DHLink(a=0.3, alpha=0.4, d=0.1 * i)
+                                                   for i in range(5)]
+    robot = Robot.from_dh(rows, name="coaxial")
+    with pytest.raises(NoClosedFormError, match="general 6R search does not apply either: axes 1 "
+                                                "and 2 coincide"):
+        ik_all(robot, robot.fk(np.full(6, 0.3)))
+
+
+def test_reversed_chain_when_the_front_cannot():
+    """Axes 1, 2, 3 parallel (no closed form in front): the reversed chain is searched."""
+    rows = [DHLink(a=0.4, alpha=0.0, d=0.1), DHLink(a=0.3, alpha=0.0, d=0.05),
+            DHLink(a=0.2, alpha=1.1, d=0.1), DHLink(a=0.15, alpha=-0.7, d=0.2),
+            DHLink(a=0.1, alpha=1.3, d=0.1), DHLink(a=0.05, alpha=0.0, d=0.1)]
+    robot = Robot.from_dh(rows)
+    q = np.array([0.3, -0.8, 1.1, 0.4, -0.6, 0.9])
+    T = robot.fk(q)
+    res = ik_all(robot, T, report=True)
+    assert res.mode == "general"
+    assert _fk_error(robot, res.q, T) < 1e-10 and _wrapped(res.q, q).min() < 1e-8
+    for f in _newton_set(robot, T, 200, np.random.default_rng(1)):
+        assert _wrapped(res.q, f).min() < 1e-6
+
+
+def test_batch_with_reference_and_locked_joint():
+    """Batches sort each target's rows by the reference; free= keeps zero padding in batches."""
+    robot = models.ur5()
+    q = np.array([[0.3, -1.0, 1.2, -0.5, 0.8, 0.2], [-0.4, -1.3, 0.9, 0.5, -0.7, 1.0]])
+    res = ik_all(robot, robot.fk(q), reference=q[0])
+    for i in range(2):
+        rows = res.solutions(i)
+        dist = np.sqrt(((rows - q[0]) ** 2).sum(1))
+        assert np.all(np.diff(dist) >= -1e-12)
+    np.testing.assert_allclose(res.solutions(0)[0], q[0], atol=1e-8)
+    with pytest.raises(InputError, match="all_turns"):
+        ik_all(robot, robot.fk(q), all_turns=True)
+    iiwa = models.iiwa7()
+    q7 = np.array([[0.3, 0.5, 0.2, -1.0, 0.4, 0.6, 0.1], [0.3, -0.5, 0.7, -1.2, -0.4, 0.6, 0.3]])
+    locked = ik_all(iiwa, iiwa.fk(q7), free={2: 0.2})
+    assert locked.q.shape[-1] == 7
+    for i in range(2):
+        k = int(locked.count[i])
+        assert np.all(locked.q[i, :k, 2] == 0.2) and np.all(locked.q[i, k:] == 0.0)
+        assert _fk_error(iiwa, locked.solutions(i), iiwa.fk(q7[i])) < 1e-10
+
+
+def test_general_search_completes_a_partial_set():
+    """The fallback of nearly ideal arms merges the general search's rows without duplicates."""
+    from serialkin.ik.analytic import _with_general
+
+    robot = models.ur5()
+    T = robot.fk(np.array([0.3, -1.0, 1.2, -0.5, 0.8, 0.2]))
+    full = ik_all(robot, T)
+    merged = _with_general(robot, T, full[:3], 1e-8, 48)
+    assert len(merged) == len(full) == 8
+    for row in full:
+        assert _wrapped(merged, row).min() < 1e-8
