@@ -4,7 +4,8 @@ One function, :func:`solve_targets`, serves the reachability map and base placem
 so the solver can be switched in one place:
 
 * ``"closed_form"`` — every closed-form solution inside the limits
-  (:func:`serialkin.ik.analytic.ik_all`, one call per target for now); a target is
+  (:func:`serialkin.ik.analytic.ik_all`: one batched call for pose targets, one call
+  per target for planar ones); a target is
   reached when there is at least one, and its number of solutions is their count;
 * ``"numerical"`` — the batch IK ``robot.ik(targets, method="lm", q0=…, seed=…,
   restarts=…)`` (compiled, all cores); a target is reached when it converges, and it
@@ -156,8 +157,13 @@ def solve_targets(robot: Any, task: str, targets: np.ndarray, solver: str, *,
     if solver == "closed_form":
         from serialkin.ik.analytic import ik_all
 
-        sols = [ik_all(robot, t) for t in targets]
-        count[:] = [len(s) for s in sols]
+        if task == "pose":  # one batched call, on every core
+            res = ik_all(robot, targets)
+            count[:] = res.count
+            sols = [res.q[i, : count[i]] for i in range(M)]
+        else:  # planar targets: one call per target (ik_all batches poses only)
+            sols = [ik_all(robot, t) for t in targets]
+            count[:] = [len(s) for s in sols]
         reached[:] = count > 0
         if reached.any():
             Q = np.concatenate([s for s in sols if len(s)], axis=0)
