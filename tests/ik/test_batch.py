@@ -115,3 +115,16 @@ def test_large_batch_is_fast():
     res = robot.ik(targets, seed=0)
     assert time.perf_counter() - t0 < 5.0
     assert res.success.mean() >= 0.999
+
+
+def test_batch_result_indexing_takes_one_integer():
+    """A batch IKResult indexes by an int; a mask or a single result gives InputTypeError."""
+    from serialkin.errors import InputTypeError
+
+    robot = models.get("ur5")
+    res = robot.ik(robot.fk(robot.random_q(3, seed=0)), seed=0)
+    assert res[1].success == bool(res.success[1])
+    with pytest.raises(InputTypeError, match="result.q\\[result.success\\]"):
+        res[res.success]
+    with pytest.raises(InputTypeError, match="single"):
+        res[0][0]

@@ -264,3 +264,12 @@ def test_nearest_into_property(q, ref, lo, width):
         other = q + 2 * np.pi * j
         if lo <= other <= hi:
             assert abs(x - ref) <= abs(other - ref) + 1e-9
+
+
+def test_batch_failure_reason_names_bodies_as_plain_text():
+    """A failed collision-aware batch solve names its closest pair as plain names (no np.str_)."""
+    robot = models.get("panda")
+    T = robot.fk(np.array([0.0, 0.3, 0.0, -2.0, 0.0, 2.0, 0.8]))
+    res = robot.ik(np.stack([T, T]), self_collision=True, margin=0.05, seed=0, restarts=1)
+    assert not res.success.any()
+    assert "np.str_" not in res[0].reason and "panda_link" in res[0].reason

@@ -153,3 +153,13 @@ def test_importing_reach_loads_neither_dask_nor_matplotlib():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          env=dict(os.environ, PYTHONPATH=SRC), timeout=120)
     assert out.stdout.strip() == "False", out.stderr
+
+
+def test_load_map_reads_an_output_folder(tmp_path):
+    """load_map accepts the folder a run wrote as well as its map.npz."""
+    from serialkin.reach import load_map, reachability_map
+
+    arm = models.get("two_link")
+    m = reachability_map(arm, 0.25, orientations=1, out=tmp_path / "run")
+    for path in (tmp_path / "run", tmp_path / "run" / "map.npz"):
+        assert np.array_equal(load_map(path).index, m.index)

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from serialkin.errors import InputTypeError
+
 _NEW = object.__new__
 _SET = object.__setattr__
 
@@ -83,9 +85,19 @@ class IKResult:
         return int(np.shape(self.q)[0]) if self.batch else 1
 
     def __getitem__(self, k: int) -> IKResult:
-        """The k-th solve of a batch result, as a single result."""
+        """The k-th solve of a batch result, as a single result.
+
+        Raises:
+            InputTypeError: ``k`` is not an integer (select many solves from the arrays,
+                e.g. ``result.q[result.success]``); indexing a single result.
+            IndexError: ``k`` out of range.
+        """
         if not self.batch:
-            raise TypeError("a single IKResult cannot be indexed; only batch results can")
+            raise InputTypeError("a single IKResult cannot be indexed; only batch results can")
+        if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)):
+            raise InputTypeError(
+                f"a batch IKResult is indexed by one integer, got {type(k).__name__}; to "
+                "select several solves use its arrays, e.g. result.q[result.success]")
         return IKResult(
             q=np.asarray(self.q)[k].copy(),
             success=bool(np.asarray(self.success)[k]),

@@ -631,9 +631,9 @@ def _pair_names(coll: _Collision, info: np.ndarray) -> tuple[str, str]:
 
     kind, i, j = int(info[K.I_PAIR]), int(info[K.I_PAIR + 1]), int(info[K.I_PAIR + 2])
     if kind == PAIR_SELF:
-        return coll.body_names[i], coll.body_names[j]
+        return str(coll.body_names[i]), str(coll.body_names[j])
     if kind == PAIR_SCENE:
-        return coll.body_names[i], coll.scene_names[j]
+        return str(coll.body_names[i]), str(coll.scene_names[j])
     return "", ""
 
 
@@ -654,14 +654,15 @@ def _collision_reason(robot: Robot, coll: _Collision, tgt_T: np.ndarray, q: np.n
         p = np.ascontiguousarray(tgt_T[:3, 3], dtype=np.float64)
         for o in range(coll.scene.shape[0]):
             if scene_point_distance(p, coll.scene, o) < 0.0:
-                where = (f"; the target position lies inside obstacle {coll.scene_names[o]!r}, "
+                name = str(coll.scene_names[o])
+                where = (f"; the target position lies inside obstacle {name!r}, "
                          "so no collision-free solution exists")
                 break
     where = where or ("; the margin may be larger than the free space around the target, or "
                       "more restarts are needed")
     return (f"every attempt that reached the target collided ({used + 1} attempt(s), "
             f"{its} iterations): best clearance {d:.3g} m < margin {coll.margin:g} m, "
-            f"closest pair {pair[0]!r}–{pair[1]!r}{where}")
+            f"closest pair {str(pair[0])!r}–{str(pair[1])!r}{where}")
 
 
 def _solve_collision(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | None,

@@ -90,9 +90,14 @@ class ReachMap:
 def load_map(path: str | Path) -> ReachMap:
     """Read a map written by :meth:`ReachMap.save` (no pickles are loaded).
 
+    Args:
+        path: the ``.npz`` file, or the output folder of a run (its ``map.npz`` is read).
+
     Raises:
         InputError: not such a file.
     """
+    if Path(path).is_dir():
+        path = Path(path) / "map.npz"
     try:
         with np.load(path, allow_pickle=False) as z:
             meta = json.loads(str(z["meta"]))
