@@ -47,6 +47,7 @@ from serialkin.ik.analytic.subproblems import (
     inv_rigid,
     mm,
     mv,
+    rotate,
     screw,
     sp1_dir,
     transform_point,
@@ -56,19 +57,6 @@ from serialkin.ik.analytic.subproblems import (
 MAX_SOLUTIONS = 16
 #: Default number of grid nodes per searched joint.
 DEFAULT_GRID = 32
-
-
-@njit(cache=True)
-def rotate(w, theta, v):
-    """``Rot(w, θ)·v`` (3,) by Rodrigues' formula, w a unit axis, v a vector."""
-    c = math.cos(theta)
-    s = math.sin(theta)
-    wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2]
-    out = np.empty(3)
-    out[0] = v[0] * c + (w[1] * v[2] - w[2] * v[1]) * s + w[0] * wv * (1.0 - c)
-    out[1] = v[1] * c + (w[2] * v[0] - w[0] * v[2]) * s + w[1] * wv * (1.0 - c)
-    out[2] = v[2] * c + (w[0] * v[1] - w[1] * v[0]) * s + w[2] * wv * (1.0 - c)
-    return out
 
 
 @njit(cache=True)

@@ -141,6 +141,35 @@ def rotation(w, theta):
 
 
 @njit(cache=True)
+def rotate(w, theta, v):
+    """``Rot(w, θ)·v`` (3,) by Rodrigues' formula, w a unit axis, v a vector."""
+    c = math.cos(theta)
+    s = math.sin(theta)
+    wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2]
+    out = np.empty(3)
+    out[0] = v[0] * c + (w[1] * v[2] - w[2] * v[1]) * s + w[0] * wv * (1.0 - c)
+    out[1] = v[1] * c + (w[2] * v[0] - w[0] * v[2]) * s + w[1] * wv * (1.0 - c)
+    out[2] = v[2] * c + (w[0] * v[1] - w[1] * v[0]) * s + w[2] * wv * (1.0 - c)
+    return out
+
+
+@njit(cache=True)
+def rotate_point(w, r, theta, p):
+    """``exp(ξ θ)·p`` (3,): the point p turned by θ about the line (w, r) (Rodrigues)."""
+    c = math.cos(theta)
+    s = math.sin(theta)
+    v0 = p[0] - r[0]
+    v1 = p[1] - r[1]
+    v2 = p[2] - r[2]
+    wv = w[0] * v0 + w[1] * v1 + w[2] * v2
+    out = np.empty(3)
+    out[0] = v0 * c + (w[1] * v2 - w[2] * v1) * s + w[0] * wv * (1.0 - c) + r[0]
+    out[1] = v1 * c + (w[2] * v0 - w[0] * v2) * s + w[1] * wv * (1.0 - c) + r[1]
+    out[2] = v2 * c + (w[0] * v1 - w[1] * v0) * s + w[2] * wv * (1.0 - c) + r[2]
+    return out
+
+
+@njit(cache=True)
 def screw(w, r, theta, prismatic):
     """``exp(ξ θ)`` (4, 4): rotation by θ about the line (w, r), or translation θ·w."""
     E = np.eye(4)
@@ -244,9 +273,11 @@ def sp2_dir(w1, w2, u, v, out):
         g2 = 0.0
     g = math.sqrt(g2)
     count = 1 if g == 0.0 else 2
+    z = np.empty(3)
     for k in range(count):
         sg = g if k == 0 else -g
-        z = alpha * w1 + beta * w2 + sg * x
+        for i in range(3):
+            z[i] = alpha * w1[i] + beta * w2[i] + sg * x[i]
         out[k, 1] = sp1_dir(w2, u, z)
         out[k, 0] = sp1_dir(w1, z, v)
     return count
