@@ -192,6 +192,46 @@ def bench_general_vs_rtb(repeat: int) -> None:
            "<= 200", times["ours"].median <= 200.0)
 
 
+def miss_rate(n_arms: int, starts: int, grids: tuple[int, ...]) -> None:
+    """Completeness of the general search: solutions found by Newton from random starts
+    (the compiled ``newton_refine`` on the robot's chain) that ``ik_all`` does not return."""
+    from serialkin.ik.analytic import _prepared
+    from serialkin.ik.analytic.refine import MAX_NEWTON, newton_refine
+
+    rng = np.random.default_rng(7)
+    totals = {g: [0, 0, 0.0] for g in grids}  # missed, reference solutions, seconds (CPU)
+    arms = 0
+    for i in range(n_arms):
+        robot = _general_arm(100 + i)
+        try:
+            if _prepared(robot, 0.05).mode != "general":
+                continue
+        except Exception:  # noqa: BLE001 - coaxial / no closed form at either end: skipped
+            continue
+        arms += 1
+        T = np.ascontiguousarray(robot.fk(robot.random_q(1, seed=i)[0]))
+        ref: list[np.ndarray] = []
+        F, meta = robot.chain.F, robot.chain.meta
+        scale = _prepared(robot, 0.05).s.scale
+        for q in rng.uniform(-np.pi, np.pi, (starts, 6)):
+            if newton_refine(q, T, F, meta, 1e-12 * scale, 1e-12, MAX_NEWTON):
+                q = _wrap(q)
+                if all(np.abs(_wrap(q - r)).max() > 1e-6 for r in ref):
+                    ref.append(q)
+        for g in grids:
+            t0 = time.thread_time()
+            S = ik_all(robot, T, grid=g)
+            totals[g][2] += time.thread_time() - t0
+            for r in ref:
+                totals[g][0] += len(S) == 0 or np.abs(_wrap(S - r)).max(axis=1).min() > 1e-6
+            totals[g][1] += len(ref)
+    print(f"\ngeneral search completeness on {arms} random general arms (of {n_arms} drawn), "
+          f"reference = distinct solutions of Newton from {starts} random starts")
+    for g, (missed, total, sec) in totals.items():
+        print(f"  grid {g:3d}: missed {missed} of {total} reference solutions; "
+              f"mean CPU time per call {1e3 * sec / max(arms, 1):.2f} ms")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--targets", type=int, default=1000)
@@ -199,8 +239,15 @@ def main() -> None:
     parser.add_argument("--no-peers", action="store_true")
     parser.add_argument("--batch", type=int, default=2000)
     parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--miss-arms", type=int, default=0,
+                        help="random general arms for the completeness study (0: skip)")
+    parser.add_argument("--miss-starts", type=int, default=200)
+    parser.add_argument("--miss-grids", type=int, nargs="+", default=[16, 24, 32])
     args = parser.parse_args()
     print(header())
+    if args.miss_arms:
+        miss_rate(args.miss_arms, args.miss_starts, tuple(args.miss_grids))
+        return
     bench_per_pose(args.batch, args.repeat)
     if not args.no_peers:
         bench_general_vs_rtb(args.repeat)

@@ -631,7 +631,7 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
             iiwa); the rest is solved as above and the locked values are put back in
             the rows. Sweeping the value samples the self-motion manifold.
         near_tol: tolerance of the nearly-ideal test [rad; m per m of size]; 0 disables it.
-        grid: nodes per searched joint of the general 6R search (default 32).
+        grid: nodes per searched joint of the general 6R search (default 24).
         reference: (n,) configuration: rows are shifted by 2π towards it (inside the
             limits) and sorted nearest first (per target in a batch; see
             :func:`sort_by_reference`); without it rows are sorted lexicographically.

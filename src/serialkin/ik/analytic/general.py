@@ -56,7 +56,7 @@ from serialkin.ik.analytic.subproblems import (
 #: Most solutions of a 6R arm.
 MAX_SOLUTIONS = 16
 #: Default number of grid nodes per searched joint.
-DEFAULT_GRID = 32
+DEFAULT_GRID = 24
 
 
 @njit(cache=True)
