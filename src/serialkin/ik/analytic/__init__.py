@@ -59,7 +59,15 @@ import numpy as np
 
 from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
 from serialkin.errors import InputError, NoClosedFormError
-from serialkin.ik.analytic.dispatch import GENERAL, MAX_ROWS, PLANAR, SCARA, UR, WRIST
+from serialkin.ik.analytic.dispatch import (
+    GENERAL,
+    MAX_ROWS,
+    PLANAR,
+    SCARA,
+    UR,
+    WRIST,
+    solve_checked,
+)
 from serialkin.ik.analytic.singular import continuous_family
 from serialkin.ik.analytic.structure import (
     CLASSES,
@@ -581,8 +589,6 @@ def _fast(robot: Robot, T: np.ndarray) -> np.ndarray | None:
     rigid to 1e-13 (the ordinary path then checks, projects or raises). The rows are the
     ordinary path's, bit for bit.
     """
-    from serialkin.ik.analytic.dispatch import solve_checked
-
     entry = _FAST.get(id(robot))
     if entry is None or entry[0]() is not robot:
         entry = _fast_entry(robot)

@@ -46,11 +46,11 @@ from serialkin.ik.analytic.subproblems import (
     CLAMP,
     dot3,
     finalize,
+    mtv,
     mv,
     planar2r,
     polish_real_root,
     poly_roots,
-    rotate,
     rotate_point,
     rotation,
     sp1_dir,
@@ -90,19 +90,19 @@ def wrist_into(Rg, W, v, q1, q2, q3, prismatic3, out, k):
     w5 = W[4].copy()
     w6 = W[5].copy()
     # X·w6 and X·v with X = R123ᵀ·R_g, by three rotations each (no 3 × 3 products)
-    xw = mv(Rg, w6)
-    xv = mv(Rg, v)
+    # (Rot(w, −θ)·x = Rot(w, θ)ᵀ·x: one sin/cos per joint)
+    R1 = rotation(W[0].copy(), q1)
+    R2 = rotation(W[1].copy(), q2)
+    xw = mtv(R2, mtv(R1, mv(Rg, w6)))
+    xv = mtv(R2, mtv(R1, mv(Rg, v)))
     if not prismatic3:
-        w3 = W[2].copy()
-        xw = rotate(w3, -q3, rotate(W[1].copy(), -q2, rotate(W[0].copy(), -q1, xw)))
-        xv = rotate(w3, -q3, rotate(W[1].copy(), -q2, rotate(W[0].copy(), -q1, xv)))
-    else:
-        xw = rotate(W[1].copy(), -q2, rotate(W[0].copy(), -q1, xw))
-        xv = rotate(W[1].copy(), -q2, rotate(W[0].copy(), -q1, xv))
+        R3 = rotation(W[2].copy(), q3)
+        xw = mtv(R3, xw)
+        xv = mtv(R3, xv)
     sol = np.empty((2, 2))
     m = sp2_dir(w4, w5, w6, xw, sol)
     for r in range(m):
-        q6 = sp1_dir(w6, v, rotate(w5, -sol[r, 1], rotate(w4, -sol[r, 0], xv)))
+        q6 = sp1_dir(w6, v, mtv(rotation(w5, sol[r, 1]), mtv(rotation(w4, sol[r, 0]), xv)))
         out[k, 0] = q1
         out[k, 1] = q2
         out[k, 2] = q3
