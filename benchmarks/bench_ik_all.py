@@ -58,6 +58,19 @@ def _times_us(fn, args) -> np.ndarray:
     return out * 1e6
 
 
+def _cpu_us(fn, number: int, repeat: int) -> tuple[float, float, float]:
+    """Median, min and max over ``repeat`` runs of the calling thread's CPU time per call
+    [us] (``time.thread_time``: less disturbed than wall time by other processes)."""
+    fn()
+    out = []
+    for _ in range(repeat):
+        t0 = time.thread_time()
+        for _ in range(number):
+            fn()
+        out.append((time.thread_time() - t0) / number * 1e6)
+    return float(np.median(out)), min(out), max(out)
+
+
 def bench_serialkin(robot: Robot, n_targets: int, seed: int = 0) -> dict:
     """Time ik_all over n_targets reachable poses; check contents and accuracy."""
     Q = robot.random_q(n_targets, seed=seed)
@@ -133,7 +146,8 @@ def bench_per_pose(n_batch: int, repeat: int) -> None:
     """Per pose, single call and batched, for exact, nearly ideal and general arms (14.1)."""
     print(f"\nper pose, single call and batched ({n_batch} targets, all cores via "
           "parallel.run); median [spread] over repeated runs")
-    print(f"{'arm':18s} {'mode':8s} {'single us':>22s} {'batched us/pose':>22s} {'#sol':>5s}")
+    print(f"{'arm':18s} {'mode':8s} {'single us':>22s} {'single CPU us':>24s} "
+          f"{'batched us/pose':>16s} {'#sol':>5s}")
     rng = np.random.default_rng(0)
     arms = [(models.ur5(), 10.0, 3.0), (models.puma560(), 10.0, 3.0),
             (_perturbed(models.ur5(), rng), None, None), (_general_arm(3), 200.0, None)]
@@ -144,11 +158,13 @@ def bench_per_pose(n_batch: int, repeat: int) -> None:
         T0 = np.ascontiguousarray(T[0])
         few = 20 if res.mode == "general" else 2000
         single = latency_us(lambda r=robot, t=T0: ik_all(r, t), few, repeat)
+        cpu = _cpu_us(lambda r=robot, t=T0: ik_all(r, t), few, repeat)
         Tb = T[: max(8, n_batch // (50 if res.mode == "general" else 1))]
         batched = latency_us(lambda r=robot, t=Tb: ik_all(r, t), 1, repeat)
         per = batched.median / len(Tb)
-        print(f"{robot.name:18s} {res.mode:8s} {single.fmt(1):>22s} "
-              f"{per:22.2f} {res.count.mean():5.1f}")
+        cpu_s = f"{cpu[0]:.1f} [{cpu[1]:.1f}-{cpu[2]:.1f}]"
+        print(f"{robot.name:18s} {res.mode:8s} {single.fmt(1):>22s} {cpu_s:>24s} "
+              f"{per:16.2f} {res.count.mean():5.1f}")
         if goal_single is not None:
             record("14.1", f"ik_all single, {robot.name} ({res.mode}), all solutions",
                    single.median, "us", f"<= {goal_single:g}", single.median <= goal_single)
@@ -182,14 +198,58 @@ def bench_general_vs_rtb(repeat: int) -> None:
     derive = time.perf_counter() - t0
     times = interleaved_us({"ours": lambda: ik_all(ours, T),
                             "rtb": lambda: solver.solve(T, joint_limits=False)}, 5, repeat)
+    cpu_ours = _cpu_us(lambda: ik_all(ours, T), 5, repeat)
+    cpu_rtb = _cpu_us(lambda: solver.solve(T, joint_limits=False), 5, repeat)
     b = np.atleast_2d(np.asarray(solver.solve(T, joint_limits=False).q, dtype=float))
     a = ik_all(ours, T)
     print(f"\ngeneral 6R vs Robotics Toolbox analytic_ik (Raghavan-Roth; derived in "
           f"{derive:.1f} s): ours {times['ours'].fmt(0)} us ({len(a)} solutions), "
           f"rtb {times['rtb'].fmt(0)} us ({len(b)} solutions), ratio rtb/ours "
-          f"{times['rtb'] / times['ours']:.2f}")
+          f"{times['rtb'] / times['ours']:.2f}; CPU time per call: ours {cpu_ours[0]:.0f} "
+          f"[{cpu_ours[1]:.0f}-{cpu_ours[2]:.0f}] us, rtb {cpu_rtb[0]:.0f} "
+          f"[{cpu_rtb[1]:.0f}-{cpu_rtb[2]:.0f}] us, ratio {cpu_rtb[0] / cpu_ours[0]:.2f}")
     record("14.1", "ik_all general 6R, all solutions, single call", times["ours"].median, "us",
            "<= 200", times["ours"].median <= 200.0)
+
+
+def miss_rate(n_arms: int, starts: int, grids: tuple[int, ...]) -> None:
+    """Completeness of the general search: solutions found by Newton from random starts
+    (the compiled ``newton_refine`` on the robot's chain) that ``ik_all`` does not return."""
+    from serialkin.ik.analytic import _prepared
+    from serialkin.ik.analytic.refine import MAX_NEWTON, newton_refine
+
+    rng = np.random.default_rng(7)
+    totals = {g: [0, 0, 0.0] for g in grids}  # missed, reference solutions, seconds (CPU)
+    arms = 0
+    for i in range(n_arms):
+        robot = _general_arm(100 + i)
+        try:
+            if _prepared(robot, 0.05).mode != "general":
+                continue
+        except Exception:  # noqa: BLE001 - coaxial / no closed form at either end: skipped
+            continue
+        arms += 1
+        T = np.ascontiguousarray(robot.fk(robot.random_q(1, seed=i)[0]))
+        ref: list[np.ndarray] = []
+        F, meta = robot.chain.F, robot.chain.meta
+        scale = _prepared(robot, 0.05).s.scale
+        for q in rng.uniform(-np.pi, np.pi, (starts, 6)):
+            if newton_refine(q, T, F, meta, 1e-12 * scale, 1e-12, MAX_NEWTON):
+                q = _wrap(q)
+                if all(np.abs(_wrap(q - r)).max() > 1e-6 for r in ref):
+                    ref.append(q)
+        for g in grids:
+            t0 = time.thread_time()
+            S = ik_all(robot, T, grid=g)
+            totals[g][2] += time.thread_time() - t0
+            for r in ref:
+                totals[g][0] += len(S) == 0 or np.abs(_wrap(S - r)).max(axis=1).min() > 1e-6
+            totals[g][1] += len(ref)
+    print(f"\ngeneral search completeness on {arms} random general arms (of {n_arms} drawn), "
+          f"reference = distinct solutions of Newton from {starts} random starts")
+    for g, (missed, total, sec) in totals.items():
+        print(f"  grid {g:3d}: missed {missed} of {total} reference solutions; "
+              f"mean CPU time per call {1e3 * sec / max(arms, 1):.2f} ms")
 
 
 def main() -> None:
@@ -199,8 +259,15 @@ def main() -> None:
     parser.add_argument("--no-peers", action="store_true")
     parser.add_argument("--batch", type=int, default=2000)
     parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--miss-arms", type=int, default=0,
+                        help="random general arms for the completeness study (0: skip)")
+    parser.add_argument("--miss-starts", type=int, default=200)
+    parser.add_argument("--miss-grids", type=int, nargs="+", default=[16, 24, 32])
     args = parser.parse_args()
     print(header())
+    if args.miss_arms:
+        miss_rate(args.miss_arms, args.miss_starts, tuple(args.miss_grids))
+        return
     bench_per_pose(args.batch, args.repeat)
     if not args.no_peers:
         bench_general_vs_rtb(args.repeat)

@@ -679,3 +679,28 @@ def test_bad_options():
         ik_all(robot, T, q0=np.zeros(6))
     with pytest.raises(InputError, match="Robot"):
         ik_all("ur5", T)
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560", "perturbed", "general"])
+def test_fast_path_equals_ordinary_path(name):
+    """One C-contiguous float64 pose (fast path) gives the ordinary path's rows bit for bit."""
+    rng = np.random.default_rng(5)
+    if name == "perturbed":
+        robot = Robot.from_dh([DHLink(a=r.a + rng.uniform(-1e-3, 1e-3),
+                                      alpha=r.alpha + rng.uniform(-0.01, 0.01),
+                                      d=r.d, theta=r.theta + rng.uniform(-0.01, 0.01))
+                               for r in models.ur5().dh], "standard")
+    elif name == "general":
+        robot = Robot.from_dh([DHLink(a=rng.uniform(0.05, 0.5), alpha=rng.uniform(-3.0, 3.0),
+                                      d=rng.uniform(-0.3, 0.3)) for _ in range(6)])
+    else:
+        robot = getattr(models, name)()
+    for q in robot.random_q(3, seed=2):
+        T = np.ascontiguousarray(robot.fk(q))
+        fast = ik_all(robot, T)
+        slow = ik_all(robot, np.asfortranarray(T))  # not C-contiguous: the ordinary path
+        ro = T.copy()
+        ro.setflags(write=False)
+        assert fast.shape[0] >= 1 and np.array_equal(fast, slow)
+        assert np.array_equal(fast, ik_all(robot, ro))
+        assert np.abs(robot.fk(fast) - T).max() < 1e-8

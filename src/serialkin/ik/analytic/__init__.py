@@ -59,7 +59,15 @@ import numpy as np
 
 from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
 from serialkin.errors import InputError, NoClosedFormError
-from serialkin.ik.analytic.dispatch import GENERAL, MAX_ROWS, PLANAR, SCARA, UR, WRIST
+from serialkin.ik.analytic.dispatch import (
+    GENERAL,
+    MAX_ROWS,
+    PLANAR,
+    SCARA,
+    UR,
+    WRIST,
+    solve_checked,
+)
 from serialkin.ik.analytic.singular import continuous_family
 from serialkin.ik.analytic.structure import (
     CLASSES,
@@ -554,6 +562,47 @@ def _as_poses(a: np.ndarray) -> np.ndarray:
     return T
 
 
+#: Fast-path entries per id(robot): (weak reference, prepared data, kernel arguments).
+_FAST: dict[int, tuple] = {}
+
+
+def _fast_entry(robot: object) -> tuple:
+    """The fast path's cached arguments for ``robot`` (default ``tol``, ``near_tol``, grid)."""
+    from serialkin.ik.analytic.general import DEFAULT_GRID
+
+    p = _prepared(robot, NEAR_TOL)  # raises the ordinary path's errors
+    head = (p.code, p.arm, p.prismatic3)
+    tail = (p.W, p.P, p.M, p.aux, p.order, p.revolute, p.qlim, p.mid, p.F, p.meta, p.refine,
+            DEFAULT_GRID, 1e-8 * p.s.scale, 1e-8, REFINE_TOL * p.s.scale, REFINE_TOL)
+    entry = (weakref.ref(robot), p, head, tail)
+    if len(_FAST) > 256:
+        _FAST.clear()
+    _FAST[id(robot)] = entry
+    return entry
+
+
+def _fast(robot: Robot, T: np.ndarray) -> np.ndarray | None:
+    """:func:`ik_all` for one C-contiguous float64 (4, 4) pose and default options.
+
+    The rigidity check and the solve are one compiled call
+    (:func:`~serialkin.ik.analytic.dispatch.solve_checked`); None when the pose is not
+    rigid to 1e-13 (the ordinary path then checks, projects or raises). The rows are the
+    ordinary path's, bit for bit.
+    """
+    entry = _FAST.get(id(robot))
+    if entry is None or entry[0]() is not robot:
+        entry = _fast_entry(robot)
+    p = entry[1]
+    out = np.empty((MAX_ROWS, p.n))
+    conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
+    k = solve_checked(*entry[2], T, *entry[3], out, conv)
+    if k < 0:
+        return None
+    if p.mode == "near" and conv[1:conv[0] + 1].sum() % 2 == 1:
+        return _with_general(robot, T, out[:k], 1e-8, entry[3][11])
+    return out[:k]
+
+
 def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool = False,
            free: Mapping[int, float] | None = None, near_tol: float = NEAR_TOL,
            grid: int | None = None, reference: object = None, weights: object = None,
@@ -588,7 +637,7 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
             iiwa); the rest is solved as above and the locked values are put back in
             the rows. Sweeping the value samples the self-motion manifold.
         near_tol: tolerance of the nearly-ideal test [rad; m per m of size]; 0 disables it.
-        grid: nodes per searched joint of the general 6R search (default 32).
+        grid: nodes per searched joint of the general 6R search (default 24).
         reference: (n,) configuration: rows are shifted by 2π towards it (inside the
             limits) and sorted nearest first (per target in a batch; see
             :func:`sort_by_reference`); without it rows are sorted lexicographically.
@@ -610,6 +659,14 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         InputError: a target that is not a rigid transform / of an accepted shape, a
             non-positive ``tol`` or an unknown option.
     """
+    if (type(target) is np.ndarray and free is None and grid is None and reference is None
+            and not report and all_turns is False and not options and type(tol) is float
+            and tol == 1e-8 and type(near_tol) is float and near_tol == NEAR_TOL
+            and target.shape == (4, 4) and target.dtype == np.float64
+            and target.flags.c_contiguous and target.flags.writeable):
+        sols = _fast(robot, target)
+        if sols is not None:
+            return sols
     if options:
         raise InputError(f"unknown option(s) for ik_all: {', '.join(sorted(options))}; "
                          "accepted: tol, all_turns, free, near_tol, grid, reference, "

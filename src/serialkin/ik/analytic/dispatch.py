@@ -18,7 +18,7 @@ from serialkin.ik.analytic.planar import solve_planar
 from serialkin.ik.analytic.refine import refine_rows
 from serialkin.ik.analytic.scara import solve_scara
 from serialkin.ik.analytic.spherical_wrist import wrist_candidates
-from serialkin.ik.analytic.subproblems import finalize
+from serialkin.ik.analytic.subproblems import finalize, rigid_error
 from serialkin.ik.analytic.ur import ur_candidates
 
 #: Class codes of :func:`solve_into`.
@@ -92,6 +92,22 @@ def solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mi
         for i in range(k):
             conv[1 + i] = 1
     return finalize(cand, k, revolute, qlim, mid, F, meta, T, True, tol_p, tol_r, out)
+
+
+@njit(cache=True)
+def solve_checked(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mid, F,
+                  meta, refine, grid, tol_p, tol_r, newton_p, newton_r, out, conv):
+    """:func:`solve_into` for a (4, 4) target that must already be rigid to 1e-13.
+
+    The fast path of ``ik_all`` (one compiled call for the check and the solve): returns
+    −1 without solving when T is not a rigid transform to 1e-13 (the caller then checks
+    it, projects the rotation or raises), else the count of :func:`solve_into` (rotation
+    verified).
+    """
+    if rigid_error(T) > 1e-13:
+        return -1
+    return solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mid, F,
+                      meta, True, refine, grid, tol_p, tol_r, newton_p, newton_r, out, conv)
 
 
 @njit(cache=True, nogil=True)

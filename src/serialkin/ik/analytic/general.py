@@ -28,9 +28,11 @@ joint description, base and tool), and it degrades gracefully near special geome
 where the eliminant's 24×24 companion matrix loses accuracy. Its cost is the grid
 (``grid``² nodes × one quartic), and two solutions closer together than about one grid
 cell can merge into one basin (an odd count, impossible for real solutions of a 6R,
-triggers one more search on a grid twice as fine). On 120 random arms (436 solutions,
-found independently by Newton from 300 random starts each) grids 24-48 missed none; an
-arm with 14 real solutions gives all 14 (tests). ``grid`` can be raised.
+triggers one more search on a grid twice as fine). On 400 random arms (1426 solutions,
+found independently by Newton from 300 random starts each; ``benchmarks/bench_ik_all.py
+--miss-arms``) grids 20 and 24 missed none, grid 16 missed 2 and grid 12 missed 4: the
+default is 24. An arm with 14 real solutions gives all 14 from grid 12 up (tests).
+``grid`` can be raised.
 """
 
 from __future__ import annotations
@@ -40,13 +42,15 @@ import math
 import numpy as np
 from numba import njit
 
-from serialkin.ik.analytic.refine import MAX_NEWTON, newton_refine
+from serialkin.ik.analytic.refine import MAX_NEWTON, newton_refine_known, wrapped_dist
 from serialkin.ik.analytic.spherical_wrist import arm_positions
 from serialkin.ik.analytic.subproblems import (
     TWO_PI,
     inv_rigid,
     mm,
+    mtv,
     mv,
+    rotation,
     screw,
     sp1_dir,
     transform_point,
@@ -54,31 +58,11 @@ from serialkin.ik.analytic.subproblems import (
 
 #: Most solutions of a 6R arm.
 MAX_SOLUTIONS = 16
+#: A Newton iterate this close to a solution already found (every joint, wrapped) [rad]
+#: stops: it converges onto it.
+KNOWN_RADIUS = 1e-4
 #: Default number of grid nodes per searched joint.
-DEFAULT_GRID = 32
-
-
-@njit(cache=True)
-def rotate(w, theta, v):
-    """``Rot(w, θ)·v`` (3,) by Rodrigues' formula, w a unit axis, v a vector."""
-    c = math.cos(theta)
-    s = math.sin(theta)
-    wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2]
-    out = np.empty(3)
-    out[0] = v[0] * c + (w[1] * v[2] - w[2] * v[1]) * s + w[0] * wv * (1.0 - c)
-    out[1] = v[1] * c + (w[2] * v[0] - w[0] * v[2]) * s + w[1] * wv * (1.0 - c)
-    out[2] = v[2] * c + (w[0] * v[1] - w[1] * v[0]) * s + w[2] * wv * (1.0 - c)
-    return out
-
-
-@njit(cache=True)
-def _wrapped_dist(a, b, n):
-    d = 0.0
-    for j in range(n):
-        x = a[j] - b[j]
-        x -= TWO_PI * math.floor(x / TWO_PI + 0.5)
-        d = max(d, abs(x))
-    return d
+DEFAULT_GRID = 24
 
 
 @njit(cache=True)
@@ -130,72 +114,96 @@ def general_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_
     w2 = W[1].copy()
     w3 = W[2].copy()
     for i5 in range(N):
+        # G = A6·E5 is applied to c, w4, u4 only: E5's part once per row, no 4 × 4 product
+        e5c = transform_point(E5[i5], c)
+        e5w = mv(E5[i5], w4)
+        e5u = mv(E5[i5], u4)
         for i6 in range(N):
-            G = mm(A6[i6], E5[i5])
-            pw = transform_point(G, c)
+            pw = transform_point(A6[i6], e5c)
             m = arm_positions(pw, W, P, aux, arm, False, arm3)
             nb[i5, i6] = m
-            gw = mv(G, w4)  # R_G w4 and R_G u4, then turned back by joints 1-3
-            gu = mv(G, u4)
+            gw = mv(A6[i6], e5w)  # R_G w4 and R_G u4, then turned back by joints 1-3
+            gu = mv(A6[i6], e5u)
             for b in range(m):
-                xw = rotate(w3, -arm3[b, 2], rotate(w2, -arm3[b, 1], rotate(w1, -arm3[b, 0], gw)))
-                xu = rotate(w3, -arm3[b, 2], rotate(w2, -arm3[b, 1], rotate(w1, -arm3[b, 0], gu)))
+                R1 = rotation(w1, arm3[b, 0])  # Rot(w, −θ)·v = Rot(w, θ)ᵀ·v, one sin/cos each
+                R2 = rotation(w2, arm3[b, 1])
+                R3 = rotation(w3, arm3[b, 2])
+                xw = mtv(R3, mtv(R2, mtv(R1, gw)))
+                xu = mtv(R3, mtv(R2, mtv(R1, gu)))
                 res[i5, i6, b] = math.sqrt((xw[0] - w4[0]) ** 2 + (xw[1] - w4[1]) ** 2
                                            + (xw[2] - w4[2]) ** 2)
                 Q[i5, i6, b, 0] = arm3[b, 0]
                 Q[i5, i6, b, 1] = arm3[b, 1]
                 Q[i5, i6, b, 2] = arm3[b, 2]
                 Q[i5, i6, b, 3] = sp1_dir(w4, u4, xu)
+    local = np.zeros((N, N, 4), dtype=np.bool_)  # residual below every neighbour's
+    for i5 in range(N):
+        for i6 in range(N):
+            for b in range(nb[i5, i6]):
+                local[i5, i6, b] = _is_local_min(res, Q, nb, i5, i6, b, N)
     k = 0
     q = np.empty(6)
     qs = np.empty(6)
     accept = 2.0 * h  # residuals this small start Newton even when not a local minimum
-    for i5 in range(N):
-        for i6 in range(N):
-            for b in range(nb[i5, i6]):
-                r = res[i5, i6, b]
-                local = True
-                for d5 in range(-1, 2):
-                    for d6 in range(-1, 2):
-                        if d5 == 0 and d6 == 0:
-                            continue
-                        j5 = (i5 + d5) % N
-                        j6 = (i6 + d6) % N
-                        best = -1
-                        bd = math.inf
-                        for bb in range(nb[j5, j6]):  # the neighbour's nearest branch
-                            dd = _wrapped_dist(Q[i5, i6, b], Q[j5, j6, bb], 3)
-                            if dd < bd:
-                                bd = dd
-                                best = bb
-                        if best >= 0 and res[j5, j6, best] < r:
-                            local = False
+    # Local minima first, then the other nodes with a residual below ``accept``; a start
+    # inside 0.5 h of a solution already found is skipped, and Newton's method stops as
+    # soon as it comes within KNOWN_RADIUS of one (it would converge onto it)
+    for phase in range(2):
+        for i5 in range(N):
+            for i6 in range(N):
+                for b in range(nb[i5, i6]):
+                    if local[i5, i6, b] != (phase == 0):
+                        continue
+                    if phase == 1 and res[i5, i6, b] > accept:
+                        continue
+                    for j in range(4):
+                        qs[j] = Q[i5, i6, b, j]
+                    qs[4] = -math.pi + h * i5
+                    qs[5] = -math.pi + h * i6
+                    for j in range(6):
+                        q[j] = qs[5 - j] if reverse else qs[j]
+                    near = False  # inside the basin of a solution already found: skip
+                    for s in range(k):
+                        if wrapped_dist(q, out[s], 6) < 0.5 * h:
+                            near = True
                             break
-                    if not local:
-                        break
-                if not local and r > accept:
-                    continue
-                for j in range(4):
-                    qs[j] = Q[i5, i6, b, j]
-                qs[4] = -math.pi + h * i5
-                qs[5] = -math.pi + h * i6
-                for j in range(6):
-                    q[j] = qs[5 - j] if reverse else qs[j]
-                near = False  # inside the basin of a solution already found: skip
-                for s in range(k):
-                    if _wrapped_dist(q, out[s], 6) < 0.5 * h:
-                        near = True
-                        break
-                if near:
-                    continue
-                if not newton_refine(q, T, F, meta, tol_p, tol_r, MAX_NEWTON):
-                    continue
-                dup = False
-                for s in range(k):
-                    if _wrapped_dist(q, out[s], 6) < 1e-7:
-                        dup = True
-                        break
-                if not dup and k < out.shape[0]:
-                    out[k] = q
-                    k += 1
+                    if near:
+                        continue
+                    if newton_refine_known(q, T, F, meta, tol_p, tol_r, MAX_NEWTON, out, k,
+                                           KNOWN_RADIUS) != 1:
+                        continue
+                    dup = False
+                    for s in range(k):
+                        if wrapped_dist(q, out[s], 6) < 1e-7:
+                            dup = True
+                            break
+                    if not dup and k < out.shape[0]:
+                        out[k] = q
+                        k += 1
     return k
+
+
+@njit(cache=True)
+def _is_local_min(res, Q, nb, i5, i6, b, N):
+    """Whether node (i5, i6) branch b is a local minimum of the residual.
+
+    Its residual must be no larger than that of each of its 8 neighbours' nearest branch
+    (nearest in the wrapped arm joints q1-q3).
+    """
+    r = res[i5, i6, b]
+    for d5 in range(-1, 2):
+        for d6 in range(-1, 2):
+            if d5 == 0 and d6 == 0:
+                continue
+            j5 = (i5 + d5) % N
+            j6 = (i6 + d6) % N
+            best = -1
+            bd = math.inf
+            for bb in range(nb[j5, j6]):  # the neighbour's nearest branch
+                dd = wrapped_dist(Q[i5, i6, b], Q[j5, j6, bb], 3)
+                if dd < bd:
+                    bd = dd
+                    best = bb
+            if best >= 0 and res[j5, j6, best] < r:
+                return False
+    return True

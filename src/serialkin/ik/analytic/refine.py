@@ -28,6 +28,18 @@ from serialkin.spatial.kernels import pose_error_into
 MAX_STEP = 0.5
 #: Newton iterations at most.
 MAX_NEWTON = 30
+TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True)
+def wrapped_dist(a, b, n):
+    """Largest |a_j − b_j| over the first n joints, each difference wrapped to [−π, π)."""
+    d = 0.0
+    for j in range(n):
+        x = a[j] - b[j]
+        x -= TWO_PI * math.floor(x / TWO_PI + 0.5)
+        d = max(d, abs(x))
+    return d
 
 
 @njit(cache=True)
@@ -46,6 +58,19 @@ def newton_refine(q, T, F, meta, tol_p, tol_r, max_iter):
     Returns:
         True when both errors fell within their tolerances.
     """
+    return newton_refine_known(q, T, F, meta, tol_p, tol_r, max_iter, q.reshape(1, -1), 0,
+                               0.0) == 1
+
+
+@njit(cache=True)
+def newton_refine_known(q, T, F, meta, tol_p, tol_r, max_iter, known, k, radius):
+    """:func:`newton_refine` that stops early on reaching a solution already known.
+
+    Before each step, when ``q`` is within ``radius`` (wrapped, every joint) of one of
+    the rows ``known[:k]`` (k, n) the iteration stops: Newton's method there converges
+    quadratically onto that row, so the start adds nothing (the general search's
+    duplicate starts). Returns 1 converged, 0 failed, −1 stopped at a known row.
+    """
     n = q.shape[0]
     J = np.empty((6, n))
     Tq = np.empty((4, 4))
@@ -59,18 +84,21 @@ def newton_refine(q, T, F, meta, tol_p, tol_r, max_iter):
         ep = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
         er = math.sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5])
         if not (math.isfinite(ep) and math.isfinite(er)):
-            return False
+            return 0
         if ep <= tol_p and er <= tol_r:
-            return True
+            return 1
+        for s in range(k):
+            if wrapped_dist(q, known[s], n) < radius:
+                return -1
         if not dls_step_into(J, e, 0.0, 1e-14, Mb, y, dq):
-            return False
+            return 0
         big = 0.0
         for j in range(n):
             big = max(big, abs(dq[j]))
         scale = 1.0 if big <= MAX_STEP else MAX_STEP / big
         for j in range(n):
             q[j] += scale * dq[j]
-    return False
+    return 0
 
 
 @njit(cache=True)

@@ -46,21 +46,19 @@ from serialkin.ik.analytic.subproblems import (
     CLAMP,
     dot3,
     finalize,
-    mm,
     mtv,
     mv,
     planar2r,
     polish_real_root,
     poly_roots,
+    rotate_point,
     rotation,
-    screw,
     sp1_dir,
     sp2_dir,
     sp3,
     sp3_slide,
     sp4,
     target_point,
-    transform_point,
 )
 
 #: Most candidate solutions of a 6-joint arm.
@@ -88,18 +86,23 @@ def wrist_into(Rg, W, v, q1, q2, q3, prismatic3, out, k):
     Returns:
         the new number of rows.
     """
-    R123 = mm(rotation(W[0].copy(), q1), rotation(W[1].copy(), q2))
-    if not prismatic3:
-        R123 = mm(R123, rotation(W[2].copy(), q3))
-    X = mm(R123.T, Rg)
     w4 = W[3].copy()
     w5 = W[4].copy()
     w6 = W[5].copy()
+    # X·w6 and X·v with X = R123ᵀ·R_g, by three rotations each (no 3 × 3 products)
+    # (Rot(w, −θ)·x = Rot(w, θ)ᵀ·x: one sin/cos per joint)
+    R1 = rotation(W[0].copy(), q1)
+    R2 = rotation(W[1].copy(), q2)
+    xw = mtv(R2, mtv(R1, mv(Rg, w6)))
+    xv = mtv(R2, mtv(R1, mv(Rg, v)))
+    if not prismatic3:
+        R3 = rotation(W[2].copy(), q3)
+        xw = mtv(R3, xw)
+        xv = mtv(R3, xv)
     sol = np.empty((2, 2))
-    m = sp2_dir(w4, w5, w6, mv(X, w6), sol)
+    m = sp2_dir(w4, w5, w6, xw, sol)
     for r in range(m):
-        R45 = mm(rotation(w4, sol[r, 0]), rotation(w5, sol[r, 1]))
-        q6 = sp1_dir(w6, v, mtv(R45, mv(X, v)))
+        q6 = sp1_dir(w6, v, mtv(rotation(w5, sol[r, 1]), mtv(rotation(w4, sol[r, 0]), xv)))
         out[k, 0] = q1
         out[k, 1] = q2
         out[k, 2] = q3
@@ -131,7 +134,7 @@ def puma_positions(pw, W, P, aux, out):
     s3 = dot3(W[2], w)
     for i in range(n1):
         q1 = q1s[i]
-        x = transform_point(screw(w1, r1, -q1, False), pw)
+        x = rotate_point(w1, r1, -q1, pw)
         m = planar2r(w, e1, P[1].copy(), P[2].copy(), c, x, sol)
         for j in range(m):
             out[k, 0] = q1
@@ -172,7 +175,7 @@ def intersecting_positions(pw, W, P, aux, prismatic3, out):
         if prismatic3:
             x = h + q3 * w3
         else:
-            x = transform_point(screw(w3, r3, q3, False), c) - o
+            x = rotate_point(w3, r3, q3, c) - o
         m = sp2_dir(w1, w2, x, g, sol)
         for j in range(m):
             out[k, 0] = sol[j, 0]
@@ -185,9 +188,12 @@ def intersecting_positions(pw, W, P, aux, prismatic3, out):
 @njit(cache=True)
 def _general_residual(theta, c, w3, r3, r2, w2, a1, ca, sa, rho2, h):
     """E(θ3) = g1² + g2² − (|u|² − (w2·u)²) of the general arm (see general_candidates)."""
-    u = mv(rotation(w3, theta), c - r3) + r3 - r2
-    uu = dot3(u, u)
-    wu = dot3(w2, u)
+    x = rotate_point(w3, r3, theta, c)  # u = Rot(w3, θ)·(c − r3) + r3 − r2, scalar
+    u0 = x[0] - r2[0]
+    u1 = x[1] - r2[1]
+    u2 = x[2] - r2[2]
+    uu = u0 * u0 + u1 * u1 + u2 * u2
+    wu = w2[0] * u0 + w2[1] * u1 + w2[2] * u2
     g1 = (rho2 - uu - a1 * a1) / (2.0 * a1)
     g2 = (h - ca * wu) / sa
     return g1 * g1 + g2 * g2 - (uu - wu * wu)
@@ -275,6 +281,11 @@ def general_positions(pw, W, P, aux, prismatic3, out):
     return k
 
 
+#: e^{−ikθ_j}/5 at the 5 samples θ_j = 2πj/5 (k = 0, 1, 2): their discrete Fourier weights.
+_FIVE = np.array([[np.exp(-1j * k * 2.0 * np.pi * j / 5.0) / 5.0 for k in range(3)]
+                  for j in range(5)])
+
+
 @njit(cache=True)
 def _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas):
     """Real roots θ3 of E(θ3) (degree-2 trigonometric polynomial) into ``thetas``; the count.
@@ -287,11 +298,10 @@ def _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas):
     coef = np.zeros(3, dtype=np.complex128)
     scale = 0.0
     for j in range(5):
-        th = 2.0 * np.pi * j / 5.0
-        e = _general_residual(th, c, w3, r3, r2, w2, a1, ca, sa, rho2, h)
+        e = _general_residual(2.0 * np.pi * j / 5.0, c, w3, r3, r2, w2, a1, ca, sa, rho2, h)
         scale = max(scale, abs(e))
         for k in range(3):
-            coef[k] += e * np.exp(-1j * k * th) / 5.0
+            coef[k] += e * _FIVE[j, k]
     poly = np.empty(5, dtype=np.complex128)  # z²·E(z) = c2 z⁴ + c1 z³ + c0 z² + c̄1 z + c̄2
     poly[0] = coef[2]
     poly[1] = coef[1]
@@ -304,16 +314,23 @@ def _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas):
     # when c2 vanishes both ends of z²·E do: drop the z factor (no spurious root z = 0)
     roots = np.empty(4, dtype=np.complex128)
     nr = poly_roots(poly if abs(poly[0]) > 1e-13 * big else poly[1:4], roots)
+    c0r = coef[0].real
+    c1r = coef[1].real
+    c1i = coef[1].imag
+    c2r = coef[2].real
+    c2i = coef[2].imag
     count = 0
     for z in roots[:nr]:
         if abs(abs(z) - 1.0) > 1e-3 or count == thetas.shape[0]:
             continue
         th = math.atan2(z.imag, z.real)
-        for _ in range(8):  # Newton on E(θ) = c0 + 2 Re(c1 e^{iθ} + c2 e^{2iθ})
-            e1 = np.exp(1j * th)
-            e2 = e1 * e1
-            f = coef[0].real + 2.0 * (coef[1] * e1 + coef[2] * e2).real
-            df = 2.0 * (1j * coef[1] * e1 + 2j * coef[2] * e2).real
+        for _ in range(8):  # Newton on E(θ) = c0 + 2 Re(c1 e^{iθ} + c2 e^{2iθ}), real form
+            cs = math.cos(th)
+            sn = math.sin(th)
+            cs2 = cs * cs - sn * sn
+            sn2 = 2.0 * sn * cs
+            f = c0r + 2.0 * (c1r * cs - c1i * sn + c2r * cs2 - c2i * sn2)
+            df = -2.0 * (c1r * sn + c1i * cs + 2.0 * (c2r * sn2 + c2i * cs2))
             if df == 0.0:
                 break
             step = f / df

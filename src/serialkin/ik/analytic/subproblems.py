@@ -141,6 +141,35 @@ def rotation(w, theta):
 
 
 @njit(cache=True)
+def rotate(w, theta, v):
+    """``Rot(w, θ)·v`` (3,) by Rodrigues' formula, w a unit axis, v a vector."""
+    c = math.cos(theta)
+    s = math.sin(theta)
+    wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2]
+    out = np.empty(3)
+    out[0] = v[0] * c + (w[1] * v[2] - w[2] * v[1]) * s + w[0] * wv * (1.0 - c)
+    out[1] = v[1] * c + (w[2] * v[0] - w[0] * v[2]) * s + w[1] * wv * (1.0 - c)
+    out[2] = v[2] * c + (w[0] * v[1] - w[1] * v[0]) * s + w[2] * wv * (1.0 - c)
+    return out
+
+
+@njit(cache=True)
+def rotate_point(w, r, theta, p):
+    """``exp(ξ θ)·p`` (3,): the point p turned by θ about the line (w, r) (Rodrigues)."""
+    c = math.cos(theta)
+    s = math.sin(theta)
+    v0 = p[0] - r[0]
+    v1 = p[1] - r[1]
+    v2 = p[2] - r[2]
+    wv = w[0] * v0 + w[1] * v1 + w[2] * v2
+    out = np.empty(3)
+    out[0] = v0 * c + (w[1] * v2 - w[2] * v1) * s + w[0] * wv * (1.0 - c) + r[0]
+    out[1] = v1 * c + (w[2] * v0 - w[0] * v2) * s + w[1] * wv * (1.0 - c) + r[1]
+    out[2] = v2 * c + (w[0] * v1 - w[1] * v0) * s + w[2] * wv * (1.0 - c) + r[2]
+    return out
+
+
+@njit(cache=True)
 def screw(w, r, theta, prismatic):
     """``exp(ξ θ)`` (4, 4): rotation by θ about the line (w, r), or translation θ·w."""
     E = np.eye(4)
@@ -149,8 +178,10 @@ def screw(w, r, theta, prismatic):
             E[i, 3] = theta * w[i]
         return E
     R = rotation(w, theta)
-    E[:3, :3] = R
     for i in range(3):
+        E[i, 0] = R[i, 0]
+        E[i, 1] = R[i, 1]
+        E[i, 2] = R[i, 2]
         E[i, 3] = r[i] - (R[i, 0] * r[0] + R[i, 1] * r[1] + R[i, 2] * r[2])
     return E
 
@@ -198,14 +229,24 @@ def sp1_dir(w, u, v):
     Returns ``atan2(w·(u' × v'), u'·v')`` with ``u'``, ``v'`` the projections on that
     plane; 0 when either projection vanishes to rounding level (< 1e-12 of |u|, |v|):
     the angle is then arbitrary (a singular configuration) and 0 is its representative.
+    Scalar code, no allocation (a hot path of every solver).
     """
-    wu = dot3(w, u)
-    wv = dot3(w, v)
-    up = u - wu * w
-    vp = v - wv * w
-    if dot3(up, up) <= 1e-24 * dot3(u, u) or dot3(vp, vp) <= 1e-24 * dot3(v, v):
+    wu = w[0] * u[0] + w[1] * u[1] + w[2] * u[2]
+    wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2]
+    u0 = u[0] - wu * w[0]
+    u1 = u[1] - wu * w[1]
+    u2 = u[2] - wu * w[2]
+    v0 = v[0] - wv * w[0]
+    v1 = v[1] - wv * w[1]
+    v2 = v[2] - wv * w[2]
+    if (u0 * u0 + u1 * u1 + u2 * u2 <= 1e-24 * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
+            or v0 * v0 + v1 * v1 + v2 * v2 <= 1e-24 * (v[0] * v[0] + v[1] * v[1]
+                                                        + v[2] * v[2])):
         return 0.0
-    return math.atan2(dot3(w, cross3(up, vp)), dot3(up, vp))
+    c0 = u1 * v2 - u2 * v1
+    c1 = u2 * v0 - u0 * v2
+    c2 = u0 * v1 - u1 * v0
+    return math.atan2(w[0] * c0 + w[1] * c1 + w[2] * c2, u0 * v0 + u1 * v1 + u2 * v2)
 
 
 @njit(cache=True)
@@ -232,9 +273,11 @@ def sp2_dir(w1, w2, u, v, out):
         g2 = 0.0
     g = math.sqrt(g2)
     count = 1 if g == 0.0 else 2
+    z = np.empty(3)
     for k in range(count):
         sg = g if k == 0 else -g
-        z = alpha * w1 + beta * w2 + sg * x
+        for i in range(3):
+            z[i] = alpha * w1[i] + beta * w2[i] + sg * x[i]
         out[k, 1] = sp1_dir(w2, u, z)
         out[k, 0] = sp1_dir(w1, z, v)
     return count
@@ -300,12 +343,17 @@ def sp4(w, b, a, c, out):
     arccos(D / sqrt(A² + B²)). When A = B = 0 any θ solves a consistent equation:
     θ = 0 is returned as the representative. Writes into ``out`` (2,), returns 0, 1 or 2.
     """
-    bp = b - dot3(w, b) * w
-    A = dot3(a, bp)
-    B = dot3(a, cross3(w, bp))
-    D = c - dot3(a, w) * dot3(w, b)
+    wb = w[0] * b[0] + w[1] * b[1] + w[2] * b[2]
+    b0 = b[0] - wb * w[0]
+    b1 = b[1] - wb * w[1]
+    b2 = b[2] - wb * w[2]
+    A = a[0] * b0 + a[1] * b1 + a[2] * b2
+    B = (a[0] * (w[1] * b2 - w[2] * b1) + a[1] * (w[2] * b0 - w[0] * b2)
+         + a[2] * (w[0] * b1 - w[1] * b0))
+    D = c - (a[0] * w[0] + a[1] * w[1] + a[2] * w[2]) * wb
     Rn = math.hypot(A, B)
-    scale = math.sqrt(dot3(a, a) * dot3(b, b))
+    scale = math.sqrt((a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+                      * (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]))
     if Rn <= 1e-12 * max(scale, 1e-300):
         if abs(D) <= 1e-9 * max(scale, 1.0):
             out[0] = 0.0
@@ -341,16 +389,28 @@ def planar2r(w, e1, c1, c2, p, t, out):
     (θ1, θ2) [rad, about +w] into ``out`` (2, 2); returns 0, 1 or 2. When the target is
     on the first axis with L1 = L2, θ1 is arbitrary and θ1 = α = 0 is returned.
     """
-    e2 = cross3(w, e1)
-    l1 = c2 - c1
-    l2 = p - c2
-    d = t - c1
-    L1 = math.hypot(dot3(e1, l1), dot3(e2, l1))
-    L2 = math.hypot(dot3(e1, l2), dot3(e2, l2))
-    phi10 = math.atan2(dot3(e2, l1), dot3(e1, l1))
-    phi20 = math.atan2(dot3(e2, l2), dot3(e1, l2)) - phi10
-    x = dot3(e1, d)
-    y = dot3(e2, d)
+    e20 = w[1] * e1[2] - w[2] * e1[1]  # e2 = w × e1, scalar code (no allocation)
+    e21 = w[2] * e1[0] - w[0] * e1[2]
+    e22 = w[0] * e1[1] - w[1] * e1[0]
+    l10 = c2[0] - c1[0]
+    l11 = c2[1] - c1[1]
+    l12 = c2[2] - c1[2]
+    l20 = p[0] - c2[0]
+    l21 = p[1] - c2[1]
+    l22 = p[2] - c2[2]
+    d0 = t[0] - c1[0]
+    d1 = t[1] - c1[1]
+    d2 = t[2] - c1[2]
+    x1 = e1[0] * l10 + e1[1] * l11 + e1[2] * l12
+    y1 = e20 * l10 + e21 * l11 + e22 * l12
+    x2 = e1[0] * l20 + e1[1] * l21 + e1[2] * l22
+    y2 = e20 * l20 + e21 * l21 + e22 * l22
+    L1 = math.hypot(x1, y1)
+    L2 = math.hypot(x2, y2)
+    phi10 = math.atan2(y1, x1)
+    phi20 = math.atan2(y2, x2) - phi10
+    x = e1[0] * d0 + e1[1] * d1 + e1[2] * d2
+    y = e20 * d0 + e21 * d1 + e22 * d2
     r2 = x * x + y * y
     th2 = _acos_clamped((r2 - L1 * L1 - L2 * L2) / (2.0 * L1 * L2))
     if math.isnan(th2):

@@ -34,7 +34,6 @@ from serialkin.ik.analytic.subproblems import (
     mv,
     planar2r,
     rotation,
-    screw,
     sp1_dir,
     sp4,
     target_point,
@@ -78,11 +77,13 @@ def ur_candidates(T, W, P, M, aux, out):
             q5 = q5s[j]
             R5 = rotation(w5, q5)
             q6 = sp1_dir(w6, mtv(X, w), mtv(R5, w))
-            G = mm(mm(mm(screw(w1, r1, -q1, False), TMinv), screw(w6, r6, -q6, False)),
-                   screw(w5, r5, -q5, False))
-            ve = mv(G, e)
+            # G = e1⁻¹·T·M⁻¹·e6⁻¹·e5⁻¹ applied to e and x4 by rotations (no 4 × 4 products)
+            # (Rot(w, −θ) = Rot(w, θ)ᵀ: the rotations already built are reused)
+            R6 = rotation(w6, q6)
+            ve = mtv(R1, mv(TMinv, mtv(R6, mtv(R5, e))))
             s = math.atan2(dot3(w, cross3(e, ve)), dot3(e, ve))
-            y = transform_point(G, x4)
+            y = mtv(R1, transform_point(TMinv, mtv(R6, mtv(R5, x4 - r5) + r5 - r6) + r6)
+                    - r1) + r1
             m = planar2r(w, e, P[1].copy(), P[2].copy(), x4, y, sol)
             for r in range(m):
                 out[k, 0] = q1
