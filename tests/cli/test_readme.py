@@ -49,6 +49,12 @@ def test_readme_command_runs(argv, tmp_path, monkeypatch):
     if args[0] == "track":
         args += ["--max-frames", "3"]
     monkeypatch.chdir(tmp_path)
+    if args[0] == "base-placement":  # the task poses the command reads
+        Path("tasks.yaml").write_text("tasks:\n  - [0.4, 0.1, 0.3, 3.1416, 0, 0]\n"
+                                      "  - [0.4, -0.2, 0.2, 3.1416, 0, 0]\n")
+    if args[0] == "calibrate" and "--simulate" not in args:  # measurements to fit
+        sim = ["calibrate", "ur5", "--simulate", "60", "--measurements", "meas.csv"]
+        assert CliRunner().invoke(cli, sim, catch_exceptions=False).exit_code == 0
     monkeypatch.setattr("webbrowser.open", lambda url: True)
     r = models.get("ur5")
     T = r.fk(r.random_q(3, seed=0))
