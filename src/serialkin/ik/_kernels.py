@@ -414,67 +414,41 @@ def _limit_step(dq, max_step):
 
 @njit(cache=True, inline="always")
 def _workspace(n):
-    """The loop's arrays for n joints, carved from one allocation (views, C-contiguous).
+    """The loop's arrays for n joints, carved from six allocations (row views, C-contiguous).
 
     Returns ``(J (6, n), T (4, 4), e (6,), dq (n,), q (n,), be (6,), sw (6,), ws)`` with
-    ``ws`` the step kernels' scratch tuple (``W_*``). One allocation instead of seventeen
-    (each costs about 50 ns with reference counting).
+    ``ws`` the step kernels' scratch tuple (``W_*``). Arrays of one shape share an
+    allocation and are its rows: a row view costs a few ns, where a reshaped slice of one
+    flat buffer costs tens (numba's reshape helper) and a separate allocation about 50.
     """
-    size = 6 * n + 16 + 6 + n + n + 6 + 6 + (6 * n + 6 + n * n + n + 36 + 6 + n + n + 16 + 6)
-    buf = np.empty(size)
-    o = 0
-    J = buf[o:o + 6 * n].reshape((6, n))
-    o += 6 * n
-    T = buf[o:o + 16].reshape((4, 4))
-    o += 16
-    e = buf[o:o + 6]
-    o += 6
-    dq = buf[o:o + n]
-    o += n
-    q = buf[o:o + n]
-    o += n
-    be = buf[o:o + 6]
-    o += 6
-    sw = buf[o:o + 6]
-    o += 6
-    Jw = buf[o:o + 6 * n].reshape((6, n))
-    o += 6 * n
-    r = buf[o:o + 6]
-    o += 6
-    A = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    g = buf[o:o + n]
-    o += n
-    M6 = buf[o:o + 36].reshape((6, 6))
-    o += 36
-    y6 = buf[o:o + 6]
-    o += 6
-    free = buf[o:o + n]
-    o += n
-    qn = buf[o:o + n]
-    o += n
-    Tn = buf[o:o + 16].reshape((4, 4))
-    o += 16
-    en = buf[o:o + 6]
-    return J, T, e, dq, q, be, sw, (Jw, r, A, g, M6, y6, free, qn, Tn, en)
+    V6 = np.empty((6, 6))  # e, be, sw, r, y6, en
+    Vn = np.empty((5, n))  # dq, q, g, free, qn
+    M = np.empty((2, 6, n))  # J, Jw
+    T2 = np.empty((2, 4, 4))  # T, Tn
+    A = np.empty((n, n))
+    M6 = np.empty((6, 6))
+    return (M[0], T2[0], V6[0], Vn[0], Vn[1], V6[1], V6[2],
+            (M[1], V6[3], A, Vn[2], M6, V6[4], Vn[3], Vn[4], T2[1], V6[5]))
 
 
 # ---------------------------------------------------------------- the shared loop
 # The three functions below are templates: compile_method copies them with the method's
 # step kernel (and the copies that call it) bound as globals, then compiles the copies.
 def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, p, window, tol, max_iter,
-             q, J, T, e, dq, ws):
+             q, J, T, e, dq, ws, fresh):
     """Iterate the step kernel from q (n,) in place; return (iterations, converged, cost).
 
-    On return q, J, T, e describe the final configuration.
+    With ``fresh`` False, J, T, e already hold the Jacobian, pose and error at q (the
+    caller evaluated them). On return q, J, T, e describe the final configuration.
     """
     n = q.shape[0]
     Jw = ws[W_JW]
     r = ws[W_R]
     qn = ws[W_QN]
     ctx = (F, meta, Tt, w, sw, lo, hi, revolute, respect)
-    jacobian_into(q, F, meta, J, T)
-    pose_error_into(T, Tt, e)
+    if fresh:
+        jacobian_into(q, F, meta, J, T)
+        pose_error_into(T, Tt, e)
     cost = task_cost(e, w)
     ref_cost = cost
     ref_it = 0
@@ -611,28 +585,28 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     total = 0
     success = False
     used = 0
-    # fallback best: the first start configuration (finite, inside the limits)
+    # the first start (q0, else the stream's first draw), evaluated once: it is the
+    # fallback best (finite, inside the limits) and the first attempt starts there
     if use_q0:
-        q_out[:] = q0
+        q[:] = q0
     else:
-        state_copy = np.empty(1, dtype=np.uint64)
-        state_copy[0] = seed
-        random_q_into(state_copy, slo, shi, q_out)
+        random_q_into(state, slo, shi, q)
     if respect:
-        project_into(q_out, lo, hi, revolute)
-    fk_into(q_out, F, meta, T)
-    pose_error_into(T, Tt, be)
-    best_cost = task_cost(be, w)
+        project_into(q, lo, hi, revolute)
+    q_out[:] = q
+    jacobian_into(q, F, meta, J, T)
+    pose_error_into(T, Tt, e)
+    be[:] = e
+    best_cost = task_cost(e, w)
     for attempt in range(restarts + 1):
         used = attempt
-        if attempt == 0 and use_q0:
-            q[:] = q0
-        else:
+        if attempt > 0:
             random_q_into(state, slo, shi, q)
-        if respect:
-            project_into(q, lo, hi, revolute)
+            if respect:
+                project_into(q, lo, hi, revolute)
         its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
-                                     respect, p, window, tol, max_iter, q, J, T, e, dq, ws)
+                                     respect, p, window, tol, max_iter, q, J, T, e, dq, ws,
+                                     attempt > 0)
         total += its
         finite = math.isfinite(cost)
         for i in range(n):
@@ -833,7 +807,8 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
         if respect:
             project_into(q, lo, hi, revolute)
         its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
-                                     respect, p, window, tol, max_iter, q, J, T, e, dq, ws)
+                                     respect, p, window, tol, max_iter, q, J, T, e, dq, ws,
+                                     True)
         total += its
         finite = math.isfinite(cost)
         for i in range(n):
@@ -861,7 +836,8 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
                     A, B, rad, sb, pa, pb, scene, W0, W1, pair, g, qn, Jw, M6, y6, v6, dq):
                 break
             its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
-                                         respect, p, window, tol, max_iter, q, J, T, e, dq, ws)
+                                         respect, p, window, tol, max_iter, q, J, T, e, dq, ws,
+                                         True)
             total += its
             if not ok or not math.isfinite(cost):
                 ok = False
