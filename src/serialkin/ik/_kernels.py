@@ -83,7 +83,7 @@ from serialkin.kinematics.kernels import fk_all_into, fk_into, jacobian_into
 from serialkin.model.limits import inside as interval_inside
 from serialkin.model.limits import normalize as interval_normalize
 from serialkin.model.limits import project as interval_project
-from serialkin.spatial.kernels import pose_error_into
+from serialkin.spatial.kernels import pose_error_into, transforms_valid
 
 #: Layout of the configuration vector ``cfg`` (float64): the loop's slots, then the
 #: method's parameters ``cfg[N_LOOP:]`` (``CompiledMethod.params``, in order).
@@ -226,6 +226,22 @@ def nearest_into(q, ref, lo, hi, revolute, bounded):
         x = q[i] + TWO_PI * k
         if not bounded or (x >= lo[i] and x <= hi[i]):
             q[i] = x
+
+
+@njit(cache=True)
+def pose_and_q0_valid(T, q0, lo, hi, rot_tol, has_q0):
+    """True when ``T`` (4, 4) is a rigid transform and ``q0`` (n,) is inside [lo, hi].
+
+    ``T`` must pass :func:`~serialkin.spatial.kernels.transforms_valid` (finite,
+    orthonormal within ``rot_tol``) and, when ``has_q0``, ``q0`` be finite and inside the
+    limits within 1e-12. The solvers' fast path asks this one question inside its
+    compiled call; when the answer is False the ordinary checks
+    (:func:`~serialkin.ik.target.parse_target`, :func:`~serialkin.ik.target.check_q0`)
+    run and raise the precise error.
+    """
+    if not transforms_valid(T.reshape((1, 4, 4)), rot_tol):
+        return False
+    return not has_q0 or inside_limits(q0, lo, hi, 1e-12)
 
 
 # ---------------------------------------------------------------- small dense algebra
@@ -661,6 +677,55 @@ def _solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
         solve_one(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k])  # noqa: F821
 
 
+# ---------------------------------------------------------------- the single call from Python
+# A call from Python pays for every argument numba unboxes (about 60 ns per array) and for
+# every array it allocates: the fast entry takes the robot's and method's constant arrays
+# packed in one vector (:func:`pack_fast`), checks its input itself and returns its
+# answer as a tuple of scalars.
+
+
+def pack_fast(F, meta, box, cfg_random, cfg_q0, rot_tol):
+    """The constant input of ``solve_fast``: one float64 vector (read-only).
+
+    Layout: ``rot_tol``, then ``F`` (n+1, 4, 4), ``meta`` (n, 5), ``box`` (5, n), and the
+    two configuration vectors (same length) without and with ``C_USE_Q0``, each raveled.
+    """
+    parts = [np.array([rot_tol], dtype=np.float64), np.ravel(F), np.ravel(meta), np.ravel(box),
+             np.ravel(cfg_random), np.ravel(cfg_q0)]
+    S = np.ascontiguousarray(np.concatenate(parts), dtype=np.float64)
+    S.setflags(write=False)
+    return S
+
+
+def _solve_fast(S, Tt, q0, seed, use_q0, q_out):
+    """``solve_one`` behind the input checks of the ordinary path, for a call from Python.
+
+    ``S`` from :func:`pack_fast`; ``Tt`` (4, 4) target; ``q0`` (n,) read when ``use_q0``;
+    ``seed`` the stream seed as an int64 (its bits are the uint64 seed); ``q_out`` (n,).
+    Returns ``(status, iterations, position error, orientation error, restarts)``:
+    status -1 when ``Tt`` is not a rigid transform (within ``rot_tol``) or q0 is not
+    finite and inside the limits (nothing solved: the caller's checks raise the precise
+    error), 1 for a success with q inside the limits, 0 for a failure.
+    """
+    n = q_out.shape[0]
+    o = 1
+    F = S[o:o + 16 * (n + 1)].reshape((n + 1, 4, 4))
+    o += 16 * (n + 1)
+    meta = S[o:o + 5 * n].reshape((n, 5))
+    o += 5 * n
+    box = S[o:o + 5 * n].reshape((5, n))
+    o += 5 * n
+    m = (S.shape[0] - o) // 2
+    cfg = S[o + m:o + 2 * m] if use_q0 else S[o:o + m]
+    if not pose_and_q0_valid(Tt, q0, box[B_LO], box[B_HI], S[0], use_q0):
+        return -1, 0, 0.0, 0.0, 0
+    info = np.empty(N_INFO)
+    solve_one(F, meta, Tt, box, q0, cfg, np.uint64(seed), q_out, info)  # noqa: F821
+    ok = info[I_SUCCESS] > 0.5 and info[I_INSIDE] > 0.5
+    return (1 if ok else 0), int(info[I_ITERATIONS]), info[I_POS_ERR], info[I_ORI_ERR], \
+        int(info[I_RESTARTS])
+
+
 # ---------------------------------------------------------------- collision-aware solves
 @njit(cache=True)
 def _clearance(q, F, L, meta, frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1, pair):
@@ -903,6 +968,9 @@ class CompiledMethod:
             stop)``, GIL released.
         solve_one_collision, solve_chunk_collision: the same with the collision check
             (:func:`_solve_one_collision`), compiled at their first call.
+        solve_fast: ``solve_fast(S, Tt, q0, seed, use_q0, q_out) -> (status, iterations,
+            position error, orientation error, restarts)``, the single call from Python
+            (:func:`_solve_fast`).
     """
 
     step: object
@@ -911,6 +979,7 @@ class CompiledMethod:
     solve_chunk: object
     solve_one_collision: object = None
     solve_chunk_collision: object = None
+    solve_fast: object = None
 
 
 _SOURCE = Path(__file__).read_bytes()
@@ -955,5 +1024,7 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
     one_c = njit(cache=True)(_bind(_solve_one_collision, name, tag, attempt_loop=attempt))
     chunk_c = njit(cache=True, nogil=True)(_bind(_solve_chunk_collision, name, tag,
                                                  solve_one_collision=one_c))
+    fast = njit(cache=True)(_bind(_solve_fast, name, tag, solve_one=one))
     return CompiledMethod(step=step, params=tuple(params), solve_one=one, solve_chunk=chunk,
-                          solve_one_collision=one_c, solve_chunk_collision=chunk_c)
+                          solve_one_collision=one_c, solve_chunk_collision=chunk_c,
+                          solve_fast=fast)
