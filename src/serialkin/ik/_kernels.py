@@ -567,6 +567,15 @@ def _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
 def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     """Solve one target with restarts; write the best q into ``q_out`` (n,) and ``info``.
 
+    Arguments as :func:`_solve_one_in`, which it calls with a fresh workspace.
+    """
+    solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info,  # noqa: F821
+                 _workspace(meta.shape[0]))
+
+
+def _solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp):
+    """Solve one target with restarts in the workspace ``wsp`` (:func:`_workspace`).
+
     Args:
         F: (n+1, 4, 4) chain fixed transforms (see :mod:`serialkin.kinematics.kernels`).
         meta: (n, 5) chain joint data.
@@ -578,6 +587,7 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
         seed: uint64 seed of this target's random stream.
         q_out: (n,) output, the best configuration found.
         info: (N_INFO,) output, see ``I_*``.
+        wsp: the loop's arrays (:func:`_workspace` of n), overwritten.
     """
     n = meta.shape[0]
     w = cfg[C_WEIGHTS:C_WEIGHTS + 6]
@@ -593,7 +603,7 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     respect = cfg[C_RESPECT] > 0.5
     use_q0 = cfg[C_USE_Q0] > 0.5
     window = int(cfg[C_WINDOW])
-    J, T, e, dq, q, be, sw, ws = _workspace(n)
+    J, T, e, dq, q, be, sw, ws = wsp
     for i in range(6):
         sw[i] = math.sqrt(w[i])
     state = np.empty(1, dtype=np.uint64)
@@ -671,10 +681,12 @@ def _solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
     (:func:`serialkin.ik.solver.solve`) hands chunks to every core through
     :func:`serialkin.kinematics.parallel.run`, the scheduler of every batch kernel. Every
     target uses the same random stream ``seed``, so a batch solve returns exactly what
-    the single solves with that seed return, whatever the chunking.
+    the single solves with that seed return, whatever the chunking. One workspace serves
+    the whole chunk.
     """
+    wsp = _workspace(meta.shape[0])
     for k in range(start, stop):
-        solve_one(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k])  # noqa: F821
+        solve_one_in(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k], wsp)  # noqa: F821
 
 
 # ---------------------------------------------------------------- the single call from Python
@@ -1019,8 +1031,12 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
     # 0.1 µs per iteration, a fifth of an lm solve), unless the step allocates
     attempt = njit(cache=True, _nrt=allocates)(_bind(_attempt, name, tag + str(int(allocates)),
                                                      step=step))
-    one = njit(cache=True)(_bind(_solve_one, name, tag, attempt_loop=attempt))
-    chunk = njit(cache=True, nogil=True)(_bind(_solve_chunk, name, tag, solve_one=one))
+    # inlined into both callers: the workspace's views then stay within one function,
+    # whose reference counting LLVM prunes (a call would incref/decref each of them)
+    one_in = njit(cache=True, inline="always")(_bind(_solve_one_in, name, tag,
+                                                     attempt_loop=attempt))
+    one = njit(cache=True)(_bind(_solve_one, name, tag, solve_one_in=one_in))
+    chunk = njit(cache=True, nogil=True)(_bind(_solve_chunk, name, tag, solve_one_in=one_in))
     one_c = njit(cache=True)(_bind(_solve_one_collision, name, tag, attempt_loop=attempt))
     chunk_c = njit(cache=True, nogil=True)(_bind(_solve_chunk_collision, name, tag,
                                                  solve_one_collision=one_c))
