@@ -39,7 +39,7 @@ import numpy as np
 from serialkin._checks import MAX_ITERATIONS, ROTATION_TOL, check_int, short_repr
 from serialkin.errors import InputError, InputTypeError
 from serialkin.ik import _kernels as K
-from serialkin.ik.registry import MethodSpec, available_methods, get_method
+from serialkin.ik.registry import _REGISTRY, MethodSpec, available_methods, get_method
 from serialkin.ik.result import IKResult
 from serialkin.ik.target import (
     DEFAULT_WEIGHTS,
@@ -482,6 +482,7 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
 _NEW = object.__new__
 _SET = object.__setattr__
 _SIGN = 1 << 63
+_F64 = np.dtype(np.float64)
 
 
 def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
@@ -495,21 +496,25 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
     None, and the ordinary path raises its precise error. The answer is the ordinary
     path's, bit for bit (same kernel, configuration and seed).
     """
-    if target.shape != (4, 4) or target.dtype != np.float64:
+    if target.dtype is not _F64 or target.shape != (4, 4):
         return None
     flags = target.flags
     if not (flags.c_contiguous and flags.writeable):
         return None
     ent = _FAST.get((id(robot), method))
-    if ent is None or ent[0]() is not robot or ent[1] is not get_method(method):
+    # the method's spec, looked up directly (an entry exists only once the registry has
+    # been discovered): a re-registered method gets a new entry
+    if ent is None or ent[0]() is not robot or ent[1] is not _REGISTRY.get(method):
         ent = _fast_entry(robot, method)
         if ent is None:
             return None
     _, _, solve_fast, S, zeros, n, name = ent
     if q0 is None:
         q0k = zeros
-    elif (type(q0) is np.ndarray and q0.shape == (n,) and q0.dtype == np.float64
-          and q0.flags.c_contiguous and q0.flags.writeable):
+    elif type(q0) is np.ndarray and q0.dtype is _F64 and q0.shape == (n,):
+        flags = q0.flags
+        if not (flags.c_contiguous and flags.writeable):
+            return None
         q0k = q0
     else:
         return None
