@@ -1,7 +1,7 @@
 """Numerical IK: success rate, time per solve and iterations per method, beside the peers.
 
 Run by hand: ``.venv/bin/python benchmarks/bench_ik.py [--targets N] [--ikpy-targets M]
-[--methods lm,dls,...] [--no-peers]``.
+[--methods lm,dls,...] [--peers rtb,pinocchio,ikpy] [--no-peers]``.
 
 For Panda, UR5 and Puma 560 (each built from Robotics Toolbox for Python's DH table, tool
 and limits, so that every solver works on the same kinematics), N reachable full-pose
@@ -197,10 +197,13 @@ def main() -> None:
                         help="comma-separated serialkin methods")
     parser.add_argument("--robots", default="Panda,UR5,Puma560")
     parser.add_argument("--no-peers", action="store_true")
+    parser.add_argument("--peers", default="rtb,pinocchio,ikpy",
+                        help="comma-separated peers to run: rtb, pinocchio, ikpy")
     args = parser.parse_args()
     import roboticstoolbox as rtb  # the robots are defined by the toolbox's DH tables
 
     methods = [m for m in args.methods.split(",") if m]
+    peers = set() if args.no_peers else {p for p in args.peers.split(",") if p}
     print(f"IK benchmark: {args.targets} reachable full-pose targets per robot, success = FK "
           f"within {ACCURACY:g} m and {ACCURACY:g} rad and q inside the limits")
     print(header())
@@ -214,7 +217,7 @@ def main() -> None:
               f"{os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs)")
         rows = []
         ref = None
-        if not args.no_peers:
+        if "rtb" in peers:
             ets = rtb_robot.ets()
             for fn in ("ik_LM", "ik_NR", "ik_GN"):
                 row = run(robot, f"rtb {fn} (C++)", rtb_solver(ets, fn), targets, q0s)
@@ -223,15 +226,17 @@ def main() -> None:
                     ref = row["median_us"]
         for m in methods:
             rows.append(run(robot, f"serialkin {m}", serialkin_solver(robot, m), targets, q0s))
-        if not args.no_peers:
+        if peers & {"pinocchio", "ikpy"}:
             fd, path = tempfile.mkstemp(suffix=".urdf")
             with os.fdopen(fd, "w") as f:
                 f.write(robot.to_urdf())
             try:
-                for label, make, count in (
-                    ("pinocchio CLIK (python)", pinocchio_solver, args.targets),
-                    ("ikpy", ikpy_solver, args.ikpy_targets),
+                for key, label, make, count in (
+                    ("pinocchio", "pinocchio CLIK (python)", pinocchio_solver, args.targets),
+                    ("ikpy", "ikpy", ikpy_solver, args.ikpy_targets),
                 ):
+                    if key not in peers:
+                        continue
                     try:
                         solver = make(robot, path)
                     except Exception as exc:  # a peer that cannot load this robot

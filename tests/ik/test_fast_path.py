@@ -51,3 +51,29 @@ def test_fast_path_declines_what_it_does_not_check():
         ur5.ik(T, q0=q0)
     assert solver._fast(ur5, T, "ccd", None, 0) is None
     assert solver._fast(ur5, T, "lm", None, np.random.default_rng(0)) is None
+
+
+def test_fast_path_seed_above_int64():
+    """A seed ≥ 2⁶³ reaches the kernel as the same 64 bits on the fast and ordinary paths."""
+    ur5 = models.ur5()
+    T = np.ascontiguousarray(ur5.fk(ur5.random_q(seed=8)))
+    frozen = T.copy()
+    frozen.setflags(write=False)
+    for seed in (2**63, 2**64 - 1, -1):
+        fast = ur5.ik(T, seed=seed)
+        assert solver._fast(ur5, T, "lm", None, seed) is not None
+        assert _same(fast, ur5.ik(frozen, seed=seed))
+
+
+def test_fast_path_failure_equals_ordinary():
+    """An unreachable pose fails on the fast path with the ordinary path's result and reason."""
+    ur5 = models.ur5()
+    T = np.eye(4)
+    T[:3, 3] = (3.0, 0.0, 0.5)  # far beyond the UR5's reach
+    frozen = T.copy()
+    frozen.setflags(write=False)
+    fast = ur5.ik(T, seed=1)
+    slow = ur5.ik(frozen, seed=1)
+    assert not fast.success
+    assert "out of reach" in fast.reason
+    assert _same(fast, slow)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -83,3 +84,20 @@ def test_manipulability_is_the_product_of_singular_values(m, n, seed):
     if m >= 2 and m <= n:
         J[1] = J[0]
         assert dls.manipulability_of(J) <= 1e-12 * np.linalg.norm(J) ** m
+
+
+@pytest.mark.parametrize("m", [1, 2, 3, 6, 7, 9])
+def test_spd_solve_matches_numpy(m):
+    """spd_solve_into solves random SPD systems as numpy does, also with x aliasing b."""
+    rng = np.random.default_rng(m)
+    for _ in range(5):
+        G = rng.normal(size=(m + 2, m))
+        A = G.T @ G + 1e-3 * np.eye(m)
+        b = rng.normal(size=m)
+        ref = np.linalg.solve(A, b)
+        x = np.empty(m)
+        assert dls.spd_solve_into(A.copy(), b, x, m)
+        np.testing.assert_allclose(x, ref, rtol=1e-10, atol=1e-12)
+        y = b.copy()
+        assert dls.spd_solve_into(A.copy(), y, y, m)
+        np.testing.assert_allclose(y, ref, rtol=1e-10, atol=1e-12)

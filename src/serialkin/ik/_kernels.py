@@ -83,7 +83,7 @@ from serialkin.kinematics.kernels import fk_all_into, fk_into, jacobian_into
 from serialkin.model.limits import inside as interval_inside
 from serialkin.model.limits import normalize as interval_normalize
 from serialkin.model.limits import project as interval_project
-from serialkin.spatial.kernels import pose_error_into
+from serialkin.spatial.kernels import pose_error_into, transforms_valid
 
 #: Layout of the configuration vector ``cfg`` (float64): the loop's slots, then the
 #: method's parameters ``cfg[N_LOOP:]`` (``CompiledMethod.params``, in order).
@@ -226,6 +226,22 @@ def nearest_into(q, ref, lo, hi, revolute, bounded):
         x = q[i] + TWO_PI * k
         if not bounded or (x >= lo[i] and x <= hi[i]):
             q[i] = x
+
+
+@njit(cache=True)
+def pose_and_q0_valid(T, q0, lo, hi, rot_tol, has_q0):
+    """True when ``T`` (4, 4) is a rigid transform and ``q0`` (n,) is inside [lo, hi].
+
+    ``T`` must pass :func:`~serialkin.spatial.kernels.transforms_valid` (finite,
+    orthonormal within ``rot_tol``) and, when ``has_q0``, ``q0`` be finite and inside the
+    limits within 1e-12. The solvers' fast path asks this one question inside its
+    compiled call; when the answer is False the ordinary checks
+    (:func:`~serialkin.ik.target.parse_target`, :func:`~serialkin.ik.target.check_q0`)
+    run and raise the precise error.
+    """
+    if not transforms_valid(T.reshape((1, 4, 4)), rot_tol):
+        return False
+    return not has_q0 or inside_limits(q0, lo, hi, 1e-12)
 
 
 # ---------------------------------------------------------------- small dense algebra
@@ -414,67 +430,41 @@ def _limit_step(dq, max_step):
 
 @njit(cache=True, inline="always")
 def _workspace(n):
-    """The loop's arrays for n joints, carved from one allocation (views, C-contiguous).
+    """The loop's arrays for n joints, carved from six allocations (row views, C-contiguous).
 
     Returns ``(J (6, n), T (4, 4), e (6,), dq (n,), q (n,), be (6,), sw (6,), ws)`` with
-    ``ws`` the step kernels' scratch tuple (``W_*``). One allocation instead of seventeen
-    (each costs about 50 ns with reference counting).
+    ``ws`` the step kernels' scratch tuple (``W_*``). Arrays of one shape share an
+    allocation and are its rows: a row view costs a few ns, where a reshaped slice of one
+    flat buffer costs tens (numba's reshape helper) and a separate allocation about 50.
     """
-    size = 6 * n + 16 + 6 + n + n + 6 + 6 + (6 * n + 6 + n * n + n + 36 + 6 + n + n + 16 + 6)
-    buf = np.empty(size)
-    o = 0
-    J = buf[o:o + 6 * n].reshape((6, n))
-    o += 6 * n
-    T = buf[o:o + 16].reshape((4, 4))
-    o += 16
-    e = buf[o:o + 6]
-    o += 6
-    dq = buf[o:o + n]
-    o += n
-    q = buf[o:o + n]
-    o += n
-    be = buf[o:o + 6]
-    o += 6
-    sw = buf[o:o + 6]
-    o += 6
-    Jw = buf[o:o + 6 * n].reshape((6, n))
-    o += 6 * n
-    r = buf[o:o + 6]
-    o += 6
-    A = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    g = buf[o:o + n]
-    o += n
-    M6 = buf[o:o + 36].reshape((6, 6))
-    o += 36
-    y6 = buf[o:o + 6]
-    o += 6
-    free = buf[o:o + n]
-    o += n
-    qn = buf[o:o + n]
-    o += n
-    Tn = buf[o:o + 16].reshape((4, 4))
-    o += 16
-    en = buf[o:o + 6]
-    return J, T, e, dq, q, be, sw, (Jw, r, A, g, M6, y6, free, qn, Tn, en)
+    V6 = np.empty((6, 6))  # e, be, sw, r, y6, en
+    Vn = np.empty((5, n))  # dq, q, g, free, qn
+    M = np.empty((2, 6, n))  # J, Jw
+    T2 = np.empty((2, 4, 4))  # T, Tn
+    A = np.empty((n, n))
+    M6 = np.empty((6, 6))
+    return (M[0], T2[0], V6[0], Vn[0], Vn[1], V6[1], V6[2],
+            (M[1], V6[3], A, Vn[2], M6, V6[4], Vn[3], Vn[4], T2[1], V6[5]))
 
 
 # ---------------------------------------------------------------- the shared loop
 # The three functions below are templates: compile_method copies them with the method's
 # step kernel (and the copies that call it) bound as globals, then compiles the copies.
 def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, p, window, tol, max_iter,
-             q, J, T, e, dq, ws):
+             q, J, T, e, dq, ws, fresh):
     """Iterate the step kernel from q (n,) in place; return (iterations, converged, cost).
 
-    On return q, J, T, e describe the final configuration.
+    With ``fresh`` False, J, T, e already hold the Jacobian, pose and error at q (the
+    caller evaluated them). On return q, J, T, e describe the final configuration.
     """
     n = q.shape[0]
     Jw = ws[W_JW]
     r = ws[W_R]
     qn = ws[W_QN]
     ctx = (F, meta, Tt, w, sw, lo, hi, revolute, respect)
-    jacobian_into(q, F, meta, J, T)
-    pose_error_into(T, Tt, e)
+    if fresh:
+        jacobian_into(q, F, meta, J, T)
+        pose_error_into(T, Tt, e)
     cost = task_cost(e, w)
     ref_cost = cost
     ref_it = 0
@@ -577,6 +567,15 @@ def _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
 def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     """Solve one target with restarts; write the best q into ``q_out`` (n,) and ``info``.
 
+    Arguments as :func:`_solve_one_in`, which it calls with a fresh workspace.
+    """
+    solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info,  # noqa: F821
+                 _workspace(meta.shape[0]))
+
+
+def _solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp):
+    """Solve one target with restarts in the workspace ``wsp`` (:func:`_workspace`).
+
     Args:
         F: (n+1, 4, 4) chain fixed transforms (see :mod:`serialkin.kinematics.kernels`).
         meta: (n, 5) chain joint data.
@@ -588,6 +587,7 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
         seed: uint64 seed of this target's random stream.
         q_out: (n,) output, the best configuration found.
         info: (N_INFO,) output, see ``I_*``.
+        wsp: the loop's arrays (:func:`_workspace` of n), overwritten.
     """
     n = meta.shape[0]
     w = cfg[C_WEIGHTS:C_WEIGHTS + 6]
@@ -603,7 +603,7 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     respect = cfg[C_RESPECT] > 0.5
     use_q0 = cfg[C_USE_Q0] > 0.5
     window = int(cfg[C_WINDOW])
-    J, T, e, dq, q, be, sw, ws = _workspace(n)
+    J, T, e, dq, q, be, sw, ws = wsp
     for i in range(6):
         sw[i] = math.sqrt(w[i])
     state = np.empty(1, dtype=np.uint64)
@@ -611,28 +611,28 @@ def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     total = 0
     success = False
     used = 0
-    # fallback best: the first start configuration (finite, inside the limits)
+    # the first start (q0, else the stream's first draw), evaluated once: it is the
+    # fallback best (finite, inside the limits) and the first attempt starts there
     if use_q0:
-        q_out[:] = q0
+        q[:] = q0
     else:
-        state_copy = np.empty(1, dtype=np.uint64)
-        state_copy[0] = seed
-        random_q_into(state_copy, slo, shi, q_out)
+        random_q_into(state, slo, shi, q)
     if respect:
-        project_into(q_out, lo, hi, revolute)
-    fk_into(q_out, F, meta, T)
-    pose_error_into(T, Tt, be)
-    best_cost = task_cost(be, w)
+        project_into(q, lo, hi, revolute)
+    q_out[:] = q
+    jacobian_into(q, F, meta, J, T)
+    pose_error_into(T, Tt, e)
+    be[:] = e
+    best_cost = task_cost(e, w)
     for attempt in range(restarts + 1):
         used = attempt
-        if attempt == 0 and use_q0:
-            q[:] = q0
-        else:
+        if attempt > 0:
             random_q_into(state, slo, shi, q)
-        if respect:
-            project_into(q, lo, hi, revolute)
+            if respect:
+                project_into(q, lo, hi, revolute)
         its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
-                                     respect, p, window, tol, max_iter, q, J, T, e, dq, ws)
+                                     respect, p, window, tol, max_iter, q, J, T, e, dq, ws,
+                                     attempt > 0)
         total += its
         finite = math.isfinite(cost)
         for i in range(n):
@@ -681,10 +681,61 @@ def _solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
     (:func:`serialkin.ik.solver.solve`) hands chunks to every core through
     :func:`serialkin.kinematics.parallel.run`, the scheduler of every batch kernel. Every
     target uses the same random stream ``seed``, so a batch solve returns exactly what
-    the single solves with that seed return, whatever the chunking.
+    the single solves with that seed return, whatever the chunking. One workspace serves
+    the whole chunk.
     """
+    wsp = _workspace(meta.shape[0])
     for k in range(start, stop):
-        solve_one(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k])  # noqa: F821
+        solve_one_in(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k], wsp)  # noqa: F821
+
+
+# ---------------------------------------------------------------- the single call from Python
+# A call from Python pays for every argument numba unboxes (about 60 ns per array) and for
+# every array it allocates: the fast entry takes the robot's and method's constant arrays
+# packed in one vector (:func:`pack_fast`), checks its input itself and returns its
+# answer as a tuple of scalars.
+
+
+def pack_fast(F, meta, box, cfg_random, cfg_q0, rot_tol):
+    """The constant input of ``solve_fast``: one float64 vector (read-only).
+
+    Layout: ``rot_tol``, then ``F`` (n+1, 4, 4), ``meta`` (n, 5), ``box`` (5, n), and the
+    two configuration vectors (same length) without and with ``C_USE_Q0``, each raveled.
+    """
+    parts = [np.array([rot_tol], dtype=np.float64), np.ravel(F), np.ravel(meta), np.ravel(box),
+             np.ravel(cfg_random), np.ravel(cfg_q0)]
+    S = np.ascontiguousarray(np.concatenate(parts), dtype=np.float64)
+    S.setflags(write=False)
+    return S
+
+
+def _solve_fast(S, Tt, q0, seed, use_q0, q_out):
+    """``solve_one`` behind the input checks of the ordinary path, for a call from Python.
+
+    ``S`` from :func:`pack_fast`; ``Tt`` (4, 4) target; ``q0`` (n,) read when ``use_q0``;
+    ``seed`` the stream seed as an int64 (its bits are the uint64 seed); ``q_out`` (n,).
+    Returns ``(status, iterations, position error, orientation error, restarts)``:
+    status -1 when ``Tt`` is not a rigid transform (within ``rot_tol``) or q0 is not
+    finite and inside the limits (nothing solved: the caller's checks raise the precise
+    error), 1 for a success with q inside the limits, 0 for a failure.
+    """
+    n = q_out.shape[0]
+    o = 1
+    F = S[o:o + 16 * (n + 1)].reshape((n + 1, 4, 4))
+    o += 16 * (n + 1)
+    meta = S[o:o + 5 * n].reshape((n, 5))
+    o += 5 * n
+    box = S[o:o + 5 * n].reshape((5, n))
+    o += 5 * n
+    m = (S.shape[0] - o) // 2
+    cfg = S[o + m:o + 2 * m] if use_q0 else S[o:o + m]
+    if not pose_and_q0_valid(Tt, q0, box[B_LO], box[B_HI], S[0], use_q0):
+        return -1, 0, 0.0, 0.0, 0
+    info = np.empty(N_INFO)
+    solve_one(F, meta, Tt, box, q0, cfg, np.uint64(seed), q_out, info)  # noqa: F821
+    ok = info[I_SUCCESS] > 0.5 and info[I_INSIDE] > 0.5
+    return (1 if ok else 0), int(info[I_ITERATIONS]), info[I_POS_ERR], info[I_ORI_ERR], \
+        int(info[I_RESTARTS])
 
 
 # ---------------------------------------------------------------- collision-aware solves
@@ -833,7 +884,8 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
         if respect:
             project_into(q, lo, hi, revolute)
         its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
-                                     respect, p, window, tol, max_iter, q, J, T, e, dq, ws)
+                                     respect, p, window, tol, max_iter, q, J, T, e, dq, ws,
+                                     True)
         total += its
         finite = math.isfinite(cost)
         for i in range(n):
@@ -861,7 +913,8 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
                     A, B, rad, sb, pa, pb, scene, W0, W1, pair, g, qn, Jw, M6, y6, v6, dq):
                 break
             its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
-                                         respect, p, window, tol, max_iter, q, J, T, e, dq, ws)
+                                         respect, p, window, tol, max_iter, q, J, T, e, dq, ws,
+                                         True)
             total += its
             if not ok or not math.isfinite(cost):
                 ok = False
@@ -927,6 +980,9 @@ class CompiledMethod:
             stop)``, GIL released.
         solve_one_collision, solve_chunk_collision: the same with the collision check
             (:func:`_solve_one_collision`), compiled at their first call.
+        solve_fast: ``solve_fast(S, Tt, q0, seed, use_q0, q_out) -> (status, iterations,
+            position error, orientation error, restarts)``, the single call from Python
+            (:func:`_solve_fast`).
     """
 
     step: object
@@ -935,6 +991,7 @@ class CompiledMethod:
     solve_chunk: object
     solve_one_collision: object = None
     solve_chunk_collision: object = None
+    solve_fast: object = None
 
 
 _SOURCE = Path(__file__).read_bytes()
@@ -974,10 +1031,16 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
     # 0.1 µs per iteration, a fifth of an lm solve), unless the step allocates
     attempt = njit(cache=True, _nrt=allocates)(_bind(_attempt, name, tag + str(int(allocates)),
                                                      step=step))
-    one = njit(cache=True)(_bind(_solve_one, name, tag, attempt_loop=attempt))
-    chunk = njit(cache=True, nogil=True)(_bind(_solve_chunk, name, tag, solve_one=one))
+    # inlined into both callers: the workspace's views then stay within one function,
+    # whose reference counting LLVM prunes (a call would incref/decref each of them)
+    one_in = njit(cache=True, inline="always")(_bind(_solve_one_in, name, tag,
+                                                     attempt_loop=attempt))
+    one = njit(cache=True)(_bind(_solve_one, name, tag, solve_one_in=one_in))
+    chunk = njit(cache=True, nogil=True)(_bind(_solve_chunk, name, tag, solve_one_in=one_in))
     one_c = njit(cache=True)(_bind(_solve_one_collision, name, tag, attempt_loop=attempt))
     chunk_c = njit(cache=True, nogil=True)(_bind(_solve_chunk_collision, name, tag,
                                                  solve_one_collision=one_c))
+    fast = njit(cache=True)(_bind(_solve_fast, name, tag, solve_one=one))
     return CompiledMethod(step=step, params=tuple(params), solve_one=one, solve_chunk=chunk,
-                          solve_one_collision=one_c, solve_chunk_collision=chunk_c)
+                          solve_one_collision=one_c, solve_chunk_collision=chunk_c,
+                          solve_fast=fast)

@@ -163,9 +163,10 @@ def step_lm(q, J, e, cost, p, ctx, ws, dq):
         free[j] = 1.0
     lam = p[0]
     for _pass in range(n + 1):
-        for i in range(6):
-            for j in range(n):
-                Jw[i, j] = sw[i] * J[i, j] * free[j]
+        if _pass > 0:  # the loop weighed Jw with every joint free
+            for i in range(6):
+                for j in range(n):
+                    Jw[i, j] = sw[i] * J[i, j] * free[j]
         _normal(Jw, r, A, g)
         d = 0.0
         for i in range(n):

@@ -39,7 +39,7 @@ import numpy as np
 from serialkin._checks import MAX_ITERATIONS, ROTATION_TOL, check_int, short_repr
 from serialkin.errors import InputError, InputTypeError
 from serialkin.ik import _kernels as K
-from serialkin.ik.registry import MethodSpec, available_methods, get_method
+from serialkin.ik.registry import _REGISTRY, MethodSpec, available_methods, get_method
 from serialkin.ik.result import IKResult
 from serialkin.ik.target import (
     DEFAULT_WEIGHTS,
@@ -47,7 +47,6 @@ from serialkin.ik.target import (
     check_q0,
     check_tol,
     parse_target,
-    pose_and_q0_valid,
     robot_arrays,
 )
 from serialkin.kinematics import kernels as FK
@@ -464,21 +463,26 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
     if not isinstance(robot, Robot) or method not in available_methods():
         return None
     spec = get_method(method)
-    if (spec.kernel is None or "pose" not in spec.targets
+    if (spec.kernel is None or spec.kernel.solve_fast is None or "pose" not in spec.targets
             or (spec.max_joints is not None and robot.n > spec.max_joints)):
         return None
     a = robot_arrays(robot)
-    T = np.eye(4)
-    tgt = Target(T, DEFAULT_WEIGHTS["pose"], "pose")
-    cfgs = tuple(_kernel_config(spec, tgt, DEFAULT_TOL, spec.max_iter, spec.restarts, True,
-                                use, spec.options) for use in (False, True))
-    zeros = np.zeros(robot.n)
-    entry = (weakref.ref(robot), spec, robot.chain.F, robot.chain.meta, a.box, a.lo, a.hi,
-             cfgs, zeros, robot.n)
+    tgt = Target(np.eye(4), DEFAULT_WEIGHTS["pose"], "pose")
+    cfgs = [_kernel_config(spec, tgt, DEFAULT_TOL, spec.max_iter, spec.restarts, True,
+                           use, spec.options) for use in (False, True)]
+    S = K.pack_fast(robot.chain.F, robot.chain.meta, a.box, cfgs[0], cfgs[1], ROTATION_TOL)
+    entry = (weakref.ref(robot), spec, spec.kernel.solve_fast, S, np.zeros(robot.n), robot.n,
+             spec.name)
     if len(_FAST) > 256:
         _FAST.clear()
     _FAST[(id(robot), method)] = entry
     return entry
+
+
+_NEW = object.__new__
+_SET = object.__setattr__
+_SIGN = 1 << 63
+_F64 = np.dtype(np.float64)
 
 
 def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
@@ -487,29 +491,31 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
 
     The common call: one C-contiguous, writeable float64 (4, 4) pose, ``q0`` None or such
     an (n,) array, ``seed`` None or an int, every other argument at its default, a
-    compiled method. The checks are those of the ordinary path in one compiled call
-    (:func:`~serialkin.ik.target.pose_and_q0_valid`); when they fail, None, and the
-    ordinary path raises its precise error. The answer is the ordinary path's, bit for
-    bit (same kernel, configuration and seed).
+    compiled method. The checks of the ordinary path run inside the one compiled call
+    (``solve_fast``, :func:`~serialkin.ik._kernels.pose_and_q0_valid`); when they fail,
+    None, and the ordinary path raises its precise error. The answer is the ordinary
+    path's, bit for bit (same kernel, configuration and seed).
     """
-    if target.shape != (4, 4) or target.dtype != np.float64:
+    if target.dtype is not _F64 or target.shape != (4, 4):
         return None
     flags = target.flags
     if not (flags.c_contiguous and flags.writeable):
         return None
     ent = _FAST.get((id(robot), method))
-    if ent is None or ent[0]() is not robot or ent[1] is not get_method(method):
+    # the method's spec, looked up directly (an entry exists only once the registry has
+    # been discovered): a re-registered method gets a new entry
+    if ent is None or ent[0]() is not robot or ent[1] is not _REGISTRY.get(method):
         ent = _fast_entry(robot, method)
         if ent is None:
             return None
-    _, spec, F, meta, box, lo, hi, cfgs, zeros, n = ent
+    _, _, solve_fast, S, zeros, n, name = ent
     if q0 is None:
         q0k = zeros
-        cfg = cfgs[0]
-    elif (type(q0) is np.ndarray and q0.shape == (n,) and q0.dtype == np.float64
-          and q0.flags.c_contiguous and q0.flags.writeable):
+    elif type(q0) is np.ndarray and q0.dtype is _F64 and q0.shape == (n,):
+        flags = q0.flags
+        if not (flags.c_contiguous and flags.writeable):
+            return None
         q0k = q0
-        cfg = cfgs[1]
     else:
         return None
     if type(seed) is int:
@@ -518,17 +524,21 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
         s = int.from_bytes(os.urandom(8), "little")
     else:
         return None
-    if not pose_and_q0_valid(target, q0k, lo, hi, ROTATION_TOL, q0 is not None):
-        return None
     q = np.empty(n)
-    info = np.empty(K.N_INFO)
-    spec.kernel.solve_one(F, meta, target, box, q0k, cfg, np.uint64(s), q, info)
-    i = info.tolist()  # one conversion instead of a numpy scalar per field
-    if i[K.I_SUCCESS] > 0.5 and i[K.I_INSIDE] > 0.5:
-        return IKResult.make(q, True, int(i[K.I_ITERATIONS]), i[K.I_POS_ERR], i[K.I_ORI_ERR],
-                             "", int(i[K.I_RESTARTS]), spec.name)
-    tgt = Target(target, DEFAULT_WEIGHTS["pose"], "pose")
-    return _result_single(robot, tgt, spec, q, info, DEFAULT_TOL, True)
+    status, its, pe, oe, used = solve_fast(S, target, q0k, s - (s & _SIGN) * 2,
+                                           q0 is not None, q)
+    if status == 1:  # IKResult.make, inlined
+        r = _NEW(IKResult)
+        _SET(r, "__dict__", {
+            "q": q, "success": True, "iterations": its, "position_error": pe,
+            "orientation_error": oe, "reason": "", "restarts": used, "method": name,
+            "clearance": np.inf, "closest_pair": ("", "")})
+        return r
+    if status < 0:
+        return None
+    reason = failure_reason(pe, oe, DEFAULT_TOL, used + 1, its, "pose",
+                            failure_hint(robot, q, DEFAULT_WEIGHTS["pose"], True, target))
+    return IKResult.make(q, False, its, pe, oe, reason, used, name)
 
 
 def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | None,

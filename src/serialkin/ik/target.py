@@ -24,11 +24,10 @@ import weakref
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
 from serialkin.errors import InputError
-from serialkin.ik._kernels import inside_limits
+from serialkin.ik._kernels import inside_limits, pose_and_q0_valid  # noqa: F401 (re-export)
 from serialkin.model.robot import Robot
 from serialkin.model.tasks import TARGET_TASKS, TASK_COORDINATES, task_weights
 from serialkin.spatial.kernels import transforms_valid
@@ -230,21 +229,6 @@ def parse_target(robot: Robot, target: object, mask: object = None) -> Target:
         T[:, 3, 3] = 1.0
     T = T[0] if single else T
     return Target(np.ascontiguousarray(T), parse_mask(mask, kind), kind)
-
-
-@njit(cache=True)
-def pose_and_q0_valid(T, q0, lo, hi, rot_tol, has_q0):
-    """True when ``T`` (4, 4) is a rigid transform and ``q0`` (n,) is inside [lo, hi].
-
-    ``T`` must pass :func:`transforms_valid` (finite, orthonormal within ``rot_tol``) and,
-    when ``has_q0``, ``q0`` be finite and inside the limits within 1e-12. The solvers'
-    fast path asks this one question in one compiled call; when the answer is False the
-    ordinary checks (:func:`parse_target`, :func:`check_q0`) run and raise the
-    precise error.
-    """
-    if not transforms_valid(T.reshape((1, 4, 4)), rot_tol):
-        return False
-    return not has_q0 or inside_limits(q0, lo, hi, 1e-12)
 
 
 def check_tol(tol: object) -> float:
