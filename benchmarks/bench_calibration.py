@@ -33,7 +33,7 @@ from serialkin.calibration import (  # noqa: E402
     simulate_measurements,
 )
 from serialkin.calibration.jacobian import whitened  # noqa: E402
-from serialkin.ik.optimize import _single_threaded_blas  # noqa: E402
+from serialkin.kinematics.parallel import single_threaded_blas  # noqa: E402
 
 TARGET_S = 1.0  # a fit should take at most a second
 
@@ -50,7 +50,7 @@ def _fd_fit(model, meas, keep):
         p[fit] = x
         return whitened(model, meas, p)[0]
 
-    with _single_threaded_blas():  # as calibrate() does
+    with single_threaded_blas():  # as calibrate() does
         sol = least_squares(fun, p0[fit], jac="2-point", method="trf", x_scale="jac",
                             ftol=1e-12, xtol=1e-12, gtol=1e-12, max_nfev=200 * len(fit))
     p = p0.copy()
