@@ -11,7 +11,7 @@ R times:
 
 * **embedded** — ``compute_chunk`` in this process (what ``reachability_map`` runs
   without a client), its runs interleaved with the Dask runs below;
-* **Dask, 1 and 2 worker processes** — ``LocalCluster``s with one thread per worker,
+* **Dask, 1 and 2 worker processes** — ``LocalCluster``s with one thread and one core per worker,
   the same chunks as tasks (after an untimed warm-up that loads the compiled kernels in
   every worker), the runs of the two clusters interleaved; scaling efficiency =
   rate(2) / (2 · rate(1));
@@ -76,7 +76,8 @@ def _interleaved(job, chunks: list[int], workers: tuple[int, ...], repeat: int
     worker, 2 workers, embedded, ...), so a change in the machine's load hits them alike.
     """
     calls = _targets(job, chunks)
-    clients = {w: local_cluster(w) for w in workers}
+    # one core per worker process, so that 1 -> 2 workers measures scaling, not sharing
+    clients = {w: local_cluster(w, cores_per_worker=1) for w in workers}
     try:
         jobs = {}
         for w, client in clients.items():

@@ -18,6 +18,7 @@ progress bar advances by chunks, and each chunk's wall time is kept in the map
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 from typing import Any
 
@@ -79,16 +80,28 @@ def connect(address: str, timeout: float = CONNECT_TIMEOUT) -> Any:
                          "the port") from exc
 
 
-def local_cluster(workers: int, threads_per_worker: int = 1) -> Any:
+def local_cluster(workers: int, threads_per_worker: int = 1,
+                  cores_per_worker: int | None = None) -> Any:
     """A client of a new ``LocalCluster`` of ``workers`` processes (close it when done).
 
+    The machine's cores are shared out: each worker process runs its compiled batch
+    kernels on ``cores_per_worker`` threads (``NUMBA_NUM_THREADS`` in the workers'
+    environment; default ``max(1, cores // workers)``), so that N workers on one machine
+    do not each start a thread per core and fight over them.
+
     Raises:
-        InputError: workers < 1, or Dask is not installed.
+        InputError: workers or cores_per_worker < 1, or Dask is not installed.
     """
     workers = check_int(workers, "workers", minimum=1)
+    if cores_per_worker is None:
+        cores = (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                 else os.cpu_count()) or 1
+        cores_per_worker = max(1, cores // workers)
+    share = str(check_int(cores_per_worker, "cores_per_worker", minimum=1))
     dd = _distributed()
     cluster = dd.LocalCluster(n_workers=workers, threads_per_worker=threads_per_worker,
                               processes=True, dashboard_address=":0",
+                              env={"NUMBA_NUM_THREADS": share},
                               scheduler_kwargs={"dashboard": False})  # HTTP on a free port
     return dd.Client(cluster)
 
