@@ -67,16 +67,22 @@ class Clearance:
 
 
 # ---------------------------------------------------------------- compiled kernels
+@njit(cache=True, nogil=True, inline="always")
+def _shape_to_world(F, shape_frame, A, B, W0, W1, s):
+    """World axis ends ``W0[s]``, ``W1[s]`` of shape s from the link frames F (n+1, 4, 4)."""
+    f = shape_frame[s]
+    for r in range(3):
+        W0[s, r] = (F[f, r, 0] * A[s, 0] + F[f, r, 1] * A[s, 1] + F[f, r, 2] * A[s, 2]
+                    + F[f, r, 3])
+        W1[s, r] = (F[f, r, 0] * B[s, 0] + F[f, r, 1] * B[s, 1] + F[f, r, 2] * B[s, 2]
+                    + F[f, r, 3])
+
+
 @njit(cache=True, nogil=True)
 def _to_world(F, shape_frame, A, B, W0, W1):
     """World axis ends of every shape from the link frames F (n+1, 4, 4)."""
     for s in range(A.shape[0]):
-        f = shape_frame[s]
-        for r in range(3):
-            W0[s, r] = (F[f, r, 0] * A[s, 0] + F[f, r, 1] * A[s, 1] + F[f, r, 2] * A[s, 2]
-                        + F[f, r, 3])
-            W1[s, r] = (F[f, r, 0] * B[s, 0] + F[f, r, 1] * B[s, 1] + F[f, r, 2] * B[s, 2]
-                        + F[f, r, 3])
+        _shape_to_world(F, shape_frame, A, B, W0, W1, s)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -84,6 +90,24 @@ def _pair(W0, W1, i, j):
     """Distance of the world axes of shapes i and j (points passed as tuples: no views)."""
     return segment_distance((W0[i, 0], W0[i, 1], W0[i, 2]), (W1[i, 0], W1[i, 1], W1[i, 2]),
                             (W0[j, 0], W0[j, 1], W0[j, 2]), (W1[j, 0], W1[j, 1], W1[j, 2]))
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _self_min(W0, W1, rad, pa, pb):
+    """(smallest ``dist(axis_i, axis_j) − r_i − r_j`` over the pairs (pa, pb), its index).
+
+    (+inf, −1) when there is no pair; world axis ends in ``W0``, ``W1``.
+    """
+    best = np.inf
+    bp = -1
+    for p in range(pa.shape[0]):
+        i = pa[p]
+        j = pb[p]
+        d = _pair(W0, W1, i, j) - rad[i] - rad[j]
+        if d < best:
+            best = d
+            bp = p
+    return best, bp
 
 
 @njit(cache=True, nogil=True)
@@ -94,17 +118,7 @@ def self_clearance_range(frames, shape_frame, A, B, rad, pa, pb, out_d, out_p, s
     W1 = np.empty((m, 3))
     for k in range(start, stop):
         _to_world(frames[k], shape_frame, A, B, W0, W1)
-        best = np.inf
-        bp = -1
-        for p in range(pa.shape[0]):
-            i = pa[p]
-            j = pb[p]
-            d = _pair(W0, W1, i, j) - rad[i] - rad[j]
-            if d < best:
-                best = d
-                bp = p
-        out_d[k] = best
-        out_p[k] = bp
+        out_d[k], out_p[k] = _self_min(W0, W1, rad, pa, pb)
 
 
 @njit(cache=True, nogil=True)
@@ -169,6 +183,28 @@ def _box_bound(W0, W1, s, r, scene, o):
                             c, c) - r - hr
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _scene_min(W0, W1, rad, scene, below):
+    """(smallest signed distance < ``below`` of a shape to a scene row, shape, row).
+
+    (``below``, −1, −1) when none is smaller; rows whose bounding sphere is farther than
+    the best so far are skipped (:func:`_box_bound`).
+    """
+    best = below
+    bs = -1
+    bo = -1
+    for s in range(W0.shape[0]):
+        for o in range(scene.shape[0]):
+            if _box_bound(W0, W1, s, rad[s], scene, o) >= best:
+                continue
+            d = _shape_scene(W0, W1, s, rad[s], scene, o)
+            if d < best:
+                best = d
+                bs = s
+                bo = o
+    return best, bs, bo
+
+
 @njit(cache=True, nogil=True)
 def scene_clearance_range(frames, shape_frame, A, B, rad, shape_body, scene, out_d, out_p,
                           start, stop):
@@ -178,20 +214,9 @@ def scene_clearance_range(frames, shape_frame, A, B, rad, shape_body, scene, out
     W1 = np.empty((m, 3))
     for k in range(start, stop):
         _to_world(frames[k], shape_frame, A, B, W0, W1)
-        best = np.inf
-        bs = -1
-        bo = -1
-        for s in range(m):
-            for o in range(scene.shape[0]):
-                if _box_bound(W0, W1, s, rad[s], scene, o) >= best:
-                    continue
-                d = _shape_scene(W0, W1, s, rad[s], scene, o)
-                if d < best:
-                    best = d
-                    bs = shape_body[s]
-                    bo = o
+        best, bs, bo = _scene_min(W0, W1, rad, scene, np.inf)
         out_d[k] = best
-        out_p[k, 0] = bs
+        out_p[k, 0] = shape_body[bs] if bs >= 0 else -1
         out_p[k, 1] = bo
 
 
@@ -243,35 +268,27 @@ def clearance_at(frames, shape_frame, A, B, rad, shape_body, pa, pb, scene, W0, 
         The clearance [m]; +inf when nothing is checked.
     """
     _to_world(frames, shape_frame, A, B, W0, W1)
-    best = np.inf
     for k in range(5):
         pair[k] = -1.0
     pair[0] = PAIR_NONE
-    for p in range(pa.shape[0]):
+    best, p = _self_min(W0, W1, rad, pa, pb)
+    if p >= 0:
         i = pa[p]
         j = pb[p]
-        d = _pair(W0, W1, i, j) - rad[i] - rad[j]
-        if d < best:
-            best = d
-            bi = shape_body[i]
-            bj = shape_body[j]
-            pair[0] = PAIR_SELF
-            pair[1] = min(bi, bj)
-            pair[2] = max(bi, bj)
-            pair[3] = i
-            pair[4] = j
-    for s in range(A.shape[0]):
-        for o in range(scene.shape[0]):
-            if _box_bound(W0, W1, s, rad[s], scene, o) >= best:
-                continue
-            d = _shape_scene(W0, W1, s, rad[s], scene, o)
-            if d < best:
-                best = d
-                pair[0] = PAIR_SCENE
-                pair[1] = shape_body[s]
-                pair[2] = o
-                pair[3] = s
-                pair[4] = o
+        bi = shape_body[i]
+        bj = shape_body[j]
+        pair[0] = PAIR_SELF
+        pair[1] = min(bi, bj)
+        pair[2] = max(bi, bj)
+        pair[3] = i
+        pair[4] = j
+    best, s, o = _scene_min(W0, W1, rad, scene, best)
+    if s >= 0:
+        pair[0] = PAIR_SCENE
+        pair[1] = shape_body[s]
+        pair[2] = o
+        pair[3] = s
+        pair[4] = o
     return best
 
 
@@ -284,14 +301,9 @@ def pair_distance_at(frames, shape_frame, A, B, rad, scene, pair, W0, W1):
     """
     s = int(pair[3])
     t = int(pair[4])
-    for k in (s, t) if pair[0] == PAIR_SELF else (s, s):
-        f = shape_frame[k]
-        for r in range(3):
-            W0[k, r] = (frames[f, r, 0] * A[k, 0] + frames[f, r, 1] * A[k, 1]
-                        + frames[f, r, 2] * A[k, 2] + frames[f, r, 3])
-            W1[k, r] = (frames[f, r, 0] * B[k, 0] + frames[f, r, 1] * B[k, 1]
-                        + frames[f, r, 2] * B[k, 2] + frames[f, r, 3])
+    _shape_to_world(frames, shape_frame, A, B, W0, W1, s)
     if pair[0] == PAIR_SELF:
+        _shape_to_world(frames, shape_frame, A, B, W0, W1, t)
         return _pair(W0, W1, s, t) - rad[s] - rad[t]
     return _shape_scene(W0, W1, s, rad[s], scene, t)
 
