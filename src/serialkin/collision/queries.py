@@ -37,7 +37,7 @@ from serialkin.kinematics import parallel
 
 __all__ = ["CHUNK", "PAIR_NONE", "PAIR_SCENE", "PAIR_SELF", "Clearance", "body_pair_distances",
            "checked_shape_pairs", "clearance_at", "pair_distance_at", "scene_point_distance",
-           "in_collision", "scene_clearance", "self_clearance"]
+           "in_collision", "scene_clearance", "self_clearance", "shapes_to_world"]
 
 #: Configurations whose link frames are computed at once (8 frames × 128 B each for a 7-axis arm).
 CHUNK = 4096
@@ -79,8 +79,12 @@ def _shape_to_world(F, shape_frame, A, B, W0, W1, s):
 
 
 @njit(cache=True, nogil=True)
-def _to_world(F, shape_frame, A, B, W0, W1):
-    """World axis ends of every shape from the link frames F (n+1, 4, 4)."""
+def shapes_to_world(F, shape_frame, A, B, W0, W1):
+    """World axis ends ``W0``, ``W1`` (m, 3) of every shape from the link frames F (n+1, 4, 4).
+
+    ``W = F[shape_frame[s]] · [A_s; 1]`` (and B_s); shared by the queries here and the
+    collision rows of :mod:`serialkin.diffik`. Trusts its input.
+    """
     for s in range(A.shape[0]):
         _shape_to_world(F, shape_frame, A, B, W0, W1, s)
 
@@ -117,7 +121,7 @@ def self_clearance_range(frames, shape_frame, A, B, rad, pa, pb, out_d, out_p, s
     W0 = np.empty((m, 3))
     W1 = np.empty((m, 3))
     for k in range(start, stop):
-        _to_world(frames[k], shape_frame, A, B, W0, W1)
+        shapes_to_world(frames[k], shape_frame, A, B, W0, W1)
         out_d[k], out_p[k] = _self_min(W0, W1, rad, pa, pb)
 
 
@@ -128,7 +132,7 @@ def pair_distances_range(frames, shape_frame, A, B, rad, pa, pb, out, start, sto
     W0 = np.empty((m, 3))
     W1 = np.empty((m, 3))
     for k in range(start, stop):
-        _to_world(frames[k], shape_frame, A, B, W0, W1)
+        shapes_to_world(frames[k], shape_frame, A, B, W0, W1)
         for p in range(pa.shape[0]):
             i = pa[p]
             j = pb[p]
@@ -213,7 +217,7 @@ def scene_clearance_range(frames, shape_frame, A, B, rad, shape_body, scene, out
     W0 = np.empty((m, 3))
     W1 = np.empty((m, 3))
     for k in range(start, stop):
-        _to_world(frames[k], shape_frame, A, B, W0, W1)
+        shapes_to_world(frames[k], shape_frame, A, B, W0, W1)
         best, bs, bo = _scene_min(W0, W1, rad, scene, np.inf)
         out_d[k] = best
         out_p[k, 0] = shape_body[bs] if bs >= 0 else -1
@@ -267,7 +271,7 @@ def clearance_at(frames, shape_frame, A, B, rad, shape_body, pa, pb, scene, W0, 
     Returns:
         The clearance [m]; +inf when nothing is checked.
     """
-    _to_world(frames, shape_frame, A, B, W0, W1)
+    shapes_to_world(frames, shape_frame, A, B, W0, W1)
     for k in range(5):
         pair[k] = -1.0
     pair[0] = PAIR_NONE

@@ -30,6 +30,7 @@ from numba import njit
 
 from serialkin._checks import check_positive
 from serialkin.collision import kernels as CK
+from serialkin.collision.queries import shapes_to_world
 from serialkin.diffik.constraints import Constraint
 from serialkin.errors import InputError
 from serialkin.kinematics import kernels as K
@@ -109,13 +110,7 @@ def model_rows_into(q, F, L, meta, shape_frame, A, B, rad, scene, pa, pb, influe
     m = A.shape[0]
     W0 = np.empty((m, 3))
     W1 = np.empty((m, 3))
-    for s in range(m):
-        f = shape_frame[s]
-        for r in range(3):
-            W0[s, r] = (frames[f, r, 0] * A[s, 0] + frames[f, r, 1] * A[s, 1]
-                        + frames[f, r, 2] * A[s, 2] + frames[f, r, 3])
-            W1[s, r] = (frames[f, r, 0] * B[s, 0] + frames[f, r, 1] * B[s, 1]
-                        + frames[f, r, 2] * B[s, 2] + frames[f, r, 3])
+    shapes_to_world(frames, shape_frame, A, B, W0, W1)
     Jbuf = np.empty((6, n))
     pbuf = np.empty(3)
     g = np.empty(n)
