@@ -564,6 +564,39 @@ def _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
     return max_iter, (pe <= tol and oe <= tol), cost
 
 
+@njit(cache=True)
+def _polish_best(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter, q, q_out,
+                 J, T, e, be, dq, ws, best_cost):
+    """The final polish (:func:`_polish`) from the best attempt ``q_out``, kept when better.
+
+    Returns (success, best cost, iterations): ``q_out`` and its error ``be`` are replaced
+    when the polish converges or lowers the cost.
+    """
+    q[:] = q_out
+    its, ok, cost = _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
+                            q, J, T, e, ws[W_JW], ws[W_R], ws[W_A], ws[W_G], dq,
+                            ws[W_QN], np.empty((6, q.shape[0])), ws[W_TN], ws[W_EN])
+    if ok or cost < best_cost:
+        q_out[:] = q
+        be[:] = e
+        return ok, cost, its
+    return False, best_cost, its
+
+
+@njit(cache=True, inline="always")
+def _write_info(info, success, total, be, w, used, best_cost, q_out, lo, hi, clearance):
+    """Fill ``info`` (N_INFO,) but the closest pair: see the ``I_*`` indices."""
+    pe, oe = task_errors(be, w)
+    info[I_SUCCESS] = 1.0 if success else 0.0
+    info[I_ITERATIONS] = total
+    info[I_POS_ERR] = pe
+    info[I_ORI_ERR] = oe
+    info[I_RESTARTS] = used
+    info[I_COST] = best_cost
+    info[I_INSIDE] = 1.0 if inside_limits(q_out, lo, hi, LIMIT_TOL) else 0.0
+    info[I_CLEARANCE] = clearance
+
+
 def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     """Solve one target with restarts; write the best q into ``q_out`` (n,) and ``info``.
 
@@ -646,28 +679,14 @@ def _solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp):
             success = True
             break
     if not success and cfg[C_POLISH] > 0.5:
-        q[:] = q_out
-        its, ok, cost = _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
-                                q, J, T, e, ws[W_JW], ws[W_R], ws[W_A], ws[W_G], dq,
-                                ws[W_QN], np.empty((6, n)), ws[W_TN], ws[W_EN])
+        success, best_cost, its = _polish_best(F, meta, Tt, w, sw, lo, hi, revolute, respect,
+                                               tol, max_iter, q, q_out, J, T, e, be, dq, ws,
+                                               best_cost)
         total += its
-        if ok or cost < best_cost:
-            best_cost = cost
-            q_out[:] = q
-            be[:] = e
-            success = ok
     normalize_into(q_out, lo, hi, revolute)
     if use_q0:
         nearest_into(q_out, q0, lo, hi, revolute, respect)
-    pe, oe = task_errors(be, w)
-    info[I_SUCCESS] = 1.0 if success else 0.0
-    info[I_ITERATIONS] = total
-    info[I_POS_ERR] = pe
-    info[I_ORI_ERR] = oe
-    info[I_RESTARTS] = used
-    info[I_COST] = best_cost
-    info[I_INSIDE] = 1.0 if inside_limits(q_out, lo, hi, LIMIT_TOL) else 0.0
-    info[I_CLEARANCE] = np.inf
+    _write_info(info, success, total, be, w, used, best_cost, q_out, lo, hi, np.inf)
     for k in range(5):
         info[I_PAIR + k] = -1.0
     info[I_PAIR] = PAIR_NONE
@@ -932,29 +951,15 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
         be[:] = hit_e
         best_cost = task_cost(be, w)
     elif not success and cfg[C_POLISH] > 0.5:
-        q[:] = q_out
-        its, ok, cost = _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
-                                q, J, T, e, ws[W_JW], ws[W_R], ws[W_A], ws[W_G], dq,
-                                ws[W_QN], np.empty((6, n)), ws[W_TN], ws[W_EN])
+        success, best_cost, its = _polish_best(F, meta, Tt, w, sw, lo, hi, revolute, respect,
+                                               tol, max_iter, q, q_out, J, T, e, be, dq, ws,
+                                               best_cost)
         total += its
-        if ok or cost < best_cost:
-            best_cost = cost
-            q_out[:] = q
-            be[:] = e
-            success = ok
     normalize_into(q_out, lo, hi, revolute)
     if use_q0:
         nearest_into(q_out, q0, lo, hi, revolute, respect)
     d = _clearance(q_out, F, L, meta, frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1, pair)
-    pe, oe = task_errors(be, w)
-    info[I_SUCCESS] = 1.0 if success and d >= margin else 0.0
-    info[I_ITERATIONS] = total
-    info[I_POS_ERR] = pe
-    info[I_ORI_ERR] = oe
-    info[I_RESTARTS] = used
-    info[I_COST] = best_cost
-    info[I_INSIDE] = 1.0 if inside_limits(q_out, lo, hi, LIMIT_TOL) else 0.0
-    info[I_CLEARANCE] = d
+    _write_info(info, success and d >= margin, total, be, w, used, best_cost, q_out, lo, hi, d)
     for k in range(5):
         info[I_PAIR + k] = pair[k]
 
