@@ -1,10 +1,17 @@
-"""All IK solutions of a general 6R arm: a 2-D search on a subproblem residual (IK-Geo style).
+"""All IK solutions of a general 6R arm: Raghavan–Roth elimination, then a 2-D search.
 
 A 6R arm in no special class (no spherical wrist, no three parallel axes) has up to 16
-solutions (Raghavan & Roth 1993; Manseur & Doty 1989). Following the approach of IK-Geo
-(A. J. Elias, J. T. Wen, *IK-Geo: unified robot inverse kinematics using subproblem
-decomposition*, Mechanism and Machine Theory 2025; arXiv:2211.05737), the unknowns that
-no subproblem can eliminate are searched, the rest are closed forms:
+solutions (Raghavan & Roth 1993; Manseur & Doty 1989). :func:`general_candidates`
+first eliminates five joints (:mod:`serialkin.ik.analytic.raghavan_roth`: a
+trigonometric eliminant of degree 8 in θ3, 17 determinants of a 12 × 12 pencil,
+about 0.1 ms per pose). Why the elimination first: it is exact (one candidate per real
+root, every one refined by Newton's method), 20-50 times faster than the search, and
+it finds the solutions closer together than a search cell. When it does not apply (a
+rank-deficient elimination near special geometry) or loses a root (a cluster of
+solutions, a singular configuration), the search below takes over, as IK-Geo does for
+every arm (A. J. Elias, J. T. Wen, *IK-Geo: unified robot inverse kinematics using
+subproblem decomposition*, Mechanism and Machine Theory 2025; arXiv:2211.05737): the
+unknowns that no subproblem can eliminate are searched, the rest are closed forms:
 
 1. Fix (q5, q6) on an N × N grid of the torus. Then
    ``G = T·M⁻¹·exp(−ξ6 q6)·exp(−ξ5 q5) = exp(ξ1 q1)···exp(ξ4 q4)`` is known.
@@ -21,18 +28,12 @@ no subproblem can eliminate are searched, the rest are closed forms:
    (:func:`~serialkin.ik.analytic.refine.newton_refine`); converged, distinct solutions
    are kept (at most :data:`MAX_SOLUTIONS`).
 
-Why a search rather than the Raghavan–Roth / Husty univariate polynomial of degree 16:
-the search reuses the closed-form subproblems already compiled here, each found
-solution is refined on the robot's own chain (so the method is exact to 1e-12 for any
-joint description, base and tool), and it degrades gracefully near special geometry
-where the eliminant's 24×24 companion matrix loses accuracy. Its cost is the grid
-(``grid``² nodes × one quartic), and two solutions closer together than about one grid
-cell can merge into one basin (an odd count, impossible for real solutions of a 6R,
-triggers one more search on a grid twice as fine). On 400 random arms (1426 solutions,
-found independently by Newton from 300 random starts each; ``benchmarks/bench_ik_all.py
---miss-arms``) grids 20 and 24 missed none, grid 16 missed 2 and grid 12 missed 4: the
-default is 24. An arm with 14 real solutions gives all 14 from grid 12 up (tests).
-``grid`` can be raised.
+The search costs the grid (``grid``² nodes × one quartic, milliseconds), and two
+solutions closer together than about one grid cell can merge into one basin (an odd
+count, impossible for real solutions of a 6R, triggers one more search on a grid twice
+as fine). On 400 random arms (1426 solutions, found independently by Newton from 300
+random starts each; ``benchmarks/bench_ik_all.py --miss-arms``) grids 20 and 24 missed
+none, grid 16 missed 2 and grid 12 missed 4: the default is 24. ``grid`` can be raised.
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ import math
 import numpy as np
 from numba import njit
 
+from serialkin.ik.analytic.raghavan_roth import rr_candidates
 from serialkin.ik.analytic.refine import MAX_NEWTON, newton_refine_known, wrapped_dist
 from serialkin.ik.analytic.spherical_wrist import arm_positions
 from serialkin.ik.analytic.subproblems import (
@@ -67,6 +69,41 @@ DEFAULT_GRID = 24
 
 @njit(cache=True)
 def general_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r, out):
+    """Every solution of a general 6R arm into ``out`` (16, 6).
+
+    By :func:`~serialkin.ik.analytic.raghavan_roth.rr_candidates` when it applies and
+    accounts for every root of its eliminant with an even count, else by
+    :func:`search_candidates`.
+
+    Args:
+        T: (4, 4) target pose (world).
+        W: (6, 3) unit joint directions at q = 0.
+        P: (6, 3) a point of each joint line at q = 0 [m].
+        M: (4, 4) tool pose at q = 0.
+        aux: class data of the 3R arm of joints 1-3 (``aux[0]`` = c, a point of axis 4,
+            then as for :func:`~serialkin.ik.analytic.spherical_wrist.arm_positions`),
+            and ``aux[-1]`` a unit vector ⟂ w4.
+        arm: arm code for ``arm_positions`` (0 planar 2 ∥ 3, 1 axes 1, 2 meet, 2 other).
+        reverse: W, P, M describe the reversed chain (joint j is joint 7 − j, tool pose
+            M⁻¹), searched for ``T⁻¹``; rows are returned in the robot's joint order.
+        grid: nodes per searched joint (N; N² nodes).
+        F: (7, 4, 4) chain transforms.
+        meta: (6, 5) chain joint data.
+        tol_p: Newton position tolerance [m].
+        tol_r: Newton rotation tolerance [rad].
+        out: (16, 6) output rows (refined, not wrapped).
+
+    Returns:
+        the number of distinct converged solutions.
+    """
+    k = rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out)
+    if k >= 0 and k % 2 == 0:
+        return k
+    return search_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r, out)
+
+
+@njit(cache=True)
+def search_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r, out):
     """Every solution of a general 6R arm found by the (q5, q6) search, into ``out`` (16, 6).
 
     Args:

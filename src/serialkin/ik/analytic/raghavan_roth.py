@@ -1,0 +1,626 @@
+"""All IK solutions of a general 6R arm by Raghavan–Roth elimination (numba, ``cache=True``).
+
+A 6R arm that no subproblem decomposes has up to 16 solutions, the real roots of one
+univariate polynomial (M. Raghavan, B. Roth, *Inverse kinematics of the general 6R
+manipulator and related linkages*, ASME J. Mech. Des. 115, 1993; the matrix form of
+D. Manocha, J. F. Canny, *Efficient inverse kinematics for general 6R manipulators*,
+IEEE T-RA 10(5), 1994). Here it is written on the product of exponentials of the
+robot's own joint lines (so any joint description, base and tool), and every
+coefficient is obtained numerically from the chain instead of from symbolic algebra:
+
+1. **Split.** With ``G = T·M⁻¹ = e1·e2·e3·e4·e5·e6`` (``e_i = exp(ξ_i θ_i)``), the
+   direction ``w6`` and a point ``c6`` of axis 6 are fixed by ``e6``, so
+   ``e3 e4 e5 (w6, c6) = e2⁻¹ e1⁻¹ G (w6, c6)``. With ``o3`` a point of axis 3, set
+   ``l = R·w6`` and ``p = (·)c6 − o3`` on each side (positions divided by the arm's size).
+2. **Fourteen equations** (Raghavan–Roth): ``l``, ``p``, ``l·p``, ``p·p``, ``l × p`` and
+   ``(p·p) l − 2 (l·p) p`` (3+3+1+1+3+3). Each left side is a combination of the 27
+   products of ``(1, c_j, s_j)`` for j = 3, 4, 5 (at most linear in each joint's cosine
+   and sine); each right side of the 9 products for j = 1, 2. The coefficients are
+   exact interpolations on 3 angles per joint (27 and 9 chain evaluations): no symbolic
+   derivation, and the claim is checked by the tests on random arms.
+3. **Eliminate θ1, θ2.** Moving the constant term left, ``P(θ3, θ4, θ5) = Q·m12`` with
+   ``Q`` (14, 8) the coefficients of the 8 non-constant products of θ1, θ2. Rows
+   ``N`` (6, 14) spanning the left null space of ``Q`` (its SVD) give six equations in
+   θ3, θ4, θ5 alone.
+4. **A 12 × 12 pencil.** The half-angle tangents x4, x5 turn each equation (times
+   ``(1+x4²)(1+x5²)``) into a polynomial in the 9 monomials ``x4^i x5^j`` (i, j ≤ 2);
+   the six equations and their products by x4 are 12 equations, linear in the 12
+   monomials ``x4^i x5^j`` (i ≤ 3, j ≤ 2): ``K(θ3)·v = 0`` with
+   ``K(θ3) = K0 + cos θ3 K1 + sin θ3 K2``.
+5. **The univariate equation.** ``det K(θ3)`` is a trigonometric polynomial of degree 8
+   (the eliminant of degree 16 in ``tan(θ3/2)``; the degree-24 determinant in the
+   half-angle carries the spurious factor ``(1 + x3²)⁴``). Its 17 coefficients are the
+   discrete Fourier transform of 17 determinants (LU). Its real roots are bracketed on
+   a grid whose cells are cut into pieces where it is monotone (at its extrema, found
+   the same way from its derivatives), so roots closer than a cell are separated, and
+   an extremum at zero (a double root) is kept as well (:func:`eliminant_roots`).
+6. **Back substitution.** For each root, the null vector of ``K(θ3)`` (Gaussian
+   elimination with complete pivoting) gives x4, x5 as ratios of its entries; the
+   least-squares solution of ``Q·m12 = P`` (the same SVD) gives ``(cos θ1, sin θ1)`` and
+   ``(cos θ2, sin θ2)``; θ6 follows by subproblem 1 on ``w6``.
+7. **Refinement.** Every candidate is polished by Newton's method on the robot's own
+   chain (:func:`~serialkin.ik.analytic.refine.newton_refine_known`) to the solver's
+   tolerance; duplicates are dropped.
+
+:func:`rr_candidates` reports failure (−1) when the elimination does not apply: ``Q``
+of rank below 8 (special geometry, e.g. intersecting or parallel neighbouring axes, where
+the closed-form classes or the 2-D search take over) or a determinant that vanishes
+identically. Kernels trust their input.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from serialkin.ik.analytic.refine import MAX_NEWTON, newton_refine_known, wrapped_dist
+from serialkin.ik.analytic.subproblems import (
+    TWO_PI,
+    inv_rigid,
+    mm,
+    mtv,
+    mv,
+    rotation,
+    screw,
+    sp1_dir,
+    transform_point,
+)
+
+#: Interpolation angles of each joint: 0, 2π/3, 4π/3 [rad].
+_ANGLES = np.array([0.0, TWO_PI / 3.0, 2.0 * TWO_PI / 3.0])
+#: Coefficients of (1, cos θ, sin θ) from values at :data:`_ANGLES`: ``c = _B_INV @ f``.
+_B_INV = np.linalg.inv(np.column_stack([np.ones(3), np.cos(_ANGLES), np.sin(_ANGLES)]))
+#: (1, cos θ, sin θ)·(1 + x²) as polynomials in x = tan(θ/2): row a, power p.
+_HALF = np.array([[1.0, 0.0, 1.0], [1.0, 0.0, -1.0], [0.0, 2.0, 0.0]])
+#: Degree of the trigonometric eliminant det K(θ3).
+DEGREE = 8
+#: Determinants sampled for its coefficients (2·DEGREE + 1).
+_N_DET = 2 * DEGREE + 1
+#: Grid on which the eliminant's roots are bracketed.
+N_GRID = 128
+#: Smallest singular value of Q, relative to the largest, for the elimination to apply.
+RANK_TOL = 1e-9
+#: Smallest pivot ratio (≈ 1/cond) of the best-conditioned sample of K(θ3): below it the
+#: pencil is nearly singular for every θ3 (an arm close to a special class, where the
+#: eliminant degenerates) and the search takes over. Random arms give 1e-2 to 0.3,
+#: arms within 0.01 rad of the UR5 or the Puma 560 1e-7 to 4e-4.
+PIVOT_TOL = 1e-3
+#: Newton iterates this close to a solution already found stop [rad] (see
+#: :func:`~serialkin.ik.analytic.refine.newton_refine_known`).
+KNOWN_RADIUS = 1e-4
+
+
+@njit(cache=True)
+def _equations(l, p, out, row):
+    """The 14 Raghavan–Roth quantities of ``l``, ``p`` (3,) into ``out[row]``.
+
+    ``[l, p, l·p, p·p, l × p, (p·p) l − 2 (l·p) p]``.
+    """
+    lp = l[0] * p[0] + l[1] * p[1] + l[2] * p[2]
+    pp = p[0] * p[0] + p[1] * p[1] + p[2] * p[2]
+    for i in range(3):
+        out[row, i] = l[i]
+        out[row, 3 + i] = p[i]
+        out[row, 11 + i] = pp * l[i] - 2.0 * lp * p[i]
+    out[row, 6] = lp
+    out[row, 7] = pp
+    out[row, 8] = l[1] * p[2] - l[2] * p[1]
+    out[row, 9] = l[2] * p[0] - l[0] * p[2]
+    out[row, 10] = l[0] * p[1] - l[1] * p[0]
+
+
+@njit(cache=True)
+def _to_coefficients(V, m):
+    """Values at the interpolation angles → coefficients of (1, c, s), along ``m`` axes.
+
+    ``V`` has shape (3^m, 14) with the joint indices in row-major order; returns the
+    same shape with each joint index turned into a basis index (a, 0: 1, 1: cos, 2: sin).
+    """
+    C = V.copy()
+    stride = 1
+    for _ in range(m):
+        stride *= 3
+    tmp = np.empty_like(C)
+    block = stride
+    for _ in range(m):
+        block //= 3
+        for r in range(C.shape[0]):
+            i = (r // block) % 3
+            base = r - i * block
+            for k in range(C.shape[1]):
+                tmp[r, k] = (_B_INV[i, 0] * C[base, k] + _B_INV[i, 1] * C[base + block, k]
+                             + _B_INV[i, 2] * C[base + 2 * block, k])
+        C[:, :] = tmp
+    return C
+
+
+@njit(cache=True)
+def _det(A):
+    """The determinant of A (n, n) by LU with partial pivoting, and min |pivot| / max |pivot|.
+
+    ``A`` is overwritten. The pivot ratio is a cheap lower bound on 1/cond(A): the
+    determinant's relative accuracy is about machine epsilon over it.
+    """
+    n = A.shape[0]
+    d = 1.0
+    pmin = math.inf
+    pmax = 0.0
+    for c in range(n):
+        piv = c
+        big = abs(A[c, c])
+        for r in range(c + 1, n):
+            if abs(A[r, c]) > big:
+                big = abs(A[r, c])
+                piv = r
+        if big == 0.0:
+            return 0.0, 0.0
+        pmin = min(pmin, big)
+        pmax = max(pmax, big)
+        if piv != c:
+            d = -d
+            for j in range(c, n):
+                A[c, j], A[piv, j] = A[piv, j], A[c, j]
+        d *= A[c, c]
+        inv = 1.0 / A[c, c]
+        for r in range(c + 1, n):
+            f = A[r, c] * inv
+            if f != 0.0:
+                for j in range(c + 1, n):
+                    A[r, j] -= f * A[c, j]
+    return d, pmin / pmax
+
+
+@njit(cache=True)
+def _null_vector(A, v):
+    """A unit null vector ``v`` (n,) of the nearly singular ``A`` (n, n, overwritten).
+
+    Gaussian elimination with complete pivoting; the last pivot is the (near) zero one,
+    the vector follows by back substitution with its last entry 1.
+    """
+    n = A.shape[0]
+    perm = np.arange(n)
+    for c in range(n - 1):
+        pr, pc, big = c, c, -1.0
+        for r in range(c, n):
+            for j in range(c, n):
+                if abs(A[r, j]) > big:
+                    big = abs(A[r, j])
+                    pr, pc = r, j
+        if big == 0.0:
+            break
+        if pr != c:
+            for j in range(n):
+                A[c, j], A[pr, j] = A[pr, j], A[c, j]
+        if pc != c:
+            for r in range(n):
+                A[r, c], A[r, pc] = A[r, pc], A[r, c]
+            perm[c], perm[pc] = perm[pc], perm[c]
+        inv = 1.0 / A[c, c]
+        for r in range(c + 1, n):
+            f = A[r, c] * inv
+            if f != 0.0:
+                for j in range(c + 1, n):
+                    A[r, j] -= f * A[c, j]
+    y = np.zeros(n)
+    y[n - 1] = 1.0
+    for i in range(n - 2, -1, -1):
+        s = 0.0
+        for j in range(i + 1, n):
+            s += A[i, j] * y[j]
+        y[i] = -s / A[i, i] if A[i, i] != 0.0 else 0.0
+    norm = 0.0
+    for i in range(n):
+        norm += y[i] * y[i]
+    norm = math.sqrt(norm)
+    for i in range(n):
+        v[perm[i]] = y[i] / norm
+
+
+@njit(cache=True)
+def _trig(a, b, t, order):
+    """Derivative ``order`` (0, 1, 2 or 3) at t of ``f(t) = a0 + Σ_k a_k cos kt + b_k sin kt``.
+
+    k = 1..DEGREE; the derivatives are exact (``d/dt cos kt = −k sin kt``).
+    """
+    c1 = math.cos(t)
+    s1 = math.sin(t)
+    ck, sk = 1.0, 0.0
+    f = a[0] if order == 0 else 0.0
+    for k in range(1, a.shape[0]):
+        ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1
+        if order == 0:
+            f += a[k] * ck + b[k] * sk
+        elif order == 1:
+            f += k * (b[k] * ck - a[k] * sk)
+        elif order == 2:
+            f -= k * k * (a[k] * ck + b[k] * sk)
+        else:
+            f -= k * k * k * (b[k] * ck - a[k] * sk)
+    return f
+
+
+@njit(cache=True)
+def _zero(a, b, lo, hi, order):
+    """Zero in [lo, hi] of derivative ``order`` of f, which changes sign there.
+
+    Newton steps on the next derivative when they stay inside the bracket, else
+    bisection; 60 iterations at most, or until the bracket is below 1e-15 rad.
+    """
+    flo = _trig(a, b, lo, order)
+    x = 0.5 * (lo + hi)
+    for _ in range(60):
+        f = _trig(a, b, x, order)
+        if f == 0.0:
+            return x
+        if (f > 0.0) == (flo > 0.0):
+            lo = x
+            flo = f
+        else:
+            hi = x
+        if hi - lo < 1e-15:
+            break
+        fp = _trig(a, b, x, order + 1)
+        xn = x - f / fp if fp != 0.0 else 0.5 * (lo + hi)
+        x = xn if lo < xn < hi else 0.5 * (lo + hi)
+    return x
+
+
+@njit(cache=True)
+def _add_root(roots, k, x):
+    """Append ``x`` wrapped to [−π, π) unless within 1e-10 rad of a root already listed."""
+    x -= TWO_PI * math.floor((x + math.pi) / TWO_PI)
+    for i in range(k):
+        d = abs(x - roots[i])
+        if min(d, TWO_PI - d) < 1e-10:
+            return k
+    if k < roots.shape[0]:
+        roots[k] = x
+        k += 1
+    return k
+
+
+@njit(cache=True)
+def _changes(u, v):
+    """Whether u and v are nonzero numbers of opposite signs."""
+    return u != 0.0 and v != 0.0 and (u > 0.0) != (v > 0.0)
+
+
+@njit(cache=True)
+def eliminant_roots(a, b, roots):
+    """Real roots in [−π, π) of the trigonometric polynomial (a, b) into ``roots``; their count.
+
+    The circle is cut into :data:`N_GRID` cells, and each cell into pieces on which f is
+    monotone: the zeros of f' (its extrema) split it, and f' is itself monotone between
+    the zeros of f'' (at most one is looked for per cell). A piece where f changes sign
+    holds exactly one root (bisected with Newton steps); an extremum where |f| is below
+    1e-10 of the coefficients' size is a double root. So two or three roots closer
+    than a cell are separated; only a cell holding two inflections of this degree-8
+    polynomial could hide a pair. Returns −1 when f vanishes identically.
+    """
+    size = 0.0
+    for k in range(a.shape[0]):
+        size += abs(a[k]) + abs(b[k])
+    if size == 0.0:
+        return -1
+    tiny = 1e-10 * size
+    h = TWO_PI / N_GRID
+    k = 0
+    cut = np.empty(4)
+    lo = -math.pi
+    f_lo = _trig(a, b, lo, 0)
+    g_lo = _trig(a, b, lo, 1)
+    s_lo = _trig(a, b, lo, 2)
+    for m in range(N_GRID):
+        hi = -math.pi + h * (m + 1)
+        f_hi = _trig(a, b, hi, 0)
+        g_hi = _trig(a, b, hi, 1)
+        s_hi = _trig(a, b, hi, 2)
+        if f_lo == 0.0:
+            k = _add_root(roots, k, lo)
+        # extrema of f in the cell: zeros of f' on the pieces between zeros of f''
+        nc = 0
+        cut[nc] = lo
+        nc += 1
+        if _changes(s_lo, s_hi):
+            x = _zero(a, b, lo, hi, 2)
+            gx = _trig(a, b, x, 1)
+            if _changes(g_lo, gx):
+                cut[nc] = _zero(a, b, lo, x, 1)
+                nc += 1
+            if _changes(gx, g_hi):
+                cut[nc] = _zero(a, b, x, hi, 1)
+                nc += 1
+        elif _changes(g_lo, g_hi):
+            cut[nc] = _zero(a, b, lo, hi, 1)
+            nc += 1
+        # one root at most on each monotone piece
+        x0 = lo
+        f0 = f_lo
+        for i in range(1, nc + 1):
+            x1 = cut[i] if i < nc else hi
+            f1 = _trig(a, b, x1, 0) if i < nc else f_hi
+            if i < nc and abs(f1) <= tiny:
+                k = _add_root(roots, k, x1)  # an extremum at zero: a double root
+            elif _changes(f0, f1):
+                k = _add_root(roots, k, _zero(a, b, x0, x1, 0))
+            x0, f0 = x1, f1
+        lo, f_lo, g_lo, s_lo = hi, f_hi, g_hi, s_hi
+    return k
+
+
+@njit(cache=True)
+def _half_angle(v, stride, count):
+    """θ with ``tan(θ/2) = v[(j+1)·stride] / v[j·stride]``, j the best-conditioned ratio.
+
+    ``v[j·stride]`` for j < count are proportional to ``x^j``; the ratio with the
+    largest denominator among the first ``count − 1`` is taken.
+    """
+    j = 0
+    big = -1.0
+    for i in range(count - 1):
+        if abs(v[i * stride]) > big:
+            big = abs(v[i * stride])
+            j = i
+    return 2.0 * math.atan2(v[(j + 1) * stride], v[j * stride])
+
+
+@njit(cache=True)
+def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
+    """Every solution of a 6R arm by Raghavan–Roth elimination into ``out`` (16, 6).
+
+    Args:
+        T: (4, 4) target pose (world).
+        W: (6, 3) unit joint directions at q = 0.
+        P: (6, 3) a point of each joint line at q = 0 [m].
+        M: (4, 4) tool pose at q = 0.
+        reverse: W, P, M describe the reversed chain (joint j is joint 7 − j, tool pose
+            M⁻¹), solved for ``T⁻¹``; rows are returned in the robot's joint order.
+        F: (7, 4, 4) chain transforms (refinement).
+        meta: (6, 5) chain joint data.
+        tol_p: Newton position tolerance [m].
+        tol_r: Newton rotation tolerance [rad].
+        out: (16, 6) output rows (refined, not wrapped).
+
+    Returns:
+        the number of distinct converged solutions, one per real root of the eliminant;
+        −1 when the elimination does not apply (Q of rank < 8, or a pencil nearly
+        singular for every θ3, see :data:`PIVOT_TOL`), and −1 − k when a root gave no
+        new solution even after polishing (a cluster of solutions or a singular
+        configuration; the k solutions found are in ``out``): in both cases the caller
+        searches instead.
+    """
+    scale = 0.0
+    for j in range(6):
+        for i in range(3):
+            scale = max(scale, abs(P[j, i] - P[0, i]))
+    for i in range(3):
+        scale = max(scale, abs(M[i, 3] - P[0, i]))
+    inv_s = 1.0 / max(scale, 1e-300)
+    Ts = inv_rigid(T) if reverse else T
+    G = mm(Ts, inv_rigid(M))
+    w6 = W[5].copy()
+    c6 = P[5].copy()
+    o3 = P[2].copy()
+    # 1-2. left side: the 14 quantities at 27 sample angles → coefficients (27, 14)
+    V = np.empty((27, 14))
+    l = np.empty(3)
+    p = np.empty(3)
+    for i3 in range(3):
+        E3 = screw(W[2], P[2], _ANGLES[i3], False)
+        for i4 in range(3):
+            E34 = mm(E3, screw(W[3], P[3], _ANGLES[i4], False))
+            for i5 in range(3):
+                E = mm(E34, screw(W[4], P[4], _ANGLES[i5], False))
+                lv = mv(E, w6)
+                pt = transform_point(E, c6)
+                for i in range(3):
+                    l[i] = lv[i]
+                    p[i] = (pt[i] - o3[i]) * inv_s
+                _equations(l, p, V, 9 * i3 + 3 * i4 + i5)
+    Cl = _to_coefficients(V, 3)
+    # right side: 9 samples of (θ1, θ2) → coefficients (9, 14)
+    lg = mv(G, w6)
+    pg = transform_point(G, c6)
+    V2 = np.empty((9, 14))
+    for i1 in range(3):
+        E1 = screw(W[0], P[0], -_ANGLES[i1], False)
+        l1 = mv(E1, lg)
+        p1 = transform_point(E1, pg)
+        for i2 in range(3):
+            E2 = screw(W[1], P[1], -_ANGLES[i2], False)
+            lv = mv(E2, l1)
+            pt = transform_point(E2, p1)
+            for i in range(3):
+                l[i] = lv[i]
+                p[i] = (pt[i] - o3[i]) * inv_s
+            _equations(l, p, V2, 3 * i1 + i2)
+    Cr = _to_coefficients(V2, 2)
+    # 3. eliminate θ1, θ2: left null space of Q (14, 8)
+    Q = np.empty((14, 8))
+    for j in range(8):
+        for k in range(14):
+            Q[k, j] = Cr[j + 1, k]
+    U, sv, Vt = np.linalg.svd(Q)
+    if not sv[7] > RANK_TOL * sv[0]:
+        return -1
+    E = np.zeros((6, 27))  # N·(left − constant), basis index 9·a3 + 3·a4 + a5
+    for r in range(6):
+        for idx in range(27):
+            s = 0.0
+            for k in range(14):
+                s += U[k, 8 + r] * Cl[idx, k]
+            E[r, idx] = s
+        s = 0.0
+        for k in range(14):
+            s += U[k, 8 + r] * Cr[0, k]
+        E[r, 0] -= s
+    # 4. the pencil K(θ3) = K[0] + cos θ3 K[1] + sin θ3 K[2] on monomials x4^i x5^j
+    K = np.zeros((3, 12, 12))
+    for r in range(6):
+        for a3 in range(3):
+            for p4 in range(3):
+                for p5 in range(3):
+                    s = 0.0
+                    for a4 in range(3):
+                        h4 = _HALF[a4, p4]
+                        if h4 != 0.0:
+                            for a5 in range(3):
+                                s += E[r, 9 * a3 + 3 * a4 + a5] * h4 * _HALF[a5, p5]
+                    K[a3, r, 3 * p4 + p5] = s
+                    K[a3, 6 + r, 3 * (p4 + 1) + p5] = s
+    # 5. the eliminant det K(θ3): 17 samples → trigonometric coefficients
+    A = np.empty((12, 12))
+    d = np.empty(_N_DET)
+    best = 0.0
+    for m in range(_N_DET):
+        d[m], ratio = _pencil_det(K, TWO_PI * m / _N_DET, A)
+        best = max(best, ratio)
+    if best < PIVOT_TOL:  # K(θ3) nearly singular for every θ3: a degenerate eliminant
+        return -1
+    ca = np.zeros(DEGREE + 1)
+    cb = np.zeros(DEGREE + 1)
+    for k in range(DEGREE + 1):
+        for m in range(_N_DET):
+            t = TWO_PI * k * m / _N_DET
+            ca[k] += d[m] * math.cos(t)
+            cb[k] += d[m] * math.sin(t)
+        ca[k] *= (1.0 if k == 0 else 2.0) / _N_DET
+        cb[k] *= 2.0 / _N_DET
+    cb[0] = 0.0
+    roots = np.empty(2 * DEGREE)
+    nr = eliminant_roots(ca, cb, roots)
+    if nr < 0:
+        return -1
+    # 6-7. back substitution and refinement; a root whose candidate does not converge to
+    # a new solution is polished on the determinant itself and tried once more
+    u6 = np.zeros(3)  # a unit vector ⟂ w6
+    ax = 0 if abs(w6[0]) < 0.9 else 1
+    u6[ax] = 1.0
+    dw = w6[ax]
+    for i in range(3):
+        u6[i] -= dw * w6[i]
+    nu = math.sqrt(u6[0] ** 2 + u6[1] ** 2 + u6[2] ** 2)
+    for i in range(3):
+        u6[i] /= nu
+    q = np.empty(6)
+    k = 0
+    lost = False
+    for ir in range(nr):
+        t3 = roots[ir]
+        found = False
+        for attempt in range(2):
+            if attempt == 1:
+                t3 = _polish_root(K, t3, A)
+            _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, u6, reverse, A, q)
+            if newton_refine_known(q, T, F, meta, tol_p, tol_r, MAX_NEWTON, out, k,
+                                   KNOWN_RADIUS) != 1:
+                continue
+            dup = False
+            for s_ in range(k):
+                if wrapped_dist(q, out[s_], 6) < 1e-7:
+                    dup = True
+                    break
+            if not dup and k < out.shape[0]:
+                out[k] = q
+                k += 1
+                found = True
+                break
+        lost = lost or not found
+    if lost:  # a root that gave no new solution: a cluster or a singular configuration
+        return -1 - k
+    return k
+
+
+@njit(cache=True)
+def _pencil_det(K, t, A):
+    """``det K(t)`` and its pivot ratio (:func:`_det`), ``K(t) = K[0] + cos t K[1] + sin t K[2]``.
+
+    K (3, 12, 12); A (12, 12) is work space.
+    """
+    c, s = math.cos(t), math.sin(t)
+    for i in range(12):
+        for j in range(12):
+            A[i, j] = K[0, i, j] + c * K[1, i, j] + s * K[2, i, j]
+    return _det(A)
+
+
+@njit(cache=True)
+def _polish_root(K, t, A):
+    """A root of ``det K(θ3)`` near t, by secant steps on the determinant itself.
+
+    The trigonometric interpolant loses relative accuracy where |det| is small compared
+    with its largest values (two close roots); the LU determinant does not. Four steps
+    at most, each kept only if it moves less than 0.01 rad.
+    """
+    h = 1e-7
+    for _ in range(4):
+        d0 = _pencil_det(K, t, A)[0]
+        d1 = _pencil_det(K, t + h, A)[0]
+        if d1 == d0:
+            break
+        step = d0 * h / (d1 - d0)
+        if not abs(step) < 0.01:
+            break
+        t -= step
+        if abs(step) < 1e-13:
+            break
+    return t
+
+
+@njit(cache=True)
+def _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, u6, reverse, A, q):
+    """The configuration (6,) of root θ3 into ``q`` (robot joint order), step 6.
+
+    x4, x5 from the null vector of ``K(θ3)``, (cos, sin) of θ1, θ2 from ``Q⁺·P``,
+    θ6 by subproblem 1 on ``w6``.
+    """
+    v = np.empty(12)
+    c3, s3 = math.cos(t3), math.sin(t3)
+    for i in range(12):
+        for j in range(12):
+            A[i, j] = K[0, i, j] + c3 * K[1, i, j] + s3 * K[2, i, j]
+    _null_vector(A, v)
+    big = -1.0
+    ib = 0
+    for i in range(12):
+        if abs(v[i]) > big:
+            big = abs(v[i])
+            ib = i
+    t5 = _half_angle(v[3 * (ib // 3):], 1, 3)
+    t4 = _half_angle(v[ib % 3:], 3, 4)
+    b3 = (1.0, c3, s3)
+    b4 = (1.0, math.cos(t4), math.sin(t4))
+    b5 = (1.0, math.cos(t5), math.sin(t5))
+    L = np.empty(14)
+    for kk in range(14):
+        s = -Cr[0, kk]
+        for a3 in range(3):
+            for a4 in range(3):
+                for a5 in range(3):
+                    s += Cl[9 * a3 + 3 * a4 + a5, kk] * b3[a3] * b4[a4] * b5[a5]
+        L[kk] = s
+    # m12 = Q⁺ L = Vᵀ diag(1/σ) U[:, :8]ᵀ L; entries (j = 3·a1 + a2 − 1): c2 0, s2 1, c1 2,
+    # s1 5
+    m12 = np.zeros(8)
+    for i in range(8):
+        s = 0.0
+        for kk in range(14):
+            s += U[kk, i] * L[kk]
+        s /= sv[i]
+        for j in range(8):
+            m12[j] += Vt[i, j] * s
+    t1 = math.atan2(m12[5], m12[2])
+    t2 = math.atan2(m12[1], m12[0])
+    # θ6: the rotation left for joint 6, R = R5ᵀ R4ᵀ R3ᵀ R2ᵀ R1ᵀ R_G, applied to u6
+    x = mv(G, u6)
+    x = mtv(rotation(W[0], t1), x)
+    x = mtv(rotation(W[1], t2), x)
+    x = mtv(rotation(W[2], t3), x)
+    x = mtv(rotation(W[3], t4), x)
+    x = mtv(rotation(W[4], t5), x)
+    t6 = sp1_dir(W[5], u6, x)
+    qs = (t1, t2, t3, t4, t5, t6)
+    for j in range(6):
+        q[j] = qs[5 - j] if reverse else qs[j]
