@@ -232,3 +232,30 @@ def test_sixteen_real_solution_arm():
     for f in newton:
         assert _wrapped(rows, f).min() < 1e-6
     assert len(ik_all(robot, T)) == 16
+
+
+@pytest.mark.parametrize("family", [
+    {0: {"a": 0.0}},                    # axes 1 and 2 intersect: joint 5 or 4 is eliminated
+    {0: {"a": 0.0}, 4: {"a": 0.0}},     # 1, 2 and 5, 6 intersect: neither end's θ1, θ2 split
+    {1: {"alpha": 0.0}},                # axes 2 ∥ 3
+    {3: {"alpha": 0.0}},                # axes 4 ∥ 5
+    {2: {"a": 0.0}},                    # axes 3 and 4 intersect
+])
+def test_partly_special_arms_by_elimination(family):
+    """Arms with one or two special pairs (no closed form): eliminated, same set as the search."""
+    rng = np.random.default_rng(17)
+    for _ in range(6):
+        rows = [dict(a=rng.uniform(0.05, 0.5), alpha=rng.uniform(-3.0, 3.0),
+                     d=rng.uniform(-0.3, 0.3)) for _ in range(6)]
+        for j, change in family.items():
+            rows[j].update(change)
+        robot = Robot.from_dh([DHLink(**r) for r in rows])
+        q = rng.uniform(-np.pi, np.pi, 6)
+        T = robot.fk(q)
+        k, found = _solve(robot, T)
+        assert k >= 2
+        assert _wrapped(found, q).min() < 1e-8
+        assert np.abs(robot.fk(found) - T).max() < 1e-10
+        _, searched = _solve(robot, T, search_candidates)
+        for r in searched:
+            assert _wrapped(found, r).min() < 1e-8

@@ -12,6 +12,9 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
    direction ``w6`` and a point ``c6`` of axis 6 are fixed by ``e6``, so
    ``e3 e4 e5 (w6, c6) = e2⁻¹ e1⁻¹ G (w6, c6)``. With ``o3`` a point of axis 3, set
    ``l = R·w6`` and ``p = (·)c6 − o3`` on each side (positions divided by the arm's size).
+   Below, this split is described; when it declines (end of this docstring), joint 5 or
+   4 is eliminated instead (``e2 e3 e4 x = e1⁻¹ G e6⁻¹ x``, ``e1 e2 e3 x = G e6⁻¹ e5⁻¹ x``),
+   then the same three on the reversed chain (:func:`_rr_split`).
 2. **Fourteen equations** (Raghavan–Roth): ``l``, ``p``, ``l·p``, ``p·p``, ``l × p`` and
    ``(p·p) l − 2 (l·p) p`` (3+3+1+1+3+3). Each left side is a combination of the 27
    products of ``(1, c_j, s_j)`` for j = 3, 4, 5 (at most linear in each joint's cosine
@@ -43,9 +46,9 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
    tolerance; duplicates are dropped.
 
 :func:`rr_candidates` reports failure (−1) when the elimination does not apply: ``Q``
-of rank below 8 (special geometry, e.g. intersecting or parallel neighbouring axes, where
-the closed-form classes or the 2-D search take over) or a determinant that vanishes
-identically. Kernels trust their input.
+of rank below 8 (e.g. axes 1 and 2 intersecting: their products are dependent) or a
+pencil nearly singular for every θ3 (an arm near a special class) — for all six splits;
+the closed-form classes or the 2-D search then take over. Kernels trust their input.
 """
 
 from __future__ import annotations
@@ -385,11 +388,43 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
 
     Returns:
         the number of distinct converged solutions, one per real root of the eliminant;
-        −1 when the elimination does not apply (Q of rank < 8, or a pencil nearly
-        singular for every θ3, see :data:`PIVOT_TOL`), and −1 − k when a root gave no
-        new solution even after polishing (a cluster of solutions or a singular
-        configuration; the k solutions found are in ``out``): in both cases the caller
-        searches instead.
+        −1 when no split applies (eliminating joint 6, 5 or 4 of the chain or of its
+        reversal: Q of rank < 8, or a pencil nearly singular for every θ3, see
+        :data:`PIVOT_TOL`), and −1 − k when a root gave no new solution even after
+        polishing (a cluster of solutions or a singular configuration; the k solutions
+        found are in ``out``): in both cases the caller searches instead.
+    """
+    Minv = inv_rigid(M)
+    Wr = np.empty((6, 3))  # the reversed chain: joint j is joint 7 − j about the line
+    Pr = np.empty((6, 3))  # (−R_Mᵀ w, M⁻¹ p), tool pose M⁻¹, target T⁻¹
+    for j in range(6):
+        for i in range(3):
+            Wr[j, i] = -(W[5 - j, 0] * M[0, i] + W[5 - j, 1] * M[1, i] + W[5 - j, 2] * M[2, i])
+            Pr[j, i] = (Minv[i, 0] * P[5 - j, 0] + Minv[i, 1] * P[5 - j, 1]
+                        + Minv[i, 2] * P[5 - j, 2] + Minv[i, 3])
+    for attempt in range(6):  # eliminated joint 6, 5, 4 of the chain, then of its reversal
+        e = 5 - attempt % 3
+        if attempt < 3:
+            k = _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out)
+        else:
+            k = _rr_split(T, Wr, Pr, Minv, not reverse, e, F, meta, tol_p, tol_r, out)
+        if k != -1:
+            return k
+    return -1
+
+
+@njit(cache=True)
+def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
+    """:func:`rr_candidates` for the split that eliminates joint ``e`` (0-based 5, 4 or 3).
+
+    With ``G = T·M⁻¹ = e1···e6`` and ``x`` the direction and a point of axis e:
+
+    * e = 6: ``e3 e4 e5 x = e2⁻¹ · e1⁻¹ · G x`` (left joints 3, 4, 5; right 2, 1);
+    * e = 5: ``e2 e3 e4 x = e1⁻¹ · G · e6⁻¹ x`` (left 2, 3, 4; right 1, 6);
+    * e = 4: ``e1 e2 e3 x = G · e6⁻¹ · e5⁻¹ x`` (left 1, 2, 3; right 6, 5);
+
+    in general ``U·exp(−ξ_D θ_D)·V·exp(−ξ_E θ_E)·W'·x`` on the right with U, V, W'
+    each I or G; the point ``o`` is on the first left axis.
     """
     scale = 0.0
     for j in range(6):
@@ -400,41 +435,49 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
     inv_s = 1.0 / max(scale, 1e-300)
     Ts = inv_rigid(T) if reverse else T
     G = mm(Ts, inv_rigid(M))
-    w6 = W[5].copy()
-    c6 = P[5].copy()
-    o3 = P[2].copy()
+    I4 = np.eye(4)
+    ja, jb, jc = e - 3, e - 2, e - 1  # left joints
+    if e == 5:
+        jd, je_, Um, Vm, Wm = 1, 0, I4, I4, G  # right: outer D, inner E
+    elif e == 4:
+        jd, je_, Um, Vm, Wm = 0, 5, I4, G, I4
+    else:
+        jd, je_, Um, Vm, Wm = 5, 4, G, I4, I4
+    w_e = W[e].copy()
+    c_e = P[e].copy()
+    o = P[ja].copy()
     # 1-2. left side: the 14 quantities at 27 sample angles → coefficients (27, 14)
     V = np.empty((27, 14))
     l = np.empty(3)
     p = np.empty(3)
     for i3 in range(3):
-        E3 = screw(W[2], P[2], _ANGLES[i3], False)
+        EA = screw(W[ja], P[ja], _ANGLES[i3], False)
         for i4 in range(3):
-            E34 = mm(E3, screw(W[3], P[3], _ANGLES[i4], False))
+            EAB = mm(EA, screw(W[jb], P[jb], _ANGLES[i4], False))
             for i5 in range(3):
-                E = mm(E34, screw(W[4], P[4], _ANGLES[i5], False))
-                lv = mv(E, w6)
-                pt = transform_point(E, c6)
+                E = mm(EAB, screw(W[jc], P[jc], _ANGLES[i5], False))
+                lv = mv(E, w_e)
+                pt = transform_point(E, c_e)
                 for i in range(3):
                     l[i] = lv[i]
-                    p[i] = (pt[i] - o3[i]) * inv_s
+                    p[i] = (pt[i] - o[i]) * inv_s
                 _equations(l, p, V, 9 * i3 + 3 * i4 + i5)
     Cl = _to_coefficients(V, 3)
-    # right side: 9 samples of (θ1, θ2) → coefficients (9, 14)
-    lg = mv(G, w6)
-    pg = transform_point(G, c6)
+    # right side: 9 samples of (θ_E, θ_D) → coefficients (9, 14)
+    lw = mv(Wm, w_e)
+    pw = transform_point(Wm, c_e)
     V2 = np.empty((9, 14))
     for i1 in range(3):
-        E1 = screw(W[0], P[0], -_ANGLES[i1], False)
-        l1 = mv(E1, lg)
-        p1 = transform_point(E1, pg)
+        EE = mm(Vm, screw(W[je_], P[je_], -_ANGLES[i1], False))
+        l1 = mv(EE, lw)
+        p1 = transform_point(EE, pw)
         for i2 in range(3):
-            E2 = screw(W[1], P[1], -_ANGLES[i2], False)
-            lv = mv(E2, l1)
-            pt = transform_point(E2, p1)
+            ED = mm(Um, screw(W[jd], P[jd], -_ANGLES[i2], False))
+            lv = mv(ED, l1)
+            pt = transform_point(ED, p1)
             for i in range(3):
                 l[i] = lv[i]
-                p[i] = (pt[i] - o3[i]) * inv_s
+                p[i] = (pt[i] - o[i]) * inv_s
             _equations(l, p, V2, 3 * i1 + i2)
     Cr = _to_coefficients(V2, 2)
     # 3. eliminate θ1, θ2: left null space of Q (14, 8)
@@ -495,12 +538,12 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
         return -1
     # 6-7. back substitution and refinement; a root whose candidate does not converge to
     # a new solution is polished on the determinant itself and tried once more
-    u6 = np.zeros(3)  # a unit vector ⟂ w6
-    ax = 0 if abs(w6[0]) < 0.9 else 1
+    u6 = np.zeros(3)  # a unit vector ⟂ w_e
+    ax = 0 if abs(w_e[0]) < 0.9 else 1
     u6[ax] = 1.0
-    dw = w6[ax]
+    dw = w_e[ax]
     for i in range(3):
-        u6[i] -= dw * w6[i]
+        u6[i] -= dw * w_e[i]
     nu = math.sqrt(u6[0] ** 2 + u6[1] ** 2 + u6[2] ** 2)
     for i in range(3):
         u6[i] /= nu
@@ -513,7 +556,7 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
         for attempt in range(2):
             if attempt == 1:
                 t3 = _polish_root(K, t3, A)
-            _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, u6, reverse, A, q)
+            _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u6, reverse, A, q)
             if newton_refine_known(q, T, F, meta, tol_p, tol_r, MAX_NEWTON, out, k,
                                    KNOWN_RADIUS) != 1:
                 continue
@@ -570,11 +613,13 @@ def _polish_root(K, t, A):
 
 
 @njit(cache=True)
-def _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, u6, reverse, A, q):
+def _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u, reverse, A, q):
     """The configuration (6,) of root θ3 into ``q`` (robot joint order), step 6.
 
-    x4, x5 from the null vector of ``K(θ3)``, (cos, sin) of θ1, θ2 from ``Q⁺·P``,
-    θ6 by subproblem 1 on ``w6``.
+    For the split eliminating joint ``e`` (see :func:`_rr_split`; "θ3, θ4, θ5" are its
+    left joints, "θ1, θ2" its right ones): x4, x5 from the null vector of ``K(θ3)``,
+    (cos, sin) of the right joints from ``Q⁺·P``, then joint e by subproblem 1 on its
+    axis (``u`` (3,) a unit vector ⟂ it).
     """
     v = np.empty(12)
     c3, s3 = math.cos(t3), math.sin(t3)
@@ -611,16 +656,18 @@ def _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, u6, reverse, A, q):
         s /= sv[i]
         for j in range(8):
             m12[j] += Vt[i, j] * s
-    t1 = math.atan2(m12[5], m12[2])
-    t2 = math.atan2(m12[1], m12[0])
-    # θ6: the rotation left for joint 6, R = R5ᵀ R4ᵀ R3ᵀ R2ᵀ R1ᵀ R_G, applied to u6
-    x = mv(G, u6)
-    x = mtv(rotation(W[0], t1), x)
-    x = mtv(rotation(W[1], t2), x)
-    x = mtv(rotation(W[2], t3), x)
-    x = mtv(rotation(W[3], t4), x)
-    x = mtv(rotation(W[4], t5), x)
-    t6 = sp1_dir(W[5], u6, x)
-    qs = (t1, t2, t3, t4, t5, t6)
+    qs = np.zeros(6)
+    qs[e - 3], qs[e - 2], qs[e - 1] = t3, t4, t5
+    inner, outer = (0, 1) if e == 5 else ((5, 0) if e == 4 else (4, 5))
+    qs[inner] = math.atan2(m12[5], m12[2])
+    qs[outer] = math.atan2(m12[1], m12[0])
+    # joint e: R_e = (R_1···R_{e−1})ᵀ R_G (R_{e+1}···R_6)ᵀ, applied to u
+    x = u.copy()
+    for j in range(e + 1, 6):
+        x = mtv(rotation(W[j], qs[j]), x)
+    x = mv(G, x)
+    for j in range(e):
+        x = mtv(rotation(W[j], qs[j]), x)
+    qs[e] = sp1_dir(W[e], u, x)
     for j in range(6):
         q[j] = qs[5 - j] if reverse else qs[j]
