@@ -112,3 +112,24 @@ def test_bad_out_buffers_are_refused(bad):
         robot.fk(robot.random_q(seed=1), out=bad)
     with pytest.raises(InputError, match="out"):
         robot.jacobian(robot.random_q(seed=1), out=bad)
+
+
+@pytest.mark.parametrize("make", [models.ur5, lambda: models.planar(2)])
+def test_single_call_fast_path_converts_other_arrays(make):
+    """Integer, float32, (n, 1) and strided q give the float64 answer (never bits reinterpreted)."""
+    robot = make()
+    n = robot.n
+    q = np.arange(1, n + 1, dtype=float) / 4
+    T, J = robot.fk(q), robot.jacobian(q)
+    for other in (np.arange(1, n + 1), q.astype(np.float32), np.repeat(q, 2)[::2]):
+        expect = (q if other.dtype.kind == "f" and other.dtype.itemsize == 8
+                  else other.astype(float))
+        np.testing.assert_allclose(robot.fk(other), robot.fk(expect.copy()), atol=1e-6)
+        np.testing.assert_allclose(robot.jacobian(other), robot.jacobian(expect.copy()),
+                                   atol=1e-6)
+    np.testing.assert_allclose(robot.fk(np.arange(1, n + 1)), robot.fk(np.arange(1.0, n + 1)))
+    column = q.reshape(n, 1)  # (n, 1) is a batch of n one-value rows: refused, not misread
+    with pytest.raises(InputError):
+        robot.fk(column)
+    assert robot.fk(q[None]).shape == (1, 4, 4) and np.array_equal(robot.fk(q[None])[0], T)
+    assert np.array_equal(robot.jacobian(q[None])[0], J)

@@ -201,27 +201,40 @@ def fk_into(q, F, meta, T):
 
 @njit(cache=True)
 def fk_one(q, P, T):
-    """End-effector pose into ``T`` (4, 4) over the packed chain; False (T untouched) on NaN q."""
+    """End-effector pose into ``T`` (4, 4) over the packed chain.
+
+    Returns 0, or (T untouched) 1 when ``q`` has a NaN/inf and 2 when it does not have n
+    values: the single-call entry of ``Robot.fk`` checks the length here, in the compiled
+    call, rather than in Python.
+    """
     n = P.shape[0] - 1
+    if q.shape[0] != n:
+        return 2
     for i in range(n):
         if not math.isfinite(q[i]):
-            return False
+            return 1
     SC = T if n <= 8 else np.empty((2, n))  # T holds the sin/cos of up to 8 joints
     _store_pose(_chain_walk(q, P, P[:n, 3, 0], P[:n, 3, 1], T, False, SC), T)
-    return True
+    return 0
 
 
 @njit(cache=True)
 def jacobian_one(q, P, J):
-    """Geometric Jacobian (eqs 33-36) into ``J`` (6, n) over the packed chain; False on NaN q."""
+    """Geometric Jacobian (eqs 33-36) into ``J`` (6, n) over the packed chain.
+
+    Returns 0, or (J untouched) 1 when ``q`` has a NaN/inf and 2 when it does not have n
+    values (checked here, as in :func:`fk_one`).
+    """
     n = P.shape[0] - 1
+    if q.shape[0] != n:
+        return 2
     for i in range(n):
         if not math.isfinite(q[i]):
-            return False
+            return 1
     kind = P[:n, 3, 0]
     t = _chain_walk(q, P, kind, P[:n, 3, 1], J, True, J)
     _finish_columns(J, kind, n, t[3], t[7], t[11])
-    return True
+    return 0
 
 
 # --- sin/cos, and batches: blocks of configurations in structure-of-arrays form -----------

@@ -59,8 +59,11 @@ def _fast() -> tuple[Any, Any, Any, Any]:
     ``fk_one``, ``jacobian_one``, ``hessian_one``, ``jacobian_dot_one``. Calling an entry
     point skips numba's per-call type dispatch (0.2-2 µs). They are compiled for ``q``
     (and ``qd``) 1-D float64 arrays of any layout, ``P`` the read-only packed chain, a
-    bool frame flag and a C-contiguous float64 output; the fast paths check exactly that
-    before calling.
+    bool frame flag and a C-contiguous float64 output. An entry point does NOT check the
+    dtype or the number of dimensions of an array (an int64 q would be read as float64):
+    the fast paths check both before calling. ``fk_one``/``jacobian_one`` check the
+    length and finiteness themselves and return a nonzero code: the fast paths then take
+    the general one, which raises the library's error.
     """
     global _FK1, _JAC1, _HESS1, _JDOT1
     import numba
@@ -419,11 +422,12 @@ class Robot:
         Raises:
             InputError: q of the wrong shape or not finite; out of the wrong kind.
         """
-        if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 and len(q) == self.n:
-            T = _EMPTY((4, 4)) if out is None else _out_array(out, (4, 4))
-            if (_FK1 or _fast()[0])(q, self._P, T):
+        if out is None and type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1:
+            # one configuration: one compiled call, which checks the length and finiteness
+            # (an entry point does not check dtype or ndim: they are checked here)
+            T = _EMPTY((4, 4))
+            if (_FK1 or _fast()[0])(q, self._P, T) == 0:
                 return T
-            raise self._nonfinite(q)
         a = self.check_q(q)
         shape = a.shape[:-1] + (4, 4)
         check_allocation("the FK batch", shape, 8, setting="the batch size")
@@ -487,12 +491,11 @@ class Robot:
             InputError: q of the wrong shape or not finite, unknown frame, link outside
                 0..n, point without link, out of the wrong kind.
         """
-        if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 and len(q) == self.n \
+        if out is None and type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 \
                 and link is None and point is None and type(frame) is str and frame == "base":
-            J = _EMPTY(self._jshape) if out is None else _out_array(out, self._jshape)
-            if (_JAC1 or _fast()[1])(q, self._P, J):
+            J = _EMPTY(self._jshape)  # one compiled call, as in fk
+            if (_JAC1 or _fast()[1])(q, self._P, J) == 0:
                 return J
-            raise self._nonfinite(q)
         a, J, T = self._jacobians(q, frame, link, point)
         shape = a.shape[:-1] + (6, self.n)
         if out is None:
