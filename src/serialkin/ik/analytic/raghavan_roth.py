@@ -12,7 +12,7 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
    direction ``w6`` and a point ``c6`` of axis 6 are fixed by ``e6``, so
    ``e3 e4 e5 (w6, c6) = e2⁻¹ e1⁻¹ G (w6, c6)``. With ``o3`` a point of axis 3, set
    ``l = R·w6`` and ``p = (·)c6 − o3`` on each side (positions divided by the arm's size).
-   Below, this split is described; when it declines (end of this docstring), joint 5 or
+   Below, this split is described; when it degenerates exactly, joint 5 or
    4 is eliminated instead (``e2 e3 e4 x = e1⁻¹ G e6⁻¹ x``, ``e1 e2 e3 x = G e6⁻¹ e5⁻¹ x``),
    then the same three on the reversed chain (:func:`_rr_split`).
 2. **Fourteen equations** (Raghavan–Roth): ``l``, ``p``, ``l·p``, ``p·p``, ``l × p`` and
@@ -46,9 +46,10 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
    tolerance; duplicates are dropped.
 
 :func:`rr_candidates` reports failure (−1) when the elimination does not apply: ``Q``
-of rank below 8 (e.g. axes 1 and 2 intersecting: their products are dependent) or a
-pencil nearly singular for every θ3 (an arm near a special class) — for all six splits;
-the closed-form classes or the 2-D search then take over. Kernels trust their input.
+of rank below 8 or a pencil singular to rounding for all six splits (an exact special
+pair, e.g. axes 1 and 2 intersecting, degenerates a split: the next one is tried), or a
+pencil nearly singular for every θ3 (an arm near a special class: no split is trusted);
+the 2-D search then takes over. Kernels trust their input.
 """
 
 from __future__ import annotations
@@ -90,6 +91,17 @@ RANK_TOL = 1e-9
 #: eliminant degenerates) and the search takes over. Random arms give 1e-2 to 0.3,
 #: arms within 0.01 rad of the UR5 or the Puma 560 1e-7 to 4e-4.
 PIVOT_TOL = 1e-3
+#: Below this pivot ratio the pencil is singular to rounding for every θ3: the split
+#: degenerates exactly (e.g. axes 1 and 2 intersecting or parallel give 1e-16 to 1e-11)
+#: and the next split is tried.
+EXACT_TOL = 1e-10
+#: :func:`_rr_split` codes: Q of rank < 8 or a pencil singular to rounding for this split
+#: (an exact special pair: the next split is tried), and a nearly degenerate eliminant
+#: (pivot ratio in [EXACT_TOL, PIVOT_TOL): an arm close to a special class, where another
+#: split can be well conditioned and still find an incomplete set of roots — seen on
+#: tilted Puma 560s — so the search answers instead).
+RANK_DEFICIENT = -1000
+NEAR_SPECIAL = -1001
 #: Newton iterates this close to a solution already found stop [rad] (see
 #: :func:`~serialkin.ik.analytic.refine.newton_refine_known`).
 KNOWN_RADIUS = 1e-4
@@ -249,7 +261,8 @@ def _zero(a, b, lo, hi, order):
     """Zero in [lo, hi] of derivative ``order`` of f, which changes sign there.
 
     Newton steps on the next derivative when they stay inside the bracket, else
-    bisection; 60 iterations at most, or until the bracket is below 1e-15 rad.
+    bisection; 60 iterations at most, or until the bracket or a Newton step is below
+    1e-15 rad.
     """
     flo = _trig(a, b, lo, order)
     x = 0.5 * (lo + hi)
@@ -266,7 +279,12 @@ def _zero(a, b, lo, hi, order):
             break
         fp = _trig(a, b, x, order + 1)
         xn = x - f / fp if fp != 0.0 else 0.5 * (lo + hi)
-        x = xn if lo < xn < hi else 0.5 * (lo + hi)
+        if lo < xn < hi:
+            if abs(xn - x) < 1e-15:
+                return xn
+            x = xn
+        else:
+            x = 0.5 * (lo + hi)
     return x
 
 
@@ -291,7 +309,59 @@ def _changes(u, v):
 
 
 @njit(cache=True)
-def eliminant_roots(a, b, roots):
+def _trig3(a, b, c1, s1):
+    """f, f' and f'' of the trigonometric polynomial (a, b) where (cos t, sin t) = (c1, s1)."""
+    ck, sk = 1.0, 0.0
+    f = a[0]
+    f1 = 0.0
+    f2 = 0.0
+    for k in range(1, a.shape[0]):
+        ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1
+        u = a[k] * ck + b[k] * sk
+        f += u
+        f1 += k * (b[k] * ck - a[k] * sk)
+        f2 -= k * k * u
+    return f, f1, f2
+
+
+@njit(cache=True)
+def _cell_pieces(a, b, lo, hi, f_lo, g_lo, s_lo, f_hi, g_hi, s_hi, tiny, roots, k):
+    """Roots of f in the cell [lo, hi] by monotone pieces (the general case); new count.
+
+    The extrema of f (zeros of f') split the cell; f' is monotone between the zeros of
+    f'' (at most one is looked for). One root at most lies on each piece.
+    """
+    cut = np.empty(4)
+    nc = 0
+    cut[nc] = lo
+    nc += 1
+    if _changes(s_lo, s_hi):
+        x = _zero(a, b, lo, hi, 2)
+        gx = _trig(a, b, x, 1)
+        if _changes(g_lo, gx):
+            cut[nc] = _zero(a, b, lo, x, 1)
+            nc += 1
+        if _changes(gx, g_hi):
+            cut[nc] = _zero(a, b, x, hi, 1)
+            nc += 1
+    elif _changes(g_lo, g_hi):
+        cut[nc] = _zero(a, b, lo, hi, 1)
+        nc += 1
+    x0 = lo
+    f0 = f_lo
+    for i in range(1, nc + 1):
+        x1 = cut[i] if i < nc else hi
+        f1 = _trig(a, b, x1, 0) if i < nc else f_hi
+        if i < nc and abs(f1) <= tiny:
+            k = _add_root(roots, k, x1)  # an extremum at zero: a double root
+        elif _changes(f0, f1):
+            k = _add_root(roots, k, _zero(a, b, x0, x1, 0))
+        x0, f0 = x1, f1
+    return k
+
+
+@njit(cache=True)
+def eliminant_roots(a, b, roots, stats):
     """Real roots in [−π, π) of the trigonometric polynomial (a, b) into ``roots``; their count.
 
     The circle is cut into :data:`N_GRID` cells, and each cell into pieces on which f is
@@ -300,8 +370,15 @@ def eliminant_roots(a, b, roots):
     holds exactly one root (bisected with Newton steps); an extremum where |f| is below
     1e-10 of the coefficients' size is a double root. So two or three roots closer
     than a cell are separated; only a cell holding two inflections of this degree-8
-    polynomial could hide a pair. Returns −1 when f vanishes identically.
+    polynomial could hide a pair. Cells where f and f' are monotone, or where f has one
+    extremum moving away from zero, are settled from their end values alone.
+    Returns −1 when f vanishes identically. ``stats`` (2,) receives how close the
+    polynomial comes to a double root: the smallest |f| at an extremum between two
+    same-sign values, over max |f| on the grid (``inf`` if none), and the smallest
+    distance between two roots [rad] (``inf`` below two roots).
     """
+    stats[0] = math.inf
+    stats[1] = math.inf
     size = 0.0
     for k in range(a.shape[0]):
         size += abs(a[k]) + abs(b[k])
@@ -309,47 +386,44 @@ def eliminant_roots(a, b, roots):
         return -1
     tiny = 1e-10 * size
     h = TWO_PI / N_GRID
+    ch, sh = math.cos(h), math.sin(h)
+    c, s = -1.0, 0.0  # cos, sin of the cell's end, advanced by the rotation of h
     k = 0
-    cut = np.empty(4)
     lo = -math.pi
-    f_lo = _trig(a, b, lo, 0)
-    g_lo = _trig(a, b, lo, 1)
-    s_lo = _trig(a, b, lo, 2)
+    f_lo, g_lo, s_lo = _trig3(a, b, c, s)
+    fmax = abs(f_lo)
     for m in range(N_GRID):
         hi = -math.pi + h * (m + 1)
-        f_hi = _trig(a, b, hi, 0)
-        g_hi = _trig(a, b, hi, 1)
-        s_hi = _trig(a, b, hi, 2)
+        if m % 16 == 15:  # re-anchor the rotation now and then (no drift)
+            c, s = math.cos(hi), math.sin(hi)
+        else:
+            c, s = c * ch - s * sh, s * ch + c * sh
+        f_hi, g_hi, s_hi = _trig3(a, b, c, s)
+        fmax = max(fmax, abs(f_hi))
         if f_lo == 0.0:
             k = _add_root(roots, k, lo)
-        # extrema of f in the cell: zeros of f' on the pieces between zeros of f''
-        nc = 0
-        cut[nc] = lo
-        nc += 1
-        if _changes(s_lo, s_hi):
-            x = _zero(a, b, lo, hi, 2)
-            gx = _trig(a, b, x, 1)
-            if _changes(g_lo, gx):
-                cut[nc] = _zero(a, b, lo, x, 1)
-                nc += 1
-            if _changes(gx, g_hi):
-                cut[nc] = _zero(a, b, x, hi, 1)
-                nc += 1
-        elif _changes(g_lo, g_hi):
-            cut[nc] = _zero(a, b, lo, hi, 1)
-            nc += 1
-        # one root at most on each monotone piece
-        x0 = lo
-        f0 = f_lo
-        for i in range(1, nc + 1):
-            x1 = cut[i] if i < nc else hi
-            f1 = _trig(a, b, x1, 0) if i < nc else f_hi
-            if i < nc and abs(f1) <= tiny:
-                k = _add_root(roots, k, x1)  # an extremum at zero: a double root
-            elif _changes(f0, f1):
-                k = _add_root(roots, k, _zero(a, b, x0, x1, 0))
-            x0, f0 = x1, f1
+        if _changes(s_lo, s_hi):  # f' may turn twice: the general case
+            k = _cell_pieces(a, b, lo, hi, f_lo, g_lo, s_lo, f_hi, g_hi, s_hi, tiny, roots, k)
+        elif _changes(f_lo, f_hi):  # at most one extremum: exactly one root
+            k = _add_root(roots, k, _zero(a, b, lo, hi, 0))
+        elif _changes(g_lo, g_hi) and (f_lo > 0.0) == (g_lo < 0.0):
+            # one extremum, and f moves toward zero first: two roots, a double one, or none
+            x = _zero(a, b, lo, hi, 1)
+            fx = _trig(a, b, x, 0)
+            if not _changes(f_lo, fx):
+                stats[0] = min(stats[0], abs(fx))
+            if abs(fx) <= tiny:
+                k = _add_root(roots, k, x)
+            elif _changes(f_lo, fx):
+                k = _add_root(roots, k, _zero(a, b, lo, x, 0))
+                k = _add_root(roots, k, _zero(a, b, x, hi, 0))
         lo, f_lo, g_lo, s_lo = hi, f_hi, g_hi, s_hi
+    if fmax > 0.0:
+        stats[0] /= fmax
+    for i in range(k):
+        for j in range(i):
+            d = abs(roots[i] - roots[j])
+            stats[1] = min(stats[1], min(d, TWO_PI - d))
     return k
 
 
@@ -389,10 +463,11 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
     Returns:
         the number of distinct converged solutions, one per real root of the eliminant;
         −1 when no split applies (eliminating joint 6, 5 or 4 of the chain or of its
-        reversal: Q of rank < 8, or a pencil nearly singular for every θ3, see
-        :data:`PIVOT_TOL`), and −1 − k when a root gave no new solution even after
-        polishing (a cluster of solutions or a singular configuration; the k solutions
-        found are in ``out``): in both cases the caller searches instead.
+        reversal, tried in turn while one degenerates exactly, :data:`EXACT_TOL`) or
+        the pencil is nearly singular for every θ3 (:data:`PIVOT_TOL`), and −1 − k
+        when a root gave no new solution even after polishing (a cluster of solutions
+        or a singular configuration; the k solutions found are in ``out``): in both
+        cases the caller searches instead.
     """
     Minv = inv_rigid(M)
     Wr = np.empty((6, 3))  # the reversed chain: joint j is joint 7 − j about the line
@@ -408,7 +483,9 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
             k = _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out)
         else:
             k = _rr_split(T, Wr, Pr, Minv, not reverse, e, F, meta, tol_p, tol_r, out)
-        if k != -1:
+        if k == NEAR_SPECIAL:  # near a special class: no split is trusted, search
+            return -1
+        if k != RANK_DEFICIENT:
             return k
     return -1
 
@@ -487,7 +564,7 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
             Q[k, j] = Cr[j + 1, k]
     U, sv, Vt = np.linalg.svd(Q)
     if not sv[7] > RANK_TOL * sv[0]:
-        return -1
+        return RANK_DEFICIENT
     E = np.zeros((6, 27))  # N·(left − constant), basis index 9·a3 + 3·a4 + a5
     for r in range(6):
         for idx in range(27):
@@ -520,8 +597,10 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
     for m in range(_N_DET):
         d[m], ratio = _pencil_det(K, TWO_PI * m / _N_DET, A)
         best = max(best, ratio)
-    if best < PIVOT_TOL:  # K(θ3) nearly singular for every θ3: a degenerate eliminant
-        return -1
+    if best < EXACT_TOL:  # K(θ3) singular for every θ3: this split degenerates exactly
+        return RANK_DEFICIENT
+    if best < PIVOT_TOL:  # nearly singular for every θ3: an arm near a special class
+        return NEAR_SPECIAL
     ca = np.zeros(DEGREE + 1)
     cb = np.zeros(DEGREE + 1)
     for k in range(DEGREE + 1):
@@ -533,9 +612,10 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
         cb[k] *= 2.0 / _N_DET
     cb[0] = 0.0
     roots = np.empty(2 * DEGREE)
-    nr = eliminant_roots(ca, cb, roots)
+    stats = np.empty(2)
+    nr = eliminant_roots(ca, cb, roots, stats)
     if nr < 0:
-        return -1
+        return NEAR_SPECIAL
     # 6-7. back substitution and refinement; a root whose candidate does not converge to
     # a new solution is polished on the determinant itself and tried once more
     u6 = np.zeros(3)  # a unit vector ⟂ w_e
