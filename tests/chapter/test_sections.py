@@ -58,3 +58,13 @@ def test_jobs_must_be_positive(tmp_path):
 
     with pytest.raises(InputError, match="jobs"):
         build_report(tmp_path, quiet=True, jobs=0, sections=["rigid_motion"])
+
+
+def test_section_4_shows_sixteen_solutions(ctx):
+    """Section 4 shows the 16-solution general 6R arm, every solution meeting FK to 1e-10."""
+    from serialkin.chapter.sections import inverse
+
+    html = inverse._section_4(ctx).html
+    assert "in <b>16</b> ways" in html
+    err = float(html.split("worst max |f(q) − T| = ")[1].split(")")[0])
+    assert err < 1e-10
