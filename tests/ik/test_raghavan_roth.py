@@ -20,21 +20,10 @@ from serialkin.ik.analytic.raghavan_roth import (
     eliminant_roots,
     rr_candidates,
 )
-from serialkin.ik.analytic.refine import newton_refine
 from serialkin.ik.analytic.structure import general_structure, joint_lines
 from serialkin.ik.analytic.subproblems import screw
 from serialkin.model.dh import DHLink
-
-
-def _wrapped(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Largest joint difference, wrapped to [-π, π]."""
-    return np.abs((np.asarray(a) - b + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)
-
-
-def _random_arm(rng: np.random.Generator) -> Robot:
-    """A random 6R standard-DH arm (general: no special structure)."""
-    return Robot.from_dh([DHLink(a=rng.uniform(0.05, 0.5), alpha=rng.uniform(-3.0, 3.0),
-                                 d=rng.uniform(-0.3, 0.3)) for _ in range(6)], name="random")
+from tests.ik.test_analytic_general import _newton_set, _perturbed, _random_arm, _wrapped
 
 
 def _quantities(l: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -136,17 +125,6 @@ def test_eliminant_roots_none_and_identically_zero():
     assert eliminant_roots(a, b, out, np.empty(2)) == 0
 
 
-def _newton_set(robot: Robot, T: np.ndarray, seeds: int, rng: np.random.Generator) -> list:
-    """Distinct solutions Newton's method reaches from random starts (independent check)."""
-    found: list[np.ndarray] = []
-    for _ in range(seeds):
-        q = rng.uniform(-np.pi, np.pi, 6)
-        if newton_refine(q, T, robot.chain.F, robot.chain.meta, 1e-11, 1e-11, 60):
-            if not any(_wrapped(q, f) < 1e-6 for f in found):
-                found.append(q)
-    return found
-
-
 def test_elimination_agrees_with_the_search_on_random_arms():
     """40 random arms: the same solution set as the 2-D search (grid 48), FK to 1e-10."""
     rng = np.random.default_rng(21)
@@ -191,11 +169,7 @@ def test_elimination_applies_to_almost_every_random_arm():
 def test_nearly_special_arm_is_declined_and_searched():
     """A Puma 560 with axes tilted by 0.01 rad: the eliminant degenerates, the search gives 8."""
     rng = np.random.default_rng(1)
-    ideal = models.puma560().with_limits(np.tile([-np.inf, np.inf], (6, 1)))
-    rows = [DHLink(a=r.a + rng.uniform(-1e-3, 1e-3), alpha=r.alpha + rng.uniform(-0.01, 0.01),
-                   d=r.d + rng.uniform(-1e-3, 1e-3), theta=r.theta + rng.uniform(-0.01, 0.01))
-            for r in ideal.dh]
-    robot = Robot.from_dh(rows, ideal.convention, base=ideal.base, tool=ideal.tool)
+    robot = _perturbed(models.puma560().with_limits(np.tile([-np.inf, np.inf], (6, 1))), rng)
     q = np.array([0.3, 0.3, 0.2, 0.6, -1.5, -2.4])
     T = robot.fk(q)
     k, _ = _solve(robot, T)
@@ -272,11 +246,7 @@ def test_tilted_arms_never_return_an_incomplete_even_set():
         ideal = make()
         for angle in (0.01, 0.001):
             for _ in range(3):
-                rows = [DHLink(a=r.a + rng.uniform(-1e-3, 1e-3),
-                               alpha=r.alpha + rng.uniform(-angle, angle),
-                               d=r.d + rng.uniform(-1e-3, 1e-3),
-                               theta=r.theta + rng.uniform(-angle, angle)) for r in ideal.dh]
-                robot = Robot.from_dh(rows, ideal.convention, base=ideal.base, tool=ideal.tool)
+                robot = _perturbed(ideal, rng, angle)
                 T = robot.fk(rng.uniform(-2.5, 2.5, 6))
                 k, rows_rr = _solve(robot, T)
                 k2, rows_search = _solve(robot, T, search_candidates)

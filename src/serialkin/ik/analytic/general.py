@@ -73,28 +73,7 @@ def general_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_
 
     By :func:`~serialkin.ik.analytic.raghavan_roth.rr_candidates` when it applies and
     accounts for every root of its eliminant with an even count, else by
-    :func:`search_candidates`.
-
-    Args:
-        T: (4, 4) target pose (world).
-        W: (6, 3) unit joint directions at q = 0.
-        P: (6, 3) a point of each joint line at q = 0 [m].
-        M: (4, 4) tool pose at q = 0.
-        aux: class data of the 3R arm of joints 1-3 (``aux[0]`` = c, a point of axis 4,
-            then as for :func:`~serialkin.ik.analytic.spherical_wrist.arm_positions`),
-            and ``aux[-1]`` a unit vector ⟂ w4.
-        arm: arm code for ``arm_positions`` (0 planar 2 ∥ 3, 1 axes 1, 2 meet, 2 other).
-        reverse: W, P, M describe the reversed chain (joint j is joint 7 − j, tool pose
-            M⁻¹), searched for ``T⁻¹``; rows are returned in the robot's joint order.
-        grid: nodes per searched joint (N; N² nodes).
-        F: (7, 4, 4) chain transforms.
-        meta: (6, 5) chain joint data.
-        tol_p: Newton position tolerance [m].
-        tol_r: Newton rotation tolerance [rad].
-        out: (16, 6) output rows (refined, not wrapped).
-
-    Returns:
-        the number of distinct converged solutions.
+    :func:`search_candidates`; arguments and result as for :func:`search_candidates`.
     """
     k = rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out)
     if k >= 0 and k % 2 == 0:
