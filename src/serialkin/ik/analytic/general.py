@@ -44,7 +44,7 @@ import numpy as np
 from numba import njit
 
 from serialkin.ik.analytic.raghavan_roth import rr_candidates
-from serialkin.ik.analytic.refine import MAX_NEWTON, newton_refine_known, wrapped_dist
+from serialkin.ik.analytic.refine import refine_new, wrapped_dist
 from serialkin.ik.analytic.spherical_wrist import arm_positions
 from serialkin.ik.analytic.subproblems import (
     TWO_PI,
@@ -185,17 +185,7 @@ def search_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r
                             break
                     if near:
                         continue
-                    if newton_refine_known(q, T, F, meta, tol_p, tol_r, MAX_NEWTON, out, k,
-                                           KNOWN_RADIUS) != 1:
-                        continue
-                    dup = False
-                    for s in range(k):
-                        if wrapped_dist(q, out[s], 6) < 1e-7:
-                            dup = True
-                            break
-                    if not dup and k < out.shape[0]:
-                        out[k] = q
-                        k += 1
+                    k = refine_new(q, T, F, meta, tol_p, tol_r, out, k, KNOWN_RADIUS)
     return k
 
 

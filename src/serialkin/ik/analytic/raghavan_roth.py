@@ -42,7 +42,7 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
    least-squares solution of ``Q·m12 = P`` (the same SVD) gives ``(cos θ1, sin θ1)`` and
    ``(cos θ2, sin θ2)``; θ6 follows by subproblem 1 on ``w6``.
 7. **Refinement.** Every candidate is polished by Newton's method on the robot's own
-   chain (:func:`~serialkin.ik.analytic.refine.newton_refine_known`) to the solver's
+   chain (:func:`~serialkin.ik.analytic.refine.refine_new`) to the solver's
    tolerance; duplicates are dropped.
 
 :func:`rr_candidates` reports failure (−1) when the elimination does not apply: ``Q``
@@ -59,7 +59,7 @@ import math
 import numpy as np
 from numba import njit
 
-from serialkin.ik.analytic.refine import MAX_NEWTON, newton_refine_known, wrapped_dist
+from serialkin.ik.analytic.refine import refine_new
 from serialkin.ik.analytic.subproblems import (
     TWO_PI,
     inv_rigid,
@@ -637,17 +637,9 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
             if attempt == 1:
                 t3 = _polish_root(K, t3, A)
             _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u6, reverse, A, q)
-            if newton_refine_known(q, T, F, meta, tol_p, tol_r, MAX_NEWTON, out, k,
-                                   KNOWN_RADIUS) != 1:
-                continue
-            dup = False
-            for s_ in range(k):
-                if wrapped_dist(q, out[s_], 6) < 1e-7:
-                    dup = True
-                    break
-            if not dup and k < out.shape[0]:
-                out[k] = q
-                k += 1
+            k_new = refine_new(q, T, F, meta, tol_p, tol_r, out, k, KNOWN_RADIUS)
+            if k_new > k:
+                k = k_new
                 found = True
                 break
         lost = lost or not found

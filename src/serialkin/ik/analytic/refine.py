@@ -113,3 +113,25 @@ def refine_rows(cand, k, T, F, meta, tol_p, tol_r, converged):
         ok = newton_refine(q, T, F, meta, tol_p, tol_r, MAX_NEWTON)
         converged[i] = ok
         cand[i] = q
+
+
+@njit(cache=True)
+def refine_new(q, T, F, meta, tol_p, tol_r, out, k, radius):
+    """Refine the start ``q`` (n,) and append it to ``out[k]`` when it is a new solution.
+
+    Newton's method (:func:`newton_refine_known`, stopping within ``radius`` of a row of
+    ``out[:k]``); a converged ``q`` within 1e-7 rad (every joint, wrapped) of a row
+    already there, or beyond the capacity of ``out`` (K, n), is not added.
+
+    Returns:
+        the new number of rows (k or k + 1).
+    """
+    if newton_refine_known(q, T, F, meta, tol_p, tol_r, MAX_NEWTON, out, k, radius) != 1:
+        return k
+    for s in range(k):
+        if wrapped_dist(q, out[s], q.shape[0]) < 1e-7:
+            return k
+    if k < out.shape[0]:
+        out[k] = q
+        return k + 1
+    return k
