@@ -97,6 +97,66 @@ def mtv(A, v):
     return out
 
 
+# --- 3-vectors as tuples ------------------------------------------------------------------
+#
+# A numba function that returns a new (3,) array pays for a heap allocation (30-50 ns),
+# which dominated the closed forms (about 100 per pose). The hot paths instead carry
+# vectors as (x, y, z) tuples, which live in registers; the functions below take tuples
+# or array rows alike (anything indexable by 0, 1, 2).
+
+
+@njit(cache=True)
+def row3(a, i):
+    """Row i of an (m, 3) array (or the first three entries of row i) as a tuple."""
+    return (a[i, 0], a[i, 1], a[i, 2])
+
+
+@njit(cache=True)
+def add3(a, b):
+    """``a + b`` of two 3-vectors, a tuple."""
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+@njit(cache=True)
+def sub3(a, b):
+    """``a − b`` of two 3-vectors, a tuple."""
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+@njit(cache=True)
+def cross3t(a, b):
+    """Cross product of two 3-vectors, a tuple (see :func:`cross3` for an array)."""
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@njit(cache=True)
+def mv3(A, v):
+    """``A[:3, :3]·v`` as a tuple (A a (3, 3) or (4, 4) array)."""
+    return (A[0, 0] * v[0] + A[0, 1] * v[1] + A[0, 2] * v[2],
+            A[1, 0] * v[0] + A[1, 1] * v[1] + A[1, 2] * v[2],
+            A[2, 0] * v[0] + A[2, 1] * v[1] + A[2, 2] * v[2])
+
+
+@njit(cache=True)
+def mtv3(A, v):
+    """``A[:3, :3]ᵀ·v`` as a tuple (A a (3, 3) or (4, 4) array)."""
+    return (A[0, 0] * v[0] + A[1, 0] * v[1] + A[2, 0] * v[2],
+            A[0, 1] * v[0] + A[1, 1] * v[1] + A[2, 1] * v[2],
+            A[0, 2] * v[0] + A[1, 2] * v[1] + A[2, 2] * v[2])
+
+
+@njit(cache=True)
+def rot3(w, c, s, v):
+    """``Rot(w, θ)·v`` as a tuple from ``c = cos θ``, ``s = sin θ`` (Rodrigues).
+
+    ``Rot(w, θ)ᵀ·v = Rot(w, −θ)·v`` is ``rot3(w, c, -s, v)``: one sin/cos per joint.
+    """
+    k = (w[0] * v[0] + w[1] * v[1] + w[2] * v[2]) * (1.0 - c)
+    return (v[0] * c + (w[1] * v[2] - w[2] * v[1]) * s + w[0] * k,
+            v[1] * c + (w[2] * v[0] - w[0] * v[2]) * s + w[1] * k,
+            v[2] * c + (w[0] * v[1] - w[1] * v[0]) * s + w[2] * k)
+
+
 @njit(cache=True)
 def target_rotation(T, M):
     """``R_T·R_Mᵀ`` (3, 3): the rotation the joints must produce, from poses T and M (4, 4)."""
@@ -263,7 +323,7 @@ def sp2_dir(w1, w2, u, v, out):
     a1v = dot3(w1, v)
     alpha = (c12 * a2u - a1v) / den
     beta = (c12 * a1v - a2u) / den
-    x = cross3(w1, w2)
+    x = cross3t(w1, w2)
     nx2 = dot3(x, x)
     uu = dot3(u, u)
     g2 = (uu - alpha * alpha - beta * beta - 2.0 * alpha * beta * c12) / nx2
@@ -273,11 +333,10 @@ def sp2_dir(w1, w2, u, v, out):
         g2 = 0.0
     g = math.sqrt(g2)
     count = 1 if g == 0.0 else 2
-    z = np.empty(3)
     for k in range(count):
         sg = g if k == 0 else -g
-        for i in range(3):
-            z[i] = alpha * w1[i] + beta * w2[i] + sg * x[i]
+        z = (alpha * w1[0] + beta * w2[0] + sg * x[0], alpha * w1[1] + beta * w2[1] + sg * x[1],
+             alpha * w1[2] + beta * w2[2] + sg * x[2])
         out[k, 1] = sp1_dir(w2, u, z)
         out[k, 0] = sp1_dir(w1, z, v)
     return count
