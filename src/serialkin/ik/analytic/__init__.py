@@ -66,7 +66,6 @@ from serialkin.ik.analytic.dispatch import (
     SCARA,
     UR,
     WRIST,
-    solve_checked,
 )
 from serialkin.ik.analytic.singular import continuous_family
 from serialkin.ik.analytic.structure import (
@@ -562,44 +561,79 @@ def _as_poses(a: np.ndarray) -> np.ndarray:
     return T
 
 
-#: Fast-path entries per id(robot): (weak reference, prepared data, kernel arguments).
+#: Fast-path entries per id(robot): (weak reference, prepared data, packed arguments).
 _FAST: dict[int, tuple] = {}
+#: The compiled entry point of ``solve_packed`` (resolved on first use by :func:`_packed_entry`).
+_SOLVE_PACKED: list[Any] = []
+
+
+def _packed_entry() -> Any:
+    """The compiled entry point of :func:`~serialkin.ik.analytic.dispatch.solve_packed`.
+
+    Calling it skips numba's type dispatch (about 1 µs with its arguments); it is
+    compiled for exactly the types the fast path passes: a writeable C-contiguous float64
+    (4, 4) target (checked by :func:`ik_all` before the call), the read-only packed arrays
+    of :func:`~serialkin.ik.analytic.dispatch.pack` and fresh outputs.
+    """
+    if not _SOLVE_PACKED:
+        import numba
+
+        from serialkin.ik.analytic.dispatch import solve_packed
+
+        Array = numba.types.Array
+        f64, i64 = numba.float64, numba.int64
+        sig = (Array(f64, 2, "C"), Array(i64, 1, "C", readonly=True),
+               Array(f64, 1, "C", readonly=True), Array(numba.boolean, 1, "C", readonly=True),
+               Array(f64, 2, "C"), Array(i64, 1, "C"))
+        solve_packed.compile(sig)  # loads from numba's cache when it can
+        _SOLVE_PACKED.append(solve_packed.overloads[sig].entry_point)
+    return _SOLVE_PACKED[0]
 
 
 def _fast_entry(robot: object) -> tuple:
-    """The fast path's cached arguments for ``robot`` (default ``tol``, ``near_tol``, grid)."""
+    """The fast path's cached data for ``robot`` (default ``tol``, ``near_tol``, grid).
+
+    ``(weak reference, prepared data, entry point, I, D, B, n, near)``: the packed
+    arguments of :func:`~serialkin.ik.analytic.dispatch.solve_packed`.
+    """
+    from serialkin.ik.analytic.dispatch import pack
     from serialkin.ik.analytic.general import DEFAULT_GRID
 
     p = _prepared(robot, NEAR_TOL)  # raises the ordinary path's errors
-    head = (p.code, p.arm, p.prismatic3)
-    tail = (p.W, p.P, p.M, p.aux, p.order, p.revolute, p.qlim, p.mid, p.F, p.meta, p.refine,
-            DEFAULT_GRID, 1e-8 * p.s.scale, 1e-8, REFINE_TOL * p.s.scale, REFINE_TOL)
-    entry = (weakref.ref(robot), p, head, tail)
+    I, D, B = pack(p.code, p.arm, p.prismatic3, p.W, p.P, p.M, p.aux, p.order, p.revolute,
+                   p.qlim, p.mid, p.F, p.meta, p.refine, DEFAULT_GRID, 1e-8 * p.s.scale, 1e-8,
+                   REFINE_TOL * p.s.scale, REFINE_TOL)
+    entry = (weakref.ref(robot), p, _packed_entry(), I, D, B, p.n, p.mode == "near")
     if len(_FAST) > 256:
         _FAST.clear()
     _FAST[id(robot)] = entry
     return entry
 
 
+_EMPTY = np.empty
+_INT64 = np.int64
+
+
 def _fast(robot: Robot, T: np.ndarray) -> np.ndarray | None:
-    """:func:`ik_all` for one C-contiguous float64 (4, 4) pose and default options.
+    """:func:`ik_all` for one C-contiguous writeable float64 (4, 4) pose, default options.
 
     The rigidity check and the solve are one compiled call
-    (:func:`~serialkin.ik.analytic.dispatch.solve_checked`); None when the pose is not
+    (:func:`~serialkin.ik.analytic.dispatch.solve_packed`); None when the pose is not
     rigid to 1e-13 (the ordinary path then checks, projects or raises). The rows are the
     ordinary path's, bit for bit.
     """
     entry = _FAST.get(id(robot))
     if entry is None or entry[0]() is not robot:
         entry = _fast_entry(robot)
-    p = entry[1]
-    out = np.empty((MAX_ROWS, p.n))
-    conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
-    k = solve_checked(*entry[2], T, *entry[3], out, conv)
+    out = _EMPTY((MAX_ROWS, entry[6]))
+    conv = _EMPTY(MAX_ROWS + 1, _INT64)
+    k = entry[2](T, entry[3], entry[4], entry[5], out, conv)
     if k < 0:
         return None
-    if p.mode == "near" and conv[1:conv[0] + 1].sum() % 2 == 1:
-        return _with_general(robot, T, out[:k], 1e-8, entry[3][11])
+    if entry[7] and conv[1:conv[0] + 1].sum() % 2 == 1:
+        from serialkin.ik.analytic.general import DEFAULT_GRID
+
+        return _with_general(robot, T, out[:k], 1e-8, DEFAULT_GRID)
     return out[:k]
 
 
