@@ -681,7 +681,8 @@ def test_bad_options():
         ik_all("ur5", T)
 
 
-@pytest.mark.parametrize("name", ["ur5", "puma560", "perturbed", "general"])
+@pytest.mark.parametrize("name", ["ur5", "puma560", "stanford", "scara", "three_link",
+                                  "perturbed", "general"])
 def test_fast_path_equals_ordinary_path(name):
     """One C-contiguous float64 pose (fast path) gives the ordinary path's rows bit for bit."""
     rng = np.random.default_rng(5)
@@ -704,3 +705,60 @@ def test_fast_path_equals_ordinary_path(name):
         assert fast.shape[0] >= 1 and np.array_equal(fast, slow)
         assert np.array_equal(fast, ik_all(robot, ro))
         assert np.abs(robot.fk(fast) - T).max() < 1e-8
+
+
+def test_tuple_vector_helpers_match_matrices():
+    """rot3, mv3, mtv3, cross3t, add3, sub3 and row3 equal the matrix/array operations."""
+    from serialkin.ik.analytic.subproblems import (
+        add3,
+        cross3t,
+        mtv3,
+        mv3,
+        rot3,
+        rotation,
+        row3,
+        sub3,
+    )
+
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        w = rng.normal(size=3)
+        w /= np.linalg.norm(w)
+        v, u = rng.normal(size=3), rng.normal(size=3)
+        th = rng.uniform(-4.0, 4.0)
+        R = rotation(w, th)
+        A = rng.normal(size=(4, 4))
+        c, s = math.cos(th), math.sin(th)
+        assert np.allclose(rot3(w, c, s, v), R @ v, atol=1e-14)
+        assert np.allclose(rot3(w, c, -s, v), R.T @ v, atol=1e-14)
+        assert np.allclose(rot3(tuple(w), c, s, tuple(v)), R @ v, atol=1e-14)
+        assert np.allclose(mv3(A, v), A[:3, :3] @ v, atol=1e-14)
+        assert np.allclose(mtv3(A, v), A[:3, :3].T @ v, atol=1e-14)
+        assert np.allclose(cross3t(u, v), np.cross(u, v), atol=1e-14)
+        assert np.allclose(add3(u, v), u + v) and np.allclose(sub3(u, v), u - v)
+        assert row3(A, 2) == tuple(A[2, :3])
+
+
+def test_packed_entry_equals_solve_into():
+    """solve_packed on pack()'s arrays gives solve_into's rows exactly, -1 if not rigid."""
+    from serialkin.ik.analytic import _prepared
+    from serialkin.ik.analytic.dispatch import MAX_ROWS, pack, solve_into, solve_packed
+
+    for robot in (models.ur5(), models.puma560(), models.stanford(), models.scara()):
+        p = _prepared(robot, 0.0)
+        args = (p.W, p.P, p.M, p.aux, p.order, p.revolute, p.qlim, p.mid, p.F, p.meta)
+        I, D, B = pack(p.code, p.arm, p.prismatic3, *args, p.refine, 24, 1e-8 * p.s.scale,
+                       1e-8, 1e-12, 1e-12)
+        for q in robot.random_q(4, seed=1):
+            T = np.ascontiguousarray(robot.fk(q))
+            out1, out2 = np.zeros((MAX_ROWS, robot.n)), np.zeros((MAX_ROWS, robot.n))
+            conv1 = np.zeros(MAX_ROWS + 1, dtype=np.int64)
+            conv2 = np.zeros(MAX_ROWS + 1, dtype=np.int64)
+            k1 = solve_into(p.code, p.arm, p.prismatic3, T, *args, True, p.refine, 24,
+                            1e-8 * p.s.scale, 1e-8, 1e-12, 1e-12, out1, conv1)
+            k2 = solve_packed(T, I, D, B, out2, conv2)
+            assert k1 == k2 >= 1
+            assert np.array_equal(out1, out2) and np.array_equal(conv1, conv2)
+        bad = T.copy()
+        bad[0, 0] += 1e-9
+        assert solve_packed(bad, I, D, B, out2, conv2) == -1
