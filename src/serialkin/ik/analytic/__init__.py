@@ -561,7 +561,7 @@ def _as_poses(a: np.ndarray) -> np.ndarray:
     return T
 
 
-#: Fast-path entries per id(robot): (weak reference, prepared data, packed arguments).
+#: Fast-path entries per id(robot): (weak reference, entry point, I, D, B, n).
 _FAST: dict[int, tuple] = {}
 #: The compiled entry point of ``solve_packed`` (resolved on first use by :func:`_packed_entry`).
 _SOLVE_PACKED: list[Any] = []
@@ -571,9 +571,10 @@ def _packed_entry() -> Any:
     """The compiled entry point of :func:`~serialkin.ik.analytic.dispatch.solve_packed`.
 
     Calling it skips numba's type dispatch (about 1 µs with its arguments); it is
-    compiled for exactly the types the fast path passes: a writeable C-contiguous float64
-    (4, 4) target (checked by :func:`ik_all` before the call), the read-only packed arrays
-    of :func:`~serialkin.ik.analytic.dispatch.pack` and fresh outputs.
+    compiled for exactly the types the fast path passes: a C-contiguous, aligned,
+    writeable float64 (4, 4) target (checked by :func:`ik_all` before the call), the
+    read-only packed arrays of :func:`~serialkin.ik.analytic.dispatch.pack` and a fresh
+    output.
     """
     if not _SOLVE_PACKED:
         import numba
@@ -584,7 +585,7 @@ def _packed_entry() -> Any:
         f64, i64 = numba.float64, numba.int64
         sig = (Array(f64, 2, "C"), Array(i64, 1, "C", readonly=True),
                Array(f64, 1, "C", readonly=True), Array(numba.boolean, 1, "C", readonly=True),
-               Array(f64, 2, "C"), Array(i64, 1, "C"))
+               Array(f64, 2, "C"))
         solve_packed.compile(sig)  # loads from numba's cache when it can
         _SOLVE_PACKED.append(solve_packed.overloads[sig].entry_point)
     return _SOLVE_PACKED[0]
@@ -593,8 +594,8 @@ def _packed_entry() -> Any:
 def _fast_entry(robot: object) -> tuple:
     """The fast path's cached data for ``robot`` (default ``tol``, ``near_tol``, grid).
 
-    ``(weak reference, prepared data, entry point, I, D, B, n, near)``: the packed
-    arguments of :func:`~serialkin.ik.analytic.dispatch.solve_packed`.
+    ``(weak reference, entry point, I, D, B, n)``: the packed arguments of
+    :func:`~serialkin.ik.analytic.dispatch.solve_packed`.
     """
     from serialkin.ik.analytic.dispatch import pack
     from serialkin.ik.analytic.general import DEFAULT_GRID
@@ -603,7 +604,7 @@ def _fast_entry(robot: object) -> tuple:
     I, D, B = pack(p.code, p.arm, p.prismatic3, p.W, p.P, p.M, p.aux, p.order, p.revolute,
                    p.qlim, p.mid, p.F, p.meta, p.refine, DEFAULT_GRID, 1e-8 * p.s.scale, 1e-8,
                    REFINE_TOL * p.s.scale, REFINE_TOL)
-    entry = (weakref.ref(robot), p, _packed_entry(), I, D, B, p.n, p.mode == "near")
+    entry = (weakref.ref(robot), _packed_entry(), I, D, B, p.n)
     if len(_FAST) > 256:
         _FAST.clear()
     _FAST[id(robot)] = entry
@@ -611,11 +612,16 @@ def _fast_entry(robot: object) -> tuple:
 
 
 _EMPTY = np.empty
-_INT64 = np.int64
+_NDARRAY = np.ndarray
+_F64 = np.dtype(np.float64)
+_SHAPE44 = (4, 4)
+#: The default of ``ik_all``'s ``tol`` (the fast path tests identity: an explicit
+#: ``tol=1e-8`` takes the ordinary path, which gives the same rows).
+_TOL = 1e-8
 
 
 def _fast(robot: Robot, T: np.ndarray) -> np.ndarray | None:
-    """:func:`ik_all` for one C-contiguous writeable float64 (4, 4) pose, default options.
+    """:func:`ik_all` for one C-contiguous, aligned, writeable float64 (4, 4) pose, defaults.
 
     The rigidity check and the solve are one compiled call
     (:func:`~serialkin.ik.analytic.dispatch.solve_packed`); None when the pose is not
@@ -625,19 +631,18 @@ def _fast(robot: Robot, T: np.ndarray) -> np.ndarray | None:
     entry = _FAST.get(id(robot))
     if entry is None or entry[0]() is not robot:
         entry = _fast_entry(robot)
-    out = _EMPTY((MAX_ROWS, entry[6]))
-    conv = _EMPTY(MAX_ROWS + 1, _INT64)
-    k = entry[2](T, entry[3], entry[4], entry[5], out, conv)
-    if k < 0:
+    out = _EMPTY((MAX_ROWS, entry[5]))
+    k = entry[1](T, entry[2], entry[3], entry[4], out)
+    if k >= 0:
+        return out[:k]
+    if k == -1:
         return None
-    if entry[7] and conv[1:conv[0] + 1].sum() % 2 == 1:
-        from serialkin.ik.analytic.general import DEFAULT_GRID
+    from serialkin.ik.analytic.general import DEFAULT_GRID
 
-        return _with_general(robot, T, out[:k], 1e-8, DEFAULT_GRID)
-    return out[:k]
+    return _with_general(robot, T, out[:-2 - k], _TOL, DEFAULT_GRID)
 
 
-def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool = False,
+def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool = False,
            free: Mapping[int, float] | None = None, near_tol: float = NEAR_TOL,
            grid: int | None = None, reference: object = None, weights: object = None,
            norm: str = "l2", report: bool = False,
@@ -693,11 +698,10 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         InputError: a target that is not a rigid transform / of an accepted shape, a
             non-positive ``tol`` or an unknown option.
     """
-    if (type(target) is np.ndarray and free is None and grid is None and reference is None
-            and not report and all_turns is False and not options and type(tol) is float
-            and tol == 1e-8 and type(near_tol) is float and near_tol == NEAR_TOL
-            and target.shape == (4, 4) and target.dtype == np.float64
-            and target.flags.c_contiguous and target.flags.writeable):
+    if (type(target) is _NDARRAY and tol is _TOL and near_tol is NEAR_TOL and free is None
+            and grid is None and reference is None and report is False and all_turns is False
+            and not options and target.shape == _SHAPE44 and target.dtype is _F64
+            and target.flags.carray):  # the defaults (by identity) and one plain pose
         sols = _fast(robot, target)
         if sols is not None:
             return sols

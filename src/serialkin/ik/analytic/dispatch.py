@@ -140,14 +140,14 @@ def pack(code, arm, prismatic3, W, P, M, aux, order, revolute, qlim, mid, F, met
 
 
 @njit(cache=True)
-def solve_packed(T, I, D, B, out, conv):
+def solve_packed(T, I, D, B, out):
     """:func:`solve_into` on the packed data of :func:`pack` (the fast path's entry).
 
-    One compiled call for the rigidity check and the solve: returns −1 without solving
-    when T (4, 4) is not a rigid transform to 1e-13 (the caller then checks it, projects
-    the rotation or raises), else the number of solutions written into ``out`` (16, n),
-    rotation verified; ``conv`` (17,) as for :func:`solve_into` (entries beyond
-    ``conv[0]`` are not written).
+    One compiled call for the rigidity check and the solve (rotation verified), into
+    ``out`` (16, n). Returns the number of solutions k >= 0; −1 without solving when
+    T (4, 4) is not a rigid transform to 1e-13 (the caller then checks it, projects the
+    rotation or raises); ``−2 − k`` when the arm is refined (nearly ideal) and an odd
+    number of its branches converged (the caller then adds the general search's rows).
     """
     if rigid_error(T) > 1e-13:
         return -1
@@ -169,5 +169,14 @@ def solve_packed(T, I, D, B, out, conv):
     F = D[o:o + 16 * (n + 1)].reshape((n + 1, 4, 4))
     o += 16 * (n + 1)
     meta = D[o:o + 5 * n].reshape((n, 5))
-    return solve_into(I[0], I[1], I[2] != 0, T, W, P, M, aux, I[_HEAD:_HEAD + I[7]], B, qlim,
-                      mid, F, meta, True, I[3] != 0, I[4], D[0], D[1], D[2], D[3], out, conv)
+    refine = I[3] != 0
+    conv = np.empty(MAX_ROWS + 1, dtype=np.int64)
+    k = solve_into(I[0], I[1], I[2] != 0, T, W, P, M, aux, I[_HEAD:_HEAD + I[7]], B, qlim,
+                   mid, F, meta, True, refine, I[4], D[0], D[1], D[2], D[3], out, conv)
+    if refine:
+        good = 0
+        for i in range(conv[0]):
+            good += conv[1 + i]
+        if good % 2 == 1:
+            return -2 - k
+    return k
