@@ -32,7 +32,7 @@ import math
 import numpy as np
 from numba import njit
 
-from serialkin.kinematics.kernels import fk_into
+from serialkin.kinematics.kernels import fk_range
 
 #: arccos arguments within this distance of ±1 are clamped (workspace boundary).
 CLAMP = 1e-9
@@ -604,9 +604,8 @@ def finalize(cand, k, revolute, qlim, mid, F, meta, T, check_rot, tol_p, tol_r, 
     accepted rows are sorted lexicographically into ``out`` (K, n). Returns their count.
     """
     n = cand.shape[1]
-    m = 0
-    q = np.empty(n)
-    Tq = np.empty((4, 4))
+    Q = np.empty((max(k, 1), n))
+    kq = 0
     for i in range(k):
         ok = True
         for j in range(n):
@@ -628,20 +627,24 @@ def finalize(cand, k, revolute, qlim, mid, F, meta, T, check_rot, tol_p, tol_r, 
                     ok = False
                     break
                 v = hi
-            q[j] = v
-        if not ok:
-            continue
-        fk_into(q, F, meta, Tq)
+            Q[kq, j] = v
+        if ok:
+            kq += 1
+    Tq = np.empty((max(kq, 1), 4, 4))
+    fk_range(Q, F, meta, Tq, 0, kq)  # the rows inside the limits, vectorised across rows
+    m = 0
+    for i in range(kq):
+        q = Q[i]
         ep = 0.0
         for r in range(3):
-            ep += (Tq[r, 3] - T[r, 3]) ** 2
+            ep += (Tq[i, r, 3] - T[r, 3]) ** 2
         if math.sqrt(ep) > tol_p:
             continue
         if check_rot:
             er = 0.0
             for r in range(3):
                 for c in range(3):
-                    er = max(er, abs(Tq[r, c] - T[r, c]))
+                    er = max(er, abs(Tq[i, r, c] - T[r, c]))
             if er > tol_r:
                 continue
         dup = False
