@@ -768,3 +768,27 @@ def test_packed_entry_equals_solve_into():
         bad = T.copy()
         bad[0, 0] += 1e-9
         assert solve_packed(bad, I, D, B, out2) == -1
+
+
+def test_subproblem_cosines_match_angles():
+    """sp1_dir_cs and the 6-column sp2_dir give cos/sin of their angles, which solve them."""
+    from serialkin.ik.analytic.subproblems import rotation, sp1_dir, sp1_dir_cs, sp2_dir
+
+    rng = np.random.default_rng(4)
+    for _ in range(20):
+        w1, w2, u = (x / np.linalg.norm(x) for x in rng.normal(size=(3, 3)))
+        th, c, s = sp1_dir_cs(w1, u, rotation(w1, 0.7) @ u)
+        assert th == sp1_dir(w1, u, rotation(w1, 0.7) @ u)
+        assert abs(th - 0.7) < 1e-12 and abs(c - math.cos(th)) < 1e-15 \
+            and abs(s - math.sin(th)) < 1e-15
+        v = rotation(w1, rng.uniform(-3, 3)) @ rotation(w2, rng.uniform(-3, 3)) @ u
+        out2, out6 = np.zeros((2, 2)), np.zeros((2, 6))
+        m = sp2_dir(w1, w2, u, v, out2)
+        assert m == sp2_dir(w1, w2, u, v, out6) >= 1
+        assert np.array_equal(out2[:m], out6[:m, :2])
+        for t1, t2, c1, s1, c2, s2 in out6[:m]:
+            assert np.allclose([c1, s1, c2, s2], [math.cos(t1), math.sin(t1), math.cos(t2),
+                                                  math.sin(t2)], atol=1e-14)
+            assert np.allclose(rotation(w1, t1) @ rotation(w2, t2) @ u, v, atol=1e-12)
+    assert sp1_dir_cs(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 2.0]),
+                      np.array([1.0, 0.0, 0.0])) == (0.0, 1.0, 0.0)

@@ -62,7 +62,7 @@ from serialkin.ik.analytic.subproblems import (
     sp3_slide,
     sp4,
     sub3,
-    target_point,
+    target_rotation,
 )
 
 #: Most candidate solutions of a 6-joint arm.
@@ -85,7 +85,7 @@ def wrist_into(gw, gv, W, v, q1, q2, q3, prismatic3, sol, out, k):
         q2: arm joint 2 value [rad].
         q3: arm joint 3 value [rad, or m when prismatic].
         prismatic3: True when joint 3 slides (Stanford class).
-        sol: (2, 2) scratch array.
+        sol: (2, 6) scratch array (see :func:`~serialkin.ik.analytic.subproblems.sp2_dir`).
         out: (8, 6) candidate rows; rows k, k+1 are written.
         k: number of rows already in ``out``.
 
@@ -111,17 +111,14 @@ def wrist_into(gw, gv, W, v, q1, q2, q3, prismatic3, sol, out, k):
         sn3 = -math.sin(q3)
         xw = rot3(w3, c3, sn3, xw)
         xv = rot3(w3, c3, sn3, xv)
-    m = sp2_dir(w4, w5, w6, xw, sol)
+    m = sp2_dir(w4, w5, w6, xw, sol)  # (q4, q5) with their cosines and sines
     for r in range(m):
-        q4 = sol[r, 0]
-        q5 = sol[r, 1]
-        q6 = sp1_dir(w6, v, rot3(w5, math.cos(q5), -math.sin(q5),
-                                 rot3(w4, math.cos(q4), -math.sin(q4), xv)))
+        q6 = sp1_dir(w6, v, rot3(w5, sol[r, 4], -sol[r, 5], rot3(w4, sol[r, 2], -sol[r, 3], xv)))
         out[k, 0] = q1
         out[k, 1] = q2
         out[k, 2] = q3
-        out[k, 3] = q4
-        out[k, 4] = q5
+        out[k, 3] = sol[r, 0]
+        out[k, 4] = sol[r, 1]
         out[k, 5] = q6
         k += 1
     return k
@@ -429,13 +426,17 @@ def wrist_candidates(T, W, P, M, aux, arm, prismatic3, out):
 
     ``aux[0]`` is the wrist centre c and ``aux[-1]`` a unit vector ⟂ w6; returns the count.
     """
-    pw, Rg = target_point(T, M, aux[0].copy())
-    arm3 = np.empty((4, 3))
+    Rg = target_rotation(T, M)
+    scratch = np.empty(27)  # wrist centre, arm rows, wrist scratch: one allocation
+    pw = scratch[0:3]
+    pw[0], pw[1], pw[2] = add3(mv3(Rg, sub3(row3(aux, 0), (M[0, 3], M[1, 3], M[2, 3]))),
+                               (T[0, 3], T[1, 3], T[2, 3]))  # T·M⁻¹·c
+    arm3 = scratch[3:15].reshape((4, 3))
+    sol = scratch[15:27].reshape((2, 6))
     m = arm_positions(pw, W, P, aux, arm, prismatic3, arm3)
     v = row3(aux, aux.shape[0] - 1)
     gw = mv3(Rg, row3(W, 5))
     gv = mv3(Rg, v)
-    sol = np.empty((2, 2))
     k = 0
     for i in range(m):
         k = wrist_into(gw, gv, W, v, arm3[i, 0], arm3[i, 1], arm3[i, 2], prismatic3, sol,

@@ -283,13 +283,14 @@ def _acos_clamped(x):
 
 
 @njit(cache=True)
-def sp1_dir(w, u, v):
-    """Subproblem 1 on directions: θ such that ``Rot(w, θ)·u`` points like ``v`` in the plane ⟂ w.
+def sp1_dir_cs(w, u, v):
+    """Subproblem 1 on directions with the cosine and sine of the angle: ``(θ, cos θ, sin θ)``.
 
-    Returns ``atan2(w·(u' × v'), u'·v')`` with ``u'``, ``v'`` the projections on that
-    plane; 0 when either projection vanishes to rounding level (< 1e-12 of |u|, |v|):
-    the angle is then arbitrary (a singular configuration) and 0 is its representative.
-    Scalar code, no allocation (a hot path of every solver).
+    θ = ``atan2(w·(u' × v'), u'·v')`` with ``u'``, ``v'`` the projections of u, v on the
+    plane ⟂ w (so ``Rot(w, θ)·u`` points like ``v`` there); cos θ and sin θ come from the
+    same two numbers (no trigonometric call). ``(0, 1, 0)`` when either projection
+    vanishes to rounding level (< 1e-12 of |u|, |v|): the angle is then arbitrary (a
+    singular configuration) and 0 is its representative. Scalar code, no allocation.
     """
     wu = w[0] * u[0] + w[1] * u[1] + w[2] * u[2]
     wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2]
@@ -302,11 +303,26 @@ def sp1_dir(w, u, v):
     if (u0 * u0 + u1 * u1 + u2 * u2 <= 1e-24 * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
             or v0 * v0 + v1 * v1 + v2 * v2 <= 1e-24 * (v[0] * v[0] + v[1] * v[1]
                                                         + v[2] * v[2])):
-        return 0.0
+        return 0.0, 1.0, 0.0
     c0 = u1 * v2 - u2 * v1
     c1 = u2 * v0 - u0 * v2
     c2 = u0 * v1 - u1 * v0
-    return math.atan2(w[0] * c0 + w[1] * c1 + w[2] * c2, u0 * v0 + u1 * v1 + u2 * v2)
+    y = w[0] * c0 + w[1] * c1 + w[2] * c2
+    x = u0 * v0 + u1 * v1 + u2 * v2
+    r = math.sqrt(x * x + y * y)
+    if r == 0.0:
+        return 0.0, 1.0, 0.0
+    return math.atan2(y, x), x / r, y / r
+
+
+@njit(cache=True)
+def sp1_dir(w, u, v):
+    """Subproblem 1 on directions: θ such that ``Rot(w, θ)·u`` points like ``v`` in the plane ⟂ w.
+
+    The angle of :func:`sp1_dir_cs`: ``atan2(w·(u' × v'), u'·v')``, 0 when either
+    projection vanishes (a singular configuration). A hot path of every solver.
+    """
+    return sp1_dir_cs(w, u, v)[0]
 
 
 @njit(cache=True)
@@ -315,7 +331,9 @@ def sp2_dir(w1, w2, u, v, out):
 
     ``u`` and ``v`` are vectors from the common point (or directions). The intermediate
     vector is ``z = α w1 + β w2 ± γ (w1 × w2)`` with ``w2·z = w2·u``, ``w1·z = w1·v`` and
-    ``|z| = |u|``. Writes rows (θ1, θ2) into ``out`` (2, 2); returns 0, 1 or 2.
+    ``|z| = |u|``. Writes rows (θ1, θ2) into ``out`` (2, 2), or (θ1, θ2, cos θ1, sin θ1,
+    cos θ2, sin θ2) when ``out`` has 6 columns (:func:`sp1_dir_cs`: no trigonometric
+    call); returns 0, 1 or 2.
     """
     c12 = dot3(w1, w2)
     den = c12 * c12 - 1.0
@@ -337,8 +355,15 @@ def sp2_dir(w1, w2, u, v, out):
         sg = g if k == 0 else -g
         z = (alpha * w1[0] + beta * w2[0] + sg * x[0], alpha * w1[1] + beta * w2[1] + sg * x[1],
              alpha * w1[2] + beta * w2[2] + sg * x[2])
-        out[k, 1] = sp1_dir(w2, u, z)
-        out[k, 0] = sp1_dir(w1, z, v)
+        t2, cs2, sn2 = sp1_dir_cs(w2, u, z)
+        t1, cs1, sn1 = sp1_dir_cs(w1, z, v)
+        out[k, 0] = t1
+        out[k, 1] = t2
+        if out.shape[1] >= 6:
+            out[k, 2] = cs1
+            out[k, 3] = sn1
+            out[k, 4] = cs2
+            out[k, 5] = sn2
     return count
 
 

@@ -34,7 +34,7 @@ from serialkin.ik.analytic.subproblems import (
     planar2r,
     rot3,
     row3,
-    sp1_dir,
+    sp1_dir_cs,
     sp4,
     sub3,
     target_rotation,
@@ -92,9 +92,7 @@ def ur_candidates(T, W, P, M, aux, out):
             q5 = q5s[j]
             c5 = math.cos(q5)
             sn5 = math.sin(q5)
-            q6 = sp1_dir(w6, Xtw, rot3(w5, c5, -sn5, w))
-            c6 = math.cos(q6)
-            sn6 = math.sin(q6)
+            q6, c6, sn6 = sp1_dir_cs(w6, Xtw, rot3(w5, c5, -sn5, w))
             # G = e1⁻¹·T·M⁻¹·e6⁻¹·e5⁻¹ applied to e and x4 by rotations (no 4 × 4 products)
             ve = rot3(w1, c1, -sn1, mv3(Rg, rot3(w6, c6, -sn6, rot3(w5, c5, -sn5, e))))
             s = math.atan2(dot3(w, cross3t(e, ve)), dot3(e, ve))
