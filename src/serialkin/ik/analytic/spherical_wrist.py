@@ -49,7 +49,8 @@ from serialkin.ik.analytic.subproblems import (
     finalize,
     mv,
     mv3,
-    planar2r,
+    planar2r_frame,
+    planar2r_solve,
     polish_real_root,
     poly_roots,
     rot3,
@@ -142,6 +143,7 @@ def puma_positions(pw, W, P, aux, out):
     buf = np.empty(6)
     q1s = buf[0:2]
     sol = buf[2:6].reshape((2, 2))
+    frame = planar2r_frame(w, e1, c2, c3, c)  # joints 2, 3 carrying c, once, not per branch
     d = sub3(pw, r1)
     n1 = sp4(w1, w, d, dot3(w, sub3(c, r1)), q1s)
     k = 0
@@ -150,7 +152,7 @@ def puma_positions(pw, W, P, aux, out):
     for i in range(n1):
         q1 = q1s[i]
         x = add3(rot3(w1, math.cos(q1), -math.sin(q1), d), r1)  # exp(−ξ1 q1)·pw
-        m = planar2r(w, e1, c2, c3, c, x, sol)
+        m = planar2r_solve(frame, x, sol)
         for j in range(m):
             out[k, 0] = q1
             out[k, 1] = s2 * sol[j, 0]

@@ -473,28 +473,36 @@ def planar2r(w, e1, c1, c2, p, t, out):
     (θ1, θ2) [rad, about +w] into ``out`` (2, 2); returns 0, 1 or 2. When the target is
     on the first axis with L1 = L2, θ1 is arbitrary and θ1 = α = 0 is returned.
     """
-    e20 = w[1] * e1[2] - w[2] * e1[1]  # e2 = w × e1, scalar code (no allocation)
-    e21 = w[2] * e1[0] - w[0] * e1[2]
-    e22 = w[0] * e1[1] - w[1] * e1[0]
-    l10 = c2[0] - c1[0]
-    l11 = c2[1] - c1[1]
-    l12 = c2[2] - c1[2]
-    l20 = p[0] - c2[0]
-    l21 = p[1] - c2[1]
-    l22 = p[2] - c2[2]
-    d0 = t[0] - c1[0]
-    d1 = t[1] - c1[1]
-    d2 = t[2] - c1[2]
-    x1 = e1[0] * l10 + e1[1] * l11 + e1[2] * l12
-    y1 = e20 * l10 + e21 * l11 + e22 * l12
-    x2 = e1[0] * l20 + e1[1] * l21 + e1[2] * l22
-    y2 = e20 * l20 + e21 * l21 + e22 * l22
-    L1 = math.hypot(x1, y1)
-    L2 = math.hypot(x2, y2)
+    return planar2r_solve(planar2r_frame(w, e1, c1, c2, p), t, out)
+
+
+@njit(cache=True)
+def planar2r_frame(w, e1, c1, c2, p):
+    """The target-independent part of :func:`planar2r`, computed once per arm.
+
+    Returns the tuple ``(e1, e2 = w × e1, c1, L1, L2, φ10, φ20)``: the plane basis and
+    origin, the projected link lengths and the link angles at the zero configuration
+    (φ10 of link 1, φ20 of link 2 relative to link 1).
+    """
+    e2 = cross3t(w, e1)
+    l1 = sub3(c2, c1)
+    l2 = sub3(p, c2)
+    x1 = dot3(e1, l1)
+    y1 = dot3(e2, l1)
+    x2 = dot3(e1, l2)
+    y2 = dot3(e2, l2)
     phi10 = math.atan2(y1, x1)
-    phi20 = math.atan2(y2, x2) - phi10
-    x = e1[0] * d0 + e1[1] * d1 + e1[2] * d2
-    y = e20 * d0 + e21 * d1 + e22 * d2
+    return ((e1[0], e1[1], e1[2]), e2, (c1[0], c1[1], c1[2]), math.hypot(x1, y1),
+            math.hypot(x2, y2), phi10, math.atan2(y2, x2) - phi10)
+
+
+@njit(cache=True)
+def planar2r_solve(frame, t, out):
+    """:func:`planar2r` for the target point t, given its :func:`planar2r_frame`."""
+    e1, e2, c1, L1, L2, phi10, phi20 = frame
+    d = sub3(t, c1)
+    x = dot3(e1, d)
+    y = dot3(e2, d)
     r2 = x * x + y * y
     th2 = _acos_clamped((r2 - L1 * L1 - L2 * L2) / (2.0 * L1 * L2))
     if math.isnan(th2):

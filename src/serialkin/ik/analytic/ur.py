@@ -31,7 +31,8 @@ from serialkin.ik.analytic.subproblems import (
     finalize,
     mtv3,
     mv3,
-    planar2r,
+    planar2r_frame,
+    planar2r_solve,
     rot3,
     row3,
     sp1_dir_cs,
@@ -72,6 +73,7 @@ def ur_candidates(T, W, P, M, aux, out):
     s2 = dot3(W[1], w)
     s3 = dot3(W[2], w)
     s4 = dot3(W[3], w)
+    frame = planar2r_frame(w, e, c2, c3, x4)  # joints 2, 3 carrying x4, once, not per branch
     x4r5 = sub3(x4, r5)
     r5r6 = sub3(r5, r6)
     tgr1 = sub3(tg, r1)
@@ -99,7 +101,7 @@ def ur_candidates(T, W, P, M, aux, out):
             a = add3(rot3(w5, c5, -sn5, x4r5), r5r6)
             b = add3(mv3(Rg, add3(rot3(w6, c6, -sn6, a), r6)), tgr1)
             y = add3(rot3(w1, c1, -sn1, b), r1)
-            m = planar2r(w, e, c2, c3, x4, y, sol)
+            m = planar2r_solve(frame, y, sol)
             for r in range(m):
                 out[k, 0] = q1
                 out[k, 1] = s2 * sol[r, 0]
