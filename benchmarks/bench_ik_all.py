@@ -34,7 +34,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-from _common import header, interleaved_us, latency_us, record  # noqa: E402
+from _common import Stat, header, interleaved_us, latency_us, record  # noqa: E402
 
 from serialkin import Robot, models  # noqa: E402
 from serialkin.ik.analytic import classify, ik_all  # noqa: E402
@@ -119,7 +119,7 @@ def bench_rtb(rtb_robot, name: str, n_targets: int, seed: int = 1) -> dict:
         same = len(a) == len(b) and all(
             np.abs(_wrap(a - row)).max(axis=1).min() < 1e-6 for row in b)
         agree += same
-    out = {"derive_s": derive, "rtb_median": np.median(t_rtb), "ours_median": np.median(t_ours),
+    out = {"derive_s": derive, "rtb": Stat(t_rtb), "ours": Stat(t_ours),
            "agree": agree / n_targets, "class": classify(ours)}
     if hasattr(rtb_robot, "ikine_a"):
         confs = ["lun", "lud", "lfn", "lfd", "run", "rud", "rfn", "rfd"]
@@ -289,14 +289,15 @@ def main() -> None:
         return
     print(f"\nvs Robotics Toolbox analytic_ik().solve (all solutions), {args.peer_targets} "
           "targets, limits off, same DH table")
-    print(f"{'robot':10s} {'derive s':>9s} {'rtb med us':>11s} {'ours med us':>12s} "
+    print("(median [10th-90th percentile] over the targets, one call each)")
+    print(f"{'robot':10s} {'derive s':>9s} {'rtb us':>20s} {'ours us':>18s} "
           f"{'ratio':>7s} {'same set':>9s}  extra")
     for rtb_robot, name in ((rtb.models.DH.UR5(), "UR5"), (rtb.models.DH.Puma560(), "Puma560")):
         r = bench_rtb(rtb_robot, name, args.peer_targets)
         extra = (f"ikine_a x 8 configs: {r['ikine_a_x8_median']:.0f} us"
                  if "ikine_a_x8_median" in r else "")
-        print(f"{name:10s} {r['derive_s']:9.1f} {r['rtb_median']:11.1f} {r['ours_median']:12.1f} "
-              f"{r['rtb_median'] / r['ours_median']:7.0f} {r['agree']:9.1%}  {extra}")
+        print(f"{name:10s} {r['derive_s']:9.1f} {r['rtb'].fmt(1):>20s} {r['ours'].fmt(1):>18s} "
+              f"{r['rtb'] / r['ours']:7.0f} {r['agree']:9.1%}  {extra}")
     print("\n(times per call on this machine, one thread)")
 
 

@@ -792,3 +792,21 @@ def test_subproblem_cosines_match_angles():
             assert np.allclose(rotation(w1, t1) @ rotation(w2, t2) @ u, v, atol=1e-12)
     assert sp1_dir_cs(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 2.0]),
                       np.array([1.0, 0.0, 0.0])) == (0.0, 1.0, 0.0)
+
+
+def test_sp4_cosines_match_angles():
+    """sp4 with 6 output entries gives the cosine and sine of each angle, which solve it."""
+    from serialkin.ik.analytic.subproblems import rotation, sp4
+
+    rng = np.random.default_rng(6)
+    for _ in range(40):
+        w, b, a = rng.normal(size=(3, 3))
+        w /= np.linalg.norm(w)
+        c = a @ rotation(w, rng.uniform(-3, 3)) @ b
+        out2, out6 = np.zeros(2), np.zeros(6)
+        m = sp4(w, b, a, c, out2)
+        assert m == sp4(w, b, a, c, out6) >= 1 and np.array_equal(out2[:m], out6[:m])
+        for i in range(m):
+            th, cs, sn = out6[i], out6[2 + 2 * i], out6[3 + 2 * i]
+            assert abs(cs - math.cos(th)) < 1e-14 and abs(sn - math.sin(th)) < 1e-14
+            assert abs(a @ rotation(w, th) @ b - c) < 1e-12

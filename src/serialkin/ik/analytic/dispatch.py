@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from serialkin.errors import InputError
 from serialkin.ik.analytic.general import MAX_SOLUTIONS as GENERAL_MAX
 from serialkin.ik.analytic.general import general_candidates
 from serialkin.ik.analytic.planar import solve_planar
@@ -125,8 +126,12 @@ def pack(code, arm, prismatic3, W, P, M, aux, order, revolute, qlim, mid, F, met
     newton_p, newton_r) then ``W``, ``P``, ``M``, ``aux``, ``qlim``, ``mid``, ``F``,
     ``meta`` flattened; ``B`` = ``revolute`` (bool). :func:`solve_packed` unpacks them as
     views of the same types, so the kernels below it are the ones already compiled.
+    Arrays of the structure (aux (k, 3)) and of the chain (F (n+1, 4, 4), meta (n, 5)).
     """
     n = W.shape[0]
+    if aux.ndim != 2 or aux.shape[1] != 3 or meta.shape != (n, 5) or F.shape != (n + 1, 4, 4):
+        raise InputError(f"pack: aux must be (k, 3), meta ({n}, 5) and F ({n + 1}, 4, 4); got "
+                         f"{aux.shape}, {meta.shape}, {F.shape}")  # the layout solve_packed reads
     order = np.asarray(order, dtype=np.int64)
     I = np.concatenate([np.array([code, arm, int(prismatic3), int(refine), grid, n,
                                   aux.shape[0], order.shape[0]], dtype=np.int64), order])

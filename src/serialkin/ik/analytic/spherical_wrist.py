@@ -140,9 +140,9 @@ def puma_positions(pw, W, P, aux, out):
     r1 = row3(P, 0)
     c2 = row3(P, 1)
     c3 = row3(P, 2)
-    buf = np.empty(6)
-    q1s = buf[0:2]
-    sol = buf[2:6].reshape((2, 2))
+    buf = np.empty(10)
+    q1s = buf[0:6]  # angles, then the cosine and sine of each (sp4)
+    sol = buf[6:10].reshape((2, 2))
     frame = planar2r_frame(w, e1, c2, c3, c)  # joints 2, 3 carrying c, once, not per branch
     d = sub3(pw, r1)
     n1 = sp4(w1, w, d, dot3(w, sub3(c, r1)), q1s)
@@ -151,7 +151,7 @@ def puma_positions(pw, W, P, aux, out):
     s3 = dot3(W[2], w)
     for i in range(n1):
         q1 = q1s[i]
-        x = add3(rot3(w1, math.cos(q1), -math.sin(q1), d), r1)  # exp(−ξ1 q1)·pw
+        x = add3(rot3(w1, q1s[2 + 2 * i], -q1s[3 + 2 * i], d), r1)  # exp(−ξ1 q1)·pw
         m = planar2r_solve(frame, x, sol)
         for j in range(m):
             out[k, 0] = q1

@@ -425,7 +425,10 @@ def sp4(w, b, a, c, out):
 
     ``A = a·b'``, ``B = a·(w × b')``, ``b'`` the part of b ⟂ w, so θ = atan2(B, A) ±
     arccos(D / sqrt(A² + B²)). When A = B = 0 any θ solves a consistent equation:
-    θ = 0 is returned as the representative. Writes into ``out`` (2,), returns 0, 1 or 2.
+    θ = 0 is returned as the representative. Writes θ into ``out`` (2,), returns 0, 1 or
+    2. With ``out`` of 6 entries also ``cos θ, sin θ`` of each solution into
+    ``out[2:4]`` and ``out[4:6]``, by the angle-sum formulas from A, B, D (no
+    trigonometric call; ``sin(arccos x) = sqrt((1 − x)(1 + x))``).
     """
     wb = w[0] * b[0] + w[1] * b[1] + w[2] * b[2]
     b0 = b[0] - wb * w[0]
@@ -438,16 +441,34 @@ def sp4(w, b, a, c, out):
     Rn = math.hypot(A, B)
     scale = math.sqrt((a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
                       * (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]))
+    cs = out.shape[0] >= 6
     if Rn <= 1e-12 * max(scale, 1e-300):
         if abs(D) <= 1e-9 * max(scale, 1.0):
             out[0] = 0.0
+            if cs:
+                out[2] = 1.0
+                out[3] = 0.0
             return 1
         return 0
     phi = math.atan2(B, A)
-    x = _acos_clamped(D / Rn)
+    cx = D / Rn
+    x = _acos_clamped(cx)
     if math.isnan(x):
         return 0
     out[0] = phi + x
+    if cs:
+        cp = A / Rn
+        sp = B / Rn
+        if x == 0.0:
+            cx, sx = 1.0, 0.0
+        elif x == math.pi:
+            cx, sx = -1.0, 0.0
+        else:
+            sx = math.sqrt((1.0 - cx) * (1.0 + cx))
+        out[2] = cp * cx - sp * sx
+        out[3] = sp * cx + cp * sx
+        out[4] = cp * cx + sp * sx
+        out[5] = sp * cx - cp * sx
     if x == 0.0:
         return 1
     out[1] = phi - x

@@ -77,23 +77,23 @@ def ur_candidates(T, W, P, M, aux, out):
     x4r5 = sub3(x4, r5)
     r5r6 = sub3(r5, r6)
     tgr1 = sub3(tg, r1)
-    buf = np.empty(8)
-    q1s = buf[0:2]
-    q5s = buf[2:4]
-    sol = buf[4:8].reshape((2, 2))
+    buf = np.empty(16)
+    q1s = buf[0:6]  # angles, then the cosine and sine of each (sp4)
+    q5s = buf[6:12]
+    sol = buf[12:16].reshape((2, 2))
     n1 = sp4(w1, w, sub3(p5, r1), dot3(w, sub3(p56, r1)), q1s)
     k = 0
     for i in range(n1):
         q1 = q1s[i]
-        c1 = math.cos(q1)
-        sn1 = math.sin(q1)
+        c1 = q1s[2 + 2 * i]
+        sn1 = q1s[3 + 2 * i]
         R1w = rot3(w1, c1, sn1, w)
         Xtw = mtv3(Rg, R1w)  # Xᵀ·w with X = R1ᵀ·R_g
         n5 = sp4(w5, w6, w, dot3(R1w, w6t), q5s)
         for j in range(n5):
             q5 = q5s[j]
-            c5 = math.cos(q5)
-            sn5 = math.sin(q5)
+            c5 = q5s[2 + 2 * j]
+            sn5 = q5s[3 + 2 * j]
             q6, c6, sn6 = sp1_dir_cs(w6, Xtw, rot3(w5, c5, -sn5, w))
             # G = e1⁻¹·T·M⁻¹·e6⁻¹·e5⁻¹ applied to e and x4 by rotations (no 4 × 4 products)
             ve = rot3(w1, c1, -sn1, mv3(Rg, rot3(w6, c6, -sn6, rot3(w5, c5, -sn5, e))))
