@@ -542,17 +542,20 @@ def _solve_batch(p: _Prepared, robot: Robot, T: np.ndarray, tol: float,
 
 
 def _as_poses(a: np.ndarray) -> np.ndarray:
-    """(N, 4, 4) targets as exact rigid transforms (checked; rotations projected on SO(3))."""
-    from serialkin.spatial.kernels import transforms_valid
+    """(N, 4, 4) targets as exact rigid transforms (checked; rotations projected on SO(3)).
+
+    The criteria of :func:`_as_pose` per target, in one compiled pass
+    (:func:`~serialkin.ik.analytic.subproblems.rigid_errors_into`).
+    """
+    from serialkin.ik.analytic.subproblems import rigid_errors_into
 
     T = np.ascontiguousarray(a, dtype=float)
-    if not transforms_valid(T, ROTATION_TOL):
-        for k in range(T.shape[0]):
-            check_transform(T[k], f"target[{k}]")
-    R = T[:, :3, :3]
-    gram = np.einsum("kij,kil->kjl", R, R) - np.eye(3)
-    off = (np.abs(gram).max(axis=(1, 2)) > 1e-13) | np.any(T[:, 3] != (0.0, 0.0, 0.0, 1.0),
-                                                          axis=1)
+    err = np.empty(T.shape[0])
+    rigid_errors_into(T, err)
+    if T.shape[0] and err.max() > ROTATION_TOL:
+        for k in np.flatnonzero(err > ROTATION_TOL):
+            check_transform(T[k], f"target[{k}]")  # raises with a message naming the fault
+    off = err > 1e-13
     if off.any():  # nearest rotations (polar decomposition) where needed, exact last rows
         T = T.copy()
         U, _, Vt = np.linalg.svd(T[off, :3, :3])

@@ -562,6 +562,13 @@ def rigid_error(T):
 
 
 @njit(cache=True)
+def rigid_errors_into(Ts, err):
+    """:func:`rigid_error` of every ``Ts[k]`` (N, 4, 4) into ``err`` (N,)."""
+    for k in range(Ts.shape[0]):
+        err[k] = rigid_error(Ts[k])
+
+
+@njit(cache=True)
 def poly_roots(coefs, out):
     """Complex roots of a polynomial of degree <= 4 (Aberth–Ehrlich iteration).
 
