@@ -42,7 +42,7 @@ Semantics:
   set is a continuum; one representative per branch is returned (the free angle set
   to 0). At a stretched elbow the two elbow branches merge into one solution.
 * The kernels are compiled by numba on first use (cached on disk afterwards); a call
-  then takes about 10-15 µs for a 6R arm of an exact class, all solutions included,
+  then takes about 4-6 µs for a 6R arm of an exact class, all solutions included,
   and milliseconds for the general search (``benchmarks/bench_ik_all.py``).
 """
 
@@ -564,7 +564,7 @@ def _as_poses(a: np.ndarray) -> np.ndarray:
     return T
 
 
-#: Fast-path entries per id(robot): (weak reference, entry point, I, D, B, n).
+#: Fast-path entries per id(robot): (weak reference, entry point, I, D, B, output shape).
 _FAST: dict[int, tuple] = {}
 #: The compiled entry point of ``solve_packed`` (resolved on first use by :func:`_packed_entry`).
 _SOLVE_PACKED: list[Any] = []
@@ -597,8 +597,8 @@ def _packed_entry() -> Any:
 def _fast_entry(robot: object) -> tuple:
     """The fast path's cached data for ``robot`` (default ``tol``, ``near_tol``, grid).
 
-    ``(weak reference, entry point, I, D, B, n)``: the packed arguments of
-    :func:`~serialkin.ik.analytic.dispatch.solve_packed`.
+    ``(weak reference, entry point, I, D, B, (16, n))``: the packed arguments of
+    :func:`~serialkin.ik.analytic.dispatch.solve_packed` and the shape of its output.
     """
     from serialkin.ik.analytic.dispatch import pack
     from serialkin.ik.analytic.general import DEFAULT_GRID
@@ -607,7 +607,7 @@ def _fast_entry(robot: object) -> tuple:
     I, D, B = pack(p.code, p.arm, p.prismatic3, p.W, p.P, p.M, p.aux, p.order, p.revolute,
                    p.qlim, p.mid, p.F, p.meta, p.refine, DEFAULT_GRID, 1e-8 * p.s.scale, 1e-8,
                    REFINE_TOL * p.s.scale, REFINE_TOL)
-    entry = (weakref.ref(robot), _packed_entry(), I, D, B, p.n)
+    entry = (weakref.ref(robot), _packed_entry(), I, D, B, (MAX_ROWS, p.n))
     if len(_FAST) > 256:
         _FAST.clear()
     _FAST[id(robot)] = entry
@@ -621,28 +621,6 @@ _SHAPE44 = (4, 4)
 #: The default of ``ik_all``'s ``tol`` (the fast path tests identity: an explicit
 #: ``tol=1e-8`` takes the ordinary path, which gives the same rows).
 _TOL = 1e-8
-
-
-def _fast(robot: Robot, T: np.ndarray) -> np.ndarray | None:
-    """:func:`ik_all` for one C-contiguous, aligned, writeable float64 (4, 4) pose, defaults.
-
-    The rigidity check and the solve are one compiled call
-    (:func:`~serialkin.ik.analytic.dispatch.solve_packed`); None when the pose is not
-    rigid to 1e-13 (the ordinary path then checks, projects or raises). The rows are the
-    ordinary path's, bit for bit.
-    """
-    entry = _FAST.get(id(robot))
-    if entry is None or entry[0]() is not robot:
-        entry = _fast_entry(robot)
-    out = _EMPTY((MAX_ROWS, entry[5]))
-    k = entry[1](T, entry[2], entry[3], entry[4], out)
-    if k >= 0:
-        return out[:k]
-    if k == -1:
-        return None
-    from serialkin.ik.analytic.general import DEFAULT_GRID
-
-    return _with_general(robot, T, out[:-2 - k], _TOL, DEFAULT_GRID)
 
 
 def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool = False,
@@ -704,10 +682,23 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
     if (type(target) is _NDARRAY and tol is _TOL and near_tol is NEAR_TOL and free is None
             and grid is None and reference is None and report is False and all_turns is False
             and not options and target.shape == _SHAPE44 and target.dtype is _F64
-            and target.flags.carray):  # the defaults (by identity) and one plain pose
-        sols = _fast(robot, target)
-        if sols is not None:
-            return sols
+            and target.flags.carray):
+        # The fast path: the defaults (by identity) and one C-contiguous, aligned, writeable
+        # float64 pose. The rigidity check and the solve are one compiled call
+        # (dispatch.solve_packed) on the robot's cached packed data; the rows are the
+        # ordinary path's, bit for bit.
+        entry = _FAST.get(id(robot))
+        if entry is None or entry[0]() is not robot:
+            entry = _fast_entry(robot)
+        out = _EMPTY(entry[5])
+        k = entry[1](target, entry[2], entry[3], entry[4], out)
+        if k >= 0:
+            return out[:k]
+        if k < -1:  # a nearly ideal arm whose converged branches are odd in number
+            from serialkin.ik.analytic.general import DEFAULT_GRID
+
+            return _with_general(robot, target, out[:-2 - k], _TOL, DEFAULT_GRID)
+        # k == -1: not rigid to 1e-13; the ordinary path checks, projects or raises
     if options:
         raise InputError(f"unknown option(s) for ik_all: {', '.join(sorted(options))}; "
                          "accepted: tol, all_turns, free, near_tol, grid, reference, "
