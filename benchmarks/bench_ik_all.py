@@ -5,7 +5,9 @@ goals <= 10 us single, <= 3 us batched), a UR5 with every axis perturbed by up t
 0.01 rad (nearly ideal: the idealised closed form refined by Newton) and a random
 general 6R arm (the 2-D search: goal <= 200 us, against Robotics Toolbox's
 Raghavan-Roth ``analytic_ik`` in the same run). IK-Geo's published native figures are
-printed beside them.
+printed beside them. Beside wall time, "CPU" columns give the calling thread's CPU time
+per single call and the process's CPU time (all threads) per pose of a batch: the work
+done, whatever share of the cores the run got on a shared machine.
 
 Run by hand: ``.venv/bin/python benchmarks/bench_ik_all.py [--targets N] [--no-peers]``.
 
@@ -69,6 +71,18 @@ def _cpu_us(fn, number: int, repeat: int) -> tuple[float, float, float]:
             fn()
         out.append((time.thread_time() - t0) / number * 1e6)
     return float(np.median(out)), min(out), max(out)
+
+
+def _process_cpu_us(fn, repeat: int) -> float:
+    """Median over ``repeat`` runs of the process's CPU time of ``fn()`` [us], all threads
+    (``time.process_time``: the work done, whatever share of the cores it got)."""
+    fn()
+    out = []
+    for _ in range(repeat):
+        t0 = time.process_time()
+        fn()
+        out.append((time.process_time() - t0) * 1e6)
+    return float(np.median(out))
 
 
 def bench_serialkin(robot: Robot, n_targets: int, seed: int = 0) -> dict:
@@ -147,7 +161,7 @@ def bench_per_pose(n_batch: int, repeat: int) -> None:
     print(f"\nper pose, single call and batched ({n_batch} targets, all cores via "
           "parallel.run); median [spread] over repeated runs")
     print(f"{'arm':18s} {'mode':8s} {'single us':>22s} {'single CPU us':>24s} "
-          f"{'batched us/pose':>16s} {'#sol':>5s}")
+          f"{'batched us/pose':>16s} {'batched CPU us/pose':>20s} {'#sol':>5s}")
     rng = np.random.default_rng(0)
     arms = [(models.ur5(), 10.0, 3.0), (models.puma560(), 10.0, 3.0),
             (_perturbed(models.ur5(), rng), None, None), (_general_arm(3), 200.0, None)]
@@ -162,9 +176,10 @@ def bench_per_pose(n_batch: int, repeat: int) -> None:
         Tb = T[: max(8, n_batch // (50 if res.mode == "general" else 1))]
         batched = latency_us(lambda r=robot, t=Tb: ik_all(r, t), 1, repeat)
         per = batched.median / len(Tb)
+        per_cpu = _process_cpu_us(lambda r=robot, t=Tb: ik_all(r, t), repeat) / len(Tb)
         cpu_s = f"{cpu[0]:.1f} [{cpu[1]:.1f}-{cpu[2]:.1f}]"
         print(f"{robot.name:18s} {res.mode:8s} {single.fmt(1):>22s} {cpu_s:>24s} "
-              f"{per:16.2f} {res.count.mean():5.1f}")
+              f"{per:16.2f} {per_cpu:20.2f} {res.count.mean():5.1f}")
         if goal_single is not None:
             record("14.1", f"ik_all single, {robot.name} ({res.mode}), all solutions",
                    single.median, "us", f"<= {goal_single:g}", single.median <= goal_single)
