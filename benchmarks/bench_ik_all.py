@@ -5,8 +5,10 @@ goals <= 10 us single, <= 3 us batched), a UR5 with every axis perturbed by up t
 0.01 rad (nearly ideal: the idealised closed form refined by Newton) and random
 general 6R arms (Raghavan-Roth elimination, the 2-D search as its fallback: goal
 <= 200 us, against Robotics Toolbox's Raghavan-Roth ``analytic_ik`` in the same run;
-one arm in detail, then the median over 50 random arms). IK-Geo's published native figures are
-printed beside them.
+one arm in detail, then the median over 50 random arms). IK-Geo's published native
+figures are printed beside them. Beside wall time, "CPU" columns give the calling
+thread's CPU time per single call and the process's CPU time (all threads) per pose of
+a batch: the work done, whatever share of the cores the run got on a shared machine.
 
 Run by hand: ``.venv/bin/python benchmarks/bench_ik_all.py [--targets N] [--no-peers]``.
 
@@ -35,7 +37,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-from _common import header, interleaved_us, latency_us, record  # noqa: E402
+from _common import Stat, header, interleaved_us, latency_us, record  # noqa: E402
 
 from serialkin import Robot, models  # noqa: E402
 from serialkin.ik.analytic import classify, ik_all  # noqa: E402
@@ -70,6 +72,18 @@ def _cpu_us(fn, number: int, repeat: int) -> tuple[float, float, float]:
             fn()
         out.append((time.thread_time() - t0) / number * 1e6)
     return float(np.median(out)), min(out), max(out)
+
+
+def _process_cpu_us(fn, repeat: int) -> float:
+    """Median over ``repeat`` runs of the process's CPU time of ``fn()`` [us], all threads
+    (``time.process_time``: the work done, whatever share of the cores it got)."""
+    fn()
+    out = []
+    for _ in range(repeat):
+        t0 = time.process_time()
+        fn()
+        out.append((time.process_time() - t0) * 1e6)
+    return float(np.median(out))
 
 
 def bench_serialkin(robot: Robot, n_targets: int, seed: int = 0) -> dict:
@@ -120,7 +134,7 @@ def bench_rtb(rtb_robot, name: str, n_targets: int, seed: int = 1) -> dict:
         same = len(a) == len(b) and all(
             np.abs(_wrap(a - row)).max(axis=1).min() < 1e-6 for row in b)
         agree += same
-    out = {"derive_s": derive, "rtb_median": np.median(t_rtb), "ours_median": np.median(t_ours),
+    out = {"derive_s": derive, "rtb": Stat(t_rtb), "ours": Stat(t_ours),
            "agree": agree / n_targets, "class": classify(ours)}
     if hasattr(rtb_robot, "ikine_a"):
         confs = ["lun", "lud", "lfn", "lfd", "run", "rud", "rfn", "rfd"]
@@ -148,7 +162,7 @@ def bench_per_pose(n_batch: int, repeat: int) -> None:
     print(f"\nper pose, single call and batched ({n_batch} targets, all cores via "
           "parallel.run); median [spread] over repeated runs")
     print(f"{'arm':18s} {'mode':8s} {'single us':>22s} {'single CPU us':>24s} "
-          f"{'batched us/pose':>16s} {'#sol':>5s}")
+          f"{'batched us/pose':>16s} {'batched CPU us/pose':>20s} {'#sol':>5s}")
     rng = np.random.default_rng(0)
     arms = [(models.ur5(), 10.0, 3.0), (models.puma560(), 10.0, 3.0),
             (_perturbed(models.ur5(), rng), None, None), (_general_arm(3), 200.0, None)]
@@ -163,9 +177,10 @@ def bench_per_pose(n_batch: int, repeat: int) -> None:
         Tb = T[: max(8, n_batch // (50 if res.mode == "general" else 1))]
         batched = latency_us(lambda r=robot, t=Tb: ik_all(r, t), 1, repeat)
         per = batched.median / len(Tb)
+        per_cpu = _process_cpu_us(lambda r=robot, t=Tb: ik_all(r, t), repeat) / len(Tb)
         cpu_s = f"{cpu[0]:.1f} [{cpu[1]:.1f}-{cpu[2]:.1f}]"
         print(f"{robot.name:18s} {res.mode:8s} {single.fmt(1):>22s} {cpu_s:>24s} "
-              f"{per:16.2f} {res.count.mean():5.1f}")
+              f"{per:16.2f} {per_cpu:20.2f} {res.count.mean():5.1f}")
         if goal_single is not None:
             record("14.1", f"ik_all single, {robot.name} ({res.mode}), all solutions",
                    single.median, "us", f"<= {goal_single:g}", single.median <= goal_single)
@@ -325,14 +340,15 @@ def main() -> None:
         return
     print(f"\nvs Robotics Toolbox analytic_ik().solve (all solutions), {args.peer_targets} "
           "targets, limits off, same DH table")
-    print(f"{'robot':10s} {'derive s':>9s} {'rtb med us':>11s} {'ours med us':>12s} "
+    print("(median [10th-90th percentile] over the targets, one call each)")
+    print(f"{'robot':10s} {'derive s':>9s} {'rtb us':>20s} {'ours us':>18s} "
           f"{'ratio':>7s} {'same set':>9s}  extra")
     for rtb_robot, name in ((rtb.models.DH.UR5(), "UR5"), (rtb.models.DH.Puma560(), "Puma560")):
         r = bench_rtb(rtb_robot, name, args.peer_targets)
         extra = (f"ikine_a x 8 configs: {r['ikine_a_x8_median']:.0f} us"
                  if "ikine_a_x8_median" in r else "")
-        print(f"{name:10s} {r['derive_s']:9.1f} {r['rtb_median']:11.1f} {r['ours_median']:12.1f} "
-              f"{r['rtb_median'] / r['ours_median']:7.0f} {r['agree']:9.1%}  {extra}")
+        print(f"{name:10s} {r['derive_s']:9.1f} {r['rtb'].fmt(1):>20s} {r['ours'].fmt(1):>18s} "
+              f"{r['rtb'] / r['ours']:7.0f} {r['agree']:9.1%}  {extra}")
     print("\n(times per call on this machine, one thread)")
 
 

@@ -681,7 +681,8 @@ def test_bad_options():
         ik_all("ur5", T)
 
 
-@pytest.mark.parametrize("name", ["ur5", "puma560", "perturbed", "general"])
+@pytest.mark.parametrize("name", ["ur5", "puma560", "stanford", "scara", "three_link",
+                                  "perturbed", "general"])
 def test_fast_path_equals_ordinary_path(name):
     """One C-contiguous float64 pose (fast path) gives the ordinary path's rows bit for bit."""
     rng = np.random.default_rng(5)
@@ -704,3 +705,108 @@ def test_fast_path_equals_ordinary_path(name):
         assert fast.shape[0] >= 1 and np.array_equal(fast, slow)
         assert np.array_equal(fast, ik_all(robot, ro))
         assert np.abs(robot.fk(fast) - T).max() < 1e-8
+
+
+def test_tuple_vector_helpers_match_matrices():
+    """rot3, mv3, mtv3, cross3t, add3, sub3 and row3 equal the matrix/array operations."""
+    from serialkin.ik.analytic.subproblems import (
+        add3,
+        cross3t,
+        mtv3,
+        mv3,
+        rot3,
+        rotation,
+        row3,
+        sub3,
+    )
+
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        w = rng.normal(size=3)
+        w /= np.linalg.norm(w)
+        v, u = rng.normal(size=3), rng.normal(size=3)
+        th = rng.uniform(-4.0, 4.0)
+        R = rotation(w, th)
+        A = rng.normal(size=(4, 4))
+        c, s = math.cos(th), math.sin(th)
+        assert np.allclose(rot3(w, c, s, v), R @ v, atol=1e-14)
+        assert np.allclose(rot3(w, c, -s, v), R.T @ v, atol=1e-14)
+        assert np.allclose(rot3(tuple(w), c, s, tuple(v)), R @ v, atol=1e-14)
+        assert np.allclose(mv3(A, v), A[:3, :3] @ v, atol=1e-14)
+        assert np.allclose(mtv3(A, v), A[:3, :3].T @ v, atol=1e-14)
+        assert np.allclose(cross3t(u, v), np.cross(u, v), atol=1e-14)
+        assert np.allclose(add3(u, v), u + v) and np.allclose(sub3(u, v), u - v)
+        assert row3(A, 2) == tuple(A[2, :3])
+
+
+def test_packed_entry_equals_solve_into():
+    """solve_packed on pack()'s arrays gives solve_into's rows exactly, -1 if not rigid."""
+    from serialkin.ik.analytic import _prepared
+    from serialkin.ik.analytic.dispatch import MAX_ROWS, pack, solve_into, solve_packed
+
+    rng = np.random.default_rng(8)
+    perturbed = Robot.from_dh([DHLink(a=r.a + rng.uniform(-1e-3, 1e-3),
+                                      alpha=r.alpha + rng.uniform(-0.01, 0.01), d=r.d,
+                                      theta=r.theta + rng.uniform(-0.01, 0.01))
+                               for r in models.ur5().dh], "standard")
+    for robot in (models.ur5(), models.puma560(), models.stanford(), models.scara(),
+                  perturbed):
+        p = _prepared(robot, 0.05)
+        args = (p.W, p.P, p.M, p.aux, p.order, p.revolute, p.qlim, p.mid, p.F, p.meta)
+        I, D, B = pack(p.code, p.arm, p.prismatic3, *args, p.refine, 24, 1e-8 * p.s.scale,
+                       1e-8, 1e-12, 1e-12)
+        for q in robot.random_q(4, seed=1):
+            T = np.ascontiguousarray(robot.fk(q))
+            out1, out2 = np.zeros((MAX_ROWS, robot.n)), np.zeros((MAX_ROWS, robot.n))
+            conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
+            k1 = solve_into(p.code, p.arm, p.prismatic3, T, *args, True, p.refine, 24,
+                            1e-8 * p.s.scale, 1e-8, 1e-12, 1e-12, out1, conv)
+            odd = p.refine and conv[1:conv[0] + 1].sum() % 2 == 1
+            assert k1 >= 1
+            assert solve_packed(T, I, D, B, out2) == (-2 - k1 if odd else k1)
+            assert np.array_equal(out1, out2)
+        bad = T.copy()
+        bad[0, 0] += 1e-9
+        assert solve_packed(bad, I, D, B, out2) == -1
+
+
+def test_subproblem_cosines_match_angles():
+    """sp1_dir_cs and the 6-column sp2_dir give cos/sin of their angles, which solve them."""
+    from serialkin.ik.analytic.subproblems import rotation, sp1_dir, sp1_dir_cs, sp2_dir
+
+    rng = np.random.default_rng(4)
+    for _ in range(20):
+        w1, w2, u = (x / np.linalg.norm(x) for x in rng.normal(size=(3, 3)))
+        th, c, s = sp1_dir_cs(w1, u, rotation(w1, 0.7) @ u)
+        assert th == sp1_dir(w1, u, rotation(w1, 0.7) @ u)
+        assert abs(th - 0.7) < 1e-12 and abs(c - math.cos(th)) < 1e-15 \
+            and abs(s - math.sin(th)) < 1e-15
+        v = rotation(w1, rng.uniform(-3, 3)) @ rotation(w2, rng.uniform(-3, 3)) @ u
+        out2, out6 = np.zeros((2, 2)), np.zeros((2, 6))
+        m = sp2_dir(w1, w2, u, v, out2)
+        assert m == sp2_dir(w1, w2, u, v, out6) >= 1
+        assert np.array_equal(out2[:m], out6[:m, :2])
+        for t1, t2, c1, s1, c2, s2 in out6[:m]:
+            assert np.allclose([c1, s1, c2, s2], [math.cos(t1), math.sin(t1), math.cos(t2),
+                                                  math.sin(t2)], atol=1e-14)
+            assert np.allclose(rotation(w1, t1) @ rotation(w2, t2) @ u, v, atol=1e-12)
+    assert sp1_dir_cs(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 2.0]),
+                      np.array([1.0, 0.0, 0.0])) == (0.0, 1.0, 0.0)
+
+
+def test_sp4_cosines_match_angles():
+    """sp4 with 6 output entries gives the cosine and sine of each angle, which solve it."""
+    from serialkin.ik.analytic.subproblems import rotation, sp4
+
+    rng = np.random.default_rng(6)
+    for _ in range(40):
+        w, b, a = rng.normal(size=(3, 3))
+        w /= np.linalg.norm(w)
+        c = a @ rotation(w, rng.uniform(-3, 3)) @ b
+        out2, out6 = np.zeros(2), np.zeros(6)
+        m = sp4(w, b, a, c, out2)
+        assert m == sp4(w, b, a, c, out6) >= 1 and np.array_equal(out2[:m], out6[:m])
+        for i in range(m):
+            th, cs, sn = out6[i], out6[2 + 2 * i], out6[3 + 2 * i]
+            assert abs(cs - math.cos(th)) < 1e-14 and abs(sn - math.sin(th)) < 1e-14
+            assert abs(a @ rotation(w, th) @ b - c) < 1e-12

@@ -96,6 +96,19 @@ def test_batch_rejects_non_rigid_target():
         ik_all(robot, T)
 
 
+def test_batch_projects_nearly_rigid_targets_like_single_calls():
+    """Targets off SO(3) by 1e-9 are projected in a batch exactly as in single calls."""
+    robot = models.ur5()
+    T = robot.fk(robot.random_q(4, seed=3))
+    T[1, 0, 0] += 1e-9
+    T[3, :3, :3] *= 1.0 + 1e-10
+    res = ik_all(robot, T)
+    for i in range(4):
+        single = ik_all(robot, T[i])
+        assert int(res.count[i]) == len(single) >= 1
+        assert np.array_equal(res.solutions(i), single)
+
+
 # ----------------------------------------------------------------------------- general 6R
 def test_general_arms_complete_and_exact():
     """Random general 6R arms: rows meet FK to 1e-10; Newton from 200 seeds finds none missed."""

@@ -42,7 +42,7 @@ Semantics:
   set is a continuum; one representative per branch is returned (the free angle set
   to 0). At a stretched elbow the two elbow branches merge into one solution.
 * The kernels are compiled by numba on first use (cached on disk afterwards); a call
-  then takes about 10-15 µs for a 6R arm of an exact class, all solutions included,
+  then takes about 4-6 µs for a 6R arm of an exact class, all solutions included,
   and milliseconds for the general search (``benchmarks/bench_ik_all.py``).
 """
 
@@ -66,7 +66,6 @@ from serialkin.ik.analytic.dispatch import (
     SCARA,
     UR,
     WRIST,
-    solve_checked,
 )
 from serialkin.ik.analytic.singular import continuous_family
 from serialkin.ik.analytic.structure import (
@@ -543,17 +542,20 @@ def _solve_batch(p: _Prepared, robot: Robot, T: np.ndarray, tol: float,
 
 
 def _as_poses(a: np.ndarray) -> np.ndarray:
-    """(N, 4, 4) targets as exact rigid transforms (checked; rotations projected on SO(3))."""
-    from serialkin.spatial.kernels import transforms_valid
+    """(N, 4, 4) targets as exact rigid transforms (checked; rotations projected on SO(3)).
+
+    The criteria of :func:`_as_pose` per target, in one compiled pass
+    (:func:`~serialkin.ik.analytic.subproblems.rigid_errors_into`).
+    """
+    from serialkin.ik.analytic.subproblems import rigid_errors_into
 
     T = np.ascontiguousarray(a, dtype=float)
-    if not transforms_valid(T, ROTATION_TOL):
-        for k in range(T.shape[0]):
-            check_transform(T[k], f"target[{k}]")
-    R = T[:, :3, :3]
-    gram = np.einsum("kij,kil->kjl", R, R) - np.eye(3)
-    off = (np.abs(gram).max(axis=(1, 2)) > 1e-13) | np.any(T[:, 3] != (0.0, 0.0, 0.0, 1.0),
-                                                          axis=1)
+    err = np.empty(T.shape[0])
+    rigid_errors_into(T, err)
+    if T.shape[0] and err.max() > ROTATION_TOL:
+        for k in np.flatnonzero(err > ROTATION_TOL):
+            check_transform(T[k], f"target[{k}]")  # raises with a message naming the fault
+    off = err > 1e-13
     if off.any():  # nearest rotations (polar decomposition) where needed, exact last rows
         T = T.copy()
         U, _, Vt = np.linalg.svd(T[off, :3, :3])
@@ -562,48 +564,66 @@ def _as_poses(a: np.ndarray) -> np.ndarray:
     return T
 
 
-#: Fast-path entries per id(robot): (weak reference, prepared data, kernel arguments).
+#: Fast-path entries per id(robot): (weak reference, entry point, I, D, B, output shape).
 _FAST: dict[int, tuple] = {}
+#: The compiled entry point of ``solve_packed`` (resolved on first use by :func:`_packed_entry`).
+_SOLVE_PACKED: list[Any] = []
+
+
+def _packed_entry() -> Any:
+    """The compiled entry point of :func:`~serialkin.ik.analytic.dispatch.solve_packed`.
+
+    Calling it skips numba's type dispatch (about 1 µs with its arguments); it is
+    compiled for exactly the types the fast path passes: a C-contiguous, aligned,
+    writeable float64 (4, 4) target (checked by :func:`ik_all` before the call), the
+    read-only packed arrays of :func:`~serialkin.ik.analytic.dispatch.pack` and a fresh
+    output.
+    """
+    if not _SOLVE_PACKED:
+        import numba
+
+        from serialkin.ik.analytic.dispatch import solve_packed
+
+        Array = numba.types.Array
+        f64, i64 = numba.float64, numba.int64
+        sig = (Array(f64, 2, "C"), Array(i64, 1, "C", readonly=True),
+               Array(f64, 1, "C", readonly=True), Array(numba.boolean, 1, "C", readonly=True),
+               Array(f64, 2, "C"))
+        solve_packed.compile(sig)  # loads from numba's cache when it can
+        _SOLVE_PACKED.append(solve_packed.overloads[sig].entry_point)
+    return _SOLVE_PACKED[0]
 
 
 def _fast_entry(robot: object) -> tuple:
-    """The fast path's cached arguments for ``robot`` (default ``tol``, ``near_tol``, grid)."""
+    """The fast path's cached data for ``robot`` (default ``tol``, ``near_tol``, grid).
+
+    ``(weak reference, entry point, I, D, B, (16, n))``: the packed arguments of
+    :func:`~serialkin.ik.analytic.dispatch.solve_packed` and the shape of its output.
+    """
+    from serialkin.ik.analytic.dispatch import pack
     from serialkin.ik.analytic.general import DEFAULT_GRID
 
     p = _prepared(robot, NEAR_TOL)  # raises the ordinary path's errors
-    head = (p.code, p.arm, p.prismatic3)
-    tail = (p.W, p.P, p.M, p.aux, p.order, p.revolute, p.qlim, p.mid, p.F, p.meta, p.refine,
-            DEFAULT_GRID, 1e-8 * p.s.scale, 1e-8, REFINE_TOL * p.s.scale, REFINE_TOL)
-    entry = (weakref.ref(robot), p, head, tail)
+    I, D, B = pack(p.code, p.arm, p.prismatic3, p.W, p.P, p.M, p.aux, p.order, p.revolute,
+                   p.qlim, p.mid, p.F, p.meta, p.refine, DEFAULT_GRID, 1e-8 * p.s.scale, 1e-8,
+                   REFINE_TOL * p.s.scale, REFINE_TOL)
+    entry = (weakref.ref(robot), _packed_entry(), I, D, B, (MAX_ROWS, p.n))
     if len(_FAST) > 256:
         _FAST.clear()
     _FAST[id(robot)] = entry
     return entry
 
 
-def _fast(robot: Robot, T: np.ndarray) -> np.ndarray | None:
-    """:func:`ik_all` for one C-contiguous float64 (4, 4) pose and default options.
-
-    The rigidity check and the solve are one compiled call
-    (:func:`~serialkin.ik.analytic.dispatch.solve_checked`); None when the pose is not
-    rigid to 1e-13 (the ordinary path then checks, projects or raises). The rows are the
-    ordinary path's, bit for bit.
-    """
-    entry = _FAST.get(id(robot))
-    if entry is None or entry[0]() is not robot:
-        entry = _fast_entry(robot)
-    p = entry[1]
-    out = np.empty((MAX_ROWS, p.n))
-    conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
-    k = solve_checked(*entry[2], T, *entry[3], out, conv)
-    if k < 0:
-        return None
-    if p.mode == "near" and conv[1:conv[0] + 1].sum() % 2 == 1:
-        return _with_general(robot, T, out[:k], 1e-8, entry[3][11])
-    return out[:k]
+_EMPTY = np.empty
+_NDARRAY = np.ndarray
+_F64 = np.dtype(np.float64)
+_SHAPE44 = (4, 4)
+#: The default of ``ik_all``'s ``tol`` (the fast path tests identity: an explicit
+#: ``tol=1e-8`` takes the ordinary path, which gives the same rows).
+_TOL = 1e-8
 
 
-def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool = False,
+def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool = False,
            free: Mapping[int, float] | None = None, near_tol: float = NEAR_TOL,
            grid: int | None = None, reference: object = None, weights: object = None,
            norm: str = "l2", report: bool = False,
@@ -659,14 +679,26 @@ def ik_all(robot: Robot, target: object, *, tol: float = 1e-8, all_turns: bool =
         InputError: a target that is not a rigid transform / of an accepted shape, a
             non-positive ``tol`` or an unknown option.
     """
-    if (type(target) is np.ndarray and free is None and grid is None and reference is None
-            and not report and all_turns is False and not options and type(tol) is float
-            and tol == 1e-8 and type(near_tol) is float and near_tol == NEAR_TOL
-            and target.shape == (4, 4) and target.dtype == np.float64
-            and target.flags.c_contiguous and target.flags.writeable):
-        sols = _fast(robot, target)
-        if sols is not None:
-            return sols
+    if (type(target) is _NDARRAY and tol is _TOL and near_tol is NEAR_TOL and free is None
+            and grid is None and reference is None and report is False and all_turns is False
+            and not options and target.shape == _SHAPE44 and target.dtype is _F64
+            and target.flags.carray):
+        # The fast path: the defaults (by identity) and one C-contiguous, aligned, writeable
+        # float64 pose. The rigidity check and the solve are one compiled call
+        # (dispatch.solve_packed) on the robot's cached packed data; the rows are the
+        # ordinary path's, bit for bit.
+        entry = _FAST.get(id(robot))
+        if entry is None or entry[0]() is not robot:
+            entry = _fast_entry(robot)
+        out = _EMPTY(entry[5])
+        k = entry[1](target, entry[2], entry[3], entry[4], out)
+        if k >= 0:
+            return out[:k]
+        if k < -1:  # a nearly ideal arm whose converged branches are odd in number
+            from serialkin.ik.analytic.general import DEFAULT_GRID
+
+            return _with_general(robot, target, out[:-2 - k], _TOL, DEFAULT_GRID)
+        # k == -1: not rigid to 1e-13; the ordinary path checks, projects or raises
     if options:
         raise InputError(f"unknown option(s) for ik_all: {', '.join(sorted(options))}; "
                          "accepted: tol, all_turns, free, near_tol, grid, reference, "

@@ -4,6 +4,9 @@
 optionally refining every candidate branch on the true chain (nearly ideal arms, see
 :mod:`serialkin.ik.analytic.refine`); :func:`solve_range` runs it over targets
 ``start..stop-1`` with the GIL released, for :func:`serialkin.kinematics.parallel.run`.
+:func:`solve_packed` is the single-call entry of ``ik_all``'s fast path: the same solve
+with the robot's read-only data packed by :func:`pack` into three arrays (a call from
+Python pays for unboxing every array argument, 50-100 ns each).
 Kernels trust their input.
 """
 
@@ -12,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from serialkin.errors import InputError
 from serialkin.ik.analytic.general import MAX_SOLUTIONS as GENERAL_MAX
 from serialkin.ik.analytic.general import general_candidates
 from serialkin.ik.analytic.planar import solve_planar
@@ -94,22 +98,6 @@ def solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mi
     return finalize(cand, k, revolute, qlim, mid, F, meta, T, True, tol_p, tol_r, out)
 
 
-@njit(cache=True)
-def solve_checked(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mid, F,
-                  meta, refine, grid, tol_p, tol_r, newton_p, newton_r, out, conv):
-    """:func:`solve_into` for a (4, 4) target that must already be rigid to 1e-13.
-
-    The fast path of ``ik_all`` (one compiled call for the check and the solve): returns
-    −1 without solving when T is not a rigid transform to 1e-13 (the caller then checks
-    it, projects the rotation or raises), else the count of :func:`solve_into` (rotation
-    verified).
-    """
-    if rigid_error(T) > 1e-13:
-        return -1
-    return solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mid, F,
-                      meta, True, refine, grid, tol_p, tol_r, newton_p, newton_r, out, conv)
-
-
 @njit(cache=True, nogil=True)
 def solve_range(code, arm, prismatic3, Ts, W, P, M, aux, order, revolute, qlim, mid, F, meta,
                 refine, grid, tol_p, tol_r, newton_p, newton_r, out, counts, conv, start,
@@ -123,3 +111,77 @@ def solve_range(code, arm, prismatic3, Ts, W, P, M, aux, order, revolute, qlim, 
         counts[i] = solve_into(code, arm, prismatic3, Ts[i], W, P, M, aux, order, revolute,
                                qlim, mid, F, meta, True, refine, grid, tol_p, tol_r, newton_p,
                                newton_r, out[i], conv[i])
+
+
+#: Header length of the packed integer array (see :func:`pack`).
+_HEAD = 8
+
+
+def pack(code, arm, prismatic3, W, P, M, aux, order, revolute, qlim, mid, F, meta, refine,
+         grid, tol_p, tol_r, newton_p, newton_r):
+    """The arguments of :func:`solve_into` but the target and outputs, in three arrays.
+
+    Returns read-only ``(I, D, B)``: ``I`` int64 = (code, arm, prismatic3, refine, grid,
+    n, rows of aux, length of order) then ``order``; ``D`` float64 = (tol_p, tol_r,
+    newton_p, newton_r) then ``W``, ``P``, ``M``, ``aux``, ``qlim``, ``mid``, ``F``,
+    ``meta`` flattened; ``B`` = ``revolute`` (bool). :func:`solve_packed` unpacks them as
+    views of the same types, so the kernels below it are the ones already compiled.
+    Arrays of the structure (aux (k, 3)) and of the chain (F (n+1, 4, 4), meta (n, 5)).
+    """
+    n = W.shape[0]
+    if aux.ndim != 2 or aux.shape[1] != 3 or meta.shape != (n, 5) or F.shape != (n + 1, 4, 4):
+        raise InputError(f"pack: aux must be (k, 3), meta ({n}, 5) and F ({n + 1}, 4, 4); got "
+                         f"{aux.shape}, {meta.shape}, {F.shape}")  # the layout solve_packed reads
+    order = np.asarray(order, dtype=np.int64)
+    I = np.concatenate([np.array([code, arm, int(prismatic3), int(refine), grid, n,
+                                  aux.shape[0], order.shape[0]], dtype=np.int64), order])
+    D = np.concatenate([np.array([tol_p, tol_r, newton_p, newton_r], dtype=float)]
+                       + [np.asarray(a, dtype=float).ravel()
+                          for a in (W, P, M, aux, qlim, mid, F, meta)])
+    B = np.array(revolute, dtype=np.bool_)
+    for a in (I, D, B):
+        a.setflags(write=False)
+    return I, D, B
+
+
+@njit(cache=True)
+def solve_packed(T, I, D, B, out):
+    """:func:`solve_into` on the packed data of :func:`pack` (the fast path's entry).
+
+    One compiled call for the rigidity check and the solve (rotation verified), into
+    ``out`` (16, n). Returns the number of solutions k >= 0; −1 without solving when
+    T (4, 4) is not a rigid transform to 1e-13 (the caller then checks it, projects the
+    rotation or raises); ``−2 − k`` when the arm is refined (nearly ideal) and an odd
+    number of its branches converged (the caller then adds the general search's rows).
+    """
+    if rigid_error(T) > 1e-13:
+        return -1
+    n = I[5]
+    na = I[6]
+    o = 4
+    W = D[o:o + 3 * n].reshape((n, 3))
+    o += 3 * n
+    P = D[o:o + 3 * n].reshape((n, 3))
+    o += 3 * n
+    M = D[o:o + 16].reshape((4, 4))
+    o += 16
+    aux = D[o:o + 3 * na].reshape((na, 3))
+    o += 3 * na
+    qlim = D[o:o + 2 * n].reshape((n, 2))
+    o += 2 * n
+    mid = D[o:o + n]
+    o += n
+    F = D[o:o + 16 * (n + 1)].reshape((n + 1, 4, 4))
+    o += 16 * (n + 1)
+    meta = D[o:o + 5 * n].reshape((n, 5))
+    refine = I[3] != 0
+    conv = np.empty(MAX_ROWS + 1, dtype=np.int64)
+    k = solve_into(I[0], I[1], I[2] != 0, T, W, P, M, aux, I[_HEAD:_HEAD + I[7]], B, qlim,
+                   mid, F, meta, True, refine, I[4], D[0], D[1], D[2], D[3], out, conv)
+    if refine:
+        good = 0
+        for i in range(conv[0]):
+            good += conv[1 + i]
+        if good % 2 == 1:
+            return -2 - k
+    return k

@@ -44,21 +44,26 @@ from numba import njit
 
 from serialkin.ik.analytic.subproblems import (
     CLAMP,
+    add3,
     dot3,
     finalize,
-    mtv,
     mv,
-    planar2r,
+    mv3,
+    planar2r_frame,
+    planar2r_solve,
     polish_real_root,
     poly_roots,
+    rot3,
     rotate_point,
     rotation,
+    row3,
     sp1_dir,
     sp2_dir,
     sp3,
     sp3_slide,
     sp4,
-    target_point,
+    sub3,
+    target_rotation,
 )
 
 #: Most candidate solutions of a 6-joint arm.
@@ -66,43 +71,50 @@ MAX_SOLUTIONS = 8
 
 
 @njit(cache=True)
-def wrist_into(Rg, W, v, q1, q2, q3, prismatic3, out, k):
+def wrist_into(gw, gv, W, v, q1, q2, q3, prismatic3, sol, out, k):
     """Append the wrist solutions (q4, q5, q6) for arm joints (q1, q2, q3) to ``out``.
 
     The arm's rotation is ``R123 = Rot(w1, q1)·Rot(w2, q2)·Rot(w3, q3)`` (without the
     last factor when joint 3 is prismatic), and ``X = R123ᵀ·R_g = R4·R5·R6``.
 
     Args:
-        Rg: (3, 3) ``R_T·R_Mᵀ``, the rotation the six joints must produce.
+        gw: ``R_g·w6`` (3,), ``R_g = R_T·R_Mᵀ`` the rotation the six joints must produce.
+        gv: ``R_g·v`` (3,).
         W: (6, 3) joint directions at q = 0.
         v: (3,) unit vector ⟂ w6.
         q1: arm joint 1 value [rad].
         q2: arm joint 2 value [rad].
         q3: arm joint 3 value [rad, or m when prismatic].
         prismatic3: True when joint 3 slides (Stanford class).
+        sol: (2, 6) scratch array (see :func:`~serialkin.ik.analytic.subproblems.sp2_dir`).
         out: (8, 6) candidate rows; rows k, k+1 are written.
         k: number of rows already in ``out``.
 
     Returns:
         the new number of rows.
     """
-    w4 = W[3].copy()
-    w5 = W[4].copy()
-    w6 = W[5].copy()
-    # X·w6 and X·v with X = R123ᵀ·R_g, by three rotations each (no 3 × 3 products)
-    # (Rot(w, −θ)·x = Rot(w, θ)ᵀ·x: one sin/cos per joint)
-    R1 = rotation(W[0].copy(), q1)
-    R2 = rotation(W[1].copy(), q2)
-    xw = mtv(R2, mtv(R1, mv(Rg, w6)))
-    xv = mtv(R2, mtv(R1, mv(Rg, v)))
+    w4 = row3(W, 3)
+    w5 = row3(W, 4)
+    w6 = row3(W, 5)
+    # X·w6 and X·v with X = R123ᵀ·R_g, by Rodrigues' formula (Rot(w, −θ) = Rot(w, θ)ᵀ):
+    # tuples and one sin/cos per joint, no 3 × 3 products and no allocation
+    w1 = row3(W, 0)
+    w2 = row3(W, 1)
+    c1 = math.cos(q1)
+    sn1 = -math.sin(q1)
+    c2 = math.cos(q2)
+    sn2 = -math.sin(q2)
+    xw = rot3(w2, c2, sn2, rot3(w1, c1, sn1, gw))
+    xv = rot3(w2, c2, sn2, rot3(w1, c1, sn1, gv))
     if not prismatic3:
-        R3 = rotation(W[2].copy(), q3)
-        xw = mtv(R3, xw)
-        xv = mtv(R3, xv)
-    sol = np.empty((2, 2))
-    m = sp2_dir(w4, w5, w6, xw, sol)
+        w3 = row3(W, 2)
+        c3 = math.cos(q3)
+        sn3 = -math.sin(q3)
+        xw = rot3(w3, c3, sn3, xw)
+        xv = rot3(w3, c3, sn3, xv)
+    m = sp2_dir(w4, w5, w6, xw, sol)  # (q4, q5) with their cosines and sines
     for r in range(m):
-        q6 = sp1_dir(w6, v, mtv(rotation(w5, sol[r, 1]), mtv(rotation(w4, sol[r, 0]), xv)))
+        q6 = sp1_dir(w6, v, rot3(w5, sol[r, 4], -sol[r, 5], rot3(w4, sol[r, 2], -sol[r, 3], xv)))
         out[k, 0] = q1
         out[k, 1] = q2
         out[k, 2] = q3
@@ -121,21 +133,26 @@ def puma_positions(pw, W, P, aux, out):
 
     Writes rows into ``out`` (4, 3) and returns their count.
     """
-    c = aux[0].copy()
-    w = aux[1].copy()
-    e1 = aux[2].copy()
-    w1 = W[0].copy()
-    r1 = P[0].copy()
-    q1s = np.empty(2)
-    n1 = sp4(w1, w, pw - r1, dot3(w, c - r1), q1s)
-    sol = np.empty((2, 2))
+    c = row3(aux, 0)
+    w = row3(aux, 1)
+    e1 = row3(aux, 2)
+    w1 = row3(W, 0)
+    r1 = row3(P, 0)
+    c2 = row3(P, 1)
+    c3 = row3(P, 2)
+    buf = np.empty(10)
+    q1s = buf[0:6]  # angles, then the cosine and sine of each (sp4)
+    sol = buf[6:10].reshape((2, 2))
+    frame = planar2r_frame(w, e1, c2, c3, c)  # joints 2, 3 carrying c, once, not per branch
+    d = sub3(pw, r1)
+    n1 = sp4(w1, w, d, dot3(w, sub3(c, r1)), q1s)
     k = 0
     s2 = dot3(W[1], w)
     s3 = dot3(W[2], w)
     for i in range(n1):
         q1 = q1s[i]
-        x = rotate_point(w1, r1, -q1, pw)
-        m = planar2r(w, e1, P[1].copy(), P[2].copy(), c, x, sol)
+        x = add3(rot3(w1, q1s[2 + 2 * i], -q1s[3 + 2 * i], d), r1)  # exp(−ξ1 q1)·pw
+        m = planar2r_solve(frame, x, sol)
         for j in range(m):
             out[k, 0] = q1
             out[k, 1] = s2 * sol[j, 0]
@@ -411,13 +428,21 @@ def wrist_candidates(T, W, P, M, aux, arm, prismatic3, out):
 
     ``aux[0]`` is the wrist centre c and ``aux[-1]`` a unit vector ⟂ w6; returns the count.
     """
-    pw, Rg = target_point(T, M, aux[0].copy())
-    arm3 = np.empty((4, 3))
+    Rg = target_rotation(T, M)
+    scratch = np.empty(27)  # wrist centre, arm rows, wrist scratch: one allocation
+    pw = scratch[0:3]
+    pw[0], pw[1], pw[2] = add3(mv3(Rg, sub3(row3(aux, 0), (M[0, 3], M[1, 3], M[2, 3]))),
+                               (T[0, 3], T[1, 3], T[2, 3]))  # T·M⁻¹·c
+    arm3 = scratch[3:15].reshape((4, 3))
+    sol = scratch[15:27].reshape((2, 6))
     m = arm_positions(pw, W, P, aux, arm, prismatic3, arm3)
-    v = aux[aux.shape[0] - 1].copy()
+    v = row3(aux, aux.shape[0] - 1)
+    gw = mv3(Rg, row3(W, 5))
+    gv = mv3(Rg, v)
     k = 0
     for i in range(m):
-        k = wrist_into(Rg, W, v, arm3[i, 0], arm3[i, 1], arm3[i, 2], prismatic3, out, k)
+        k = wrist_into(gw, gv, W, v, arm3[i, 0], arm3[i, 1], arm3[i, 2], prismatic3, sol,
+                       out, k)
     return k
 
 

@@ -32,7 +32,7 @@ import math
 import numpy as np
 from numba import njit
 
-from serialkin.kinematics.kernels import fk_into
+from serialkin.kinematics.kernels import fk_range
 
 #: arccos arguments within this distance of ±1 are clamped (workspace boundary).
 CLAMP = 1e-9
@@ -95,6 +95,66 @@ def mtv(A, v):
     for i in range(3):
         out[i] = A[0, i] * v[0] + A[1, i] * v[1] + A[2, i] * v[2]
     return out
+
+
+# --- 3-vectors as tuples ------------------------------------------------------------------
+#
+# A numba function that returns a new (3,) array pays for a heap allocation (30-50 ns),
+# which dominated the closed forms (about 100 per pose). The hot paths instead carry
+# vectors as (x, y, z) tuples, which live in registers; the functions below take tuples
+# or array rows alike (anything indexable by 0, 1, 2).
+
+
+@njit(cache=True)
+def row3(a, i):
+    """Row i of an (m, 3) array (or the first three entries of row i) as a tuple."""
+    return (a[i, 0], a[i, 1], a[i, 2])
+
+
+@njit(cache=True)
+def add3(a, b):
+    """``a + b`` of two 3-vectors, a tuple."""
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+@njit(cache=True)
+def sub3(a, b):
+    """``a − b`` of two 3-vectors, a tuple."""
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+@njit(cache=True)
+def cross3t(a, b):
+    """Cross product of two 3-vectors, a tuple (see :func:`cross3` for an array)."""
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@njit(cache=True)
+def mv3(A, v):
+    """``A[:3, :3]·v`` as a tuple (A a (3, 3) or (4, 4) array)."""
+    return (A[0, 0] * v[0] + A[0, 1] * v[1] + A[0, 2] * v[2],
+            A[1, 0] * v[0] + A[1, 1] * v[1] + A[1, 2] * v[2],
+            A[2, 0] * v[0] + A[2, 1] * v[1] + A[2, 2] * v[2])
+
+
+@njit(cache=True)
+def mtv3(A, v):
+    """``A[:3, :3]ᵀ·v`` as a tuple (A a (3, 3) or (4, 4) array)."""
+    return (A[0, 0] * v[0] + A[1, 0] * v[1] + A[2, 0] * v[2],
+            A[0, 1] * v[0] + A[1, 1] * v[1] + A[2, 1] * v[2],
+            A[0, 2] * v[0] + A[1, 2] * v[1] + A[2, 2] * v[2])
+
+
+@njit(cache=True)
+def rot3(w, c, s, v):
+    """``Rot(w, θ)·v`` as a tuple from ``c = cos θ``, ``s = sin θ`` (Rodrigues).
+
+    ``Rot(w, θ)ᵀ·v = Rot(w, −θ)·v`` is ``rot3(w, c, -s, v)``: one sin/cos per joint.
+    """
+    k = (w[0] * v[0] + w[1] * v[1] + w[2] * v[2]) * (1.0 - c)
+    return (v[0] * c + (w[1] * v[2] - w[2] * v[1]) * s + w[0] * k,
+            v[1] * c + (w[2] * v[0] - w[0] * v[2]) * s + w[1] * k,
+            v[2] * c + (w[0] * v[1] - w[1] * v[0]) * s + w[2] * k)
 
 
 @njit(cache=True)
@@ -223,13 +283,14 @@ def _acos_clamped(x):
 
 
 @njit(cache=True)
-def sp1_dir(w, u, v):
-    """Subproblem 1 on directions: θ such that ``Rot(w, θ)·u`` points like ``v`` in the plane ⟂ w.
+def sp1_dir_cs(w, u, v):
+    """Subproblem 1 on directions with the cosine and sine of the angle: ``(θ, cos θ, sin θ)``.
 
-    Returns ``atan2(w·(u' × v'), u'·v')`` with ``u'``, ``v'`` the projections on that
-    plane; 0 when either projection vanishes to rounding level (< 1e-12 of |u|, |v|):
-    the angle is then arbitrary (a singular configuration) and 0 is its representative.
-    Scalar code, no allocation (a hot path of every solver).
+    θ = ``atan2(w·(u' × v'), u'·v')`` with ``u'``, ``v'`` the projections of u, v on the
+    plane ⟂ w (so ``Rot(w, θ)·u`` points like ``v`` there); cos θ and sin θ come from the
+    same two numbers (no trigonometric call). ``(0, 1, 0)`` when either projection
+    vanishes to rounding level (< 1e-12 of |u|, |v|): the angle is then arbitrary (a
+    singular configuration) and 0 is its representative. Scalar code, no allocation.
     """
     wu = w[0] * u[0] + w[1] * u[1] + w[2] * u[2]
     wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2]
@@ -242,11 +303,26 @@ def sp1_dir(w, u, v):
     if (u0 * u0 + u1 * u1 + u2 * u2 <= 1e-24 * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
             or v0 * v0 + v1 * v1 + v2 * v2 <= 1e-24 * (v[0] * v[0] + v[1] * v[1]
                                                         + v[2] * v[2])):
-        return 0.0
+        return 0.0, 1.0, 0.0
     c0 = u1 * v2 - u2 * v1
     c1 = u2 * v0 - u0 * v2
     c2 = u0 * v1 - u1 * v0
-    return math.atan2(w[0] * c0 + w[1] * c1 + w[2] * c2, u0 * v0 + u1 * v1 + u2 * v2)
+    y = w[0] * c0 + w[1] * c1 + w[2] * c2
+    x = u0 * v0 + u1 * v1 + u2 * v2
+    r = math.sqrt(x * x + y * y)
+    if r == 0.0:
+        return 0.0, 1.0, 0.0
+    return math.atan2(y, x), x / r, y / r
+
+
+@njit(cache=True)
+def sp1_dir(w, u, v):
+    """Subproblem 1 on directions: θ such that ``Rot(w, θ)·u`` points like ``v`` in the plane ⟂ w.
+
+    The angle of :func:`sp1_dir_cs`: ``atan2(w·(u' × v'), u'·v')``, 0 when either
+    projection vanishes (a singular configuration). A hot path of every solver.
+    """
+    return sp1_dir_cs(w, u, v)[0]
 
 
 @njit(cache=True)
@@ -255,7 +331,9 @@ def sp2_dir(w1, w2, u, v, out):
 
     ``u`` and ``v`` are vectors from the common point (or directions). The intermediate
     vector is ``z = α w1 + β w2 ± γ (w1 × w2)`` with ``w2·z = w2·u``, ``w1·z = w1·v`` and
-    ``|z| = |u|``. Writes rows (θ1, θ2) into ``out`` (2, 2); returns 0, 1 or 2.
+    ``|z| = |u|``. Writes rows (θ1, θ2) into ``out`` (2, 2), or (θ1, θ2, cos θ1, sin θ1,
+    cos θ2, sin θ2) when ``out`` has 6 columns (:func:`sp1_dir_cs`: no trigonometric
+    call); returns 0, 1 or 2.
     """
     c12 = dot3(w1, w2)
     den = c12 * c12 - 1.0
@@ -263,7 +341,7 @@ def sp2_dir(w1, w2, u, v, out):
     a1v = dot3(w1, v)
     alpha = (c12 * a2u - a1v) / den
     beta = (c12 * a1v - a2u) / den
-    x = cross3(w1, w2)
+    x = cross3t(w1, w2)
     nx2 = dot3(x, x)
     uu = dot3(u, u)
     g2 = (uu - alpha * alpha - beta * beta - 2.0 * alpha * beta * c12) / nx2
@@ -273,13 +351,19 @@ def sp2_dir(w1, w2, u, v, out):
         g2 = 0.0
     g = math.sqrt(g2)
     count = 1 if g == 0.0 else 2
-    z = np.empty(3)
     for k in range(count):
         sg = g if k == 0 else -g
-        for i in range(3):
-            z[i] = alpha * w1[i] + beta * w2[i] + sg * x[i]
-        out[k, 1] = sp1_dir(w2, u, z)
-        out[k, 0] = sp1_dir(w1, z, v)
+        z = (alpha * w1[0] + beta * w2[0] + sg * x[0], alpha * w1[1] + beta * w2[1] + sg * x[1],
+             alpha * w1[2] + beta * w2[2] + sg * x[2])
+        t2, cs2, sn2 = sp1_dir_cs(w2, u, z)
+        t1, cs1, sn1 = sp1_dir_cs(w1, z, v)
+        out[k, 0] = t1
+        out[k, 1] = t2
+        if out.shape[1] >= 6:
+            out[k, 2] = cs1
+            out[k, 3] = sn1
+            out[k, 4] = cs2
+            out[k, 5] = sn2
     return count
 
 
@@ -341,7 +425,10 @@ def sp4(w, b, a, c, out):
 
     ``A = a·b'``, ``B = a·(w × b')``, ``b'`` the part of b ⟂ w, so θ = atan2(B, A) ±
     arccos(D / sqrt(A² + B²)). When A = B = 0 any θ solves a consistent equation:
-    θ = 0 is returned as the representative. Writes into ``out`` (2,), returns 0, 1 or 2.
+    θ = 0 is returned as the representative. Writes θ into ``out`` (2,), returns 0, 1 or
+    2. With ``out`` of 6 entries also ``cos θ, sin θ`` of each solution into
+    ``out[2:4]`` and ``out[4:6]``, by the angle-sum formulas from A, B, D (no
+    trigonometric call; ``sin(arccos x) = sqrt((1 − x)(1 + x))``).
     """
     wb = w[0] * b[0] + w[1] * b[1] + w[2] * b[2]
     b0 = b[0] - wb * w[0]
@@ -354,16 +441,34 @@ def sp4(w, b, a, c, out):
     Rn = math.hypot(A, B)
     scale = math.sqrt((a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
                       * (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]))
+    cs = out.shape[0] >= 6
     if Rn <= 1e-12 * max(scale, 1e-300):
         if abs(D) <= 1e-9 * max(scale, 1.0):
             out[0] = 0.0
+            if cs:
+                out[2] = 1.0
+                out[3] = 0.0
             return 1
         return 0
     phi = math.atan2(B, A)
-    x = _acos_clamped(D / Rn)
+    cx = D / Rn
+    x = _acos_clamped(cx)
     if math.isnan(x):
         return 0
     out[0] = phi + x
+    if cs:
+        cp = A / Rn
+        sp = B / Rn
+        if x == 0.0:
+            cx, sx = 1.0, 0.0
+        elif x == math.pi:
+            cx, sx = -1.0, 0.0
+        else:
+            sx = math.sqrt((1.0 - cx) * (1.0 + cx))
+        out[2] = cp * cx - sp * sx
+        out[3] = sp * cx + cp * sx
+        out[4] = cp * cx + sp * sx
+        out[5] = sp * cx - cp * sx
     if x == 0.0:
         return 1
     out[1] = phi - x
@@ -389,28 +494,36 @@ def planar2r(w, e1, c1, c2, p, t, out):
     (θ1, θ2) [rad, about +w] into ``out`` (2, 2); returns 0, 1 or 2. When the target is
     on the first axis with L1 = L2, θ1 is arbitrary and θ1 = α = 0 is returned.
     """
-    e20 = w[1] * e1[2] - w[2] * e1[1]  # e2 = w × e1, scalar code (no allocation)
-    e21 = w[2] * e1[0] - w[0] * e1[2]
-    e22 = w[0] * e1[1] - w[1] * e1[0]
-    l10 = c2[0] - c1[0]
-    l11 = c2[1] - c1[1]
-    l12 = c2[2] - c1[2]
-    l20 = p[0] - c2[0]
-    l21 = p[1] - c2[1]
-    l22 = p[2] - c2[2]
-    d0 = t[0] - c1[0]
-    d1 = t[1] - c1[1]
-    d2 = t[2] - c1[2]
-    x1 = e1[0] * l10 + e1[1] * l11 + e1[2] * l12
-    y1 = e20 * l10 + e21 * l11 + e22 * l12
-    x2 = e1[0] * l20 + e1[1] * l21 + e1[2] * l22
-    y2 = e20 * l20 + e21 * l21 + e22 * l22
-    L1 = math.hypot(x1, y1)
-    L2 = math.hypot(x2, y2)
+    return planar2r_solve(planar2r_frame(w, e1, c1, c2, p), t, out)
+
+
+@njit(cache=True)
+def planar2r_frame(w, e1, c1, c2, p):
+    """The target-independent part of :func:`planar2r`, computed once per arm.
+
+    Returns the tuple ``(e1, e2 = w × e1, c1, L1, L2, φ10, φ20)``: the plane basis and
+    origin, the projected link lengths and the link angles at the zero configuration
+    (φ10 of link 1, φ20 of link 2 relative to link 1).
+    """
+    e2 = cross3t(w, e1)
+    l1 = sub3(c2, c1)
+    l2 = sub3(p, c2)
+    x1 = dot3(e1, l1)
+    y1 = dot3(e2, l1)
+    x2 = dot3(e1, l2)
+    y2 = dot3(e2, l2)
     phi10 = math.atan2(y1, x1)
-    phi20 = math.atan2(y2, x2) - phi10
-    x = e1[0] * d0 + e1[1] * d1 + e1[2] * d2
-    y = e20 * d0 + e21 * d1 + e22 * d2
+    return ((e1[0], e1[1], e1[2]), e2, (c1[0], c1[1], c1[2]), math.hypot(x1, y1),
+            math.hypot(x2, y2), phi10, math.atan2(y2, x2) - phi10)
+
+
+@njit(cache=True)
+def planar2r_solve(frame, t, out):
+    """:func:`planar2r` for the target point t, given its :func:`planar2r_frame`."""
+    e1, e2, c1, L1, L2, phi10, phi20 = frame
+    d = sub3(t, c1)
+    x = dot3(e1, d)
+    y = dot3(e2, d)
     r2 = x * x + y * y
     th2 = _acos_clamped((r2 - L1 * L1 - L2 * L2) / (2.0 * L1 * L2))
     if math.isnan(th2):
@@ -446,6 +559,13 @@ def rigid_error(T):
            - T[0, 1] * (T[1, 0] * T[2, 2] - T[1, 2] * T[2, 0])
            + T[0, 2] * (T[1, 0] * T[2, 1] - T[1, 1] * T[2, 0]))
     return max(err, abs(det - 1.0))
+
+
+@njit(cache=True)
+def rigid_errors_into(Ts, err):
+    """:func:`rigid_error` of every ``Ts[k]`` (N, 4, 4) into ``err`` (N,)."""
+    for k in range(Ts.shape[0]):
+        err[k] = rigid_error(Ts[k])
 
 
 @njit(cache=True)
@@ -545,9 +665,8 @@ def finalize(cand, k, revolute, qlim, mid, F, meta, T, check_rot, tol_p, tol_r, 
     accepted rows are sorted lexicographically into ``out`` (K, n). Returns their count.
     """
     n = cand.shape[1]
-    m = 0
-    q = np.empty(n)
-    Tq = np.empty((4, 4))
+    Q = np.empty((max(k, 1), n))
+    kq = 0
     for i in range(k):
         ok = True
         for j in range(n):
@@ -569,20 +688,24 @@ def finalize(cand, k, revolute, qlim, mid, F, meta, T, check_rot, tol_p, tol_r, 
                     ok = False
                     break
                 v = hi
-            q[j] = v
-        if not ok:
-            continue
-        fk_into(q, F, meta, Tq)
+            Q[kq, j] = v
+        if ok:
+            kq += 1
+    Tq = np.empty((max(kq, 1), 4, 4))
+    fk_range(Q, F, meta, Tq, 0, kq)  # the rows inside the limits, vectorised across rows
+    m = 0
+    for i in range(kq):
+        q = Q[i]
         ep = 0.0
         for r in range(3):
-            ep += (Tq[r, 3] - T[r, 3]) ** 2
+            ep += (Tq[i, r, 3] - T[r, 3]) ** 2
         if math.sqrt(ep) > tol_p:
             continue
         if check_rot:
             er = 0.0
             for r in range(3):
                 for c in range(3):
-                    er = max(er, abs(Tq[r, c] - T[r, c]))
+                    er = max(er, abs(Tq[i, r, c] - T[r, c]))
             if er > tol_r:
                 continue
         dup = False

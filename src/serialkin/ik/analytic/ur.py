@@ -25,19 +25,20 @@ import numpy as np
 from numba import njit
 
 from serialkin.ik.analytic.subproblems import (
-    cross3,
+    add3,
+    cross3t,
     dot3,
     finalize,
-    inv_rigid,
-    mm,
-    mtv,
-    mv,
-    planar2r,
-    rotation,
-    sp1_dir,
+    mtv3,
+    mv3,
+    planar2r_frame,
+    planar2r_solve,
+    rot3,
+    row3,
+    sp1_dir_cs,
     sp4,
-    target_point,
-    transform_point,
+    sub3,
+    target_rotation,
 )
 
 #: Most candidate solutions.
@@ -46,45 +47,61 @@ MAX_SOLUTIONS = 8
 
 @njit(cache=True)
 def ur_candidates(T, W, P, M, aux, out):
-    """Candidates for a ``ur``-class arm; aux = (p56, w, e ⟂ w). Returns the count."""
-    p56 = aux[0].copy()
-    w = aux[1].copy()
-    e = aux[2].copy()
-    w1 = W[0].copy()
-    r1 = P[0].copy()
-    w5 = W[4].copy()
-    r5 = P[4].copy()
-    w6 = W[5].copy()
-    r6 = P[5].copy()
-    p5, Rg = target_point(T, M, p56)
-    w6t = mv(Rg, w6)
-    TMinv = mm(T, inv_rigid(M))
-    x4 = P[3].copy()
+    """Candidates for a ``ur``-class arm; aux = (p56, w, e ⟂ w). Returns the count.
+
+    Vectors are tuples (no allocation per branch) and every rotation is applied by
+    Rodrigues' formula from one sin/cos per joint value (``Rot(w, −θ) = Rot(w, θ)ᵀ``).
+    """
+    p56 = row3(aux, 0)
+    w = row3(aux, 1)
+    e = row3(aux, 2)
+    w1 = row3(W, 0)
+    r1 = row3(P, 0)
+    w5 = row3(W, 4)
+    r5 = row3(P, 4)
+    w6 = row3(W, 5)
+    r6 = row3(P, 5)
+    c2 = row3(P, 1)
+    c3 = row3(P, 2)
+    x4 = row3(P, 3)
+    Rg = target_rotation(T, M)
+    # T·M⁻¹ = [R_g, t_g] with t_g = t_T − R_g·t_M
+    mt = mv3(Rg, (M[0, 3], M[1, 3], M[2, 3]))
+    tg = (T[0, 3] - mt[0], T[1, 3] - mt[1], T[2, 3] - mt[2])
+    p5 = add3(mv3(Rg, p56), tg)
+    w6t = mv3(Rg, w6)
     s2 = dot3(W[1], w)
     s3 = dot3(W[2], w)
     s4 = dot3(W[3], w)
-    q1s = np.empty(2)
-    q5s = np.empty(2)
-    sol = np.empty((2, 2))
-    n1 = sp4(w1, w, p5 - r1, dot3(w, p56 - r1), q1s)
+    frame = planar2r_frame(w, e, c2, c3, x4)  # joints 2, 3 carrying x4, once, not per branch
+    x4r5 = sub3(x4, r5)
+    r5r6 = sub3(r5, r6)
+    tgr1 = sub3(tg, r1)
+    buf = np.empty(16)
+    q1s = buf[0:6]  # angles, then the cosine and sine of each (sp4)
+    q5s = buf[6:12]
+    sol = buf[12:16].reshape((2, 2))
+    n1 = sp4(w1, w, sub3(p5, r1), dot3(w, sub3(p56, r1)), q1s)
     k = 0
     for i in range(n1):
         q1 = q1s[i]
-        R1 = rotation(w1, q1)
-        X = mm(R1.T, Rg)
-        n5 = sp4(w5, w6, w, dot3(mv(R1, w), w6t), q5s)
+        c1 = q1s[2 + 2 * i]
+        sn1 = q1s[3 + 2 * i]
+        R1w = rot3(w1, c1, sn1, w)
+        Xtw = mtv3(Rg, R1w)  # Xᵀ·w with X = R1ᵀ·R_g
+        n5 = sp4(w5, w6, w, dot3(R1w, w6t), q5s)
         for j in range(n5):
             q5 = q5s[j]
-            R5 = rotation(w5, q5)
-            q6 = sp1_dir(w6, mtv(X, w), mtv(R5, w))
+            c5 = q5s[2 + 2 * j]
+            sn5 = q5s[3 + 2 * j]
+            q6, c6, sn6 = sp1_dir_cs(w6, Xtw, rot3(w5, c5, -sn5, w))
             # G = e1⁻¹·T·M⁻¹·e6⁻¹·e5⁻¹ applied to e and x4 by rotations (no 4 × 4 products)
-            # (Rot(w, −θ) = Rot(w, θ)ᵀ: the rotations already built are reused)
-            R6 = rotation(w6, q6)
-            ve = mtv(R1, mv(TMinv, mtv(R6, mtv(R5, e))))
-            s = math.atan2(dot3(w, cross3(e, ve)), dot3(e, ve))
-            y = mtv(R1, transform_point(TMinv, mtv(R6, mtv(R5, x4 - r5) + r5 - r6) + r6)
-                    - r1) + r1
-            m = planar2r(w, e, P[1].copy(), P[2].copy(), x4, y, sol)
+            ve = rot3(w1, c1, -sn1, mv3(Rg, rot3(w6, c6, -sn6, rot3(w5, c5, -sn5, e))))
+            s = math.atan2(dot3(w, cross3t(e, ve)), dot3(e, ve))
+            a = add3(rot3(w5, c5, -sn5, x4r5), r5r6)
+            b = add3(mv3(Rg, add3(rot3(w6, c6, -sn6, a), r6)), tgr1)
+            y = add3(rot3(w1, c1, -sn1, b), r1)
+            m = planar2r_solve(frame, y, sol)
             for r in range(m):
                 out[k, 0] = q1
                 out[k, 1] = s2 * sol[r, 0]
