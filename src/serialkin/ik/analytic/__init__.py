@@ -22,11 +22,11 @@ class                       structure                                           
 Beyond these exact classes (see ``docs/ik-analytic.md``): a 6-joint arm within
 ``near_tol`` of a class (a calibrated robot) is solved on the idealised class and every
 branch refined by Newton's method on the true model (:mod:`~serialkin.ik.analytic.refine`);
-any other 6R arm by the 2-D search of :mod:`~serialkin.ik.analytic.general` (up to 16
-solutions); ``free={index: value}`` locks joints (7R arms); a batch of targets
-(..., 4, 4) returns an :class:`AllSolutions`. Other robots raise
-:class:`~serialkin.errors.NoClosedFormError`, whose message says which structural test
-failed and points to the numerical solvers (``robot.ik(target, method="lm")``).
+any other 6R arm by :mod:`~serialkin.ik.analytic.general` (Raghavan–Roth elimination,
+a 2-D search as its fallback; up to 16 solutions); ``free={index: value}`` locks
+joints (7R arms); a batch of targets (..., 4, 4) returns an :class:`AllSolutions`.
+Other robots raise :class:`~serialkin.errors.NoClosedFormError`, whose message says which
+structural test failed and points to the numerical solvers (``robot.ik(target, method="lm")``).
 
 Semantics:
 
@@ -43,7 +43,8 @@ Semantics:
   to 0). At a stretched elbow the two elbow branches merge into one solution.
 * The kernels are compiled by numba on first use (cached on disk afterwards); a call
   then takes about 4-6 µs for a 6R arm of an exact class, all solutions included,
-  and milliseconds for the general search (``benchmarks/bench_ik_all.py``).
+  and about 0.1 ms for a general 6R arm (milliseconds when the elimination declines and
+  the search answers; ``benchmarks/bench_ik_all.py``).
 """
 
 from __future__ import annotations
@@ -174,7 +175,7 @@ def _prepared(robot: Robot, near_tol: float = 0.0) -> _Prepared:
     """The robot's solver data, cached per robot and ``near_tol``.
 
     Its exact class; else (6 joints) the class it is within ``near_tol`` of (solved on
-    the idealised axes, refined on the true chain); else (6R) the general search.
+    the idealised axes, refined on the true chain); else (6R) the general solver.
     """
     if not isinstance(robot, Robot):
         raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
@@ -328,8 +329,8 @@ class AllSolutions:
             ``'general_6r'``).
         mode: ``'exact'`` (closed form of the exact class), ``'near'`` (the arm is within
             the tolerance of ``kind``: solved for the idealised axes, every branch refined
-            on the true model) or ``'general'`` (the 2-D search of
-            :mod:`serialkin.ik.analytic.general`).
+            on the true model) or ``'general'`` (Raghavan–Roth elimination or the 2-D
+            search of :mod:`serialkin.ik.analytic.general`).
         continuous: (..., k_max) bool, with ``report=True``: solution j of target i lies
             on a continuous family of solutions (a singular target: the row is one
             representative, :func:`~serialkin.ik.analytic.singular.continuous_family`);
@@ -637,8 +638,8 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
       ``near_tol`` rad, ``near_tol``·size m; e.g. a calibrated robot): the closed form of
       the idealised arm gives one candidate per branch, each refined by Newton's method
       on the true model to 1e-12 (``report=True`` says per branch whether it converged);
-    * any other 6R arm: the 2-D search of :mod:`serialkin.ik.analytic.general` (up to 16
-      solutions, each refined to 1e-12).
+    * any other 6R arm: Raghavan–Roth elimination, with a 2-D search as its fallback
+      (:mod:`serialkin.ik.analytic.general`; up to 16 solutions, each refined to 1e-12).
 
     Args:
         robot: the robot.
