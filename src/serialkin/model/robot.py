@@ -422,11 +422,18 @@ class Robot:
         Raises:
             InputError: q of the wrong shape or not finite; out of the wrong kind.
         """
-        if out is None and type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1:
+        if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1:
             # one configuration: one compiled call, which checks the length and finiteness
-            # (an entry point does not check dtype or ndim: they are checked here)
-            T = _EMPTY((4, 4))
-            if (_FK1 or _fast()[0])(q, self._P, T) == 0:
+            # (an entry point does not check dtype or ndim: they are checked here, and
+            # out's; anything else takes the general path below)
+            if out is None:
+                T = _EMPTY((4, 4))
+            elif type(out) is _NDARRAY and out.dtype is _F64 and out.shape == (4, 4) \
+                    and out.flags.carray:
+                T = out
+            else:
+                T = None
+            if T is not None and (_FK1 or _fast()[0])(q, self._P, T) == 0:
                 return T
         a = self.check_q(q)
         shape = a.shape[:-1] + (4, 4)
@@ -491,10 +498,16 @@ class Robot:
             InputError: q of the wrong shape or not finite, unknown frame, link outside
                 0..n, point without link, out of the wrong kind.
         """
-        if out is None and type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 \
-                and link is None and point is None and type(frame) is str and frame == "base":
-            J = _EMPTY(self._jshape)  # one compiled call, as in fk
-            if (_JAC1 or _fast()[1])(q, self._P, J) == 0:
+        if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 and link is None \
+                and point is None and type(frame) is str and frame == "base":
+            if out is None:  # one compiled call, as in fk
+                J = _EMPTY(self._jshape)
+            elif type(out) is _NDARRAY and out.dtype is _F64 and out.shape == self._jshape \
+                    and out.flags.carray:
+                J = out
+            else:
+                J = None
+            if J is not None and (_JAC1 or _fast()[1])(q, self._P, J) == 0:
                 return J
         a, J, T = self._jacobians(q, frame, link, point)
         shape = a.shape[:-1] + (6, self.n)
