@@ -10,7 +10,9 @@ inside the limits. Every solver gets the same targets and initial guesses, and a
 counts as a **success only when FK of the returned q is within 1e-6 m and 1e-6 rad of the
 target and q is inside the joint limits** (checked here with serialkin's FK, not by the
 solver's own flag). Times are wall-clock per call of the public API: median, 10-90 %
-spread over the targets, and mean.
+spread over the targets, and mean; the goal's rows (serialkin ``lm`` and the toolbox's
+``ik_LM``) time every target ``--passes`` times (default 3) and report the median of the
+passes' medians and their range ("runs", the run-to-run spread).
 
 Peers, in the same run when the ``bench`` extra is installed:
 
@@ -27,7 +29,7 @@ Peers, in the same run when the ``bench`` extra is installed:
 serialkin rows use ``robot.ik(T, method=..., q0=q0, seed=k)`` with each method's default
 tolerance (1e-9), iteration budget and restarts. The last column is the ratio of the
 median time to Robotics Toolbox's ``ik_LM``. A final line times the batch kernel (all N
-targets in one call across the cores): median and spread of 7 runs after one untimed run.
+targets in one call across the cores): median and spread of 9 runs after one untimed run.
 
 The robots' limits are those the toolbox's IK enforces (``robot.qlim``; for its UR5,
 whose DH table has none, ±π).
@@ -87,22 +89,30 @@ def accurate(robot: Robot, q: np.ndarray, T: np.ndarray) -> bool:
     return bool(np.linalg.norm(e[:3]) <= ACCURACY and np.linalg.norm(e[3:]) <= ACCURACY)
 
 
-def run(robot, name, solve, targets, q0s):
-    """Time ``solve(T, q0, k) -> (q, iterations)`` over the targets; return a row dict."""
+def run(robot, name, solve, targets, q0s, passes=1):
+    """Time ``solve(T, q0, k) -> (q, iterations)`` over the targets; return a row dict.
+
+    With ``passes`` > 1 the targets are timed that many times: the median is the median
+    of the passes' medians, ``runs`` their range (the run-to-run spread).
+    """
     solve(targets[0], q0s[0], 0)  # warm up (compilation, caches)
-    times = np.empty(len(targets))
+    times = np.empty((passes, len(targets)))
     iters = np.empty(len(targets))
     ok = np.zeros(len(targets), dtype=bool)
-    for k, (T, q0) in enumerate(zip(targets, q0s)):
-        t0 = time.perf_counter()
-        q, its = solve(T, q0, k)
-        times[k] = time.perf_counter() - t0
-        iters[k] = its
-        ok[k] = accurate(robot, q, T)
+    for p in range(passes):
+        for k, (T, q0) in enumerate(zip(targets, q0s)):
+            t0 = time.perf_counter()
+            q, its = solve(T, q0, k)
+            times[p, k] = time.perf_counter() - t0
+            if p == 0:
+                iters[k] = its
+                ok[k] = accurate(robot, q, T)
     p10, p90 = np.percentile(times, [10, 90]) * 1e6
+    runs = np.median(times, axis=1) * 1e6
     return {"solver": name, "n": len(targets), "success": ok.mean(),
-            "median_us": np.median(times) * 1e6, "mean_us": times.mean() * 1e6,
-            "p10_us": p10, "p90_us": p90, "median_it": np.median(iters)}
+            "median_us": float(np.median(runs)), "mean_us": times.mean() * 1e6,
+            "p10_us": p10, "p90_us": p90, "median_it": np.median(iters),
+            "runs": f"{runs.min():.1f}-{runs.max():.1f}"}
 
 
 def serialkin_solver(robot, method):
@@ -181,18 +191,23 @@ def ikpy_solver(robot, urdf_path):
 
 def print_rows(rows, ref_median):
     print(f"  {'solver':24s} {'targets':>7s} {'success':>8s} {'median us':>10s} "
-          f"{'p10-p90 us':>14s} {'mean us':>10s} {'median it':>9s} {'median / ik_LM':>14s}")
+          f"{'runs us':>11s} {'p10-p90 us':>14s} {'mean us':>10s} {'median it':>9s} "
+          f"{'median / ik_LM':>14s}")
     for r in rows:
         ratio = f"{r['median_us'] / ref_median:14.2f}" if ref_median else f"{'':>14s}"
         spread = f"{r['p10_us']:.1f}-{r['p90_us']:.1f}"
         print(f"  {r['solver']:24s} {r['n']:7d} {r['success']:8.1%} {r['median_us']:10.1f} "
-              f"{spread:>14s} {r['mean_us']:10.1f} {r['median_it']:9.0f} {ratio}", flush=True)
+              f"{r['runs']:>11s} {spread:>14s} {r['mean_us']:10.1f} {r['median_it']:9.0f} "
+              f"{ratio}", flush=True)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--targets", type=int, default=1000)
     parser.add_argument("--ikpy-targets", type=int, default=100)
+    parser.add_argument("--passes", type=int, default=3,
+                        help="timed passes over the targets for rtb ik_LM and serialkin lm "
+                             "(median of the pass medians; the others get one pass)")
     parser.add_argument("--methods", default=",".join(DEFAULT_METHODS),
                         help="comma-separated serialkin methods")
     parser.add_argument("--robots", default="Panda,UR5,Puma560")
@@ -220,12 +235,14 @@ def main() -> None:
         if "rtb" in peers:
             ets = rtb_robot.ets()
             for fn in ("ik_LM", "ik_NR", "ik_GN"):
-                row = run(robot, f"rtb {fn} (C++)", rtb_solver(ets, fn), targets, q0s)
+                row = run(robot, f"rtb {fn} (C++)", rtb_solver(ets, fn), targets, q0s,
+                          args.passes if fn == "ik_LM" else 1)
                 rows.append(row)
                 if fn == "ik_LM":
                     ref = row["median_us"]
         for m in methods:
-            rows.append(run(robot, f"serialkin {m}", serialkin_solver(robot, m), targets, q0s))
+            rows.append(run(robot, f"serialkin {m}", serialkin_solver(robot, m), targets, q0s,
+                            args.passes if m == "lm" else 1))
         if peers & {"pinocchio", "ikpy"}:
             fd, path = tempfile.mkstemp(suffix=".urdf")
             with os.fdopen(fd, "w") as f:
@@ -253,10 +270,10 @@ def main() -> None:
                        r["median_us"], "us", "<= 8 at 100 %", met)
         res = robot.ik(targets, q0=q0s, seed=0)
         per = Stat(wall_s(lambda r=robot, t=targets, q=q0s: r.ik(t, q0=q, seed=0),
-                          repeat=7).values / args.targets * 1e6)
+                          repeat=9).values / args.targets * 1e6)
         ok = np.mean([accurate(robot, q, T) for q, T in zip(res.q, targets)])
         print(f"  batch kernel (lm, {args.targets} targets in one call, {numba_threads()} "
-              f"threads): {per.fmt(2)} us per target (median [spread] of 7 runs), "
+              f"threads): {per.fmt(2)} us per target (median [spread] of 9 runs), "
               f"success {ok:.1%}")
         record("11.3", f"IK lm batch, {rname}, {numba_threads()} threads: us per target "
                f"at {ok:.1%} success", per.median, "us", "<= 4", per.median <= 4.0)
