@@ -49,6 +49,15 @@ def _solve(robot: Robot, T: np.ndarray, kernel=rr_candidates) -> tuple[int, np.n
     return k, out[:max(k, 0)]
 
 
+def _assert_complete(robot: Robot, T: np.ndarray, q: np.ndarray, rows: np.ndarray) -> None:
+    """Rows meet FK to 1e-10, include q and every row of the 2-D search (grid 48)."""
+    assert _wrapped(rows, q).min() < 1e-8
+    assert np.abs(robot.fk(rows) - T).max() < 1e-10
+    _, searched = _solve(robot, T, search_candidates)
+    for r in searched:
+        assert _wrapped(rows, r).min() < 1e-8
+
+
 @settings(max_examples=15, deadline=None)
 @given(st.lists(st.tuples(st.floats(-1.0, 1.0), st.floats(-3.1, 3.1), st.floats(-1.0, 1.0)),
                 min_size=6, max_size=6), st.integers(0, 2**32 - 1))
@@ -136,11 +145,7 @@ def test_elimination_agrees_with_the_search_on_random_arms():
         if k < 0:  # declined: the search answers (rare; checked below that it is rare)
             continue
         assert k % 2 == 0 and k >= 2
-        assert _wrapped(rows, q).min() < 1e-8
-        assert np.abs(robot.fk(rows) - T).max() < 1e-10
-        k2, rows2 = _solve(robot, T, search_candidates)
-        for r in rows2:
-            assert _wrapped(rows, r).min() < 1e-8
+        _assert_complete(robot, T, q, rows)
 
 
 def test_elimination_misses_nothing_newton_finds():
@@ -186,17 +191,15 @@ def test_nearly_special_arm_is_declined_and_searched():
 def test_sixteen_real_solution_arm():
     """An arm and pose with 16 real solutions (the most a 6R has): all 16, Newton agrees.
 
-    The DH table was found by a random walk from the 14-solution arm of
-    test_analytic_general (the published Manseur–Doty and Raghavan–Roth tables were not
-    at hand); 16 is confirmed independently by Newton's method from 300 random starts and
-    by the 2-D search.
+    The DH table (``chapter.sections.inverse.ARM16``) was found by a random walk from the
+    14-solution arm of test_analytic_general (the published Manseur–Doty and
+    Raghavan–Roth tables were not at hand); 16 is confirmed independently by Newton's
+    method from 300 random starts and by the 2-D search.
     """
-    a = [0.9783, 0.2463, 0.5547, 0.0997, 1.2249, 0.3515]
-    alpha = [-0.8372, 1.3472, -1.7796, 1.2287, -1.5585, 2.7402]
-    d = [-0.0017, 0.2408, 0.7272, -0.169, -0.0999, 0.4972]
-    robot = Robot.from_dh([DHLink(a=a[i], alpha=alpha[i], d=d[i]) for i in range(6)])
-    q = np.array([-2.3429, 1.801, 3.0488, 0.3575, 1.1886, -0.1766])
-    T = robot.fk(q)
+    from serialkin.chapter.sections.inverse import ARM16, Q16  # the report shows it too
+
+    robot = Robot.from_dh([DHLink(a=a, alpha=al, d=d) for a, al, d in zip(*ARM16)])
+    T = robot.fk(np.array(Q16))
     k, rows = _solve(robot, T)
     assert k == 16
     assert np.abs(robot.fk(rows) - T).max() < 1e-10
@@ -228,11 +231,7 @@ def test_partly_special_arms_by_elimination(family):
         T = robot.fk(q)
         k, found = _solve(robot, T)
         assert k >= 2
-        assert _wrapped(found, q).min() < 1e-8
-        assert np.abs(robot.fk(found) - T).max() < 1e-10
-        _, searched = _solve(robot, T, search_candidates)
-        for r in searched:
-            assert _wrapped(found, r).min() < 1e-8
+        _assert_complete(robot, T, q, found)
 
 
 def test_tilted_arms_never_return_an_incomplete_even_set():
