@@ -118,7 +118,7 @@ def test_eliminant_roots_separates_close_roots(roots):
     """Every real root of a degree-8 trigonometric polynomial, clusters included, to 1e-8 rad."""
     a, b = _trig_from_roots(roots)
     out = np.empty(16)
-    k = eliminant_roots(a, b, out, np.empty(2))
+    k = eliminant_roots(a, b, out)
     assert k == 16
     found = np.sort(out[:k])
     np.testing.assert_allclose(found, np.sort(roots), atol=1e-8)
@@ -129,9 +129,9 @@ def test_eliminant_roots_none_and_identically_zero():
     a = np.zeros(DEGREE + 1)
     b = np.zeros(DEGREE + 1)
     out = np.empty(16)
-    assert eliminant_roots(a, b, out, np.empty(2)) == -1
+    assert eliminant_roots(a, b, out) == -1
     a[0], a[3] = 2.0, 1.0  # 2 + cos 3θ > 0
-    assert eliminant_roots(a, b, out, np.empty(2)) == 0
+    assert eliminant_roots(a, b, out) == 0
 
 
 def test_elimination_agrees_with_the_search_on_random_arms():

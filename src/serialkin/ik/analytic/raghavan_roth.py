@@ -361,7 +361,7 @@ def _cell_pieces(a, b, lo, hi, f_lo, g_lo, s_lo, f_hi, g_hi, s_hi, tiny, roots, 
 
 
 @njit(cache=True)
-def eliminant_roots(a, b, roots, stats):
+def eliminant_roots(a, b, roots):
     """Real roots in [−π, π) of the trigonometric polynomial (a, b) into ``roots``; their count.
 
     The circle is cut into :data:`N_GRID` cells, and each cell into pieces on which f is
@@ -372,13 +372,8 @@ def eliminant_roots(a, b, roots, stats):
     than a cell are separated; only a cell holding two inflections of this degree-8
     polynomial could hide a pair. Cells where f and f' are monotone, or where f has one
     extremum moving away from zero, are settled from their end values alone.
-    Returns −1 when f vanishes identically. ``stats`` (2,) receives how close the
-    polynomial comes to a double root: the smallest |f| at an extremum between two
-    same-sign values, over max |f| on the grid (``inf`` if none), and the smallest
-    distance between two roots [rad] (``inf`` below two roots).
+    Returns −1 when f vanishes identically.
     """
-    stats[0] = math.inf
-    stats[1] = math.inf
     size = 0.0
     for k in range(a.shape[0]):
         size += abs(a[k]) + abs(b[k])
@@ -391,7 +386,6 @@ def eliminant_roots(a, b, roots, stats):
     k = 0
     lo = -math.pi
     f_lo, g_lo, s_lo = _trig3(a, b, c, s)
-    fmax = abs(f_lo)
     for m in range(N_GRID):
         hi = -math.pi + h * (m + 1)
         if m % 16 == 15:  # re-anchor the rotation now and then (no drift)
@@ -399,7 +393,6 @@ def eliminant_roots(a, b, roots, stats):
         else:
             c, s = c * ch - s * sh, s * ch + c * sh
         f_hi, g_hi, s_hi = _trig3(a, b, c, s)
-        fmax = max(fmax, abs(f_hi))
         if f_lo == 0.0:
             k = _add_root(roots, k, lo)
         if _changes(s_lo, s_hi):  # f' may turn twice: the general case
@@ -410,20 +403,12 @@ def eliminant_roots(a, b, roots, stats):
             # one extremum, and f moves toward zero first: two roots, a double one, or none
             x = _zero(a, b, lo, hi, 1)
             fx = _trig(a, b, x, 0)
-            if not _changes(f_lo, fx):
-                stats[0] = min(stats[0], abs(fx))
             if abs(fx) <= tiny:
                 k = _add_root(roots, k, x)
             elif _changes(f_lo, fx):
                 k = _add_root(roots, k, _zero(a, b, lo, x, 0))
                 k = _add_root(roots, k, _zero(a, b, x, hi, 0))
         lo, f_lo, g_lo, s_lo = hi, f_hi, g_hi, s_hi
-    if fmax > 0.0:
-        stats[0] /= fmax
-    for i in range(k):
-        for j in range(i):
-            d = abs(roots[i] - roots[j])
-            stats[1] = min(stats[1], min(d, TWO_PI - d))
     return k
 
 
@@ -612,8 +597,7 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
         cb[k] *= 2.0 / _N_DET
     cb[0] = 0.0
     roots = np.empty(2 * DEGREE)
-    stats = np.empty(2)
-    nr = eliminant_roots(ca, cb, roots, stats)
+    nr = eliminant_roots(ca, cb, roots)
     if nr < 0:
         return NEAR_SPECIAL
     # 6-7. back substitution and refinement; a root whose candidate does not converge to
