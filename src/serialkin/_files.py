@@ -30,6 +30,7 @@ import json
 import math
 import os
 import stat
+import xml.etree.ElementTree as ET
 from collections.abc import Collection, Sequence
 from pathlib import Path
 from typing import Any
@@ -329,6 +330,21 @@ def parse_json(text: str, origin: str, *, error: ErrorType = InputError) -> obje
     if _depth_exceeds(data, MAX_DEPTH):
         raise error(f"{origin}: nesting deeper than {MAX_DEPTH} levels")
     return data
+
+
+def parse_xml(data: str | bytes, origin: str, *, error: ErrorType = InputError) -> ET.Element:
+    """Parse an XML document (URDF, MJCF) with :mod:`xml.etree.ElementTree`; its root element.
+
+    Raises:
+        error: malformed XML (with line and column), or an encoding Python does not know.
+    """
+    try:
+        return ET.fromstring(data)
+    except ET.ParseError as exc:
+        line, col = exc.position
+        raise error(f"{origin}: malformed XML at line {line}, column {col}: {exc}") from exc
+    except (ValueError, LookupError) as exc:  # e.g. an encoding Python does not know
+        raise error(f"{origin}: cannot read the XML ({exc})") from exc
 
 
 # ------------------------------------------------------------------------------ fields

@@ -69,7 +69,7 @@ from pathlib import Path
 import numpy as np
 
 from serialkin._checks import short_repr
-from serialkin._files import MAX_NUMBER, read_bytes
+from serialkin._files import MAX_NUMBER, parse_xml, read_bytes
 from serialkin.errors import NotSupportedError, RobotDefinitionError
 from serialkin.model.geometry import Box, Capsule, Cylinder, LinkGeometry, Mesh, Shape, Sphere
 from serialkin.model.joint import Joint
@@ -491,29 +491,11 @@ class _Reader:
 
 
 # ------------------------------------------------------------------------------ files
-def _parse(text: str, source: str) -> ET.Element:
-    try:
-        return ET.fromstring(text)
-    except ET.ParseError as exc:
-        line, col = exc.position
-        raise RobotDefinitionError(
-            f"{source}: malformed XML at line {line}, column {col}: {exc}") from exc
-    except (ValueError, LookupError) as exc:
-        raise RobotDefinitionError(f"{source}: cannot read the XML ({exc})") from exc
-
-
 def _read_file(path: Path) -> ET.Element:
     if not path.exists():
         raise RobotDefinitionError(f"MJCF file {short_repr(str(path))} does not exist")
     data = read_bytes(path, what="MJCF file", error=RobotDefinitionError)
-    try:
-        return ET.fromstring(data)
-    except ET.ParseError as exc:
-        line, col = exc.position
-        raise RobotDefinitionError(
-            f"{path}: malformed XML at line {line}, column {col}: {exc}") from exc
-    except (ValueError, LookupError) as exc:
-        raise RobotDefinitionError(f"{path}: cannot read the XML ({exc})") from exc
+    return parse_xml(data, str(path), error=RobotDefinitionError)
 
 
 def _expand_includes(el: ET.Element, folder: Path, source: str, stack: tuple[str, ...]) -> None:
@@ -621,7 +603,7 @@ def robot_from_mjcf(path_or_string: str | os.PathLike[str], base_body: str | Non
         text = text.decode()
     if text.lstrip().startswith("<"):
         source, folder = "<string>", None
-        root = _parse(text, source)
+        root = parse_xml(text, source, error=RobotDefinitionError)
     else:
         path = Path(text)
         source, folder = str(path), path.resolve().parent

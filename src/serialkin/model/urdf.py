@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from serialkin._checks import short_repr
-from serialkin._files import MAX_NUMBER
+from serialkin._files import MAX_NUMBER, parse_xml
 from serialkin.errors import NotSupportedError, RobotDefinitionError
 from serialkin.model.geometry import Box, Capsule, Cylinder, LinkGeometry, Mesh, Shape, Sphere
 from serialkin.model.joint import Joint
@@ -95,15 +95,7 @@ def _read_xml(path_or_string: str | os.PathLike[str]) -> tuple[ET.Element, str]:
             raise RobotDefinitionError(f"URDF file {short_repr(text)} does not exist")
         source = str(path)
         data = read_bytes(path, what="URDF file", error=RobotDefinitionError)
-    try:
-        root = ET.fromstring(data)
-    except ET.ParseError as exc:
-        line, col = exc.position
-        raise RobotDefinitionError(
-            f"{source}: malformed XML at line {line}, column {col}: {exc}"
-        ) from exc
-    except (ValueError, LookupError) as exc:  # e.g. an encoding Python does not know
-        raise RobotDefinitionError(f"{source}: cannot read the XML ({exc})") from exc
+    root = parse_xml(data, source, error=RobotDefinitionError)
     if root.tag != "robot":
         raise RobotDefinitionError(f"{source}: the root element must be <robot>, got <{root.tag}>")
     return root, source
