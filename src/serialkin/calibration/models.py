@@ -50,6 +50,7 @@ import numpy as np
 
 from serialkin._checks import as_vector, check_choice, short_repr
 from serialkin.errors import InputError, InputTypeError
+from serialkin.model.dh import DHLink
 from serialkin.model.joint import Joint
 from serialkin.model.robot import Robot
 from serialkin.spatial.transforms import make_transform
@@ -332,16 +333,25 @@ def error_model(robot: Robot, kind: str = "auto", *, hayati: object = "auto",
     return ErrorModel(robot, kind, b.params, b.steps, b.pending, links)
 
 
+def _joint_and_offset(b: _Builder, i: int, r: DHLink, name: str) -> None:
+    """Joint i about z and its θ offset, in the order the chain applies them.
+
+    A revolute joint turns by ``q + θ``: the joint, then the offset θ_i; a prismatic one
+    turns by θ_i first, then slides.
+    """
+    if r.type == "R":
+        b.joint(i, np.array(_AXES["z"]), "R", name)
+        b.param(f"theta{i + 1}", "z", "R", r.theta, i)
+    else:
+        b.param(f"theta{i + 1}", "z", "R", r.theta, i)
+        b.joint(i, np.array(_AXES["z"]), "P", name)
+
+
 def _dh_chain(b: _Builder, robot: Robot, hayati: Sequence[int]) -> None:
     for i, r in enumerate(robot.dh):
         k, name = i + 1, robot.joint_names[i]
         if robot.convention == "standard":
-            if r.type == "R":
-                b.joint(i, np.array(_AXES["z"]), "R", name)
-                b.param(f"theta{k}", "z", "R", r.theta, i)
-            else:
-                b.param(f"theta{k}", "z", "R", r.theta, i)
-                b.joint(i, np.array(_AXES["z"]), "P", name)
+            _joint_and_offset(b, i, r, name)
             if i in hayati:  # d_i slides along an axis parallel to the next: fixed
                 b.fixed(make_transform(p=[0.0, 0.0, r.d]))
             else:
@@ -355,12 +365,7 @@ def _dh_chain(b: _Builder, robot: Robot, hayati: Sequence[int]) -> None:
                 b.param(f"beta{k}", "y", "R", 0.0, i)
             b.param(f"alpha{k}", "x", "R", r.alpha, i)
             b.param(f"a{k}", "x", "P", r.a, i)
-            if r.type == "R":
-                b.joint(i, np.array(_AXES["z"]), "R", name)
-                b.param(f"theta{k}", "z", "R", r.theta, i)
-            else:
-                b.param(f"theta{k}", "z", "R", r.theta, i)
-                b.joint(i, np.array(_AXES["z"]), "P", name)
+            _joint_and_offset(b, i, r, name)
             if i + 1 in hayati:  # joint i+1 is parallel to this one: d_i is fixed
                 b.fixed(make_transform(p=[0.0, 0.0, r.d]))
             else:
