@@ -35,8 +35,10 @@ iterations and solves only about 3 in 4 full-pose targets within its budget.
 
 Options (keyword arguments of ``robot.ik``; defaults in ``METHODS[name].options``):
 ``damping`` (λ), ``stall_window`` (iterations within which the cost must halve before
-a restart), ``max_step`` (``pinv``: cap on max |Δq_i|; ``sdls``: γ_max), ``rcond``
-(relative singular-value cut-off) and, for ``lm``, ``polish``: when every attempt
+a restart), ``stall_ratio`` (``lm``: an attempt also restarts when two iterations in a
+row each leave the cost above this fraction of its previous value), ``max_step``
+(``pinv``: cap on max |Δq_i|; ``sdls``: γ_max), ``rcond`` (relative singular-value
+cut-off) and, for ``lm``, ``polish``: when every attempt
 failed, refine the best one with a monotone Levenberg-Marquardt down to a local
 least-squares minimum, so that an unreachable target returns the closest pose found.
 """
@@ -364,7 +366,7 @@ _register("pinv", step_pinv, (("max_step", False), ("rcond", False)), 100, 50,
 _register("dls", step_dls, (("damping", True),), 200, 50, {"damping": 0.01, "stall_window": 30},
           "damped least squares Jᵀ(JJᵀ+λ²I)⁻¹e with fixed damping λ (eq 46)", linear=True)
 _register("lm", step_lm, (("damping", True),), 100, 100,
-          {"damping": 0.03, "stall_window": 5, "polish": True},
+          {"damping": 0.03, "stall_window": 5, "stall_ratio": 0.6, "polish": True},
           "Levenberg-Marquardt, damping λE adapted to the error, limit-aware (default)",
           limits=_LIMIT_AWARE)
 _register("lm_wampler", step_lm_wampler, (("damping", True),), 200, 50,

@@ -313,7 +313,8 @@ def _same_options(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
 def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
     """The tail ``cfg[C_WINDOW:]`` of the kernel configuration.
 
-    The loop's stagnation window and polish flag, then the method's own parameters
+    The loop's stagnation window, polish flag and stall ratio, then the method's own
+    parameters
     (``spec.kernel.params``, in order).
     """
     from serialkin._checks import check_positive
@@ -332,6 +333,11 @@ def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
     p[K.C_POLISH - base] = 1.0 if polish else 0.0
     p[K.C_WINDOW - base] = check_int(opts.get("stall_window", 20), "stall_window", minimum=1,
                                      maximum=MAX_ITERATIONS)
+    ratio = check_positive(opts.get("stall_ratio", 0.0), "stall_ratio", allow_zero=True)
+    if ratio >= 1.0:
+        raise InputError(f"stall_ratio must be in [0, 1) (0 turns the rule off), got "
+                         f"{ratio!r}")
+    p[K.C_STALL_RATIO - base] = ratio
     for i, (name, zero_ok) in enumerate(names):
         p[K.N_LOOP - base + i] = check_positive(opts[name], name, allow_zero=zero_ok)
     if default:
