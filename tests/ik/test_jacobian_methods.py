@@ -291,3 +291,36 @@ def test_a_new_compiled_method_is_one_step_kernel_and_one_registration(near_solu
             assert np.array_equal(one.q, batch.q[k])
     finally:
         registry._REGISTRY.pop(spec.name)
+
+
+def test_stall_ratio_only_ends_attempts_earlier():
+    """With restarts off, lm with stall_ratio stops no later than without, on the same path.
+
+    The rule ends an attempt when two iterations in a row each leave the cost above ρ
+    times its previous value; until it fires the iterates are those of the attempt
+    without it, so a success with it is the same success without it.
+    """
+    robot = models.panda()
+    rng = np.random.default_rng(11)
+    fired = 0
+    for _ in range(40):
+        T = robot.fk(robot.random_q(seed=rng))
+        q0 = robot.random_q(seed=rng)
+        kw = dict(q0=q0, restarts=0, polish=False, seed=0)
+        on = robot.ik(T, **kw)
+        off = robot.ik(T, stall_ratio=0.0, **kw)
+        assert on.iterations <= off.iterations
+        if on.success:
+            np.testing.assert_array_equal(on.q, off.q)
+            assert on.iterations == off.iterations
+        fired += on.iterations < off.iterations
+    assert fired > 0  # the rule does end some attempts on this sample
+
+
+@pytest.mark.parametrize("bad", [1.0, 1.5, -0.1, float("nan")])
+def test_stall_ratio_out_of_range_is_an_error(bad):
+    """stall_ratio outside [0, 1) raises an InputError naming it."""
+    robot = models.ur5()
+    T = robot.fk(robot.random_q(seed=0))
+    with pytest.raises(InputError, match="stall_ratio"):
+        robot.ik(T, stall_ratio=bad)
