@@ -286,15 +286,20 @@ def _sincos_scalar(x):
 
 @njit(cache=True)
 def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
-    """Poses of configurations ``Q[k0:k0+B]`` into ``out``.
+    """Poses of configurations ``Q[k0:k0+B]`` into ``out``; True if a q was NaN or ±inf.
 
     Scratch: T (12, _BLOCK) the poses' top rows, X (n, _BLOCK) the block's joint values
     joint-major (so every per-joint loop reads contiguous memory), c, s (_BLOCK,).
+    The finiteness test rides on the read of every q: ``z = Σ 0·q`` is 0 for finite
+    values and NaN as soon as one is NaN or infinite (one multiply-add per value).
     """
     n = meta.shape[0]
+    z = 0.0
     for b in range(B):
         for i in range(n):
-            X[i, b] = Q[k0 + b, i] + meta[i, 4]
+            v = Q[k0 + b, i]
+            z += 0.0 * v
+            X[i, b] = v + meta[i, 4]
     for j in range(12):
         v = F[0, j // 4, j % 4]
         for b in range(B):
@@ -341,6 +346,23 @@ def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
         o[3, 1] = 0.0
         o[3, 2] = 0.0
         o[3, 3] = 1.0
+    return z != z
+
+
+@njit(cache=True, inline="always")
+def _fk_blocks(Q, F, meta, out, start, stop):
+    """Poses of ``Q[start:stop]`` into ``out`` block by block; True if a q was not finite."""
+    T = np.empty((12, _BLOCK))
+    X = np.empty((meta.shape[0], _BLOCK))
+    c = np.empty(_BLOCK)
+    s = np.empty(_BLOCK)
+    bad = False
+    k0 = start
+    while k0 < stop:
+        B = min(_BLOCK, stop - k0)
+        bad |= _fk_block(Q, F, meta, out, k0, B, T, X, c, s)
+        k0 += B
+    return bad
 
 
 # --- batches: range kernels ----------------------------------------------------------------
@@ -355,17 +377,22 @@ def fk_range(Q, F, meta, out, start, stop):
     """End-effector poses of ``Q[start:stop]`` (Q (N, n)) into ``out`` (N, 4, 4).
 
     Walks the range in blocks of ``_BLOCK`` configurations (structure of arrays, see
-    :func:`_sincos`).
+    :func:`_sincos`). Trusts that every q is finite; :func:`fk_checked_range` checks.
     """
-    T = np.empty((12, _BLOCK))
-    X = np.empty((meta.shape[0], _BLOCK))
-    c = np.empty(_BLOCK)
-    s = np.empty(_BLOCK)
-    k0 = start
-    while k0 < stop:
-        B = min(_BLOCK, stop - k0)
-        _fk_block(Q, F, meta, out, k0, B, T, X, c, s)
-        k0 += B
+    _fk_blocks(Q, F, meta, out, start, stop)
+
+
+@njit(cache=True, nogil=True)
+def fk_checked_range(Q, F, meta, out, bad, start, stop):
+    """:func:`fk_range`, setting ``bad[0] = 1`` (bad: int64 (1,)) if a q is not finite.
+
+    The batch path of ``Robot.fk`` validates its input this way: the kernel reads every
+    q anyway, so the finiteness test costs one multiply-add per value instead of a
+    separate pass over the batch (``np.isfinite(Q).all()``, 10 % of a 100,000-pose call).
+    Poses of non-finite configurations are not finite; the caller raises.
+    """
+    if _fk_blocks(Q, F, meta, out, start, stop):
+        bad[0] = 1
 
 
 @njit(cache=True)
