@@ -137,21 +137,6 @@ class _Job:
                     self.idle.set()
 
 
-def _entry_point(kernel: Callable[..., Any], args: tuple) -> Callable[..., Any]:
-    """The compiled entry point of a numba ``kernel`` for ``(*args, start, stop)``.
-
-    Resolved once per batch, so that every chunk skips numba's type dispatch (a few µs
-    with many arguments). Anything else is returned unchanged.
-    """
-    typeof = getattr(kernel, "typeof_pyval", None)
-    if typeof is None:
-        return kernel
-    sig = tuple(typeof(a) for a in args) + (typeof(0), typeof(0))
-    if sig not in kernel.overloads:
-        kernel.compile(sig)  # loads from numba's cache when it can
-    return kernel.overloads[sig].entry_point
-
-
 def run(kernel: Callable[..., Any], args: tuple, N: int, grain: int) -> None:
     """Run ``kernel(*args, start, stop)`` over items 0..N-1 on every thread, chunk by chunk.
 
@@ -176,7 +161,7 @@ def run(kernel: Callable[..., Any], args: tuple, N: int, grain: int) -> None:
         kernel(*args, 0, N)
         return
     participants = min(nthreads, N // grain)
-    job = _Job(_entry_point(kernel, args), args, N, grain, participants)
+    job = _Job(kernel, args, N, grain, participants)
     pool = _pool(nthreads - 1)
     for _ in range(participants - 1):
         pool.submit(job.work)
