@@ -23,7 +23,7 @@ one thread on the free core. :func:`run` instead
 * makes the calling thread a participant, so that the batch never waits for a worker
   thread that has not been scheduled yet: the caller waits only for chunks already
   claimed and still running;
-* runs small batches (fewer than two chunks) on the calling thread alone;
+* runs small batches (fewer than two grains) on the calling thread alone;
 * uses only the cores other processes leave free (as OpenMP's ``OMP_DYNAMIC`` does): on
   Linux it reads the number of runnable tasks from ``/proc/loadavg`` (at most every
   20 ms) and counts as free the usable CPUs minus the other runnable tasks. On a 2-core
@@ -149,7 +149,7 @@ def run(kernel: Callable[..., Any], args: tuple, N: int, grain: int) -> None:
             the module docstring); pick ~50-100 µs of work, so that a chunk costs far
             more than claiming it (~2 µs) and a late chunk delays the batch little.
 
-    Batches of fewer than two chunks, and every batch when one thread is configured,
+    Batches of fewer than two grains, and every batch when one thread is configured,
     run on the calling thread. Exceptions raised by the kernel are re-raised here.
     """
     grain = max(1, int(grain))
