@@ -25,7 +25,8 @@ and the same for the peers when the ``bench`` extra is installed:
 
 Each latency is the **median over 15 runs** of ``number`` calls, serialkin's and the
 peers' runs interleaved (so that they see the same machine load), with the 10–90 %
-spread of the runs; throughputs are the median of 7 runs. Ratios are serialkin / peer
+spread of the runs; throughputs are the median of 20 runs (serialkin) and of 3 (the
+peers' Python loops). Ratios are serialkin / peer
 medians: below 1 is faster for latencies, above 1 is faster for throughput.
 """
 
@@ -157,7 +158,7 @@ def bench_robot(robot: sk.Robot, batch: int, number: int) -> list[tuple]:
                            "rtb_hess": lambda: ets.hessian0(q)})
     t = interleaved_us({**sk_calls, **peer_calls}, number)
     robot.fk(Q[:10])
-    sk_batch = Stat(batch / wall_s(lambda: robot.fk(Q), repeat=7).values / 1e6)
+    sk_batch = Stat(batch / wall_s(lambda: robot.fk(Q), repeat=20).values / 1e6)
     pin_batch = rtb_batch = None
     if peer is not None:
         k = min(batch, 20000)

@@ -112,13 +112,16 @@ def _describe(x: object) -> str:
     return f"{type(x).__name__} {short_repr(x, 100)}"
 
 
-def as_float_array(x: object, name: str, *, ndim: int | None = None) -> np.ndarray:
+def as_float_array(x: object, name: str, *, ndim: int | None = None,
+                   finite: bool = True) -> np.ndarray:
     """Return ``x`` as a finite float64 array, or raise naming ``name``.
 
     Args:
         x: array-like of real numbers.
         name: the argument's name, used in error messages.
         ndim: required number of dimensions, or None for any.
+        finite: check that every entry is finite (False: the caller's compiled kernel
+            checks while it reads, and calls this again to raise the same error).
 
     Raises:
         InputTypeError: ``x`` is not numeric (strings, objects, complex numbers).
@@ -140,7 +143,7 @@ def as_float_array(x: object, name: str, *, ndim: int | None = None) -> np.ndarr
         a = a.astype(np.float64)
     if ndim is not None and a.ndim != ndim:
         raise InputError(f"{name} must have {ndim} dimension(s), got shape {a.shape}")
-    if not np.isfinite(a).all():
+    if finite and not np.isfinite(a).all():
         bad = np.argwhere(~np.isfinite(a))[0]
         raise InputError(
             f"{name} must be finite, got {a[tuple(bad)]} at index {tuple(int(i) for i in bad)}"

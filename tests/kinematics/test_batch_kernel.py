@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -9,7 +11,9 @@ from hypothesis import strategies as st
 from numba import njit
 
 import serialkin as sk
+from serialkin.errors import InputError
 from serialkin.kinematics import kernels as K
+from serialkin.kinematics import parallel
 from serialkin.model.chain import z_alignment
 from serialkin.model.dh import link_transform, parse_dh_rows
 from tests.kinematics._fd import dh_rows, random_transform
@@ -109,3 +113,39 @@ def test_single_calls_match_link_products_on_long_chains(rows, seed, huge):
     Q = np.stack([q, q])
     np.testing.assert_allclose(robot.fk(q), robot.fk(Q)[1], atol=1e-12)
     np.testing.assert_allclose(robot.jacobian(q), robot.jacobian(Q)[1], atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["ur5", "scara"])
+@pytest.mark.parametrize("where", [0, 63, 64, 2047, 4999])
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_batch_nonfinite_q_raises_the_checked_error(name, where, value, monkeypatch):
+    """A NaN/inf anywhere in a batch (any block, chunk, joint kind) raises check_q's InputError."""
+    monkeypatch.setattr(parallel, "free_cores", lambda: 64)  # the threaded path too
+    robot = sk.models.get(name)
+    Q = robot.random_q(5000, seed=5)
+    Q[where, where % robot.n] = value
+    for shaped in (Q, Q.reshape(50, 100, robot.n)):
+        with pytest.raises(InputError, match="q must be finite") as expected:
+            robot.check_q(shaped)
+        with pytest.raises(InputError) as got:
+            robot.fk(shaped, out=np.empty(shaped.shape[:-1] + (4, 4)))
+        assert str(got.value) == str(expected.value)
+    with pytest.raises(InputError, match=re.escape(f"got {value} at index ({where}, ")):
+        robot.fk(Q)
+
+
+def test_checked_range_flags_only_nonfinite_values():
+    """fk_checked_range sets its flag for NaN/inf, not for huge finite q, and equals fk_range."""
+    robot = sk.models.get("scara")  # revolute and prismatic joints
+    Q = robot.random_q(300, seed=6)
+    Q[7, 0], Q[8, 2] = 1e300, -1e300
+    c = robot.chain
+    T1, T2, bad = np.empty((300, 4, 4)), np.empty((300, 4, 4)), np.zeros(1, dtype=np.int64)
+    K.fk_range(Q, c.F, c.meta, T1, 0, 300)
+    K.fk_checked_range(Q, c.F, c.meta, T2, bad, 0, 300)
+    assert bad[0] == 0 and np.array_equal(T1, T2, equal_nan=True)
+    Q[299, 3] = np.nan
+    K.fk_checked_range(Q, c.F, c.meta, T2, bad, 0, 299)
+    assert bad[0] == 0  # outside the range
+    K.fk_checked_range(Q, c.F, c.meta, T2, bad, 299, 300)
+    assert bad[0] == 1

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import threading
+
 import numba
 import numpy as np
 import pytest
@@ -133,3 +135,26 @@ def test_single_call_fast_path_converts_other_arrays(make):
         robot.fk(column)
     assert robot.fk(q[None]).shape == (1, 4, 4) and np.array_equal(robot.fk(q[None])[0], T)
     assert np.array_equal(robot.jacobian(q[None])[0], J)
+
+
+@pytest.mark.parametrize(("N", "grain", "threads"), [(100_000, 2048, 2), (10_000, 16, 4),
+                                                     (4097, 2048, 2), (9, 4, 8)])
+def test_guided_chunks_shrink_to_the_grain(N, grain, threads, monkeypatch):
+    """Chunks tile [0, N) in claim order, each max(grain, remaining/(2·participants)) items."""
+    monkeypatch.setattr(parallel, "threads", lambda: threads)
+    calls = []
+    lock = threading.Lock()
+
+    def kernel(start, stop):
+        with lock:
+            calls.append((start, stop))
+
+    parallel.run(kernel, (), N, grain)
+    calls.sort()
+    assert calls[0][0] == 0 and calls[-1][1] == N
+    assert all(a[1] == b[0] for a, b in zip(calls, calls[1:]))
+    participants = min(threads, N // grain)
+    for start, stop in calls:
+        assert stop - start == min(N - start, max(grain, (N - start) // (2 * participants)))
+    if N >= 8 * grain * participants:
+        assert len(calls) < N / grain / 2  # far fewer hand-offs than fixed-grain chunks

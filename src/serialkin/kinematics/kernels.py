@@ -286,25 +286,43 @@ def _sincos_scalar(x):
 
 @njit(cache=True)
 def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
-    """Poses of configurations ``Q[k0:k0+B]`` into ``out``.
+    """Poses of configurations ``Q[k0:k0+B]`` into ``out``; True if a q was NaN or ±inf.
 
     Scratch: T (12, _BLOCK) the poses' top rows, X (n, _BLOCK) the block's joint values
     joint-major (so every per-joint loop reads contiguous memory), c, s (_BLOCK,).
+    The finiteness test rides on the read of every q: ``z = Σ 0·q`` is 0 for finite
+    values and NaN as soon as one is NaN or infinite (one multiply-add per value).
     """
     n = meta.shape[0]
+    z = 0.0
     for b in range(B):
         for i in range(n):
-            X[i, b] = Q[k0 + b, i] + meta[i, 4]
+            v = Q[k0 + b, i]
+            z += 0.0 * v
+            X[i, b] = v + meta[i, 4]
     for j in range(12):
         v = F[0, j // 4, j % 4]
         for b in range(B):
             T[j, b] = v
     for i in range(n):
         x = X[i]
+        A = F[i + 1]
+        a00, a01, a02, a03 = A[0, 0], A[0, 1], A[0, 2], A[0, 3]
+        a10, a11, a12, a13 = A[1, 0], A[1, 1], A[1, 2], A[1, 3]
+        a20, a21, a22, a23 = A[2, 0], A[2, 1], A[2, 2], A[2, 3]
+        # one pass over T per joint: its motion M_i and then F[i+1] (the same operations
+        # in the same order as two passes, so the same bits, with half the T traffic)
         if meta[i, 3] == PRISMATIC:
             for r in range(3):
                 for b in range(B):
-                    T[4 * r + 3, b] += x[b] * T[4 * r + 2, b]
+                    t0 = T[4 * r, b]
+                    t1 = T[4 * r + 1, b]
+                    t2 = T[4 * r + 2, b]
+                    t3 = T[4 * r + 3, b] + x[b] * t2
+                    T[4 * r, b] = t0 * a00 + t1 * a10 + t2 * a20
+                    T[4 * r + 1, b] = t0 * a01 + t1 * a11 + t2 * a21
+                    T[4 * r + 2, b] = t0 * a02 + t1 * a12 + t2 * a22
+                    T[4 * r + 3, b] = t3 + (t0 * a03 + t1 * a13 + t2 * a23)
         else:
             big = False
             for b in range(B):
@@ -318,21 +336,13 @@ def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
                 for b in range(B):
                     t0 = T[4 * r, b]
                     t1 = T[4 * r + 1, b]
-                    T[4 * r, b] = t0 * c[b] + t1 * s[b]
-                    T[4 * r + 1, b] = t1 * c[b] - t0 * s[b]
-        A = F[i + 1]
-        a00, a01, a02, a03 = A[0, 0], A[0, 1], A[0, 2], A[0, 3]
-        a10, a11, a12, a13 = A[1, 0], A[1, 1], A[1, 2], A[1, 3]
-        a20, a21, a22, a23 = A[2, 0], A[2, 1], A[2, 2], A[2, 3]
-        for r in range(3):
-            for b in range(B):
-                t0 = T[4 * r, b]
-                t1 = T[4 * r + 1, b]
-                t2 = T[4 * r + 2, b]
-                T[4 * r, b] = t0 * a00 + t1 * a10 + t2 * a20
-                T[4 * r + 1, b] = t0 * a01 + t1 * a11 + t2 * a21
-                T[4 * r + 2, b] = t0 * a02 + t1 * a12 + t2 * a22
-                T[4 * r + 3, b] += t0 * a03 + t1 * a13 + t2 * a23
+                    t2 = T[4 * r + 2, b]
+                    u0 = t0 * c[b] + t1 * s[b]
+                    u1 = t1 * c[b] - t0 * s[b]
+                    T[4 * r, b] = u0 * a00 + u1 * a10 + t2 * a20
+                    T[4 * r + 1, b] = u0 * a01 + u1 * a11 + t2 * a21
+                    T[4 * r + 2, b] = u0 * a02 + u1 * a12 + t2 * a22
+                    T[4 * r + 3, b] += u0 * a03 + u1 * a13 + t2 * a23
     for b in range(B):
         o = out[k0 + b]
         for j in range(12):
@@ -341,6 +351,23 @@ def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
         o[3, 1] = 0.0
         o[3, 2] = 0.0
         o[3, 3] = 1.0
+    return z != z
+
+
+@njit(cache=True, inline="always")
+def _fk_blocks(Q, F, meta, out, start, stop):
+    """Poses of ``Q[start:stop]`` into ``out`` block by block; True if a q was not finite."""
+    T = np.empty((12, _BLOCK))
+    X = np.empty((meta.shape[0], _BLOCK))
+    c = np.empty(_BLOCK)
+    s = np.empty(_BLOCK)
+    bad = False
+    k0 = start
+    while k0 < stop:
+        B = min(_BLOCK, stop - k0)
+        bad |= _fk_block(Q, F, meta, out, k0, B, T, X, c, s)
+        k0 += B
+    return bad
 
 
 # --- batches: range kernels ----------------------------------------------------------------
@@ -355,17 +382,22 @@ def fk_range(Q, F, meta, out, start, stop):
     """End-effector poses of ``Q[start:stop]`` (Q (N, n)) into ``out`` (N, 4, 4).
 
     Walks the range in blocks of ``_BLOCK`` configurations (structure of arrays, see
-    :func:`_sincos`).
+    :func:`_sincos`). Trusts that every q is finite; :func:`fk_checked_range` checks.
     """
-    T = np.empty((12, _BLOCK))
-    X = np.empty((meta.shape[0], _BLOCK))
-    c = np.empty(_BLOCK)
-    s = np.empty(_BLOCK)
-    k0 = start
-    while k0 < stop:
-        B = min(_BLOCK, stop - k0)
-        _fk_block(Q, F, meta, out, k0, B, T, X, c, s)
-        k0 += B
+    _fk_blocks(Q, F, meta, out, start, stop)
+
+
+@njit(cache=True, nogil=True)
+def fk_checked_range(Q, F, meta, out, bad, start, stop):
+    """:func:`fk_range`, setting ``bad[0] = 1`` (bad: int64 (1,)) if a q is not finite.
+
+    The batch path of ``Robot.fk`` validates its input this way: the kernel reads every
+    q anyway, so the finiteness test costs one multiply-add per value instead of a
+    separate pass over the batch (``np.isfinite(Q).all()``, 10 % of a 100,000-pose call).
+    Poses of non-finite configurations are not finite; the caller raises.
+    """
+    if _fk_blocks(Q, F, meta, out, start, stop):
+        bad[0] = 1
 
 
 @njit(cache=True)

@@ -381,9 +381,13 @@ class Robot:
         return self._copy(joints=joints, dh=dh)
 
     # ------------------------------------------------------------------ validation
-    def check_q(self, q: object, name: str = "q") -> np.ndarray:
-        """Return ``q`` as a finite float64 array of shape (..., n), or raise naming it."""
-        a = as_float_array(q, name)
+    def check_q(self, q: object, name: str = "q", *, finite: bool = True) -> np.ndarray:
+        """Return ``q`` as a finite float64 array of shape (..., n), or raise naming it.
+
+        ``finite=False`` skips the finiteness test, for a caller whose kernel tests
+        while it reads (the FK batch); it calls ``check_q`` again to raise.
+        """
+        a = as_float_array(q, name, finite=finite)
         if a.ndim == 0 or a.shape[-1] != self.n:
             got = f"{a.shape[-1]} values" if a.ndim else "a scalar"
             raise InputError(
@@ -420,7 +424,8 @@ class Robot:
             (4, 4) or (..., 4, 4) homogeneous transforms.
 
         Raises:
-            InputError: q of the wrong shape or not finite; out of the wrong kind.
+            InputError: q of the wrong shape or not finite (a batch's ``out`` may then
+                have been written); out of the wrong kind.
         """
         if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1:
             # one configuration: one compiled call, which checks the length and finiteness
@@ -435,7 +440,9 @@ class Robot:
                 T = None
             if T is not None and (_FK1 or _fast()[0])(q, self._P, T) == 0:
                 return T
-        a = self.check_q(q)
+        a = self.check_q(q, finite=False)  # the batch kernel tests finiteness as it reads
+        if a.ndim == 1:
+            a = self.check_q(a)
         shape = a.shape[:-1] + (4, 4)
         check_allocation("the FK batch", shape, 8, setting="the batch size")
         T = np.empty(shape) if out is None else _out_array(out, shape)
@@ -443,8 +450,11 @@ class Robot:
             K.fk_into(np.ascontiguousarray(a), self._F, self._meta, T)
             return T
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
-        parallel.run(K.fk_range, (flat, self._F, self._meta, T.reshape(-1, 4, 4)),
+        bad = np.zeros(1, dtype=np.int64)
+        parallel.run(K.fk_checked_range, (flat, self._F, self._meta, T.reshape(-1, 4, 4), bad),
                      flat.shape[0], grain=max(256, 12288 // self.n))
+        if bad[0]:
+            self.check_q(a)  # raises the error naming the first non-finite entry
         return T
 
     def fk_all(self, q: object) -> np.ndarray:
