@@ -748,8 +748,9 @@ def _run_chunks(solve_chunk: Any, F: np.ndarray, meta: np.ndarray, Tt: np.ndarra
                 info: np.ndarray) -> None:
     """Solve a batch with the method's ``solve_chunk`` on every core.
 
-    Scheduled by :func:`serialkin.kinematics.parallel.run` (chunks of 8 targets claimed
-    dynamically, so a few slow targets or a busy core do not leave the batch waiting).
+    Scheduled by :func:`serialkin.kinematics.parallel.run` (guided chunks of at least 8
+    targets claimed dynamically, so a few slow targets or a busy core do not leave the
+    batch waiting).
     """
     parallel.run(solve_chunk, (F, meta, Tt, box, Q0, cfg, seed64, Q, info), Tt.shape[0],
                  grain=8)
