@@ -374,6 +374,20 @@ def test_fuzz_ik_options(option, value):
             assert r.within_limits(res.q)
 
 
+@pytest.mark.parametrize("method", ["lm", "ccd"])
+def test_huge_start_angle_keeps_the_reported_error(method):
+    """A q0 of 8.9e9 rad on an unbounded joint: the returned q has the error reported.
+
+    Moving such an angle by whole turns rounds it by ~1e-6 rad (found by the fuzzer
+    above: a success whose returned q missed the 1e-6 tolerance).
+    """
+    r = sk.models.planar(3, qlim=(-2.0, np.inf))
+    res = r.ik([1.0, 1.0], q0=[0.0, 0.0, 8916041057.0], max_iter=50, method=method)
+    err = np.linalg.norm(r.fk(res.q)[:2, 3] - [1.0, 1.0])
+    assert abs(err - res.position_error) <= 1e-12
+    assert not res.success or err <= 1e-6
+
+
 @settings(max_examples=100, deadline=None)
 @given(call=st.sampled_from(["random_q", "manipulability", "jacobian_link", "with_limits",
                              "within_limits", "circle_step", "planar_n"]), value=_WEIRD)

@@ -85,6 +85,7 @@ from numba import njit
 from serialkin.collision.queries import PAIR_NONE, clearance_at, pair_distance_at
 from serialkin.kinematics.dls import dls_step_into, spd_solve_into
 from serialkin.kinematics.kernels import fk_all_into, fk_into, jacobian_into
+from serialkin.model.limits import TIDY_MAX
 from serialkin.model.limits import inside as interval_inside
 from serialkin.model.limits import normalize as interval_normalize
 from serialkin.model.limits import project as interval_project
@@ -216,10 +217,12 @@ def nearest_into(q, ref, lo, hi, revolute, bounded):
     ref_i|`` is convex in k, that is ``k = round((ref_i − q_i)/2π)`` clamped to
     ``[⌈(lo_i − q_i)/2π⌉, ⌊(hi_i − q_i)/2π⌋]``. This only matters for ranges wider than 2π
     (the UR5's ±2π) and unlimited joints. Prismatic joints are untouched; ``ref`` (n,) is
-    the initial guess q0.
+    the initial guess q0. Neither q_i nor the moved value may exceed
+    :data:`~serialkin.model.limits.TIDY_MAX` in magnitude (rounding would change the
+    pose): else q_i stays.
     """
     for i in range(q.shape[0]):
-        if revolute[i] == 0 or not math.isfinite(ref[i]) or not math.isfinite(q[i]):
+        if revolute[i] == 0 or not abs(ref[i]) <= TIDY_MAX or not abs(q[i]) <= TIDY_MAX:
             continue
         k = math.floor((ref[i] - q[i]) / TWO_PI + 0.5)
         if bounded:
@@ -230,7 +233,7 @@ def nearest_into(q, ref, lo, hi, revolute, bounded):
                 kmax = math.floor((hi[i] - q[i]) / TWO_PI)
                 k = min(k, kmax)
         x = q[i] + TWO_PI * k
-        if not bounded or (x >= lo[i] and x <= hi[i]):
+        if (not bounded or (x >= lo[i] and x <= hi[i])) and abs(x) <= TIDY_MAX:
             q[i] = x
 
 

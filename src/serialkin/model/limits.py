@@ -31,6 +31,13 @@ from serialkin.errors import InputError, RobotDefinitionError
 
 TWO_PI = 2.0 * math.pi
 
+#: Largest |angle| [rad] that :func:`normalize` and the IK's nearest-representative
+#: step move by whole turns. ``x + 2πk`` is rounded by about ``ulp(x)/2 + |k|·2.4e-16``
+#: rad (the double ``2π`` is not exact): about 1e-12 rad here, but 1e-6 rad at 1e10 rad,
+#: enough to break a solution's tolerance. A larger angle is left as it is (its pose is
+#: the one the solver measured).
+TIDY_MAX = 1e4
+
 #: Largest magnitude of a finite joint limit [rad or m]; beyond it the sampling box and
 #: the IK cost overflow. Use an infinite end (``±inf``, ``null`` in files) for no limit.
 MAX_LIMIT = MAX_JOINT_VALUE
@@ -192,8 +199,10 @@ def normalize(x, lo, hi, revolute):
     whole turns when possible. Inside: with both ends infinite it is wrapped into
     [-π, π); with one open side, the representative in [-π, π) is taken when it is
     inside, else the one nearest the finite end; with both ends finite it is unchanged.
+    An angle beyond :data:`TIDY_MAX` in magnitude is never moved (rounding would change
+    its pose).
     """
-    if not revolute:
+    if not revolute or not abs(x) <= TIDY_MAX:
         return x
     if not (x >= lo and x <= hi):
         y = wrap_angle(x, lo, hi)
