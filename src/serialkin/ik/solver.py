@@ -729,8 +729,8 @@ def _solve_collision(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray
                  (F, L, meta, Tt, box, Q0, cfg, seed64, *coll.arrays, coll.ccfg, Q, info),
                  N, grain=4)
     ok = info[:, K.I_SUCCESS] > 0.5
-    if respect and ok.any():
-        ok &= robot.within_limits(Q, LIMIT_TOL)
+    if respect:  # honest_success's guard, evaluated by the kernel
+        ok &= info[:, K.I_INSIDE] > 0.5
     pairs = np.array([_pair_names(coll, info[k]) for k in range(N)], dtype=str).reshape(N, 2)
     reasons = np.array(
         ["" if ok[k] else _collision_reason(robot, coll, Tt[k], Q[k], info[k], tuple(pairs[k]),
@@ -817,21 +817,19 @@ def _result_single(robot: Robot, tgt: Target, spec: MethodSpec, q: np.ndarray,
 
 def _result_batch(robot: Robot, tgt: Target, spec: MethodSpec, Q: np.ndarray,
                   info: np.ndarray, tol: float, respect: bool) -> IKResult:
+    # the final guard of honest_success, evaluated by the kernel (info[:, I_INSIDE])
     ok = info[:, K.I_SUCCESS] > 0.5
-    if respect and ok.any():
-        ok &= robot.within_limits(Q, LIMIT_TOL)
+    if respect:
+        ok &= info[:, K.I_INSIDE] > 0.5
     its = info[:, K.I_ITERATIONS].astype(np.int64)
     used = info[:, K.I_RESTARTS].astype(np.int64)
     pe, oe = info[:, K.I_POS_ERR].copy(), info[:, K.I_ORI_ERR].copy()
-    reasons = np.array(
-        ["" if ok[k] else failure_reason(pe[k], oe[k], tol, used[k] + 1, its[k], tgt.kind,
-                                         failure_hint(robot, Q[k], tgt.weights, respect,
-                                                      tgt.T[k]))
-         for k in range(Q.shape[0])],
-        dtype=object,
-    ).astype(str)
+    reasons = [""] * Q.shape[0]
+    for k in np.flatnonzero(~ok):  # a sentence for each failure only
+        reasons[k] = failure_reason(pe[k], oe[k], tol, used[k] + 1, its[k], tgt.kind,
+                                    failure_hint(robot, Q[k], tgt.weights, respect, tgt.T[k]))
     return IKResult(q=Q, success=ok, iterations=its, position_error=pe, orientation_error=oe,
-                    reason=reasons, restarts=used, method=spec.name)
+                    reason=np.array(reasons, dtype=str), restarts=used, method=spec.name)
 
 
 def _problem(robot: Robot, T: np.ndarray, tgt: Target, tol: float, respect: bool) -> IKProblem:

@@ -192,10 +192,12 @@ def parse_target(robot: Robot, target: object, mask: object = None) -> Target:
             rotation block, last row not [0, 0, 0, 1]), a shape that is none of the
             accepted ones, a planar target on a non-planar robot, or a bad mask.
     """
-    if (isinstance(target, np.ndarray) and target.shape == (4, 4)
-            and target.dtype == np.float64):
+    if (isinstance(target, np.ndarray) and target.ndim in (2, 3)
+            and target.shape[-2:] == (4, 4) and target.dtype == np.float64):
+        # one pose or a batch: the compiled check (check_transform's criteria, no
+        # temporaries); only a failing target takes the numpy path, which names the fault
         T = np.ascontiguousarray(target)
-        if transforms_valid(T.reshape(1, 4, 4), ROTATION_TOL):
+        if transforms_valid(T.reshape(-1, 4, 4), ROTATION_TOL):
             return Target(T, parse_mask(mask, "pose"), "pose")
     a = as_float_array(target, "target")
     if a.ndim >= 2 and a.shape[-2:] == (4, 4):
