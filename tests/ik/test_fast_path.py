@@ -110,3 +110,16 @@ def test_fast_path_declines_other_types_and_shapes():
         ur5.ik(T, q0=q0[:5].copy())
     with pytest.raises(InputError, match="target"):
         ur5.ik(T[:3].copy())
+
+
+def test_robot_pickles_after_fast_solves():
+    """A robot that has used the fast path pickles (its IK caches are left out) and solves alike."""
+    import pickle
+
+    ur5 = models.ur5()
+    T = np.ascontiguousarray(ur5.fk(ur5.random_q(seed=3)))
+    ref = ur5.ik(T, seed=4)
+    assert ur5._ik_fast  # the fast path prepared its entry on the robot
+    copy = pickle.loads(pickle.dumps(ur5))
+    assert copy._ik_fast == {}
+    assert _same(copy.ik(T, seed=4), ref)

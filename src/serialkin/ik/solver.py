@@ -458,22 +458,17 @@ def solve(
                          bool(respect_limits), opts)
 
 
-#: Fast-path entries per (id(robot), method): see :func:`_fast`.
-_FAST: dict[tuple[int, str], tuple] = {}
-
-
 def _fast_entry(robot: object, method: str) -> tuple | None:
     """The prepared arrays of the fast path for ``robot`` and ``method`` (None: not eligible).
 
-    ``(weak reference to robot, spec, entry point of solve_fast, S, zeros (n,), (n,) q0
-    strides, method name)``: ``S`` the packed constants (:func:`~serialkin.ik._kernels.pack_fast`)
-    and the compiled entry point of the method's ``solve_fast`` for a read-only ``S``, C
-    (4, 4) target, C (n,) q0 and q, an int64 seed and a bool. Calling the entry point skips
-    numba's per-call type dispatch (about 0.2 µs for six arguments); it does not check
-    dtypes, layouts or shapes, so :func:`_fast` does.
+    ``(spec, entry point of solve_fast, S, zeros (n,), (n,) q0 strides, method name)``,
+    kept in ``robot._ik_fast[method]``: ``S`` the packed constants
+    (:func:`~serialkin.ik._kernels.pack_fast`) and the compiled entry point of the
+    method's ``solve_fast`` for a read-only ``S``, C (4, 4) target, C (n,) q0 and q, an
+    int64 seed and a bool. Calling the entry point skips numba's per-call type dispatch
+    (about 0.2 µs for six arguments); it does not check dtypes, layouts or shapes, so
+    :func:`_fast` does.
     """
-    import weakref
-
     import numba
 
     if not isinstance(robot, Robot) or method not in available_methods():
@@ -493,11 +488,9 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
            numba.types.boolean, vec)
     dispatcher = spec.kernel.solve_fast
     dispatcher.compile(sig)  # loads from numba's cache when it can
-    entry = (weakref.ref(robot), spec, dispatcher.overloads[sig].entry_point, S,
-             np.zeros(robot.n), (8,) if robot.n > 1 else None, spec.name)
-    if len(_FAST) > 256:
-        _FAST.clear()
-    _FAST[(id(robot), method)] = entry
+    entry = (spec, dispatcher.overloads[sig].entry_point, S, np.zeros(robot.n),
+             (8,) if robot.n > 1 else None, spec.name)
+    robot._ik_fast[method] = entry
     return entry
 
 
@@ -508,6 +501,11 @@ _F64 = np.dtype(np.float64)
 _NDARRAY = np.ndarray
 #: Strides of a C-contiguous float64 (4, 4) array.
 _C44 = (32, 8)
+#: The fields of a fast-path success that do not vary (copied, then filled: cheaper than
+#: building the dictionary).
+_SUCCESS = {"q": None, "success": True, "iterations": 0, "position_error": 0.0,
+            "orientation_error": 0.0, "reason": "", "restarts": 0, "method": "",
+            "clearance": np.inf, "closest_pair": ("", "")}
 
 
 def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
@@ -524,14 +522,14 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
     """
     if target.dtype is not _F64 or target.strides != _C44 or target.shape != (4, 4):
         return None
-    ent = _FAST.get((id(robot), method))
+    ent = robot._ik_fast.get(method)
     # the method's spec, looked up directly (an entry exists only once the registry has
     # been discovered): a re-registered method gets a new entry
-    if ent is None or ent[0]() is not robot or ent[1] is not _REGISTRY.get(method):
+    if ent is None or ent[0] is not _REGISTRY.get(method):
         ent = _fast_entry(robot, method)
         if ent is None:
             return None
-    _, _, solve_fast, S, zeros, strides, name = ent
+    _, solve_fast, S, zeros, strides, name = ent
     if q0 is None:
         q0k = zeros
     elif (type(q0) is _NDARRAY and q0.dtype is _F64 and q0.shape == zeros.shape
@@ -551,11 +549,15 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
     q = np.empty(zeros.shape[0])
     status, its, pe, oe, used = solve_fast(S, target, q0k, s, q0 is not None, q)
     if status == 1:  # IKResult.make, inlined
+        d = _SUCCESS.copy()
+        d["q"] = q
+        d["iterations"] = its
+        d["position_error"] = pe
+        d["orientation_error"] = oe
+        d["restarts"] = used
+        d["method"] = name
         r = _NEW(IKResult)
-        _SET(r, "__dict__", {
-            "q": q, "success": True, "iterations": its, "position_error": pe,
-            "orientation_error": oe, "reason": "", "restarts": used, "method": name,
-            "clearance": np.inf, "closest_pair": ("", "")})
+        _SET(r, "__dict__", d)
         return r
     if status < 0:
         return None

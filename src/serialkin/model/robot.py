@@ -195,6 +195,16 @@ class Robot:
         self._P = self.chain.packed
         self._qshape = (self.n,)
         self._jshape = (6, self.n)
+        #: the IK fast path's prepared entries per method (``serialkin.ik.solver._fast``),
+        #: kept here so that they live and die with the robot (never pickled: they hold
+        #: compiled entry points)
+        self._ik_fast: dict[str, tuple] = {}
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The robot's state for pickling (e.g. to Dask workers), without the IK caches."""
+        state = dict(self.__dict__)
+        state["_ik_fast"] = {}
+        return state
 
     # ------------------------------------------------------------------ constructors
     @classmethod
