@@ -151,6 +151,22 @@ def _to_coefficients(V, m):
     return C
 
 
+@njit(cache=True, inline="always")
+def _eliminate_below(A, c):
+    """One Gaussian elimination step: rows below c minus multiples of row c (pivot A[c, c]).
+
+    Only the columns right of c are updated (column c below the pivot is left as is:
+    neither caller reads it again).
+    """
+    n = A.shape[0]
+    inv = 1.0 / A[c, c]
+    for r in range(c + 1, n):
+        f = A[r, c] * inv
+        if f != 0.0:
+            for j in range(c + 1, n):
+                A[r, j] -= f * A[c, j]
+
+
 @njit(cache=True)
 def _det(A):
     """The determinant of A (n, n) by LU with partial pivoting, and min |pivot| / max |pivot|.
@@ -178,12 +194,7 @@ def _det(A):
             for j in range(c, n):
                 A[c, j], A[piv, j] = A[piv, j], A[c, j]
         d *= A[c, c]
-        inv = 1.0 / A[c, c]
-        for r in range(c + 1, n):
-            f = A[r, c] * inv
-            if f != 0.0:
-                for j in range(c + 1, n):
-                    A[r, j] -= f * A[c, j]
+        _eliminate_below(A, c)
     return d, pmin / pmax
 
 
@@ -212,12 +223,7 @@ def _null_vector(A, v):
             for r in range(n):
                 A[r, c], A[r, pc] = A[r, pc], A[r, c]
             perm[c], perm[pc] = perm[pc], perm[c]
-        inv = 1.0 / A[c, c]
-        for r in range(c + 1, n):
-            f = A[r, c] * inv
-            if f != 0.0:
-                for j in range(c + 1, n):
-                    A[r, j] -= f * A[c, j]
+        _eliminate_below(A, c)
     y = np.zeros(n)
     y[n - 1] = 1.0
     for i in range(n - 2, -1, -1):
