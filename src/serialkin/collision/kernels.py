@@ -50,9 +50,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.spatial.segments import closest_segment_segment
+
+from .._jit import njit
 
 __all__ = [
     "GOLDEN_STEPS",

@@ -25,7 +25,6 @@ import weakref
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from serialkin._checks import check_real
 from serialkin.collision.acm import AllowedCollisionMatrix, default_acm
@@ -34,6 +33,8 @@ from serialkin.collision.model import CollisionModel
 from serialkin.collision.shapes import encode_scene
 from serialkin.errors import InputError
 from serialkin.kinematics import parallel
+
+from .._jit import njit
 
 __all__ = ["CHUNK", "PAIR_NONE", "PAIR_SCENE", "PAIR_SELF", "Clearance", "body_pair_distances",
            "checked_shape_pairs", "clearance_at", "pair_distance_at", "scene_point_distance",

@@ -27,9 +27,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.kinematics.dls import chol_factor_into, lower_solve_into, lower_t_solve_into
+
+from .._jit import njit
 
 __all__ = ["INFEASIBLE", "ITERATION_LIMIT", "NOT_CONVEX", "OPTIMAL", "dual_active_set",
            "solve_bounded"]

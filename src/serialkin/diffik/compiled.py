@@ -15,7 +15,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.diffik.active_set import OPTIMAL, solve_bounded
 from serialkin.diffik.constraints import obstacle_rows_into, self_rows_into
@@ -23,6 +22,8 @@ from serialkin.kinematics import kernels as K
 from serialkin.kinematics.dls import weigh_rows_into
 from serialkin.redundancy.obstacles import update_geometry_into
 from serialkin.spatial.kernels import pose_error_into
+
+from .._jit import njit
 
 __all__ = ["CONFLICT", "CONVERGED", "NO_PROGRESS", "qp_point_into"]
 

@@ -28,7 +28,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from serialkin._checks import as_float_array, check_positive
 from serialkin.errors import InputError
@@ -40,6 +39,8 @@ from serialkin.redundancy.obstacles import (
     pair_gradient_into,
 )
 from serialkin.spatial.segments import closest_segment_segment
+
+from .._jit import njit
 
 __all__ = ["CollisionAvoidance", "Constraint", "PositionLimit", "StepBox", "VelocityLimit"]
 

@@ -26,7 +26,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from serialkin._checks import check_positive
 from serialkin.collision import kernels as CK
@@ -34,6 +33,8 @@ from serialkin.collision.queries import shapes_to_world
 from serialkin.diffik.constraints import Constraint
 from serialkin.errors import InputError
 from serialkin.kinematics import kernels as K
+
+from .._jit import njit
 
 __all__ = ["ModelCollisionAvoidance", "model_rows_into"]
 

@@ -80,7 +80,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from numba import njit
 
 from serialkin.collision.queries import PAIR_NONE, clearance_at, pair_distance_at
 from serialkin.kinematics.dls import dls_step_into, spd_solve_into
@@ -90,6 +89,8 @@ from serialkin.model.limits import inside as interval_inside
 from serialkin.model.limits import normalize as interval_normalize
 from serialkin.model.limits import project as interval_project
 from serialkin.spatial.kernels import pose_error_into, transforms_valid
+
+from .._jit import njit
 
 #: Layout of the configuration vector ``cfg`` (float64): the loop's slots, then the
 #: method's parameters ``cfg[N_LOOP:]`` (``CompiledMethod.params``, in order).

@@ -63,10 +63,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.ik._kernels import MAX_ITER, RUNNING, TWO_PI, stopping_test
 from serialkin.kinematics.kernels import PRISMATIC, jacobian_into
+
+from .._jit import njit
 
 
 @njit(cache=True, inline="always")

@@ -53,12 +53,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.errors import NotSupportedError
 from serialkin.ik._kernels import MAX_ITER, RUNNING, stopping_test
 from serialkin.ik.ccd import _axis_point, _clamp_angle_step
 from serialkin.kinematics.kernels import fk_into, jacobian_into
+
+from .._jit import njit
 
 #: Axis alignment tolerance (|z_i × z_0|) for "parallel joint axes".
 PARALLEL_TOL = 1e-9

@@ -48,7 +48,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.ik._kernels import (
     W_A,
@@ -75,6 +74,8 @@ from serialkin.kinematics.dls import dls_step_into, spd_solve_into
 from serialkin.kinematics.kernels import fk_into
 from serialkin.model.limits import wrap_angle as interval_wrap
 from serialkin.spatial.kernels import pose_error_into
+
+from .._jit import njit
 
 _PROJECTION = (
     "projection after every step: a revolute joint is shifted by 2π when that brings it "

@@ -41,13 +41,14 @@ import math
 from collections.abc import Callable
 
 import numpy as np
-from numba import njit
 from scipy.optimize import minimize
 
 from serialkin.ik._kernels import task_cost, task_errors
 from serialkin.kinematics.kernels import fk_into, jacobian_into
 from serialkin.kinematics.parallel import single_threaded_blas
 from serialkin.spatial.kernels import pose_error_into
+
+from .._jit import njit
 
 #: Names of the methods implemented here (scipy method used for each).
 SCIPY_METHODS = {"bfgs": "L-BFGS-B", "powell": "Powell"}

@@ -34,7 +34,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from .._jit import fma, njit
 
 REVOLUTE = 0
 PRISMATIC = 1
@@ -44,13 +45,7 @@ PRISMATIC = 1
 def _post_multiply(T, A):
     """T ← T · A for rigid transforms (last rows [0 0 0 1]), in place, no allocation."""
     for r in range(3):
-        t0 = T[r, 0]
-        t1 = T[r, 1]
-        t2 = T[r, 2]
-        T[r, 0] = t0 * A[0, 0] + t1 * A[1, 0] + t2 * A[2, 0]
-        T[r, 1] = t0 * A[0, 1] + t1 * A[1, 1] + t2 * A[2, 1]
-        T[r, 2] = t0 * A[0, 2] + t1 * A[1, 2] + t2 * A[2, 2]
-        T[r, 3] += t0 * A[0, 3] + t1 * A[1, 3] + t2 * A[2, 3]
+        T[r, 0], T[r, 1], T[r, 2], T[r, 3] = _row_times(T[r, 0], T[r, 1], T[r, 2], T[r, 3], A)
 
 
 @njit(cache=True, inline="always")
@@ -59,23 +54,23 @@ def _apply_joint(T, meta_i, qi):
     x = qi + meta_i[4]
     if meta_i[3] == PRISMATIC:
         for r in range(3):
-            T[r, 3] += x * T[r, 2]
+            T[r, 3] = fma(x, T[r, 2], T[r, 3])
         return
     s, c = _sincos_scalar(x)
     for r in range(3):
         t0 = T[r, 0]
         t1 = T[r, 1]
-        T[r, 0] = t0 * c + t1 * s
-        T[r, 1] = t1 * c - t0 * s
+        T[r, 0] = fma(t1, s, t0 * c)
+        T[r, 1] = fma(-t0, s, t1 * c)
 
 
 @njit(cache=True, inline="always")
 def _row_times(t0, t1, t2, t3, A):
     """One row [t0 t1 t2 t3] of a rigid transform times the rigid transform A."""
-    return (t0 * A[0, 0] + t1 * A[1, 0] + t2 * A[2, 0],
-            t0 * A[0, 1] + t1 * A[1, 1] + t2 * A[2, 1],
-            t0 * A[0, 2] + t1 * A[1, 2] + t2 * A[2, 2],
-            t0 * A[0, 3] + t1 * A[1, 3] + t2 * A[2, 3] + t3)
+    return (fma(t2, A[2, 0], fma(t1, A[1, 0], t0 * A[0, 0])),
+            fma(t2, A[2, 1], fma(t1, A[1, 1], t0 * A[0, 1])),
+            fma(t2, A[2, 2], fma(t1, A[1, 2], t0 * A[0, 2])),
+            fma(t2, A[2, 3], fma(t1, A[1, 3], fma(t0, A[0, 3], t3))))
 
 
 @njit(cache=True, inline="always")
@@ -158,13 +153,13 @@ def _chain_walk(q, F, kind, off, J, record, SC):
             J[0, i], J[1, i], J[2, i] = a3, b3, c3
             J[3, i], J[4, i], J[5, i] = a2, b2, c2
         if kind[i] == PRISMATIC:
-            a3 += x * a2
-            b3 += x * b2
-            c3 += x * c2
+            a3 = fma(x, a2, a3)
+            b3 = fma(x, b2, b3)
+            c3 = fma(x, c2, c3)
         else:
-            a0, a1 = a0 * c + a1 * s, a1 * c - a0 * s
-            b0, b1 = b0 * c + b1 * s, b1 * c - b0 * s
-            c0, c1 = c0 * c + c1 * s, c1 * c - c0 * s
+            a0, a1 = fma(a1, s, a0 * c), fma(-a0, s, a1 * c)
+            b0, b1 = fma(b1, s, b0 * c), fma(-b0, s, b1 * c)
+            c0, c1 = fma(c1, s, c0 * c), fma(-c0, s, c1 * c)
         A = F[i + 1]
         a0, a1, a2, a3 = _row_times(a0, a1, a2, a3, A)
         b0, b1, b2, b3 = _row_times(b0, b1, b2, b3, A)
@@ -182,7 +177,7 @@ def _store_pose(t, T):
     T[3, 3] = 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=False)
 def fk_into(q, F, meta, T):
     """End-effector pose (eq 11) into ``T`` (4, 4) for one configuration ``q`` (n,)."""
     n = meta.shape[0]
@@ -199,7 +194,7 @@ def fk_into(q, F, meta, T):
 # (``P[i, 3, 0]``, ``P[i, 3, 1]``) — and allocate nothing.
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=False)
 def fk_one(q, P, T):
     """End-effector pose into ``T`` (4, 4) over the packed chain.
 
@@ -257,16 +252,25 @@ _P3 = 2.0222662487959506e-21
 @njit(cache=True, inline="always")
 def _sincos(x):
     """(sin x, cos x) for |x| ≤ 1e5, branch-free so loops over it vectorise (see above)."""
-    kf = math.floor(x * _TWO_OVER_PI + 0.5)
-    r = ((x - kf * _P1) - kf * _P2) - kf * _P3
+    kf = math.floor(fma(x, _TWO_OVER_PI, 0.5))
+    r = fma(-kf, _P3, fma(-kf, _P2, fma(-kf, _P1, x)))
     z = r * r
-    sr = r + r * z * (-1.0 / 6.0 + z * (1.0 / 120.0 + z * (-1.0 / 5040.0 + z * (
-        1.0 / 362880.0 + z * (-2.505210838544172e-08 + z * (
-            1.6059043836821613e-10 + z * -7.647163731819816e-13))))))
-    cr = 1.0 + z * (-0.5 + z * (1.0 / 24.0 + z * (-1.0 / 720.0 + z * (
-        2.48015873015873e-05 + z * (-2.755731922398589e-07 + z * (
-            2.08767569878681e-09 + z * (-1.1470745597729725e-11
-                                        + z * 4.779477332387385e-14)))))))
+    # Horner in fused multiply-adds: sin r = r + r·z·ps(z), cos r = 1 + z·pc(z)
+    ps = fma(z, -7.647163731819816e-13, 1.6059043836821613e-10)
+    ps = fma(z, ps, -2.505210838544172e-08)
+    ps = fma(z, ps, 1.0 / 362880.0)
+    ps = fma(z, ps, -1.0 / 5040.0)
+    ps = fma(z, ps, 1.0 / 120.0)
+    ps = fma(z, ps, -1.0 / 6.0)
+    sr = fma(r * z, ps, r)
+    pc = fma(z, 4.779477332387385e-14, -1.1470745597729725e-11)
+    pc = fma(z, pc, 2.08767569878681e-09)
+    pc = fma(z, pc, -2.755731922398589e-07)
+    pc = fma(z, pc, 2.48015873015873e-05)
+    pc = fma(z, pc, -1.0 / 720.0)
+    pc = fma(z, pc, 1.0 / 24.0)
+    pc = fma(z, pc, -0.5)
+    cr = fma(z, pc, 1.0)
     quadrant = kf - 4.0 * math.floor(kf * 0.25)  # 0, 1, 2, 3
     odd = quadrant == 1.0 or quadrant == 3.0
     sv = cr if odd else sr
@@ -284,7 +288,7 @@ def _sincos_scalar(x):
     return _sincos(x)
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=False)
 def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
     """Poses of configurations ``Q[k0:k0+B]`` into ``out``; True if a q was NaN or ±inf.
 
@@ -318,11 +322,11 @@ def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
                     t0 = T[4 * r, b]
                     t1 = T[4 * r + 1, b]
                     t2 = T[4 * r + 2, b]
-                    t3 = T[4 * r + 3, b] + x[b] * t2
-                    T[4 * r, b] = t0 * a00 + t1 * a10 + t2 * a20
-                    T[4 * r + 1, b] = t0 * a01 + t1 * a11 + t2 * a21
-                    T[4 * r + 2, b] = t0 * a02 + t1 * a12 + t2 * a22
-                    T[4 * r + 3, b] = t3 + (t0 * a03 + t1 * a13 + t2 * a23)
+                    t3 = fma(x[b], t2, T[4 * r + 3, b])
+                    T[4 * r, b] = fma(t2, a20, fma(t1, a10, t0 * a00))
+                    T[4 * r + 1, b] = fma(t2, a21, fma(t1, a11, t0 * a01))
+                    T[4 * r + 2, b] = fma(t2, a22, fma(t1, a12, t0 * a02))
+                    T[4 * r + 3, b] = fma(t2, a23, fma(t1, a13, fma(t0, a03, t3)))
         else:
             big = False
             for b in range(B):
@@ -337,12 +341,12 @@ def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
                     t0 = T[4 * r, b]
                     t1 = T[4 * r + 1, b]
                     t2 = T[4 * r + 2, b]
-                    u0 = t0 * c[b] + t1 * s[b]
-                    u1 = t1 * c[b] - t0 * s[b]
-                    T[4 * r, b] = u0 * a00 + u1 * a10 + t2 * a20
-                    T[4 * r + 1, b] = u0 * a01 + u1 * a11 + t2 * a21
-                    T[4 * r + 2, b] = u0 * a02 + u1 * a12 + t2 * a22
-                    T[4 * r + 3, b] += u0 * a03 + u1 * a13 + t2 * a23
+                    u0 = fma(t1, s[b], t0 * c[b])
+                    u1 = fma(-t0, s[b], t1 * c[b])
+                    T[4 * r, b] = fma(t2, a20, fma(u1, a10, u0 * a00))
+                    T[4 * r + 1, b] = fma(t2, a21, fma(u1, a11, u0 * a01))
+                    T[4 * r + 2, b] = fma(t2, a22, fma(u1, a12, u0 * a02))
+                    T[4 * r + 3, b] = fma(t2, a23, fma(u1, a13, fma(u0, a03, T[4 * r + 3, b])))
     for b in range(B):
         o = out[k0 + b]
         for j in range(12):

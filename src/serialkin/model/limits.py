@@ -24,10 +24,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin._checks import MAX_JOINT_VALUE, short_repr
 from serialkin.errors import InputError, RobotDefinitionError
+
+from .._jit import njit
 
 TWO_PI = 2.0 * math.pi
 

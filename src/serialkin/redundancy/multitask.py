@@ -36,7 +36,6 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from numba import njit
 
 from serialkin._checks import (
     MAX_ITERATIONS,
@@ -62,6 +61,8 @@ from serialkin.redundancy.obstacles import (
 )
 from serialkin.spatial.kernels import pose_error_into
 
+from .._jit import njit_exact
+
 __all__ = [
     "MultiTaskResolver",
     "SolveStats",
@@ -83,7 +84,7 @@ def smoothstep(s: np.ndarray | float) -> np.ndarray:
 ONE_SIDED_RANGE = 2.0 * math.pi
 
 
-@njit(cache=True)
+@njit_exact(cache=True)
 def _limit_weight_and_push(q, lo, hi, buffer, max_weight):
     """Eq 49 weight of one joint and its signed depth into the buffer (towards mid-range).
 
@@ -165,7 +166,7 @@ _W, _DAMP, _SING, _W0, _WL, _BUF, _WC, _KREP, _GAIN, _MAXX, _MAXQ, _TOL, _ITER =
 _LINKR, _USE_LIM, _USE_OBS, _HAS_TOOL = 13, 14, 15, 16
 
 
-@njit(cache=True)
+@njit_exact(cache=True)
 def eq48_into(q, xdot, J, rows, F, L, meta, cfg, qlim, enc, influence, link, frames, P0, P1, Tee,
               T, SC, B, D, C, Jbuf, pbuf, A, rhs, qdot):
     """Eq 48 (corrected): ``q̇ = (JᵀWJ + J_cᵀW_cJ_c + J_LᵀW_LJ_L + W_s)⁻¹(JᵀWẋ + …)``.
@@ -238,7 +239,7 @@ def eq48_into(q, xdot, J, rows, F, L, meta, cfg, qlim, enc, influence, link, fra
     spd_solve_into(A, rhs, qdot, n)
 
 
-@njit(cache=True)
+@njit_exact(cache=True)
 def multitask_solve_into(q, target, rows, F, L, meta, cfg, qlim, enc, influence, link, frames,
                          P0, P1, Tee, T, SC, B, D, C, Jbuf, pbuf, A, rhs, qdot, J, Tpose, e6):
     """Iterate eq 48 towards ``target`` (4, 4) from ``q`` (updated in place).

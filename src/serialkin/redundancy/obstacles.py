@@ -35,12 +35,13 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numba import njit
 
 from serialkin._checks import as_vector, check_positive
 from serialkin.errors import InputError, InputTypeError
 from serialkin.kinematics import kernels as K
 from serialkin.spatial.segments import closest_segment_segment
+
+from .._jit import njit_exact
 
 __all__ = [
     "Capsule",
@@ -211,7 +212,7 @@ def encode_obstacles(obstacles: Sequence[Obstacle]) -> np.ndarray:
 
 
 # --------------------------------------------------------------------- compiled geometry
-@njit(cache=True)
+@njit_exact(cache=True)
 def segment_obstacle_kernel(P0, P1, obs, link_radius, T, SC, B, D, C):
     """Closest points between every segment and every obstacle (eqs 51-53, corrected).
 
@@ -366,7 +367,7 @@ class _Geometry:
         return u, g
 
 
-@njit(cache=True)
+@njit_exact(cache=True)
 def update_geometry_into(q, F, L, meta, has_tool, enc, link_radius, frames, P0, P1, Tee, T, SC,
                          B, D, C):
     """Link frames, link segments and every segment-obstacle closest pair at q.
@@ -391,7 +392,7 @@ def update_geometry_into(q, F, L, meta, has_tool, enc, link_radius, frames, P0, 
         segment_obstacle_kernel(P0, P1, enc, link_radius, T, SC, B, D, C)
 
 
-@njit(cache=True)
+@njit_exact(cache=True)
 def pair_gradient_into(q, F, L, meta, frames, P0, P1, link, T, SC, B, D, i, j, Jbuf, pbuf,
                        u, g):
     """Unit vector u (eq 54, corrected) and clearance gradient ``g = uᵀ J_sc`` of one pair.
@@ -442,7 +443,7 @@ def pair_gradient_into(q, F, L, meta, frames, P0, P1, link, T, SC, B, D, i, j, J
         g[c] += t * (u[0] * Jbuf[0, c] + u[1] * Jbuf[1, c] + u[2] * Jbuf[2, c])
 
 
-@njit(cache=True)
+@njit_exact(cache=True)
 def accumulate_obstacle_task(q, F, L, meta, frames, P0, P1, link, T, SC, B, D, C, influence,
                              max_weight, repulsive_gain, A, rhs, Jbuf, pbuf):
     """Add the obstacle task of eq 48 to the normal equations ``A q̇ = rhs`` in place.

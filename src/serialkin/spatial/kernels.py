@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from .._jit import njit
 
 #: Below this rotation angle [rad] θ/sin θ is replaced by its series 1 + θ²/6 + 7θ⁴/360.
 SMALL_ANGLE = 1e-3

@@ -7,7 +7,7 @@ validation happens at the public boundary.
 
 from __future__ import annotations
 
-from numba import njit
+from .._jit import njit
 
 
 @njit(cache=True, nogil=True)

@@ -33,7 +33,6 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
-from numba import njit
 
 from serialkin._checks import MAX_ITERATIONS, check_choice, check_int, check_positive
 from serialkin.diffik.resolver import QPResolver
@@ -49,12 +48,14 @@ from serialkin.spatial.kernels import pose_error_into
 from serialkin.tracking.path import Path
 from serialkin.tracking.trajectory import JointJump, PathFailure, Trajectory
 
+from .._jit import njit_exact
+
 __all__ = ["ON_UNREACHABLE", "dls_track", "joint_jumps", "limit_margins", "track"]
 
 ON_UNREACHABLE = ("continue", "stop")
 
 
-@njit(cache=True)
+@njit_exact(cache=True)
 def dls_track(q0, targets, rows, F, meta, lam, tol, max_iter, max_step, accept, stop_on_fail,
               kick, lo, hi, revolute, Q, ITER, ERR):
     """Compiled DLS path tracking (eq 46 corrected, the 6-link algorithm).

@@ -13,7 +13,6 @@ Kernels trust their input.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from serialkin.errors import InputError
 from serialkin.ik.analytic.general import MAX_SOLUTIONS as GENERAL_MAX
@@ -24,6 +23,8 @@ from serialkin.ik.analytic.scara import solve_scara
 from serialkin.ik.analytic.spherical_wrist import wrist_candidates
 from serialkin.ik.analytic.subproblems import finalize, rigid_error
 from serialkin.ik.analytic.ur import ur_candidates
+
+from ..._jit import njit
 
 #: Class codes of :func:`solve_into`.
 PLANAR, SCARA, WRIST, UR, GENERAL = 0, 1, 2, 3, 4

@@ -41,7 +41,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.ik.analytic.raghavan_roth import rr_candidates
 from serialkin.ik.analytic.refine import refine_new, wrapped_dist
@@ -57,6 +56,8 @@ from serialkin.ik.analytic.subproblems import (
     sp1_dir,
     transform_point,
 )
+
+from ..._jit import njit
 
 #: Most solutions of a 6R arm.
 MAX_SOLUTIONS = 16

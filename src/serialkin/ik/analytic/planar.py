@@ -21,7 +21,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.ik.analytic.subproblems import (
     cross3,
@@ -31,6 +30,8 @@ from serialkin.ik.analytic.subproblems import (
     planar2r,
     target_point,
 )
+
+from ..._jit import njit
 
 #: Most candidate solutions of the parallel-axis family.
 MAX_SOLUTIONS = 2

@@ -57,7 +57,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.ik.analytic.refine import refine_new
 from serialkin.ik.analytic.subproblems import (
@@ -71,6 +70,8 @@ from serialkin.ik.analytic.subproblems import (
     sp1_dir,
     transform_point,
 )
+
+from ..._jit import njit
 
 #: Interpolation angles of each joint: 0, 2π/3, 4π/3 [rad].
 _ANGLES = np.array([0.0, TWO_PI / 3.0, 2.0 * TWO_PI / 3.0])

@@ -18,11 +18,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.kinematics.dls import dls_step_into
 from serialkin.kinematics.kernels import jacobian_into
 from serialkin.spatial.kernels import pose_error_into
+
+from ..._jit import njit
 
 #: Largest Newton step, any joint [rad or m]; larger steps are scaled down.
 MAX_STEP = 0.5

@@ -16,10 +16,11 @@ solutions (elbow left / right).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from serialkin.ik.analytic.planar import MAX_SOLUTIONS, planar_candidates
 from serialkin.ik.analytic.subproblems import dot3, finalize
+
+from ..._jit import njit
 
 
 @njit(cache=True)

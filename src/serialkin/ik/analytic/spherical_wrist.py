@@ -40,7 +40,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.ik.analytic.subproblems import (
     CLAMP,
@@ -65,6 +64,8 @@ from serialkin.ik.analytic.subproblems import (
     sub3,
     target_rotation,
 )
+
+from ..._jit import njit
 
 #: Most candidate solutions of a 6-joint arm.
 MAX_SOLUTIONS = 8

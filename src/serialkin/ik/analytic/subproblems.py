@@ -30,9 +30,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.kinematics.kernels import fk_range
+
+from ..._jit import njit
 
 #: arccos arguments within this distance of ±1 are clamped (workspace boundary).
 CLAMP = 1e-9

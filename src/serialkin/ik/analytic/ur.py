@@ -22,7 +22,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from serialkin.ik.analytic.subproblems import (
     add3,
@@ -40,6 +39,8 @@ from serialkin.ik.analytic.subproblems import (
     sub3,
     target_rotation,
 )
+
+from ..._jit import njit
 
 #: Most candidate solutions.
 MAX_SOLUTIONS = 8
