@@ -149,3 +149,61 @@ def test_checked_range_flags_only_nonfinite_values():
     assert bad[0] == 0  # outside the range
     K.fk_checked_range(Q, c.F, c.meta, T2, bad, 299, 300)
     assert bad[0] == 1
+
+
+@pytest.mark.parametrize("where", [0, 1999])
+@pytest.mark.parametrize("value", [np.nan, np.inf])
+def test_jacobian_and_link_frame_batches_raise_the_checked_error(where, value, monkeypatch):
+    """A NaN/inf in a jacobian, fk_all or hessian batch raises check_q's error."""
+    monkeypatch.setattr(parallel, "free_cores", lambda: 64)  # the threaded path too
+    robot = sk.models.get("scara")  # revolute and prismatic joints
+    Q = robot.random_q(2000, seed=7)
+    Q[where, where % robot.n] = value
+    with pytest.raises(InputError, match="q must be finite") as expected:
+        robot.check_q(Q)
+    calls = [lambda: robot.jacobian(Q), lambda: robot.jacobian(Q, "ee"),
+             lambda: robot.jacobian(Q, link=2, point=[0.1, 0.0, 0.0]),
+             lambda: robot.jacobian(Q, out=np.empty((2000, 6, robot.n))),
+             lambda: robot.fk_all(Q), lambda: robot.hessian(Q)]
+    for call in calls:
+        with pytest.raises(InputError) as got:
+            call()
+        assert str(got.value) == str(expected.value)
+
+
+def test_range_kernels_flag_only_nonfinite_rows():
+    """jacobian/point_jacobian/fk_all ranges flag NaN rows (NaN output), not huge finite q."""
+    robot = sk.models.get("scara")
+    c = robot.chain
+    n = robot.n
+    Q = robot.random_q(40, seed=8)
+    Q[3, 0], Q[4, 2] = 1e300, -1e300
+    J, T, P = np.empty((40, 6, n)), np.empty((40, 4, 4)), np.empty((40, 3))
+    A = np.empty((40, n + 1, 4, 4))
+    pt = np.array([0.1, 0.0, 0.0])
+    for k in range(2):
+        bad = np.zeros(1, dtype=np.int64)
+        K.jacobian_range(Q, c.F, c.meta, J, T, bad, 0, 40)
+        K.point_jacobian_range(Q, c.F, c.L, c.meta, 2, pt, J, P, bad, 0, 40)
+        K.fk_all_range(Q, c.F, c.L, c.meta, A, bad, 0, 40)
+        if k == 0:
+            assert bad[0] == 0
+            Q[39, 1] = np.nan
+        else:
+            assert bad[0] == 1
+            assert np.isnan(J[39]).all() and np.isnan(P[39]).all() and np.isnan(A[39]).all()
+            assert np.isfinite(J[:39]).all() and np.isfinite(A[:3]).all()
+
+
+def test_batch_jacobian_out_is_written_in_place():
+    """jacobian(Q, out=J) in the base frame fills the caller's buffer itself (views too)."""
+    robot = sk.models.get("ur5")
+    Q = robot.random_q((3, 5), seed=9)
+    expected = robot.jacobian(Q)
+    big = np.zeros((2, 3, 5, 6, robot.n))
+    view = big[1]  # a C-contiguous view: its base is big
+    assert robot.jacobian(Q, out=view) is view
+    assert np.array_equal(big[1], expected) and not big[0].any()
+    E = np.empty((3, 5, 6, robot.n))
+    assert robot.jacobian(Q, "ee", out=E) is E
+    np.testing.assert_array_equal(E, robot.jacobian(Q, "ee"))

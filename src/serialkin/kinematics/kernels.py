@@ -404,6 +404,19 @@ def fk_checked_range(Q, F, meta, out, bad, start, stop):
         bad[0] = 1
 
 
+@njit(cache=True, inline="always")
+def finite_row(q):
+    """True when every entry of ``q`` (n,) is finite: the batch kernels' input check.
+
+    A batch kernel reads every q anyway; testing it there costs a compare per value,
+    where ``np.isfinite(Q).all()`` before the call is a separate pass over the batch.
+    """
+    for i in range(q.shape[0]):
+        if not math.isfinite(q[i]):
+            return False
+    return True
+
+
 @njit(cache=True)
 def fk_all_into(q, F, L, meta, out):
     """Every link frame 0..n (base to last link, without the tool) into ``out`` (n+1, 4, 4)."""
@@ -418,10 +431,18 @@ def fk_all_into(q, F, L, meta, out):
 
 
 @njit(cache=True, nogil=True)
-def fk_all_range(Q, F, L, meta, out, start, stop):
-    """Link frames of ``Q[start:stop]`` (Q (N, n)) into ``out`` (N, n+1, 4, 4)."""
+def fk_all_range(Q, F, L, meta, out, bad, start, stop):
+    """Link frames of ``Q[start:stop]`` (Q (N, n)) into ``out`` (N, n+1, 4, 4).
+
+    A configuration with a NaN/inf sets ``bad[0] = 1`` (bad: int64 (1,)) and its frames
+    are NaN; the caller raises (:func:`finite_row`).
+    """
     for k in range(start, stop):
-        fk_all_into(Q[k], F, L, meta, out[k])
+        if finite_row(Q[k]):
+            fk_all_into(Q[k], F, L, meta, out[k])
+        else:
+            bad[0] = 1
+            out[k] = math.nan
 
 
 @njit(cache=True, inline="always")
@@ -488,10 +509,18 @@ def joint_axes_into(q, F, meta, P, W):
 
 
 @njit(cache=True, nogil=True)
-def jacobian_range(Q, F, meta, J, T, start, stop):
-    """Geometric Jacobians (N, 6, n) and poses (N, 4, 4) of ``Q[start:stop]`` (Q (N, n))."""
+def jacobian_range(Q, F, meta, J, T, bad, start, stop):
+    """Geometric Jacobians (N, 6, n) and poses (N, 4, 4) of ``Q[start:stop]`` (Q (N, n)).
+
+    Non-finite configurations set ``bad[0] = 1`` and get NaN (:func:`fk_all_range`).
+    """
     for k in range(start, stop):
-        jacobian_into(Q[k], F, meta, J[k], T[k])
+        if finite_row(Q[k]):
+            jacobian_into(Q[k], F, meta, J[k], T[k])
+        else:
+            bad[0] = 1
+            J[k] = math.nan
+            T[k] = math.nan
 
 
 @njit(cache=True)
@@ -519,10 +548,18 @@ def point_jacobian_into(q, F, L, meta, link, point, J, p_out):
 
 
 @njit(cache=True, nogil=True)
-def point_jacobian_range(Q, F, L, meta, link, point, J, P, start, stop):
-    """Point Jacobians (N, 6, n) and point positions (N, 3) of ``Q[start:stop]``."""
+def point_jacobian_range(Q, F, L, meta, link, point, J, P, bad, start, stop):
+    """Point Jacobians (N, 6, n) and point positions (N, 3) of ``Q[start:stop]``.
+
+    Non-finite configurations set ``bad[0] = 1`` and get NaN (:func:`fk_all_range`).
+    """
     for k in range(start, stop):
-        point_jacobian_into(Q[k], F, L, meta, link, point, J[k], P[k])
+        if finite_row(Q[k]):
+            point_jacobian_into(Q[k], F, L, meta, link, point, J[k], P[k])
+        else:
+            bad[0] = 1
+            J[k] = math.nan
+            P[k] = math.nan
 
 
 # --- second order: Hessian and time derivative of the geometric Jacobian ------------------

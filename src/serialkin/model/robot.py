@@ -476,13 +476,16 @@ class Robot:
         Returns:
             (..., n+1, 4, 4). For a standard-DH robot these are the DH frames 0..n.
         """
-        a = self.check_q(q)
+        a = self.check_q(q, finite=False)  # the kernel tests finiteness as it reads
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
         check_allocation("the link frames", (flat.shape[0], self.n + 1, 4, 4), 8,
                          setting="the batch size")
         out = np.empty((flat.shape[0], self.n + 1, 4, 4))
-        parallel.run(K.fk_all_range, (flat, self._F, self._L, self._meta, out), flat.shape[0],
-                     grain=max(32, 1536 // self.n))
+        bad = np.zeros(1, dtype=np.int64)
+        parallel.run(K.fk_all_range, (flat, self._F, self._L, self._meta, out, bad),
+                     flat.shape[0], grain=max(32, 1536 // self.n))
+        if bad[0]:
+            self.check_q(a)  # raises the error naming the first non-finite entry
         return out.reshape(a.shape[:-1] + (self.n + 1, 4, 4))
 
     def jacobian(
@@ -515,8 +518,9 @@ class Robot:
             (6, n) or (..., 6, n).
 
         Raises:
-            InputError: q of the wrong shape or not finite, unknown frame, link outside
-                0..n, point without link, out of the wrong kind.
+            InputError: q of the wrong shape or not finite (a batch's ``out`` may then
+                have been written), unknown frame, link outside 0..n, point without
+                link, out of the wrong kind.
         """
         if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 and link is None \
                 and point is None and type(frame) is str and frame == "base":
@@ -529,31 +533,41 @@ class Robot:
                 J = None
             if J is not None and (_JAC1 or _fast()[1])(q, self._P, J) == 0:
                 return J
-        a, J, T = self._jacobians(q, frame, link, point)
+        a, J, T = self._jacobians(q, frame, link, point, out)
+        if out is not None and link is None and frame == "base":  # written in place
+            return out
         shape = a.shape[:-1] + (6, self.n)
         if out is None:
             return J.reshape(shape)
         _out_array(out, shape)[...] = J.reshape(shape)
         return out
 
-    def _jacobians(self, q: object, frame: str, link: int | None,
-                   point: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _jacobians(self, q: object, frame: str, link: int | None, point: object,
+                   out: object = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Validated q (..., n), Jacobians (N, 6, n) in ``frame`` and the frames' poses (N, 4, 4).
 
         The poses are the tool's (``link`` None) or link ``link``'s frame (not the point's).
+        With ``out`` (the caller's (..., 6, n) buffer) and the tool's Jacobian in the base
+        frame, the Jacobians are written straight into it (J is then a view of out).
         """
         check_choice(frame, "frame", ("base", "ee"))
-        a = self.check_q(q)
+        a = self.check_q(q, finite=False)  # the kernels test finiteness as they read
         flat = np.ascontiguousarray(a.reshape(-1, self.n))
         N = flat.shape[0]
         check_allocation("the Jacobian batch", (N, 6 * self.n + 16), 8, setting="the batch size")
-        J = np.empty((N, 6, self.n))
         grain = max(16, 3072 // self.n)
+        bad = np.zeros(1, dtype=np.int64)
         if link is None:
             if point is not None:
                 raise InputError("point is given without link; pass link=k (0..n) as well")
+            if out is not None and frame == "base":
+                J = _out_array(out, a.shape[:-1] + (6, self.n)).reshape(N, 6, self.n)
+            else:
+                J = np.empty((N, 6, self.n))
             T = np.empty((N, 4, 4))
-            parallel.run(K.jacobian_range, (flat, self._F, self._meta, J, T), N, grain)
+            parallel.run(K.jacobian_range, (flat, self._F, self._meta, J, T, bad), N, grain)
+            if bad[0]:
+                self.check_q(a)  # raises the error naming the first non-finite entry
         else:
             k = check_int(link, "link")
             if k > self.n:
@@ -562,9 +576,12 @@ class Robot:
             if p.shape != (3,):
                 raise InputError(f"point must have 3 values, got shape {p.shape}")
             P = np.empty((N, 3))
+            J = np.empty((N, 6, self.n))
             parallel.run(K.point_jacobian_range,
-                         (flat, self._F, self._L, self._meta, k, np.ascontiguousarray(p), J, P),
-                         N, grain)
+                         (flat, self._F, self._L, self._meta, k, np.ascontiguousarray(p), J, P,
+                          bad), N, grain)
+            if bad[0]:
+                self.check_q(a)  # raises the error naming the first non-finite entry
             T = self.fk_all(flat)[:, k]
         if frame == "ee":
             Rt = np.swapaxes(T[:, :3, :3], -1, -2)
