@@ -4,19 +4,27 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from serialkin.kinematics import dls
 
 
 def _reference(J, e, lam):
-    m = J.shape[0]
-    return J.T @ np.linalg.solve(J @ J.T + lam * lam * np.eye(m), e)
+    """Jᵀ(JJᵀ+λ²I)⁻¹e as the least-squares solution of [J; λI] Δq ≈ [e; 0] (QR, stable).
+
+    The same vector as the closed form, computed without forming JJᵀ: for m > n that
+    matrix has rank n and its m×m solve loses about 2·log10(1/λ) digits, enough for
+    the reference itself to miss a 1e-9 tolerance at λ = 1e-3.
+    """
+    n = J.shape[1]
+    return np.linalg.lstsq(np.vstack([J, lam * np.eye(n)]), np.concatenate([e, np.zeros(n)]),
+                           rcond=None)[0]
 
 
 @settings(max_examples=40, deadline=None)
 @given(st.integers(1, 6), st.integers(1, 8), st.floats(1e-3, 1.0), st.integers(0, 2**32 - 1))
+@example(m=4, n=2, lam=0.001953125, seed=0)  # tall J, small λ: failed with the m×m route
 def test_step_matches_closed_form(m, n, lam, seed):
     """Δq = Jᵀ(JJᵀ+λ²I)⁻¹e and it satisfies the normal equations (JᵀJ+λ²I)Δq = Jᵀe."""
     rng = np.random.default_rng(seed)
@@ -101,3 +109,17 @@ def test_spd_solve_matches_numpy(m):
         y = b.copy()
         assert dls.spd_solve_into(A.copy(), y, y, m)
         np.testing.assert_allclose(y, ref, rtol=1e-10, atol=1e-12)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(2, 6), st.integers(1, 5), st.floats(1e-4, 1e-2), st.integers(0, 2**32 - 1))
+def test_tall_jacobian_step_is_accurate_for_small_damping(m, n, lam, seed):
+    """A tall J (m > n) with small λ: the step equals the stacked least squares to 1e-12."""
+    if n >= m:
+        n = m - 1
+    rng = np.random.default_rng(seed)
+    J = rng.standard_normal((m, n))
+    e = rng.standard_normal(m)
+    dq = np.empty(n)
+    assert dls.dls_step_into(J, e, lam * lam, 0.0, np.empty((m, m)), np.empty(m), dq)
+    np.testing.assert_allclose(dq, _reference(J, e, lam), rtol=1e-12, atol=1e-14)

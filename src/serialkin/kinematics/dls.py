@@ -41,6 +41,7 @@ __all__ = [
     "dls_step_batch",
     "dls_step_into",
     "gram_into",
+    "gram_t_into",
     "manipulability_batch",
     "manipulability_of",
     "spd_solve_into",
@@ -181,22 +182,39 @@ def gram_into(J, M):
 
 
 @njit(cache=True)
-def dls_factor_into(J, lam2, floor, M):
+def gram_t_into(J, M):
+    """``M[:n, :n] = Jᵀ J`` of J (m, n); returns ``max_j (JᵀJ)_jj`` (0 for n = 0)."""
+    m, n = J.shape
+    d = 0.0
+    for j in range(n):
+        for k in range(j, n):
+            s = 0.0
+            for i in range(m):
+                s += J[i, j] * J[i, k]
+            M[j, k] = s
+            M[k, j] = s
+        d = max(d, M[j, j])
+    return d
+
+
+@njit(cache=True)
+def dls_factor_into(J, lam2, floor, M, columns=False):
     """Cholesky factor of ``J Jᵀ + λ² I`` (m, m) into M; J (m, n), ``lam2`` = λ².
 
-    When the matrix is not positive definite (λ = 0 at a singularity) and ``floor > 0``,
-    retries once with ``λ² + floor·(1 + max_i (J Jᵀ)_ii)``.
+    With ``columns``, of ``Jᵀ J + λ² I`` (n, n) into ``M[:n, :n]`` instead. When the
+    matrix is not positive definite (λ = 0 at a singularity) and ``floor > 0``, retries
+    once with ``λ² + floor·(1 + max_i G_ii)``, G the Gram matrix.
 
     Returns:
         True, or False when no factor was found.
     """
-    m = J.shape[0]
+    k = J.shape[1] if columns else J.shape[0]
     l2 = lam2
     for _ in range(2):
-        d = gram_into(J, M)
-        for i in range(m):
+        d = gram_t_into(J, M) if columns else gram_into(J, M)
+        for i in range(k):
             M[i, i] += l2
-        if chol_factor_into(M, m):
+        if chol_factor_into(M, k):
             return True
         if not floor > 0.0:
             return False
@@ -208,22 +226,39 @@ def dls_factor_into(J, lam2, floor, M):
 def dls_step_into(J, e, lam2, floor, M, y, dq):
     """DLS step ``Δq = Jᵀ (J Jᵀ + λ² I)⁻¹ e`` (eq 46, corrected) into ``dq``.
 
+    With more task rows than joints (m > n) the same step is solved as
+    ``(Jᵀ J + λ² I) Δq = Jᵀ e`` (the two are equal: ``Jᵀ(JJᵀ + λ²I) = (JᵀJ + λ²I)Jᵀ``):
+    the n×n system is smaller, and it is as well conditioned as J itself, where
+    ``J Jᵀ`` has rank at most n < m and its m×m system is as ill-conditioned as
+    ``1/λ²`` (with λ = 0.002 and a random 4×2 J the m×m route kept about nine
+    correct digits, the n×n one all but one, against 50-digit arithmetic).
+
     Args:
         J: (m, n) task Jacobian (weighted rows: pass ``diag(√w) J``).
         e: (m,) task error (weighted rows: ``√w ⊙ e``) [task units].
         lam2: λ² ≥ 0 [task units² per joint unit²].
-        floor: relative damping floor for a retry when ``J Jᵀ + λ² I`` is singular
+        floor: relative damping floor for a retry when the system is singular
             (0: no retry); see :func:`dls_factor_into`.
-        M: (m, m) buffer (Cholesky factor on return).
-        y: (m,) buffer, ``y = (J Jᵀ + λ² I)⁻¹ e`` on return.
+        M: (m, m) buffer (overwritten by a Cholesky factor).
+        y: (m,) buffer (overwritten).
         dq: (n,) output [joint units].
 
     Returns:
         True, or False when the system is singular (dq not written).
     """
+    m, n = J.shape
+    if m > n:
+        if not dls_factor_into(J, lam2, floor, M, True):
+            return False
+        for j in range(n):
+            s = 0.0
+            for i in range(m):
+                s += J[i, j] * e[i]
+            y[j] = s
+        chol_solve_into(M, y, dq, n)
+        return True
     if not dls_factor_into(J, lam2, floor, M):
         return False
-    m, n = J.shape
     chol_solve_into(M, e, y, m)
     for j in range(n):
         s = 0.0
