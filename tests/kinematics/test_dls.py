@@ -123,3 +123,18 @@ def test_tall_jacobian_step_is_accurate_for_small_damping(m, n, lam, seed):
     dq = np.empty(n)
     assert dls.dls_step_into(J, e, lam * lam, 0.0, np.empty((m, m)), np.empty(m), dq)
     np.testing.assert_allclose(dq, _reference(J, e, lam), rtol=1e-12, atol=1e-14)
+
+
+@pytest.mark.parametrize("shape", [(3, 7), (6, 6), (6, 3), (5, 1)])
+def test_inverse_times_error_is_the_step_for_every_shape(shape):
+    """J^# e equals dls_step_into's Δq for wide, square and tall J (tall: the n×n form)."""
+    m, n = shape
+    rng = np.random.default_rng(11)
+    J = rng.standard_normal((m, n))
+    e = rng.standard_normal(m)
+    inv, dq = np.empty((n, m)), np.empty(n)
+    for lam in (0.5, 1e-3):
+        assert dls.dls_inverse_into(J, lam * lam, 0.0, np.empty((m, m)), np.empty(m), inv)
+        assert dls.dls_step_into(J, e, lam * lam, 0.0, np.empty((m, m)), np.empty(m), dq)
+        np.testing.assert_allclose(inv @ e, dq, rtol=1e-10, atol=1e-13)
+        np.testing.assert_allclose(dq, _reference(J, e, lam), rtol=1e-9, atol=1e-12)

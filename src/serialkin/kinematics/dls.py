@@ -272,11 +272,24 @@ def dls_step_into(J, e, lam2, floor, M, y, dq):
 def dls_inverse_into(J, lam2, floor, M, y, out):
     """DLS inverse ``J^# = Jᵀ (J Jᵀ + λ² I)⁻¹`` (n, m) of J (m, n) into ``out``.
 
-    Buffers: M (m, m), y (m,). Returns False when the system is singular.
+    For a tall J (m > n) computed as ``(JᵀJ + λ² I)⁻¹ Jᵀ``, the same matrix from the
+    better conditioned n×n system (see :func:`dls_step_into`), so that ``J^# e`` is
+    the step for every shape. Buffers: M (m, m), y (m,). Returns False when the system
+    is singular.
     """
+    m, n = J.shape
+    if m > n:
+        if not dls_factor_into(J, lam2, floor, M, True):
+            return False
+        for c in range(m):
+            for j in range(n):
+                y[j] = J[c, j]
+            chol_solve_into(M, y, y, n)
+            for j in range(n):
+                out[j, c] = y[j]
+        return True
     if not dls_factor_into(J, lam2, floor, M):
         return False
-    m, n = J.shape
     for c in range(m):
         for i in range(m):
             y[i] = 0.0
