@@ -41,7 +41,6 @@ __all__ = [
     "dls_step_batch",
     "dls_step_into",
     "gram_into",
-    "gram_t_into",
     "manipulability_batch",
     "manipulability_of",
     "spd_solve_into",
@@ -167,7 +166,10 @@ def spd_solve_into(A, b, x, m):
 
 @njit(cache=True)
 def gram_into(J, M):
-    """``M = J Jᵀ`` (m, m) of J (m, n); returns ``max_i M_ii`` (0 for m = 0)."""
+    """``M = J Jᵀ`` (m, m) of J (m, n); returns ``max_i M_ii`` (0 for m = 0).
+
+    Called with the view ``J.T`` it gives ``Jᵀ J`` (n, n) (:func:`dls_factor_into`).
+    """
     m, n = J.shape
     d = 0.0
     for i in range(m):
@@ -178,22 +180,6 @@ def gram_into(J, M):
             M[i, k] = s
             M[k, i] = s
         d = max(d, M[i, i])
-    return d
-
-
-@njit(cache=True)
-def gram_t_into(J, M):
-    """``M[:n, :n] = Jᵀ J`` of J (m, n); returns ``max_j (JᵀJ)_jj`` (0 for n = 0)."""
-    m, n = J.shape
-    d = 0.0
-    for j in range(n):
-        for k in range(j, n):
-            s = 0.0
-            for i in range(m):
-                s += J[i, j] * J[i, k]
-            M[j, k] = s
-            M[k, j] = s
-        d = max(d, M[j, j])
     return d
 
 
@@ -211,7 +197,7 @@ def dls_factor_into(J, lam2, floor, M, columns=False):
     k = J.shape[1] if columns else J.shape[0]
     l2 = lam2
     for _ in range(2):
-        d = gram_t_into(J, M) if columns else gram_into(J, M)
+        d = gram_into(J.T, M) if columns else gram_into(J, M)
         for i in range(k):
             M[i, i] += l2
         if chol_factor_into(M, k):
