@@ -158,3 +158,29 @@ def test_guided_chunks_shrink_to_the_grain(N, grain, threads, monkeypatch):
         assert stop - start == min(N - start, max(grain, (N - start) // (2 * participants)))
     if N >= 8 * grain * participants:
         assert len(calls) < N / grain / 2  # far fewer hand-offs than fixed-grain chunks
+
+
+def test_min_items_keeps_a_batch_on_the_calling_thread():
+    """run(..., min_items=M) makes one call on the calling thread for fewer than M items."""
+    calls = []
+    parallel.run(lambda start, stop: calls.append((start, stop, threading.get_ident())), (),
+                 1000, 10, min_items=1001)
+    assert calls == [(0, 1000, threading.get_ident())]
+
+
+def test_small_ik_batches_do_not_wake_a_worker(monkeypatch):
+    """IK batches below PARALLEL_MIN_TARGETS never use the pool; larger ones do (2 threads)."""
+    from serialkin.ik import solver
+
+    monkeypatch.setattr(parallel, "threads", lambda: 2)
+    used = []
+    real_pool = parallel._pool
+    monkeypatch.setattr(parallel, "_pool", lambda workers: used.append(workers) or
+                        real_pool(workers))
+    robot = models.ur5()
+    for N, pooled in ((solver.PARALLEL_MIN_TARGETS - 1, False),
+                      (solver.PARALLEL_MIN_TARGETS, True)):
+        used.clear()
+        Q = robot.random_q(N, seed=4)
+        res = robot.ik(robot.fk(Q), q0=robot.random_q(N, seed=5), seed=0)
+        assert bool(used) is pooled and res.success.all()

@@ -752,10 +752,17 @@ def _run_chunks(solve_chunk: Any, F: np.ndarray, meta: np.ndarray, Tt: np.ndarra
 
     Scheduled by :func:`serialkin.kinematics.parallel.run` (guided chunks of at least 8
     targets claimed dynamically, so a few slow targets or a busy core do not leave the
-    batch waiting).
+    batch waiting); fewer than :data:`PARALLEL_MIN_TARGETS` targets run on the calling
+    thread.
     """
     parallel.run(solve_chunk, (F, meta, Tt, box, Q0, cfg, seed64, Q, info), Tt.shape[0],
-                 grain=8)
+                 grain=8, min_items=PARALLEL_MIN_TARGETS)
+
+
+#: Batches of fewer targets are solved on the calling thread: waking a second thread
+#: costs more than it saves (UR5 ``lm``, 2 cores: 16, 40, 100 targets took 2.2×, 1.5×,
+#: 1.0× as long on two threads as on one; 400 targets 0.74×).
+PARALLEL_MIN_TARGETS = 128
 
 
 def _kernel_config(spec: MethodSpec, tgt: Target, tol: float, max_iter: int, restarts: int,

@@ -23,7 +23,13 @@ one thread on the free core. :func:`run` instead
 * makes the calling thread a participant, so that the batch never waits for a worker
   thread that has not been scheduled yet: the caller waits only for chunks already
   claimed and still running;
-* runs small batches (fewer than two grains) on the calling thread alone;
+* runs small batches (fewer than two grains, or fewer than the caller's
+  ``min_items``) on the calling thread alone. Waking a worker and waiting for its last
+  chunk cost 50–300 µs on a 2-vCPU VM (``pool.submit`` about 50 µs, the caller's own
+  wake-up at the end up to 140 µs): an IK batch, whose targets vary in cost, of 16 and
+  40 targets took 2.2× and 1.5× *longer* on two threads than on one, and of 100
+  targets as long; so IK batches pass ``min_items`` (see
+  :data:`serialkin.ik.solver.PARALLEL_MIN_TARGETS`);
 * uses only the cores other processes leave free (as OpenMP's ``OMP_DYNAMIC`` does): on
   Linux it reads the number of runnable tasks from ``/proc/loadavg`` (at most every
   20 ms) and counts as free the usable CPUs minus the other runnable tasks. On a 2-core
@@ -137,7 +143,8 @@ class _Job:
                     self.idle.set()
 
 
-def run(kernel: Callable[..., Any], args: tuple, N: int, grain: int) -> None:
+def run(kernel: Callable[..., Any], args: tuple, N: int, grain: int,
+        min_items: int = 0) -> None:
     """Run ``kernel(*args, start, stop)`` over items 0..N-1 on every thread, chunk by chunk.
 
     Args:
@@ -148,12 +155,15 @@ def run(kernel: Callable[..., Any], args: tuple, N: int, grain: int) -> None:
         grain: the smallest chunk (and the last chunks' size, see the guided schedule in
             the module docstring); pick ~50-100 µs of work, so that a chunk costs far
             more than claiming it (~2 µs) and a late chunk delays the batch little.
+        min_items: the smallest batch worth waking a worker for (for kernels whose
+            items vary in cost, where two grains are not enough; see above).
 
-    Batches of fewer than two grains, and every batch when one thread is configured,
-    run on the calling thread. Exceptions raised by the kernel are re-raised here.
+    Batches of fewer than two grains or ``min_items`` items, and every batch when one
+    thread is configured, run on the calling thread. Exceptions raised by the kernel
+    are re-raised here.
     """
     grain = max(1, int(grain))
-    if N < 2 * grain:
+    if N < 2 * grain or N < min_items:
         kernel(*args, 0, N)
         return
     nthreads = min(threads(), free_cores())
