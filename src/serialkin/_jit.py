@@ -6,8 +6,9 @@ the addition that consumes it into one fused multiply-add (``fma(a, b, c) = a·b
 rounded once). It is the only fast-math flag used: it never reorders a sum, never assumes
 finite values (NaN and ±inf still propagate and are still detected) and each fused
 operation is at least as accurate as the two it replaces (one rounding instead of two).
-Measured on the kernels (x86-64 with FMA3): batch FK 42 → 36 ns per UR5 pose on one
-thread; an IK ``lm`` solve 11.1 → 9.3 µs on Panda (``benchmarks/bench_ik.py``). Results
+Measured on the kernels (x86-64 with FMA3): batch FK 42 → 33 ns per UR5 pose on one
+thread; an IK ``lm`` iteration 10–20 % faster, a Panda solve 10.7–11.3 → 9.3–10.1 µs
+(``benchmarks/bench_ik.py``, old and new trees interleaved). Results
 may differ from an uncontracted build in the last bits; every path through the same
 kernel still gives the same bits (batch and single FK, fast and ordinary IK paths).
 
