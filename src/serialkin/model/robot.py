@@ -533,8 +533,9 @@ class Robot:
                 J = None
             if J is not None and (_JAC1 or _fast()[1])(q, self._P, J) == 0:
                 return J
-        a, J, T = self._jacobians(q, frame, link, point, out)
-        if out is not None and link is None and frame == "base":  # written in place
+        in_place = out is not None and link is None and frame == "base"
+        a, J, T = self._jacobians(q, frame, link, point, out if in_place else None)
+        if in_place:
             return out
         shape = a.shape[:-1] + (6, self.n)
         if out is None:
@@ -547,8 +548,8 @@ class Robot:
         """Validated q (..., n), Jacobians (N, 6, n) in ``frame`` and the frames' poses (N, 4, 4).
 
         The poses are the tool's (``link`` None) or link ``link``'s frame (not the point's).
-        With ``out`` (the caller's (..., 6, n) buffer) and the tool's Jacobian in the base
-        frame, the Jacobians are written straight into it (J is then a view of out).
+        With ``out`` (the caller's (..., 6, n) buffer; only for the tool's Jacobian in the
+        base frame) the Jacobians are written straight into it (J is then a view of out).
         """
         check_choice(frame, "frame", ("base", "ee"))
         a = self.check_q(q, finite=False)  # the kernels test finiteness as they read
@@ -560,7 +561,7 @@ class Robot:
         if link is None:
             if point is not None:
                 raise InputError("point is given without link; pass link=k (0..n) as well")
-            if out is not None and frame == "base":
+            if out is not None:
                 J = _out_array(out, a.shape[:-1] + (6, self.n)).reshape(N, 6, self.n)
             else:
                 J = np.empty((N, 6, self.n))
