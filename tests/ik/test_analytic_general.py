@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from serialkin import Robot, models
@@ -187,6 +187,50 @@ def test_perturbed_arm_keeps_all_eight(name):
             assert _wrapped(general, row).min() < 1e-8
 
 
+@pytest.mark.parametrize("name", ["ur5", "puma560"])
+def test_perturbed_arm_finds_elbow_pairs_beyond_the_ideal_reach(name):
+    """Nearly stretched or folded elbows: the generating q is found on the perturbed arm.
+
+    There the idealised arm may not reach the target (its elbow cosine just beyond ±1)
+    while the true arm does; the elbow pair is seeded from the mirrored cosine.
+    """
+    ideal = getattr(models, name)().with_limits(np.tile([-np.inf, np.inf], (6, 1)))
+    rng = np.random.default_rng(3)
+    robot = _perturbed(ideal, rng)
+    # joint 3 at which the elbow is stretched: 0 (UR5), −π/2 + atan2(a3, d4) (Puma 560)
+    stretched = 0.0 if name == "ur5" else -np.pi / 2 + np.arctan2(ideal.dh[2].a, ideal.dh[3].d)
+    checked = 0
+    for _ in range(60):
+        q = rng.uniform(-2.5, 2.5, 6)
+        q[2] = stretched + rng.choice([-1.0, 1.0]) * rng.uniform(0.03, 0.2)
+        if np.linalg.svd(robot.jacobian(q), compute_uv=False)[-1] < 1e-2:
+            continue
+        T = robot.fk(q)
+        rows = ik_all(robot, T)
+        assert len(rows) and _fk_error(robot, rows, T) < 1e-10
+        assert _wrapped(rows, q).min() < 1e-8
+        checked += 1
+    assert checked >= 30
+
+
+def test_nearly_ideal_arm_with_no_ideal_branch_searches():
+    """Twists 0.04 rad from parallel: the ideal arm has no branch, the general search finds q."""
+    rows = [(0.4987506651811687, -3.1, -0.24260510254300965),
+            (0.6, 0.13776417329501234, 0.03291284264336697),
+            (0.6, -1.3773398454226284, 0.012124242871671687),
+            (0.10463034150498009, -0.7669567390616154, -0.0012323339016401258),
+            (0.0, -2.779621577459745, 0.25019971473342106),
+            (0.39864062469091965, -3.1, -0.04845387186362354)]
+    robot = Robot.from_dh([DHLink(a=a, alpha=al, d=d) for a, al, d in rows])
+    q = np.array([0.831472676318362, -0.746834909974023, 1.103817981120967,
+                  -1.8604047989335761, -0.9214242360588618, 0.27214618940453184])
+    T = robot.fk(q)
+    res = ik_all(robot, T, report=True)
+    assert res.mode == "near" and int(res.branches) == 0
+    assert int(res.count) >= 2 and _wrapped(res.q, q).min() < 1e-8
+    assert _fk_error(robot, res.q, T) < 1e-10
+
+
 # ----------------------------------------------------------------------------- locked joints
 @pytest.mark.parametrize("name, index", [("panda", 2), ("iiwa7", 2), ("iiwa7", 0)])
 def test_locked_joint_of_7r_arm(name, index):
@@ -284,7 +328,14 @@ def test_continuous_family_flag():
     assert batch.continuous.shape == batch.q.shape[:2] and batch.continuous[0].any()
 
 
+#: A 6R arm whose axes 4, 5, 6 are parallel (a planar 3R behind joint 3) and 2 ∥ 3: each
+#: solution has a partner with the other wrist elbow and the same q1, q2, q3.
+_PARALLEL_WRIST = [(0.0, 1.0, 0.0), (0.25, 0.0, 0.0), (0.0, 1.0, 0.0), (0.5, 0.0, 0.0),
+                   (0.5, 0.0, 0.0), (0.0, 0.0, 0.0)]
+
+
 @settings(max_examples=12, deadline=None)
+@example(rows=_PARALLEL_WRIST, seed=0)
 @given(st.lists(st.tuples(st.floats(0.0, 0.6), st.floats(-3.1, 3.1), st.floats(-0.4, 0.4)),
                 min_size=6, max_size=6),
        st.integers(0, 2**31 - 1))
@@ -301,6 +352,21 @@ def test_any_dh_table_round_trip(rows, seed):
     assert _fk_error(robot, sols, T) < 1e-9 * max(1.0, float(np.abs(T[:3, 3]).max()))
     if np.linalg.svd(robot.jacobian(q), compute_uv=False)[-1] > 1e-2:  # regular q: found
         assert len(sols) and _wrapped(sols, q).min() < 1e-7
+
+
+def test_solutions_sharing_the_eliminated_joint_are_all_found():
+    """Elbow pairs that share the eliminated θ (a 2-D null space of K(θ)) all come back."""
+    robot = Robot.from_dh([DHLink(a=a, alpha=al, d=d) for a, al, d in _PARALLEL_WRIST])
+    q = np.random.default_rng(0).uniform(-np.pi, np.pi, 6)
+    T = robot.fk(q)
+    sols = ik_all(robot, T)
+    assert len(sols) == 8
+    assert _fk_error(robot, sols, T) < 1e-9
+    assert _wrapped(sols, q).min() < 1e-9
+    for s in sols:  # the partner: same q1..q3, wrist elbow q5 → −q5
+        partner = _wrapped(sols[:, :3], s[:3]) < 1e-9
+        assert partner.sum() == 2
+        assert np.allclose(sols[partner, 4].sum(), 0.0, atol=1e-9)
 
 
 def test_coaxial_joints_refuse_with_reason():

@@ -695,7 +695,7 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
         k = entry[1](target, entry[2], entry[3], entry[4], out)
         if k >= 0:
             return out[:k]
-        if k < -1:  # a nearly ideal arm whose converged branches are odd in number
+        if k < -1:  # a nearly ideal arm whose refined branches are doubtful
             from serialkin.ik.analytic.general import DEFAULT_GRID
 
             return _with_general(robot, target, out[:-2 - k], _TOL, DEFAULT_GRID)
@@ -750,9 +750,11 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
                 for j in range(int(counts[i])):
                     cont[i, j] = continuous_family(robot, T[i], out[i, j])
             cont = cont.reshape(lead + (kmax,))
-        if p.mode == "near":  # an odd number of converged branches: general search too
+        if p.mode == "near":  # doubtful refined branches: general search too
+            from serialkin.ik.analytic.dispatch import refined_doubtful
+
             for i in range(T.shape[0]):
-                if conv[i, 1:conv[i, 0] + 1].sum() % 2 == 1:
+                if refined_doubtful(conv[i]):
                     rows = _with_general(robot, T[i], out[i, :counts[i]], tol, grid)
                     counts[i] = min(len(rows), MAX_ROWS)
                     out[i, :counts[i]] = rows[:MAX_ROWS]
@@ -772,8 +774,11 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
                    p.qlim, p.mid, p.F, p.meta, check_rot, p.refine, grid, tol * p.s.scale, tol,
                    REFINE_TOL * p.s.scale, REFINE_TOL, out, conv)
     sols = out[:k]
-    if p.mode == "near" and conv[1:conv[0] + 1].sum() % 2 == 1:
-        sols = _with_general(robot, T, sols, tol, grid)
+    if p.mode == "near":
+        from serialkin.ik.analytic.dispatch import refined_doubtful
+
+        if refined_doubtful(conv):
+            sols = _with_general(robot, T, sols, tol, grid)
     if all_turns and k:
         sols = _expand_turns(sols, p.revolute, p.qlim)
     if reference is not None:

@@ -21,7 +21,7 @@ from serialkin.ik.analytic.planar import solve_planar
 from serialkin.ik.analytic.refine import refine_rows
 from serialkin.ik.analytic.scara import solve_scara
 from serialkin.ik.analytic.spherical_wrist import wrist_candidates
-from serialkin.ik.analytic.subproblems import finalize, rigid_error
+from serialkin.ik.analytic.subproblems import ELBOW_SLACK, finalize, rigid_error
 from serialkin.ik.analytic.ur import ur_candidates
 
 from ..._jit import njit
@@ -77,10 +77,11 @@ def solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mi
         return solve_scara(T, W, P, M, order, aux[0].copy(), aux[1].copy(), revolute, qlim,
                            mid, F, meta, check_rot, tol_p, tol_r, out)
     cand = np.zeros((MAX_ROWS, n))
+    slack = ELBOW_SLACK if refine else 0.0  # idealised arm: elbow seeds beyond its reach
     if code == WRIST:
-        k = wrist_candidates(T, W, P, M, aux, arm, prismatic3, cand)
+        k = wrist_candidates(T, W, P, M, aux, arm, prismatic3, slack, cand)
     elif code == UR:
-        k = ur_candidates(T, W, P, M, aux, cand)
+        k = ur_candidates(T, W, P, M, aux, slack, cand)
     else:
         k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, grid, F, meta, newton_p,
                                newton_r, cand)
@@ -152,8 +153,8 @@ def solve_packed(T, I, D, B, out):
     One compiled call for the rigidity check and the solve (rotation verified), into
     ``out`` (16, n). Returns the number of solutions k >= 0; −1 without solving when
     T (4, 4) is not a rigid transform to 1e-13 (the caller then checks it, projects the
-    rotation or raises); ``−2 − k`` when the arm is refined (nearly ideal) and an odd
-    number of its branches converged (the caller then adds the general search's rows).
+    rotation or raises); ``−2 − k`` when the arm is refined (nearly ideal) and its branches
+    are doubtful (:func:`refined_doubtful`; the caller then adds the general search's rows).
     """
     if rigid_error(T) > 1e-13:
         return -1
@@ -179,10 +180,25 @@ def solve_packed(T, I, D, B, out):
     conv = np.empty(MAX_ROWS + 1, dtype=np.int64)
     k = solve_into(I[0], I[1], I[2] != 0, T, W, P, M, aux, I[_HEAD:_HEAD + I[7]], B, qlim,
                    mid, F, meta, True, refine, I[4], D[0], D[1], D[2], D[3], out, conv)
-    if refine:
-        good = 0
-        for i in range(conv[0]):
-            good += conv[1 + i]
-        if good % 2 == 1:
-            return -2 - k
+    if refine and refined_doubtful(conv):
+        return -2 - k
     return k
+
+
+@njit(cache=True)
+def refined_doubtful(conv):
+    """Whether a nearly ideal arm's refined branches may have missed a true solution.
+
+    ``conv`` (17,) as :func:`solve_into` fills it. Doubtful when an odd number of
+    branches converged on the true chain (real solutions of a 6R come in pairs: one was
+    lost, e.g. near a singularity of the true arm) or none did (the idealised arm may
+    have no solution where the true arm has some: measured on random arms with twists
+    0.04 rad from parallel). Only the general search can tell, so the caller adds its
+    rows. Branches failing in pairs while others converge are usually solutions the
+    idealised arm has and the true arm has not (a target near the workspace boundary):
+    searching for them would cost the search on most such targets for no miss found.
+    """
+    good = 0
+    for i in range(conv[0]):
+        good += conv[1 + i]
+    return good % 2 == 1 or good == 0

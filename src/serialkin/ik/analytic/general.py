@@ -137,7 +137,7 @@ def search_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r
         e5u = mv(E5[i5], u4)
         for i6 in range(N):
             pw = transform_point(A6[i6], e5c)
-            m = arm_positions(pw, W, P, aux, arm, False, arm3)
+            m = arm_positions(pw, W, P, aux, arm, False, 0.0, arm3)
             nb[i5, i6] = m
             gw = mv(A6[i6], e5w)  # R_G w4 and R_G u4, then turned back by joints 1-3
             gu = mv(A6[i6], e5u)

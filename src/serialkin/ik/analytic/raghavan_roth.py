@@ -38,7 +38,9 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
    the same way from its derivatives), so roots closer than a cell are separated, and
    an extremum at zero (a double root) is kept as well (:func:`eliminant_roots`).
 6. **Back substitution.** For each root, the null vector of ``K(θ3)`` (Gaussian
-   elimination with complete pivoting) gives x4, x5 as ratios of its entries; the
+   elimination with complete pivoting) gives x4, x5 as ratios of its entries (a root
+   where that null space has two or more dimensions is shared by several solutions:
+   the search answers instead, :data:`MULTIPLE_TOL`); the
    least-squares solution of ``Q·m12 = P`` (the same SVD) gives ``(cos θ1, sin θ1)`` and
    ``(cos θ2, sin θ2)``; θ6 follows by subproblem 1 on ``w6``.
 7. **Refinement.** Every candidate is polished by Newton's method on the robot's own
@@ -96,6 +98,12 @@ PIVOT_TOL = 1e-3
 #: degenerates exactly (e.g. axes 1 and 2 intersecting or parallel give 1e-16 to 1e-11)
 #: and the next split is tried.
 EXACT_TOL = 1e-10
+#: Below this ratio of K(θ3)'s second-smallest pivot to its largest (complete pivoting),
+#: the pencil at a root has a null space of two or more dimensions: several solutions share
+#: that θ3 (e.g. the two elbows of three parallel axes 4, 5, 6 behind it; 1e-16 to 1e-13
+#: there) and back substitution, which takes one null vector, would find one of them, so
+#: the search answers instead. Random arms give 7e-5 and above (550 roots of 150 arms).
+MULTIPLE_TOL = 1e-8
 #: :func:`_rr_split` codes: Q of rank < 8 or a pencil singular to rounding for this split
 #: (an exact special pair: the next split is tried), and a nearly degenerate eliminant
 #: (pivot ratio in [EXACT_TOL, PIVOT_TOL): an arm close to a special class, where another
@@ -204,7 +212,9 @@ def _null_vector(A, v):
     """A unit null vector ``v`` (n,) of the nearly singular ``A`` (n, n, overwritten).
 
     Gaussian elimination with complete pivoting; the last pivot is the (near) zero one,
-    the vector follows by back substitution with its last entry 1.
+    the vector follows by back substitution with its last entry 1. Returns the
+    second-smallest pivot relative to the largest, |u_{n−2,n−2}| / |u_00|: near zero
+    when the null space has two or more dimensions, where ``v`` is one vector of it.
     """
     n = A.shape[0]
     perm = np.arange(n)
@@ -238,6 +248,7 @@ def _null_vector(A, v):
     norm = math.sqrt(norm)
     for i in range(n):
         v[perm[i]] = y[i] / norm
+    return abs(A[n - 2, n - 2]) / abs(A[0, 0]) if A[0, 0] != 0.0 else 0.0
 
 
 @njit(cache=True)
@@ -458,7 +469,8 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
         reversal, tried in turn while one degenerates exactly, :data:`EXACT_TOL`) or
         the pencil is nearly singular for every θ3 (:data:`PIVOT_TOL`), and −1 − k
         when a root gave no new solution even after polishing (a cluster of solutions
-        or a singular configuration; the k solutions found are in ``out``): in both
+        or a singular configuration) or belongs to several solutions
+        (:data:`MULTIPLE_TOL`; the k solutions found so far are in ``out``): in both
         cases the caller searches instead.
     """
     Minv = inv_rigid(M)
@@ -627,7 +639,9 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
         for attempt in range(2):
             if attempt == 1:
                 t3 = _polish_root(K, t3, A)
-            _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u6, reverse, A, q)
+            second = _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u6, reverse, A, q)
+            if second < MULTIPLE_TOL:  # K(θ3) has a null space of 2+ dimensions: this θ3
+                return -1 - k  # belongs to several solutions, one null vector gives one
             k_new = refine_new(q, T, F, meta, tol_p, tol_r, out, k, KNOWN_RADIUS)
             if k_new > k:
                 k = k_new
@@ -689,7 +703,7 @@ def _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u, reverse, A, q):
     for i in range(12):
         for j in range(12):
             A[i, j] = K[0, i, j] + c3 * K[1, i, j] + s3 * K[2, i, j]
-    _null_vector(A, v)
+    second = _null_vector(A, v)
     big = -1.0
     ib = 0
     for i in range(12):
@@ -734,3 +748,4 @@ def _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u, reverse, A, q):
     qs[e] = sp1_dir(W[e], u, x)
     for j in range(6):
         q[j] = qs[5 - j] if reverse else qs[j]
+    return second

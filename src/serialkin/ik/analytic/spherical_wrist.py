@@ -127,10 +127,11 @@ def wrist_into(gw, gv, W, v, q1, q2, q3, prismatic3, sol, out, k):
 
 
 @njit(cache=True)
-def puma_positions(pw, W, P, aux, out):
+def puma_positions(pw, W, P, aux, slack, out):
     """Arm joints (q1, q2, q3) of a ``puma``-class arm putting c on ``pw``.
 
-    aux = (c, w, e1 ⟂ w, ...).
+    aux = (c, w, e1 ⟂ w, ...); ``slack``: elbow seeds beyond the reach
+    (:func:`~serialkin.ik.analytic.subproblems.planar2r_solve`; 0 for an exact solve).
 
     Writes rows into ``out`` (4, 3) and returns their count.
     """
@@ -153,7 +154,7 @@ def puma_positions(pw, W, P, aux, out):
     for i in range(n1):
         q1 = q1s[i]
         x = add3(rot3(w1, q1s[2 + 2 * i], -q1s[3 + 2 * i], d), r1)  # exp(−ξ1 q1)·pw
-        m = planar2r_solve(frame, x, sol)
+        m = planar2r_solve(frame, x, sol, slack)
         for j in range(m):
             out[k, 0] = q1
             out[k, 1] = s2 * sol[j, 0]
@@ -409,25 +410,27 @@ def _quartic_stroke(h0, b, w2, a1, ca, sa, rho2, h, parallel, strokes):
 
 
 @njit(cache=True)
-def arm_positions(pw, W, P, aux, arm, prismatic3, out):
+def arm_positions(pw, W, P, aux, arm, prismatic3, slack, out):
     """Joints (q1, q2, q3) that put the point ``aux[0]`` (at q = 0) on ``pw`` (3,) [m].
 
     ``arm`` 0: axes 2 ∥ 3 (:func:`puma_positions`); 1: axes 1, 2 meet
     (:func:`intersecting_positions`); 2: otherwise (:func:`general_positions`). Rows into
-    ``out`` (4, 3); returns their count (0-4).
+    ``out`` (4, 3); returns their count (0-4). ``slack``: elbow seeds beyond the reach
+    for ``arm`` 0 (:func:`puma_positions`; 0 for an exact solve).
     """
     if arm == 0:
-        return puma_positions(pw, W, P, aux, out)
+        return puma_positions(pw, W, P, aux, slack, out)
     if arm == 1:
         return intersecting_positions(pw, W, P, aux, prismatic3, out)
     return general_positions(pw, W, P, aux, prismatic3, out)
 
 
 @njit(cache=True)
-def wrist_candidates(T, W, P, M, aux, arm, prismatic3, out):
+def wrist_candidates(T, W, P, M, aux, arm, prismatic3, slack, out):
     """Candidate rows (8, 6) of a spherical-wrist arm: the arm joints, then the wrist.
 
     ``aux[0]`` is the wrist centre c and ``aux[-1]`` a unit vector ⟂ w6; returns the count.
+    ``slack``: elbow seeds beyond the reach (:func:`arm_positions`; 0 for an exact solve).
     """
     Rg = target_rotation(T, M)
     scratch = np.empty(27)  # wrist centre, arm rows, wrist scratch: one allocation
@@ -436,7 +439,7 @@ def wrist_candidates(T, W, P, M, aux, arm, prismatic3, out):
                                (T[0, 3], T[1, 3], T[2, 3]))  # T·M⁻¹·c
     arm3 = scratch[3:15].reshape((4, 3))
     sol = scratch[15:27].reshape((2, 6))
-    m = arm_positions(pw, W, P, aux, arm, prismatic3, arm3)
+    m = arm_positions(pw, W, P, aux, arm, prismatic3, slack, arm3)
     v = row3(aux, aux.shape[0] - 1)
     gw = mv3(Rg, row3(W, 5))
     gv = mv3(Rg, v)
@@ -474,5 +477,5 @@ def solve_spherical_wrist(T, W, P, M, aux, arm, prismatic3, revolute, qlim, mid,
         number of solutions (0-8).
     """
     cand = np.zeros((MAX_SOLUTIONS, 6))
-    k = wrist_candidates(T, W, P, M, aux, arm, prismatic3, cand)
+    k = wrist_candidates(T, W, P, M, aux, arm, prismatic3, 0.0, cand)
     return finalize(cand, k, revolute, qlim, mid, F, meta, T, True, tol_p, tol_r, out)

@@ -41,6 +41,9 @@ CLAMP = 1e-9
 SNAP = 1e-14
 #: Two solutions closer than this in every joint (after wrapping) are one solution.
 DUPLICATE_TOL = 1e-9
+#: Elbow cosines this far beyond ±1 still seed a nearly ideal arm's two elbow branches
+#: (:func:`planar2r_solve`); see docs/ik-analytic.md for the measurement.
+ELBOW_SLACK = 0.25
 #: Solutions within this distance outside a joint limit are clipped onto it.
 LIMIT_TOL = 1e-10
 TWO_PI = 2.0 * math.pi
@@ -495,7 +498,7 @@ def planar2r(w, e1, c1, c2, p, t, out):
     (θ1, θ2) [rad, about +w] into ``out`` (2, 2); returns 0, 1 or 2. When the target is
     on the first axis with L1 = L2, θ1 is arbitrary and θ1 = α = 0 is returned.
     """
-    return planar2r_solve(planar2r_frame(w, e1, c1, c2, p), t, out)
+    return planar2r_solve(planar2r_frame(w, e1, c1, c2, p), t, out, 0.0)
 
 
 @njit(cache=True)
@@ -519,16 +522,26 @@ def planar2r_frame(w, e1, c1, c2, p):
 
 
 @njit(cache=True)
-def planar2r_solve(frame, t, out):
-    """:func:`planar2r` for the target point t, given its :func:`planar2r_frame`."""
+def planar2r_solve(frame, t, out, slack):
+    """:func:`planar2r` for the target point t, given its :func:`planar2r_frame`.
+
+    ``slack`` ≥ 0: a target out of reach whose elbow cosine ``c`` lies within
+    ``1 + slack`` of the boundary (|c| ≤ 1 + slack) still gives two rows, those of the
+    mirrored cosine ``sign(c)·(2 − |c|)`` (as far inside the reach as c is outside): the
+    seeds of an idealised arm's refinement (:data:`ELBOW_SLACK`), where the true arm may
+    reach what the ideal one does not. 0 for an exact solve.
+    """
     e1, e2, c1, L1, L2, phi10, phi20 = frame
     d = sub3(t, c1)
     x = dot3(e1, d)
     y = dot3(e2, d)
     r2 = x * x + y * y
-    th2 = _acos_clamped((r2 - L1 * L1 - L2 * L2) / (2.0 * L1 * L2))
+    c = (r2 - L1 * L1 - L2 * L2) / (2.0 * L1 * L2)
+    th2 = _acos_clamped(c)
     if math.isnan(th2):
-        return 0
+        if not abs(c) <= 1.0 + slack:
+            return 0
+        th2 = math.acos(math.copysign(2.0 - abs(c), c))
     alpha = math.atan2(y, x)
     beta = math.atan2(L2 * math.sin(th2), L1 + L2 * math.cos(th2))
     out[0, 0] = alpha - beta - phi10

@@ -47,8 +47,11 @@ MAX_SOLUTIONS = 8
 
 
 @njit(cache=True)
-def ur_candidates(T, W, P, M, aux, out):
+def ur_candidates(T, W, P, M, aux, slack, out):
     """Candidates for a ``ur``-class arm; aux = (p56, w, e ⟂ w). Returns the count.
+
+    ``slack``: elbow seeds beyond the reach (:func:`~serialkin.ik.analytic.subproblems.
+    planar2r_solve`; 0 for an exact solve).
 
     Vectors are tuples (no allocation per branch) and every rotation is applied by
     Rodrigues' formula from one sin/cos per joint value (``Rot(w, −θ) = Rot(w, θ)ᵀ``).
@@ -102,7 +105,7 @@ def ur_candidates(T, W, P, M, aux, out):
             a = add3(rot3(w5, c5, -sn5, x4r5), r5r6)
             b = add3(mv3(Rg, add3(rot3(w6, c6, -sn6, a), r6)), tgr1)
             y = add3(rot3(w1, c1, -sn1, b), r1)
-            m = planar2r_solve(frame, y, sol)
+            m = planar2r_solve(frame, y, sol, slack)
             for r in range(m):
                 out[k, 0] = q1
                 out[k, 1] = s2 * sol[r, 0]
@@ -122,5 +125,5 @@ def solve_ur(T, W, P, M, aux, revolute, qlim, mid, F, meta, tol_p, tol_r, out):
     Returns the number of solutions (0-8).
     """
     cand = np.zeros((MAX_SOLUTIONS, 6))
-    k = ur_candidates(T, W, P, M, aux, cand)
+    k = ur_candidates(T, W, P, M, aux, 0.0, cand)
     return finalize(cand, k, revolute, qlim, mid, F, meta, T, True, tol_p, tol_r, out)
