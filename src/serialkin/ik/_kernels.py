@@ -468,6 +468,44 @@ def _workspace(n):
             (M[1], V6[3], A, Vn[2], M6, V6[4], Vn[3], Vn[4], T2[1], V6[5]))
 
 
+@njit(cache=True, inline="always")
+def _settings(cfg, box):
+    """The loop's settings from ``cfg`` (indices ``C_*``) and ``box`` (rows ``B_*``).
+
+    Returns ``(w, p, lo, hi, slo, shi, revolute, tol, max_iter, restarts, respect,
+    use_q0, window, ratio)``: the task weights (6,), the method's parameters, the joint
+    limits and sampling box (n,) each, the joint types, the tolerance, the iteration
+    budget per attempt, the restarts, whether limits are respected, whether q0 is the
+    first start, the stagnation window and stall ratio.
+    """
+    return (cfg[C_WEIGHTS:C_WEIGHTS + 6], cfg[N_LOOP:], box[B_LO], box[B_HI], box[B_SLO],
+            box[B_SHI], box[B_REVOLUTE], cfg[C_TOL], int(cfg[C_MAX_ITER]),
+            int(cfg[C_RESTARTS]), cfg[C_RESPECT] > 0.5, cfg[C_USE_Q0] > 0.5,
+            int(cfg[C_WINDOW]), cfg[C_STALL_RATIO])
+
+
+@njit(cache=True, inline="always")
+def _finite_attempt(cost, q):
+    """Whether an attempt ended with a finite cost and a finite q (n,)."""
+    if not math.isfinite(cost):
+        return False
+    for i in range(q.shape[0]):
+        if not math.isfinite(q[i]):
+            return False
+    return True
+
+
+@njit(cache=True, inline="always")
+def _tidy(q_out, q0, use_q0, lo, hi, revolute, respect):
+    """Tidy the returned q (n,) in place: wrapped, then turned nearest to q0 when given.
+
+    :func:`normalize_into`, then (``use_q0``) :func:`nearest_into`.
+    """
+    normalize_into(q_out, lo, hi, revolute)
+    if use_q0:
+        nearest_into(q_out, q0, lo, hi, revolute, respect)
+
+
 # ---------------------------------------------------------------- the shared loop
 # The three functions below are templates: compile_method copies them with the method's
 # step kernel (and the copies that call it) bound as globals, then compiles the copies.
@@ -655,21 +693,8 @@ def _solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp):
         info: (N_INFO,) output, see ``I_*``.
         wsp: the loop's arrays (:func:`_workspace` of n), overwritten.
     """
-    n = meta.shape[0]
-    w = cfg[C_WEIGHTS:C_WEIGHTS + 6]
-    p = cfg[N_LOOP:]
-    lo = box[B_LO]
-    hi = box[B_HI]
-    slo = box[B_SLO]
-    shi = box[B_SHI]
-    revolute = box[B_REVOLUTE]
-    tol = cfg[C_TOL]
-    max_iter = int(cfg[C_MAX_ITER])
-    restarts = int(cfg[C_RESTARTS])
-    respect = cfg[C_RESPECT] > 0.5
-    use_q0 = cfg[C_USE_Q0] > 0.5
-    window = int(cfg[C_WINDOW])
-    ratio = cfg[C_STALL_RATIO]
+    (w, p, lo, hi, slo, shi, revolute, tol, max_iter, restarts, respect, use_q0, window,
+     ratio) = _settings(cfg, box)
     J, T, e, dq, q, be, sw, ws = wsp
     for i in range(6):
         sw[i] = math.sqrt(w[i])
@@ -701,10 +726,7 @@ def _solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp):
                                      respect, p, window, ratio, tol, max_iter, q, J, T, e,
                                      dq, ws, attempt > 0)
         total += its
-        finite = math.isfinite(cost)
-        for i in range(n):
-            if not math.isfinite(q[i]):
-                finite = False
+        finite = _finite_attempt(cost, q)
         if finite and (ok or cost < best_cost):
             best_cost = cost
             q_out[:] = q
@@ -717,9 +739,7 @@ def _solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp):
                                                tol, max_iter, q, q_out, J, T, e, be, dq, ws,
                                                best_cost)
         total += its
-    normalize_into(q_out, lo, hi, revolute)
-    if use_q0:
-        nearest_into(q_out, q0, lo, hi, revolute, respect)
+    _tidy(q_out, q0, use_q0, lo, hi, revolute, respect)
     _write_info(info, success, total, be, w, used, best_cost, q_out, lo, hi, np.inf)
     for k in range(5):
         info[I_PAIR + k] = -1.0
@@ -879,20 +899,8 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
     the scene (k, 16) and ``ccfg`` (:data:`N_CCFG`,).
     """
     n = meta.shape[0]
-    w = cfg[C_WEIGHTS:C_WEIGHTS + 6]
-    p = cfg[N_LOOP:]
-    lo = box[B_LO]
-    hi = box[B_HI]
-    slo = box[B_SLO]
-    shi = box[B_SHI]
-    revolute = box[B_REVOLUTE]
-    tol = cfg[C_TOL]
-    max_iter = int(cfg[C_MAX_ITER])
-    restarts = int(cfg[C_RESTARTS])
-    respect = cfg[C_RESPECT] > 0.5
-    use_q0 = cfg[C_USE_Q0] > 0.5
-    window = int(cfg[C_WINDOW])
-    ratio = cfg[C_STALL_RATIO]
+    (w, p, lo, hi, slo, shi, revolute, tol, max_iter, restarts, respect, use_q0, window,
+     ratio) = _settings(cfg, box)
     margin = ccfg[K_MARGIN]
     pushes = int(ccfg[K_PUSHES])
     m = A.shape[0]
@@ -941,10 +949,7 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
                                      respect, p, window, ratio, tol, max_iter, q, J, T, e,
                                      dq, ws, True)
         total += its
-        finite = math.isfinite(cost)
-        for i in range(n):
-            if not math.isfinite(q[i]):
-                finite = False
+        finite = _finite_attempt(cost, q)
         if not finite:
             continue
         if not ok:
@@ -990,9 +995,7 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
                                                tol, max_iter, q, q_out, J, T, e, be, dq, ws,
                                                best_cost)
         total += its
-    normalize_into(q_out, lo, hi, revolute)
-    if use_q0:
-        nearest_into(q_out, q0, lo, hi, revolute, respect)
+    _tidy(q_out, q0, use_q0, lo, hi, revolute, respect)
     d = _clearance(q_out, F, L, meta, frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1, pair)
     _write_info(info, success and d >= margin, total, be, w, used, best_cost, q_out, lo, hi, d)
     for k in range(5):
