@@ -20,8 +20,20 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+
+# One BLAS thread in every benchmark process. OpenBLAS's worker threads keep spinning
+# for a while after a call, so a peer that calls BLAS (the Pinocchio CLIK loop through
+# numpy, ikpy through scipy) took a core away from the batch measured next: Panda's IK
+# batch measured 5.62 [4.74-8.42] us per target after the CLIK rows against 4.40
+# [4.33-4.53] with one BLAS thread (the kernels measured here use no BLAS; the peers'
+# 6x7 matrices gain nothing from BLAS threads). The variable covers libraries loaded
+# later (scipy's own OpenBLAS), threadpoolctl those already loaded (numpy's).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
+threadpool_limits(limits=1, user_api="blas")
 
 
 class Stat:

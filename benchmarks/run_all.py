@@ -69,7 +69,9 @@ def main(argv: list[str] | None = None) -> int:
     status = 0
     with tempfile.TemporaryDirectory() as tmp:
         results = Path(tmp) / "results.jsonl"
-        env = dict(os.environ, SERIALKIN_BENCH_RESULTS=str(results))
+        # one BLAS thread from the start of every script (see _common.py)
+        env = dict(os.environ, SERIALKIN_BENCH_RESULTS=str(results), OPENBLAS_NUM_THREADS="1",
+                   MKL_NUM_THREADS="1")
         for script in sorted(HERE.glob("bench_*.py")):
             if wanted and script.stem.removeprefix("bench_") not in wanted:
                 continue
