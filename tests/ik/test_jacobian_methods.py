@@ -4,13 +4,25 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numba import njit
 
 import serialkin.ik as ik
 from serialkin import models
 from serialkin.errors import InputError
 from serialkin.ik import registry
-from serialkin.ik._kernels import W_A, W_G, W_JW, W_R, _normal, compile_method
+from serialkin.ik._kernels import (
+    W_A,
+    W_FREE,
+    W_G,
+    W_JW,
+    W_R,
+    _normal,
+    _workspace,
+    compile_method,
+)
+from serialkin.ik.jacobian_methods import step_lm
 from serialkin.ik.registry import MethodSpec, register_method
 from serialkin.kinematics.dls import spd_solve_into
 from serialkin.spatial import transl
@@ -121,6 +133,49 @@ def test_lm_default_step(near_solution):
     mu = 0.03 * E + 1e-12 * (1 + A.diagonal().max())
     dq = np.linalg.solve(A + mu * np.eye(6), J.T @ e)
     assert np.allclose(_one_step(robot, "lm", q0, T, polish=False), q0 + dq, atol=1e-12)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(6, 9), st.integers(0, 2**32 - 1))
+def test_lm_active_set_step_is_the_reduced_solve(n, seed):
+    """The lm step with joints frozen at limits solves the reduced normal equations exactly.
+
+    q starts with some joints on a limit and the free step pushing them out: the step
+    (from A's one factorisation, by multipliers) must equal the solve of the normal
+    equations restricted to the joints left free, with 0 for the frozen ones.
+    """
+    rng = np.random.default_rng(seed)
+    J = rng.normal(size=(6, n))
+    e = rng.normal(size=6)
+    lo = np.full(n, -1.0)
+    hi = np.full(n, 1.0)
+    q = rng.uniform(-0.5, 0.5, n)
+    at = rng.random(n) < 0.5
+    q[at] = np.where(rng.random(at.sum()) < 0.5, -1.0, 1.0)
+    revolute = np.zeros(n)  # prismatic-like: no 2π shift
+    sw = np.ones(6)
+    J_, T_, e_, dq, q_, be_, sw_, ws = _workspace(n)
+    ws[W_JW][:] = J
+    ws[W_R][:] = e
+    cost = 0.5 * float(e @ e)
+    lam = 0.03
+    ctx = (None, None, None, np.ones(6), sw, lo, hi, revolute, True)
+    assert step_lm(q, J, e, cost, np.array([lam]), ctx, ws, dq)
+    free = ws[W_FREE] > 0.5
+    frozen = ~free
+    # every frozen joint sits on a limit (the step would have pushed it out)
+    assert np.all(np.isin(q[frozen], (-1.0, 1.0)))
+    A = J.T @ J
+    mu = lam * cost + 1e-12 * (1.0 + A.diagonal().max())
+    A += mu * np.eye(n)
+    ref = np.zeros(n)
+    ref[free] = np.linalg.solve(A[np.ix_(free, free)], (J.T @ e)[free])
+    np.testing.assert_allclose(dq, ref, rtol=1e-9, atol=1e-12)
+    assert np.all(dq[frozen] == 0.0)
+    # and no free joint on a limit is still pushed outwards
+    x = q + dq
+    out = free & (((x < lo) & (q <= lo)) | ((x > hi) & (q >= hi)))
+    assert not out.any()
 
 
 def test_newton_and_gauss_newton_steps(near_solution):

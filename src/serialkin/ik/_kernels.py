@@ -37,7 +37,8 @@ method's parameters (the option values named by
 ``(F, meta, Tt, w, sw, lo, hi, revolute, respect)`` (chain, target, weights and
 ``√w``, limits, whether to respect them) and ``ws`` the scratch tuple indexed by the
 ``W_*`` constants (``Jw`` (6, n), ``r`` (6,), ``A`` (n, n), ``g`` (n,), ``M6`` (6, 6),
-``y6`` (6,), ``free`` (n,), ``qn`` (n,), ``Tn`` (4, 4), ``en`` (6,)). The loop then moves
+``y6`` (6,), ``free`` (n,), ``qn`` (n,), ``Tn`` (4, 4), ``en`` (6,), and for ``lm``'s
+active set ``Z`` (n, n), ``S`` (n, n), ``idx`` (n,), ``u`` (n,)). The loop then moves
 to ``q + Δq`` projected onto the joint ranges.
 
 Why one loop compiled per method (rather than a dispatch on a method code or a step
@@ -116,6 +117,10 @@ W_FREE = 6  # (n,)
 W_QN = 7  # (n,)
 W_TN = 8  # (4, 4)
 W_EN = 9  # (6,)
+W_Z = 10  # (n, n) lm's active set: rows A⁻¹e_j of the frozen joints j
+W_S = 11  # (n, n) lm's active set: the frozen block of A⁻¹, then its factor
+W_IDX = 12  # (n,) lm's active set: the frozen joints' indices (as floats)
+W_U = 13  # (n,) lm's active set: right-hand side, then the multipliers
 
 #: Rows of the per-robot ``box`` array (5, n).
 B_LO = 0  # lower joint limits (-inf allowed)
@@ -459,13 +464,14 @@ def _workspace(n):
     flat buffer costs tens (numba's reshape helper) and a separate allocation about 50.
     """
     V6 = np.empty((6, 6))  # e, be, sw, r, y6, en
-    Vn = np.empty((5, n))  # dq, q, g, free, qn
+    Vn = np.empty((7, n))  # dq, q, g, free, qn, idx, u
     M = np.empty((2, 6, n))  # J, Jw
     T2 = np.empty((2, 4, 4))  # T, Tn
-    A = np.empty((n, n))
+    A = np.empty((3, n, n))  # A, Z, S
     M6 = np.empty((6, 6))
     return (M[0], T2[0], V6[0], Vn[0], Vn[1], V6[1], V6[2],
-            (M[1], V6[3], A, Vn[2], M6, V6[4], Vn[3], Vn[4], T2[1], V6[5]))
+            (M[1], V6[3], A[0], Vn[2], M6, V6[4], Vn[3], Vn[4], T2[1], V6[5], A[1], A[2],
+             Vn[5], Vn[6]))
 
 
 @njit(cache=True, inline="always")

@@ -54,12 +54,16 @@ from serialkin.ik._kernels import (
     W_EN,
     W_FREE,
     W_G,
+    W_IDX,
     W_JW,
     W_M6,
     W_QN,
     W_R,
+    W_S,
     W_TN,
+    W_U,
     W_Y6,
+    W_Z,
     _jacobi_svd,
     _limit_step,
     _normal,
@@ -70,7 +74,7 @@ from serialkin.ik._kernels import (
     task_cost,
 )
 from serialkin.ik.registry import MethodSpec, register_method
-from serialkin.kinematics.dls import dls_step_into, spd_solve_into
+from serialkin.kinematics.dls import dls_step_into, factored_solve_into, spd_solve_into
 from serialkin.kinematics.kernels import fk_into
 from serialkin.model.limits import wrap_angle as interval_wrap
 from serialkin.spatial.kernels import pose_error_into
@@ -148,10 +152,14 @@ def step_lm(q, J, e, cost, p, ctx, ws, dq):
     plus a 1e-12 relative floor): strongly damped far from the target, the Gauss-Newton
     step (quadratic convergence) at it; every step is taken (non-monotone: it escapes
     shallow local minima that a monotone trust-region LM falls into). With the limits
-    respected, a joint at a limit whose step points outward is frozen (its column
-    removed) and the step recomputed for the others, at most n times.
+    respected, a joint at a limit whose step points outward is frozen and the step
+    recomputed for the others, at most n times: the minimiser of the same quadratic
+    ``½ΔqᵀAΔq − gᵀΔq`` (``A = JwᵀJw + μI``, ``g = Jwᵀr``) with ``Δq_i = 0`` for the
+    frozen set S, ``Δq = Δq₀ − A⁻¹E_S λ`` with ``(A⁻¹)_SS λ = (Δq₀)_S`` (Δq₀ the free
+    step, E_S the columns of I in S). A's factor is reused: each frozen joint costs two
+    triangular substitutions (its column of A⁻¹) and S's small system, not a new normal
+    matrix and factorisation.
     """
-    sw = ctx[4]
     lo = ctx[5]
     hi = ctx[6]
     revolute = ctx[7]
@@ -160,27 +168,29 @@ def step_lm(q, J, e, cost, p, ctx, ws, dq):
     r = ws[W_R]
     A = ws[W_A]
     g = ws[W_G]
-    free = ws[W_FREE]
     n = q.shape[0]
+    lam = p[0]
+    _normal(Jw, r, A, g)
+    d = 0.0
+    for i in range(n):
+        d = max(d, A[i, i])
+    mu = lam * cost + 1e-12 * (1.0 + d)
+    for i in range(n):
+        A[i, i] += mu
+    if not spd_solve_into(A, g, dq, n):
+        return False
+    if not respect:
+        return True
+    free = ws[W_FREE]
+    Z = ws[W_Z]
+    S = ws[W_S]
+    idx = ws[W_IDX]
+    u = ws[W_U]
     for j in range(n):
         free[j] = 1.0
-    lam = p[0]
-    for _pass in range(n + 1):
-        if _pass > 0:  # the loop weighed Jw with every joint free
-            for i in range(6):
-                for j in range(n):
-                    Jw[i, j] = sw[i] * J[i, j] * free[j]
-        _normal(Jw, r, A, g)
-        d = 0.0
-        for i in range(n):
-            d = max(d, A[i, i])
-        mu = lam * cost + 1e-12 * (1.0 + d)
-        for i in range(n):
-            A[i, i] += mu + (1.0 - free[i])
-        if not spd_solve_into(A, g, dq, n):
-            return False
-        if not respect:
-            return True
+        g[j] = dq[j]  # g now keeps the free step Δq₀ (A holds the factor)
+    k = 0
+    for _pass in range(n):
         changed = False
         for i in range(n):
             x = q[i] + dq[i]
@@ -190,9 +200,32 @@ def step_lm(q, J, e, cost, p, ctx, ws, dq):
                 continue  # a 2π shift brings it inside: not blocked
             if (x < lo[i] and q[i] <= lo[i] + 1e-12) or (x > hi[i] and q[i] >= hi[i] - 1e-12):
                 free[i] = 0.0
+                idx[k] = i
+                z = Z[k]
+                for j in range(n):
+                    z[j] = 0.0
+                z[i] = 1.0
+                factored_solve_into(A, z, z, n)  # A⁻¹ e_i
+                k += 1
                 changed = True
         if not changed:
             return True
+        if k == n:  # every joint frozen
+            for j in range(n):
+                dq[j] = 0.0
+            return True
+        for a in range(k):
+            ia = int(idx[a])
+            u[a] = g[ia]
+            for b in range(k):
+                S[a, b] = Z[b, ia]
+        if not spd_solve_into(S, u, u, k):
+            return False
+        for j in range(n):
+            t = g[j]
+            for a in range(k):
+                t -= Z[a, j] * u[a]
+            dq[j] = t * free[j]  # exactly 0 for the frozen joints
     return True
 
 
