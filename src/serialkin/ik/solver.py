@@ -461,7 +461,8 @@ def solve(
 def _fast_entry(robot: object, method: str) -> tuple | None:
     """The prepared arrays of the fast path for ``robot`` and ``method`` (None: not eligible).
 
-    ``(spec, entry point of solve_fast, S, zeros (n,), (n,) q0 strides, method name)``,
+    ``(spec, entry point of solve_fast, S, zeros (n,), the strides (8,) of a contiguous q0,
+    method name)``,
     kept in ``robot._ik_fast[method]``: ``S`` the packed constants
     (:func:`~serialkin.ik._kernels.pack_fast`) and the compiled entry point of the
     method's ``solve_fast`` for a read-only ``S``, C (4, 4) target, C (n,) q0 and q, an
@@ -488,8 +489,8 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
            numba.types.boolean, vec)
     dispatcher = spec.kernel.solve_fast
     dispatcher.compile(sig)  # loads from numba's cache when it can
-    entry = (spec, dispatcher.overloads[sig].entry_point, S, np.zeros(robot.n),
-             (8,) if robot.n > 1 else None, spec.name)
+    entry = (spec, dispatcher.overloads[sig].entry_point, S, np.zeros(robot.n), (8,),
+             spec.name)
     robot._ik_fast[method] = entry
     return entry
 
@@ -501,8 +502,8 @@ _F64 = np.dtype(np.float64)
 _NDARRAY = np.ndarray
 #: Strides of a C-contiguous float64 (4, 4) array.
 _C44 = (32, 8)
-#: The fields of a fast-path success that do not vary (copied, then filled: cheaper than
-#: building the dictionary).
+#: The fields of a fast-path success that do not vary (copied into the new result's
+#: ``__dict__``, then filled: cheaper than building the dictionary).
 _SUCCESS = {"q": None, "success": True, "iterations": 0, "position_error": 0.0,
             "orientation_error": 0.0, "reason": "", "restarts": 0, "method": "",
             "clearance": np.inf, "closest_pair": ("", "")}
@@ -532,9 +533,9 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
     _, solve_fast, S, zeros, strides, name = ent
     if q0 is None:
         q0k = zeros
-    elif (type(q0) is _NDARRAY and q0.dtype is _F64 and q0.shape == zeros.shape
-          and (strides is None or q0.strides == strides)):
-        q0k = q0
+    elif (type(q0) is _NDARRAY and q0.dtype is _F64 and q0.nbytes == zeros.nbytes
+          and q0.strides == strides):
+        q0k = q0  # strides (8,): one dimension, contiguous; nbytes: n values
     else:
         return None
     if type(seed) is int and 0 <= seed < _SIGN:
@@ -549,15 +550,15 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
     q = np.empty(zeros.shape[0])
     status, its, pe, oe, used = solve_fast(S, target, q0k, s, q0 is not None, q)
     if status == 1:  # IKResult.make, inlined
-        d = _SUCCESS.copy()
+        r = _NEW(IKResult)
+        d = r.__dict__
+        d.update(_SUCCESS)
         d["q"] = q
         d["iterations"] = its
         d["position_error"] = pe
         d["orientation_error"] = oe
         d["restarts"] = used
         d["method"] = name
-        r = _NEW(IKResult)
-        _SET(r, "__dict__", d)
         return r
     if status < 0:
         return None
