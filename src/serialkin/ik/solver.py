@@ -496,7 +496,6 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
 
 
 _NEW = object.__new__
-_SET = object.__setattr__
 _SIGN = 1 << 63
 _F64 = np.dtype(np.float64)
 _NDARRAY = np.ndarray
