@@ -35,7 +35,7 @@ RANK_TOL = 1e-6
 
 
 def _drop_near_dependent(Js: np.ndarray, keep: np.ndarray, seq: Sequence[int],
-                         floor: float) -> None:
+                         floor: float) -> np.ndarray:
     """Unkeep columns until the kept scaled columns' smallest singular value is ≥ ``floor``.
 
     Gram–Schmidt residuals above ``tol`` do not bound the kept set's σ_min: residuals
@@ -44,16 +44,20 @@ def _drop_near_dependent(Js: np.ndarray, keep: np.ndarray, seq: Sequence[int],
     kept columns carrying at least half the largest weight of the last right singular
     vector (the near-dependency), the one latest in the priority order ``seq`` is
     dropped: it lies within σ_min·2√k of the others' span. ``keep`` (p,) is updated.
+
+    Returns:
+        the singular values (descending) of the final kept columns (empty when none).
     """
     rank_of = {k: i for i, k in enumerate(seq)}
     while keep.any():
         idx = np.flatnonzero(keep)
-        _, s, Vt = np.linalg.svd(Js[:, idx], full_matrices=False)
+        s = np.linalg.svd(Js[:, idx], compute_uv=False)
         if s[-1] >= floor:
-            return
-        w = np.abs(Vt[-1])
+            return s
+        w = np.abs(np.linalg.svd(Js[:, idx], full_matrices=False)[2][-1])
         heavy = idx[w >= 0.5 * w.max()]
         keep[max(heavy, key=lambda k: rank_of[int(k)])] = False
+    return np.zeros(0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -140,7 +144,7 @@ def analyse(J: np.ndarray, names: Sequence[str], *, kind: str = "",
         if nr > tol:
             keep[k] = True
             basis = np.column_stack([basis, r / nr])
-    _drop_near_dependent(Js, keep, seq, 0.1 * tol)
+    s = _drop_near_dependent(Js, keep, seq, 0.1 * tol)
     reasons = []
     what = f"{kind} measurements" if kind else "the measurements"
     idx = np.flatnonzero(keep)
@@ -158,7 +162,6 @@ def analyse(J: np.ndarray, names: Sequence[str], *, kind: str = "",
         else:
             reasons.append(f"{names[k]} cannot be separated from {', '.join(others)} "
                            f"(a combination of them) using {what}")
-    s = np.linalg.svd(Js[:, keep], compute_uv=False) if keep.any() else np.zeros(0)
     s_all = np.linalg.svd(Js, compute_uv=False) if p else np.zeros(0)
     cond_all = _condition(s_all) if effect.all() else float("inf")
     return Identifiability(tuple(names), keep, s, _condition(s), cond_all, tuple(reasons),
