@@ -154,7 +154,7 @@ def test_lm_active_set_step_is_the_reduced_solve(n, seed):
     q[at] = np.where(rng.random(at.sum()) < 0.5, -1.0, 1.0)
     revolute = np.zeros(n)  # prismatic-like: no 2π shift
     sw = np.ones(6)
-    J_, T_, e_, dq, q_, be_, sw_, ws = _workspace(n)
+    _, _, _, dq, _, _, _, ws, _, _ = _workspace(n)
     ws[W_JW][:] = J
     ws[W_R][:] = e
     cost = 0.5 * float(e @ e)

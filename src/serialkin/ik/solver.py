@@ -833,12 +833,15 @@ def _result_batch(robot: Robot, tgt: Target, spec: MethodSpec, Q: np.ndarray,
     its = info[:, K.I_ITERATIONS].astype(np.int64)
     used = info[:, K.I_RESTARTS].astype(np.int64)
     pe, oe = info[:, K.I_POS_ERR].copy(), info[:, K.I_ORI_ERR].copy()
-    reasons = [""] * Q.shape[0]
-    for k in np.flatnonzero(~ok):  # a sentence for each failure only
-        reasons[k] = failure_reason(pe[k], oe[k], tol, used[k] + 1, its[k], tgt.kind,
-                                    failure_hint(robot, Q[k], tgt.weights, respect, tgt.T[k]))
+    failed = np.flatnonzero(~ok)
+    said = [failure_reason(pe[k], oe[k], tol, used[k] + 1, its[k], tgt.kind,
+                           failure_hint(robot, Q[k], tgt.weights, respect, tgt.T[k]))
+            for k in failed]  # a sentence for each failure only
+    # the str array np.array(list of N str) makes, without building it from N objects
+    reasons = np.zeros(Q.shape[0], dtype=f"<U{max(map(len, said), default=1) or 1}")
+    reasons[failed] = said
     return IKResult(q=Q, success=ok, iterations=its, position_error=pe, orientation_error=oe,
-                    reason=np.array(reasons, dtype=str), restarts=used, method=spec.name)
+                    reason=reasons, restarts=used, method=spec.name)
 
 
 def _problem(robot: Robot, T: np.ndarray, tgt: Target, tol: float, respect: bool) -> IKProblem:

@@ -27,7 +27,11 @@ import numpy as np
 
 from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
 from serialkin.errors import InputError
-from serialkin.ik._kernels import inside_limits, pose_and_q0_valid  # noqa: F401 (re-export)
+from serialkin.ik._kernels import (  # noqa: F401 (re-export)
+    inside_limits,
+    pose_and_q0_valid,
+    rows_inside_limits,
+)
 from serialkin.model.robot import Robot
 from serialkin.model.tasks import TARGET_TASKS, TASK_COORDINATES, task_weights
 from serialkin.spatial.kernels import transforms_valid
@@ -251,10 +255,13 @@ def check_q0(robot: Robot, q0: object, n_targets: int | None, respect_limits: bo
     Raises:
         InputError: wrong size, NaN/inf, or (with ``respect_limits``) outside the limits.
     """
-    if n_targets is None and isinstance(q0, np.ndarray) and q0.dtype == np.float64 \
-            and q0.shape == (robot.n,) and q0.flags.c_contiguous:
+    if isinstance(q0, np.ndarray) and q0.dtype == np.float64 and q0.flags.c_contiguous \
+            and q0.shape == ((robot.n,) if n_targets is None else (n_targets, robot.n)):
+        # the common call, checked in one compiled pass (finite, inside the limits)
         arr = robot_arrays(robot)
-        if inside_limits(q0, arr.lo, arr.hi, 1e-12 if respect_limits else np.inf):
+        tol = 1e-12 if respect_limits else np.inf
+        if (inside_limits(q0, arr.lo, arr.hi, tol) if n_targets is None
+                else rows_inside_limits(q0, arr.lo, arr.hi, tol)):
             return q0
     q = robot.check_q(q0, "q0")
     if n_targets is None:
