@@ -136,6 +136,21 @@ def test_interval_helpers(lo, width, open_hi, x):
         assert L.inside(n, lo, hi, 0.0)
 
 
+@given(t=st.one_of(st.floats(allow_nan=True, allow_infinity=True),
+                   st.floats(-2 * math.pi, 2 * math.pi),
+                   st.sampled_from([0.0, -0.0, 2 * math.pi, -2 * math.pi, math.pi, -math.pi,
+                                    np.nextafter(2 * math.pi, 0), np.nextafter(-2 * math.pi, 0),
+                                    5e-324, -5e-324])))
+def test_turn_mod_is_python_modulo_bit_for_bit(t):
+    """turn_mod's fast paths give exactly t % 2π (Python's floor modulo), signed zeros too."""
+    got, want = L.turn_mod(t), t % (2 * math.pi)
+    if math.isnan(want):
+        assert math.isnan(got)
+    else:
+        assert math.copysign(1.0, got) == math.copysign(1.0, want) and got == want
+        assert 0.0 <= got <= 2 * math.pi  # a tiny negative t rounds up to 2π, as with %
+
+
 def test_sampling_box_documented_ranges():
     """Open sides sample a documented finite range: [-π, π], [hi − 2π, hi], [lo, lo + 2π]."""
     box = L.sampling_box(np.array([-np.inf, -np.inf, 5.0, -np.inf, -np.inf]),

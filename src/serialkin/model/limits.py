@@ -155,6 +155,21 @@ def clamp(x, lo, hi):
     return x
 
 
+@njit(cache=True, inline="always")
+def turn_mod(t):
+    """``t mod 2π`` in [0, 2π] (a tiny negative t rounds up to 2π), bit for bit ``t % (2π)``.
+
+    Within one turn of 0, the common case after an IK step, that is ``t`` or ``t + 2π``
+    (Python's float modulo is fmod, exact here, then + 2π when the signs differ), with
+    no call to fmod (about 14 ns, against 4 for the test).
+    """
+    if t > 0.0 and t < TWO_PI:
+        return t
+    if t < 0.0 and t > -TWO_PI:
+        return t + TWO_PI
+    return t % TWO_PI
+
+
 @njit(cache=True)
 def wrap_angle(x, lo, hi):
     """An angle ``x + 2πk`` inside ``[lo, hi]``, or NaN when the interval holds none.
@@ -166,10 +181,10 @@ def wrap_angle(x, lo, hi):
     if x >= lo and x <= hi:
         return x
     if math.isfinite(lo):
-        y = lo + (x - lo) % TWO_PI
+        y = lo + turn_mod(x - lo)
         return y if y <= hi else math.nan
     if math.isfinite(hi):
-        return hi - (hi - x) % TWO_PI
+        return hi - turn_mod(hi - x)
     return x
 
 
@@ -187,7 +202,7 @@ def project(x, lo, hi, revolute):
         y = wrap_angle(x, lo, hi)
         if not math.isnan(y):
             return y
-        y = lo + (x - lo) % TWO_PI  # lo and hi are finite here: y in (hi, lo + 2π)
+        y = lo + turn_mod(x - lo)  # lo and hi are finite here: y in (hi, lo + 2π)
         return hi if y - hi <= lo + TWO_PI - y else lo
     return clamp(x, lo, hi)
 
@@ -210,12 +225,12 @@ def normalize(x, lo, hi, revolute):
         return x if math.isnan(y) else y
     if math.isfinite(lo) and math.isfinite(hi):
         return x
-    r = (x + math.pi) % TWO_PI - math.pi
+    r = turn_mod(x + math.pi) - math.pi
     if r >= lo and r <= hi:
         return r
     if math.isfinite(lo):
-        return lo + (x - lo) % TWO_PI
-    return hi - (hi - x) % TWO_PI
+        return lo + turn_mod(x - lo)
+    return hi - turn_mod(hi - x)
 
 
 def sampling_box(lo: np.ndarray, hi: np.ndarray, half_range: np.ndarray) -> np.ndarray:
