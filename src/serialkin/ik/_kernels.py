@@ -467,23 +467,34 @@ def _limit_step(dq, max_step):
 
 @njit(cache=True, inline="always")
 def _workspace(n):
-    """The loop's arrays for n joints, carved from seven allocations (row views, C-contiguous).
+    """The loop's four buffers for n joints, ``(B, C, T2, state)``; :func:`_carve` cuts them.
+
+    ``B`` (3n + 25, n), ``C`` (12, 6), ``T2`` (2, 4, 4) float64 and ``state`` (1,) uint64.
+    Four allocations rather than one per array; the views are cut where they are used
+    (:func:`_carve`), in a function without reference counting when it can be: with it,
+    each view costs an atomic increment and decrement of its buffer's count.
+    """
+    return (np.empty((3 * n + 25, n)), np.empty((12, 6)), np.empty((2, 4, 4)),
+            np.empty(1, dtype=np.uint64))
+
+
+@njit(cache=True, inline="always")
+def _carve(buffers):
+    """The loop's arrays, C-contiguous views of :func:`_workspace`'s buffers.
 
     Returns ``(J (6, n), T (4, 4), e (6,), dq (n,), q (n,), be (6,), sw (6,), ws, Jn (6, n),
     state (1,) uint64)`` with ``ws`` the step kernels' scratch tuple (``W_*``), ``Jn`` the
-    polish's trial Jacobian and ``state`` the random stream. Arrays of one shape share an
-    allocation and are its rows: a row view costs a few ns, where a reshaped slice of one
-    flat buffer costs tens (numba's reshape helper) and a separate allocation about 50.
+    polish's trial Jacobian and ``state`` the random stream. Arrays of one width share a
+    buffer as its rows or blocks of rows: such a view costs a few ns, where a reshaped
+    slice of one flat buffer costs tens (numba's reshape helper).
     """
-    V6 = np.empty((6, 6))  # e, be, sw, r, y6, en
-    Vn = np.empty((7, n))  # dq, q, g, free, qn, idx, u
-    M = np.empty((3, 6, n))  # J, Jw, Jn
-    T2 = np.empty((2, 4, 4))  # T, Tn
-    A = np.empty((3, n, n))  # A, Z, S
-    M6 = np.empty((6, 6))
-    return (M[0], T2[0], V6[0], Vn[0], Vn[1], V6[1], V6[2],
-            (M[1], V6[3], A[0], Vn[2], M6, V6[4], Vn[3], Vn[4], T2[1], V6[5], A[1], A[2],
-             Vn[5], Vn[6]), M[2], np.empty(1, dtype=np.uint64))
+    B, C, T2, state = buffers
+    n = B.shape[1]
+    J, Jw, Jn = B[3 * n:3 * n + 6], B[3 * n + 6:3 * n + 12], B[3 * n + 12:3 * n + 18]
+    V = B[3 * n + 18:]  # dq, q, g, free, qn, idx, u
+    return (J, T2[0], C[0], V[0], V[1], C[1], C[2],
+            (Jw, C[3], B[:n], V[2], C[6:], C[4], V[3], V[4], T2[1], C[5], B[n:2 * n],
+             B[2 * n:3 * n], V[5], V[6]), Jn, state)
 
 
 @njit(cache=True, inline="always")
@@ -722,11 +733,11 @@ def _solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp):
         seed: uint64 seed of this target's random stream.
         q_out: (n,) output, the best configuration found.
         info: (N_INFO,) output, see ``I_*``.
-        wsp: the loop's arrays (:func:`_workspace` of n), overwritten.
+        wsp: the loop's buffers (:func:`_workspace` of n), overwritten.
     """
     (w, p, lo, hi, slo, shi, revolute, tol, max_iter, restarts, respect, use_q0, window,
      ratio) = _settings(cfg, box)
-    J, T, e, dq, q, be, sw, ws, Jn, state = wsp
+    J, T, e, dq, q, be, sw, ws, Jn, state = _carve(wsp)
     for i in range(6):
         sw[i] = math.sqrt(w[i])
     state[0] = seed
@@ -934,7 +945,7 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
     margin = ccfg[K_MARGIN]
     pushes = int(ccfg[K_PUSHES])
     m = A.shape[0]
-    J, T, e, dq, q, be, sw, ws, Jn, state = _workspace(n)
+    J, T, e, dq, q, be, sw, ws, Jn, state = _carve(_workspace(n))
     frames = np.empty((n + 1, 4, 4))
     W0 = np.empty((m, 3))
     W1 = np.empty((m, 3))
