@@ -28,8 +28,10 @@ Notation (shapes): n joints; ``e`` (6,) the pose error ``[p_t − p; log(R_t R�
 from the configuration ``q`` (n,) with its Jacobian ``J`` (6, n), pose error ``e`` (6,) and
 cost ``E``, with the weighted ``Jw`` and ``r`` already in the workspace, it writes the
 step ``Δq`` into ``dq`` (n,) and returns True (False: no step possible, the attempt
-ends). It is inlined into the attempt loop, which is compiled without numba's reference
-counting (NRT: an incref/decref of every array the step touches, every iteration) unless
+ends). A step only reads ``Jw`` and ``r``: with unit weights (every full-pose target)
+they are ``J`` and ``e`` themselves, not copies (3-4 % of a solve). It is inlined into
+the attempt loop, which is compiled without numba's reference counting (NRT: an
+incref/decref of every array the step touches, every iteration) unless
 the method is registered with ``allocates=True``: a step that allocates or copies arrays,
 itself or in a helper it calls (as :func:`_pinv_step` does), needs it. ``p`` holds the
 method's parameters (the option values named by
@@ -552,6 +554,11 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, p, window, ratio, to
     Jw = ws[W_JW]
     r = ws[W_R]
     qn = ws[W_QN]
+    unit = True
+    for i in range(6):
+        unit &= sw[i] == 1.0
+    if unit:  # Jw = J and r = e: the step reads them in place (steps never write them)
+        ws = (J, e) + ws[2:]
     ctx = (F, meta, Tt, w, sw, lo, hi, revolute, respect)
     if fresh:
         jacobian_into(q, F, meta, J, T)
@@ -579,7 +586,8 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, p, window, ratio, to
         else:
             slow = 0
         prev = cost
-        _weigh(J, e, sw, Jw, r)
+        if not unit:
+            _weigh(J, e, sw, Jw, r)
         if not step(q, J, e, cost, p, ctx, ws, dq):  # noqa: F821 (bound by compile_method)
             return it, False, cost
         for j in range(n):
