@@ -346,27 +346,27 @@ def _transpose_times(Jw, r, g):
 
 @njit(cache=True, inline="always")
 def _normal(Jw, r, A, g):
-    """A = Jwᵀ Jw (n×n) and g = Jwᵀ r (n,).
+    """The lower triangle of A = Jwᵀ Jw (n×n, diagonal included) and g = Jwᵀ r (n,).
 
-    Each entry is a sum of six products added pairwise, ``((a₀ + a₁) + (a₂ + a₃)) +
-    (a₄ + a₅)``: three dependent additions instead of six, which lets the processor
-    overlap the entries (about 30 % faster for the 6×6 and 7×7 systems of IK than a
-    running sum, to rounding the same).
+    The lower triangle is all :func:`~serialkin.kinematics.dls.spd_solve_into` reads (a
+    caller that needs all of A mirrors it). Each entry is a sum of six products added
+    pairwise, ``((a₀ + a₁) + (a₂ + a₃)) + (a₄ + a₅)``: three dependent additions instead
+    of six, which lets the processor overlap the entries (about 30 % faster for the 6×6
+    and 7×7 systems of IK than a running sum, to rounding the same). Row i is computed
+    along the contiguous rows of Jw, which LLVM vectorises (7×7: 55 → 38 ns against the
+    column order, the same bits).
     """
     n = Jw.shape[1]
+    J0, J1, J2, J3, J4, J5 = Jw[0], Jw[1], Jw[2], Jw[3], Jw[4], Jw[5]
+    for j in range(n):
+        g[j] = (J0[j] * r[0] + J1[j] * r[1]) + (J2[j] * r[2] + J3[j] * r[3]) \
+            + (J4[j] * r[4] + J5[j] * r[5])
     for i in range(n):
-        a0 = Jw[0, i]
-        a1 = Jw[1, i]
-        a2 = Jw[2, i]
-        a3 = Jw[3, i]
-        a4 = Jw[4, i]
-        a5 = Jw[5, i]
-        g[i] = (a0 * r[0] + a1 * r[1]) + (a2 * r[2] + a3 * r[3]) + (a4 * r[4] + a5 * r[5])
-        for j in range(i, n):
-            s = ((a0 * Jw[0, j] + a1 * Jw[1, j]) + (a2 * Jw[2, j] + a3 * Jw[3, j])
-                 + (a4 * Jw[4, j] + a5 * Jw[5, j]))
-            A[i, j] = s
-            A[j, i] = s
+        a0, a1, a2, a3, a4, a5 = J0[i], J1[i], J2[i], J3[i], J4[i], J5[i]
+        Ai = A[i]
+        for j in range(i + 1):
+            Ai[j] = (a0 * J0[j] + a1 * J1[j]) + (a2 * J2[j] + a3 * J3[j]) \
+                + (a4 * J4[j] + a5 * J5[j])
 
 
 @njit(cache=True)

@@ -375,6 +375,9 @@ def step_gauss_newton(q, J, e, cost, p, ctx, ws, dq):
     A = ws[W_A]
     g = ws[W_G]
     _normal(ws[W_JW], ws[W_R], A, g)
+    for i in range(dq.shape[0]):  # the upper triangle, which the SVD reads too
+        for j in range(i + 1, dq.shape[0]):
+            A[i, j] = A[j, i]
     _pinv_step(A, g, dq, p[0])
     return True
 
