@@ -210,7 +210,9 @@ def rows_inside_limits(Q, lo, hi, tol):
 def project_into(q, lo, hi, revolute):
     """Project ``q`` (n,) onto the joint ranges [lo, hi], in place (:func:`limits.project`)."""
     for i in range(q.shape[0]):
-        q[i] = interval_project(q[i], lo[i], hi[i], revolute[i] != 0)
+        x = q[i]
+        if not (x >= lo[i] and x <= hi[i]):  # inside: unchanged, without the call
+            q[i] = interval_project(x, lo[i], hi[i], revolute[i] != 0)
 
 
 @njit(cache=True)
