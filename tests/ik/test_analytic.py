@@ -742,7 +742,7 @@ def test_tuple_vector_helpers_match_matrices():
 def test_packed_entry_equals_solve_into():
     """solve_packed on pack()'s arrays gives solve_into's rows exactly, -1 if not rigid."""
     from serialkin.ik.analytic import _prepared
-    from serialkin.ik.analytic.dispatch import MAX_ROWS, pack, solve_into, solve_packed
+    from serialkin.ik.analytic.dispatch import MAX_ROWS, for_class, pack, solve_into
 
     rng = np.random.default_rng(8)
     perturbed = Robot.from_dh([DHLink(a=r.a + rng.uniform(-1e-3, 1e-3),
@@ -763,11 +763,12 @@ def test_packed_entry_equals_solve_into():
                             1e-8 * p.s.scale, 1e-8, 1e-12, 1e-12, out1, conv)
             odd = p.refine and conv[1:conv[0] + 1].sum() % 2 == 1
             assert k1 >= 1
-            assert solve_packed(T, I, D, B, out2) == (-2 - k1 if odd else k1)
+            packed = for_class(p.code, p.refine).solve_packed
+            assert packed(T, I, D, B, out2) == (-2 - k1 if odd else k1)
             assert np.array_equal(out1, out2)
         bad = T.copy()
         bad[0, 0] += 1e-9
-        assert solve_packed(bad, I, D, B, out2) == -1
+        assert for_class(p.code, p.refine).solve_packed(bad, I, D, B, out2) == -1
 
 
 def test_subproblem_cosines_match_angles():

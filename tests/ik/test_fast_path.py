@@ -80,9 +80,8 @@ def test_fast_path_failure_equals_ordinary():
 
 
 def test_fast_path_declines_other_types_and_shapes():
-    """Another dtype, layout or shape takes the ordinary path; read-only arrays the fast one.
-
-    Either way the answer is the same.
+    """A pose in another layout or float type is copied into the fast path; a strided q0
+    takes the ordinary path; read-only arrays the fast one. Either way the same answer.
     """
     ur5 = models.ur5()
     T = np.ascontiguousarray(ur5.fk(ur5.random_q(seed=3)))
@@ -92,17 +91,18 @@ def test_fast_path_declines_other_types_and_shapes():
     frozen_q0.setflags(write=False)
     frozen_T = T.copy()
     frozen_T.setflags(write=False)
-    variants = [
-        (np.asfortranarray(T), q0),  # F layout
-        (T, np.ascontiguousarray(np.stack([q0, q0]).T)[:, 0]),  # strided view
-        (np.ascontiguousarray(np.stack([T, T], axis=-1))[..., 0], q0),  # strided target
-    ]
-    for Tv, qv in variants:
-        assert solver._fast(ur5, Tv, "lm", qv, 2) is None
-        assert _same(ur5.ik(Tv, q0=qv, seed=2), ref)
+    strided_q0 = np.ascontiguousarray(np.stack([q0, q0]).T)[:, 0]
+    assert solver._fast(ur5, T, "lm", strided_q0, 2) is None
+    assert _same(ur5.ik(T, q0=strided_q0, seed=2), ref)
+    copied = [np.asfortranarray(T),  # F layout, as the Robotics Toolbox returns poses
+              np.ascontiguousarray(np.stack([T, T], axis=-1))[..., 0]]  # strided
+    for Tv in copied:
+        assert _same(solver._fast(ur5, Tv, "lm", q0, 2), ref)
+        assert _same(ur5.ik(Tv, q0=q0, seed=2), ref)
     for Tv, qv in ((T, frozen_q0), (frozen_T, q0)):  # read-only: only read
         assert _same(solver._fast(ur5, Tv, "lm", qv, 2), ref)
-    assert solver._fast(ur5, T.astype(np.float32), "lm", None, 2) is None
+    T32 = T.astype(np.float32)
+    assert _same(solver._fast(ur5, T32, "lm", q0, 2), ur5.ik(T32.astype(float), q0=q0, seed=2))
     assert solver._fast(ur5, T, "lm", q0.astype(np.int64), 2) is None
     assert solver._fast(ur5, T, "lm", q0[:5].copy(), 2) is None
     assert solver._fast(ur5, T[:3].copy(), "lm", None, 2) is None

@@ -68,7 +68,7 @@ class Clearance:
 
 
 # ---------------------------------------------------------------- compiled kernels
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _shape_to_world(F, shape_frame, A, B, W0, W1, s):
     """World axis ends ``W0[s]``, ``W1[s]`` of shape s from the link frames F (n+1, 4, 4)."""
     f = shape_frame[s]
@@ -90,14 +90,14 @@ def shapes_to_world(F, shape_frame, A, B, W0, W1):
         _shape_to_world(F, shape_frame, A, B, W0, W1, s)
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _pair(W0, W1, i, j):
     """Distance of the world axes of shapes i and j (points passed as tuples: no views)."""
     return segment_distance((W0[i, 0], W0[i, 1], W0[i, 2]), (W1[i, 0], W1[i, 1], W1[i, 2]),
                             (W0[j, 0], W0[j, 1], W0[j, 2]), (W1[j, 0], W1[j, 1], W1[j, 2]))
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _self_min(W0, W1, rad, pa, pb):
     """(smallest ``dist(axis_i, axis_j) − r_i − r_j`` over the pairs (pa, pb), its index).
 
@@ -172,7 +172,7 @@ def _shape_scene(W0, W1, s, r, scene, o):
     return segment_distance((a0[0], a0[1], 0.0), (a1[0], a1[1], 0.0), c, c) - r - scene[o, 3]
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _box_bound(W0, W1, s, r, scene, o):
     """A lower bound of the signed distance of capsule s to scene row o (−inf unless a box).
 
@@ -188,7 +188,7 @@ def _box_bound(W0, W1, s, r, scene, o):
                             c, c) - r - hr
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _scene_min(W0, W1, rad, scene, below):
     """(smallest signed distance < ``below`` of a shape to a scene row, shape, row).
 

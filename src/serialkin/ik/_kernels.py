@@ -78,9 +78,7 @@ from __future__ import annotations
 
 import hashlib
 import math
-import types
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -93,7 +91,7 @@ from serialkin.model.limits import normalize as interval_normalize
 from serialkin.model.limits import project as interval_project
 from serialkin.spatial.kernels import pose_error_into, transforms_valid
 
-from .._jit import njit
+from .._jit import bind, dependency_stamp, njit
 
 #: Layout of the configuration vector ``cfg`` (float64): the loop's slots, then the
 #: method's parameters ``cfg[N_LOOP:]`` (``CompiledMethod.params``, in order).
@@ -167,7 +165,7 @@ TWO_PI = 2.0 * math.pi
 
 
 # ---------------------------------------------------------------- random stream
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _next_u64(state):
     """splitmix64: advance ``state`` (uint64[1]) and return the next 64-bit output."""
     state[0] = state[0] + np.uint64(0x9E3779B97F4A7C15)
@@ -275,7 +273,7 @@ def pose_and_q0_valid(T, q0, lo, hi, rot_tol, has_q0):
 
 
 # ---------------------------------------------------------------- small dense algebra
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def task_cost(e, w):
     """The weighted cost ``E = ½ Σ w_i e_i²`` of the pose error ``e`` (6,), weights ``w`` (6,)."""
     c = 0.0
@@ -284,7 +282,7 @@ def task_cost(e, w):
     return 0.5 * c
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def task_errors(e, w):
     """(position error [m], orientation error [rad]): the norms of ``e`` (6,) over w_i > 0."""
     p = 0.0
@@ -326,7 +324,7 @@ def stopping_test(T, T_target, w, tol_pos, tol_orient, it, window, min_progress,
     return RUNNING, ref
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _weigh(J, e, sw, Jw, r):
     """Jw = diag(√w) J and r = √w ⊙ e."""
     n = J.shape[1]
@@ -336,7 +334,7 @@ def _weigh(J, e, sw, Jw, r):
             Jw[i, j] = sw[i] * J[i, j]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _transpose_times(Jw, r, g):
     """The product g = Jwᵀ r (n,) of Jw (6, n) and r (6,), in place in ``g``."""
     for i in range(Jw.shape[1]):
@@ -346,7 +344,7 @@ def _transpose_times(Jw, r, g):
         g[i] = s
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _normal(Jw, r, A, g):
     """The lower triangle of A = Jwᵀ Jw (n×n, diagonal included) and g = Jwᵀ r (n,).
 
@@ -458,7 +456,7 @@ def _pinv_step(M, rhs, dq, rcond):
             dq[j] += a * V[j, k]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _limit_step(dq, max_step):
     """Scale dq so that max |dq_i| ≤ max_step (direction kept)."""
     big = 0.0
@@ -517,7 +515,7 @@ def _settings(cfg, box):
             int(cfg[C_WINDOW]), cfg[C_STALL_RATIO])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _finite_attempt(cost, q):
     """Whether an attempt ended with a finite cost and a finite q (n,)."""
     if not math.isfinite(cost):
@@ -528,7 +526,7 @@ def _finite_attempt(cost, q):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _tidy(q_out, q0, use_q0, lo, hi, revolute, respect):
     """Tidy the returned q (n,) in place: wrapped, then turned nearest to q0 when given.
 
@@ -605,7 +603,7 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, p, window, ratio, to
     return max_iter, (pe <= tol and oe <= tol), cost
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _copy(src, dst):
     """``dst[...] = src`` for two distinct C-contiguous arrays of one shape (1-D or 2-D).
 
@@ -706,7 +704,7 @@ def _polish_best(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter, q
     return False, best_cost, its
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _write_info(info, success, total, be, w, used, best_cost, q_out, lo, hi, clearance):
     """Fill ``info`` (N_INFO,) but the closest pair: see the ``I_*`` indices."""
     pe, oe = task_errors(be, w)
@@ -856,7 +854,10 @@ def _solve_fast(S, Tt, q0, seed, use_q0, q_out):
     if not pose_and_q0_valid(Tt, q0, box[B_LO], box[B_HI], S[0], use_q0):
         return -1, 0, 0.0, 0.0, 0
     info = np.empty(N_INFO)
-    solve_one(F, meta, Tt, box, q0, cfg, np.uint64(seed), q_out, info)  # noqa: F821
+    # solve_one_in directly, not through solve_one: one level less of compiled calls (each
+    # level re-optimises everything below it at its first compile: 2 s of a first ik)
+    solve_one_in(F, meta, Tt, box, q0, cfg, np.uint64(seed), q_out, info,  # noqa: F821
+                 _workspace(n))
     ok = info[I_SUCCESS] > 0.5 and info[I_INSIDE] > 0.5
     return (1 if ok else 0), int(info[I_ITERATIONS]), info[I_POS_ERR], info[I_ORI_ERR], \
         int(info[I_RESTARTS])
@@ -1087,21 +1088,13 @@ class CompiledMethod:
     solve_fast: object = None
 
 
-_SOURCE = Path(__file__).read_bytes()
-
-
 def _bind(template, name: str, tag: str, **bound):
-    """A copy of the Python function ``template`` whose globals also hold ``bound``.
+    """:func:`serialkin._jit.bind` under a name carrying the method's name and ``tag``.
 
-    Its name carries the method's name and ``tag``, so that numba's on-disk cache (keyed
-    by name and source file) keeps one entry per method and per version of the sources.
+    So that numba's on-disk cache (keyed by name and source file) keeps one entry per
+    method and per version of the sources.
     """
-    g = dict(template.__globals__)
-    g.update(bound)
-    fn = types.FunctionType(template.__code__, g, f"{template.__name__}_{name}")
-    fn.__qualname__ = f"{template.__name__.lstrip('_')}_{name}_{tag}"
-    fn.__doc__ = template.__doc__
-    return fn
+    return bind(template, f"{template.__name__.lstrip('_')}_{name}_{tag}", **bound)
 
 
 def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *,
@@ -1113,12 +1106,13 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
     attempt loop and the per-target loop around it are then compiled with reference
     counting, about 0.1 µs slower per iteration and 0.35 µs per target). Compilation is
     lazy (at the first call) and cached on disk; the cache entry's name holds a hash of
-    this module's and the step's module's sources, so editing either recompiles.
+    this module's and the step's module's sources and of everything they import
+    (:func:`serialkin._jit.dependency_stamp`), so editing any of them recompiles.
     """
     import inspect
 
-    step_src = Path(inspect.getfile(step.py_func)).read_bytes()
-    tag = hashlib.sha1(_SOURCE + step_src).hexdigest()[:10]
+    stamps = dependency_stamp(__file__) + dependency_stamp(inspect.getfile(step.py_func))
+    tag = hashlib.sha1(stamps.encode()).hexdigest()[:10]
     # the attempt loop itself allocates nothing: without reference counting (NRT), which
     # would incref/decref every array the inlined step touches, each iteration (about
     # 0.1 µs per iteration, a fifth of an lm solve), unless the step allocates
@@ -1137,7 +1131,7 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
     one_c = njit(cache=True)(_bind(_solve_one_collision, name, tag, attempt_loop=attempt))
     chunk_c = njit(cache=True, nogil=True)(_bind(_solve_chunk_collision, name, tag,
                                                  solve_one_collision=one_c))
-    fast = njit(cache=True)(_bind(_solve_fast, name, tag, solve_one=one))
+    fast = njit(cache=True)(_bind(_solve_fast, name, tag, solve_one_in=one_in))
     return CompiledMethod(step=step, params=tuple(params), solve_one=one, solve_chunk=chunk,
                           solve_one_collision=one_c, solve_chunk_collision=chunk_c,
                           solve_fast=fast)

@@ -70,7 +70,7 @@ from serialkin.kinematics.kernels import PRISMATIC, jacobian_into
 from .._jit import njit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _clamp_angle_step(phi, qi, lo, hi):
     """Best admissible rotation step for a joint at ``qi`` with limits [lo, hi].
 
@@ -92,7 +92,7 @@ def _clamp_angle_step(phi, qi, lo, hi):
     return b
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _axis_point(J, i, px, py, pz):
     """A point on the axis of revolute joint ``i``, from the Jacobian ``J`` (6, n) at ``p``.
 
@@ -110,7 +110,7 @@ def _axis_point(J, i, px, py, pz):
     return (px - (vy * zz - vz * zy), py - (vz * zx - vx * zz), pz - (vx * zy - vy * zx))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _pair_terms(w, zx, zy, zz, vx, vy, vz, dx, dy, dz):
     """One vector pair's weighted share of (k1, k2, k3) in the one-joint cost (module doc).
 

@@ -112,13 +112,13 @@ def fabrik_domain(robot: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np
     return a, e1, e2, sign
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _wrap(x):
     """Angle wrapped to (−π, π]."""
     return math.atan2(math.sin(x), math.cos(x))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _reach(P, a, b, x, y, length):
     """Place point ``b`` of ``P`` (m, 2) at ``length`` from point ``a`` towards ``(x, y)``.
 

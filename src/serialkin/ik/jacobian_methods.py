@@ -99,7 +99,7 @@ MAX_JOINTS_CUBIC = 1000
 # the weighted Jacobian and residual at q.
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step_transpose(q, J, e, cost, p, ctx, ws, dq):
     """``Δq = α Jwᵀ r`` with ``α = ⟨r, Jw Jwᵀ r⟩ / |Jw Jwᵀ r|²`` (Buss 2004; Wolovich & Elliott).
 
@@ -124,7 +124,7 @@ def step_transpose(q, J, e, cost, p, ctx, ws, dq):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step_pinv(q, J, e, cost, p, ctx, ws, dq):
     """``Δq = Jw⁺ r`` (eq 40; σ below ``rcond·σ_max`` dropped), scaled to max |Δq_i| ≤ max_step.
 
@@ -135,7 +135,7 @@ def step_pinv(q, J, e, cost, p, ctx, ws, dq):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step_dls(q, J, e, cost, p, ctx, ws, dq):
     """``Δq = Jwᵀ (Jw Jwᵀ + λ² I)⁻¹ r`` (eq 46 as corrected in the errata), fixed λ = ``p[0]``.
 
@@ -144,7 +144,7 @@ def step_dls(q, J, e, cost, p, ctx, ws, dq):
     return dls_step_into(ws[W_JW], ws[W_R], p[0] * p[0], 1e-12, ws[W_M6], ws[W_Y6], dq)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step_lm(q, J, e, cost, p, ctx, ws, dq):
     """Error-damped Levenberg-Marquardt with a limit-aware active set, λ = ``p[0]``.
 
@@ -229,7 +229,7 @@ def step_lm(q, J, e, cost, p, ctx, ws, dq):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _damped_normal_step(ws, wn, dq):
     """``(JwᵀJw + wn I) Δq = Jwᵀ r``; a singular matrix is retried with a 1e-12 relative floor."""
     Jw = ws[W_JW]
@@ -252,19 +252,19 @@ def _damped_normal_step(ws, wn, dq):
     return spd_solve_into(A, g, dq, n)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step_lm_wampler(q, J, e, cost, p, ctx, ws, dq):
     """``(JwᵀJw + λI) Δq = Jwᵀ r`` (Wampler 1986), λ = ``p[0]``; every step taken."""
     return _damped_normal_step(ws, p[0], dq)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step_lm_chan(q, J, e, cost, p, ctx, ws, dq):
     """``(JwᵀJw + λE I) Δq = Jwᵀ r`` (Chan & Lawrence 1988), λ = ``p[0]``; every step taken."""
     return _damped_normal_step(ws, p[0] * cost, dq)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step_lm_sugihara(q, J, e, cost, p, ctx, ws, dq):
     """``(JwᵀJw + (E + λ) I) Δq = Jwᵀ r`` (Sugihara 2011), λ = ``p[0]``; every step taken."""
     return _damped_normal_step(ws, cost + p[0], dq)
@@ -321,7 +321,7 @@ def _sdls_into(Jw, r, dq, gamma_max):
 
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step_sdls(q, J, e, cost, p, ctx, ws, dq):
     """Selectively damped least squares (Buss & Kim 2005), γ_max = ``p[0]``.
 
@@ -333,7 +333,7 @@ def step_sdls(q, J, e, cost, p, ctx, ws, dq):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step_newton(q, J, e, cost, p, ctx, ws, dq):
     """Newton-Raphson (eq 41 in n dimensions): ``Δq = Jw⁺ r`` (rcond = ``p[0]``), backtracking.
 
@@ -369,7 +369,7 @@ def step_newton(q, J, e, cost, p, ctx, ws, dq):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step_gauss_newton(q, J, e, cost, p, ctx, ws, dq):
     """Gauss-Newton on the normal equations, ``Δq = (JwᵀJw)⁺ Jwᵀ r`` (rcond ``p[0]``), full step."""
     A = ws[W_A]

@@ -155,7 +155,7 @@ def spd_solve_into(A, b, x, m):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def factored_solve_into(L, b, x, m):
     """Solve ``L Lᵀ x = b`` with the factor :func:`spd_solve_into` leaves in its ``A``.
 
@@ -255,7 +255,7 @@ def dls_step_into(J, e, lam2, floor, M, y, dq):
             y[j] = s
         chol_solve_into(M, y, dq, n)
         return True
-    if not dls_factor_into(J, lam2, floor, M):
+    if not dls_factor_into(J, lam2, floor, M, False):
         return False
     chol_solve_into(M, e, y, m)
     for j in range(n):
@@ -286,7 +286,7 @@ def dls_inverse_into(J, lam2, floor, M, y, out):
             for j in range(n):
                 out[j, c] = y[j]
         return True
-    if not dls_factor_into(J, lam2, floor, M):
+    if not dls_factor_into(J, lam2, floor, M, False):
         return False
     for c in range(m):
         for i in range(m):

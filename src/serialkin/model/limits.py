@@ -155,7 +155,7 @@ def clamp(x, lo, hi):
     return x
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def turn_mod(t):
     """``t mod 2π`` in [0, 2π] (a tiny negative t rounds up to 2π), bit for bit ``t % (2π)``.
 

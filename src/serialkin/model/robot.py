@@ -46,40 +46,43 @@ if TYPE_CHECKING:
 _F64 = np.dtype(np.float64)
 _NDARRAY = np.ndarray
 _EMPTY = np.empty
-#: Entry points of the single-call kernels, resolved on first use by :func:`_fast`.
+#: Entry points of the single-call kernels, each resolved on first use by :func:`_resolve`.
 _FK1: Any = None
 _JAC1: Any = None
 _HESS1: Any = None
 _JDOT1: Any = None
 
 
-def _fast() -> tuple[Any, Any, Any, Any]:
-    """Resolve (once) the compiled entry points of the single-call kernels.
+def _resolve(name: str) -> Any:
+    """Compile (or load from numba's cache) the single-call kernel ``name`` on first use.
 
-    ``fk_one``, ``jacobian_one``, ``hessian_one``, ``jacobian_dot_one``. Calling an entry
-    point skips numba's per-call type dispatch (0.2-2 µs). They are compiled for ``q``
-    (and ``qd``) 1-D float64 arrays of any layout, ``P`` the read-only packed chain, a
-    bool frame flag and a C-contiguous float64 output. An entry point does NOT check the
-    dtype or the number of dimensions of an array (an int64 q would be read as float64):
-    the fast paths check both before calling. ``fk_one``/``jacobian_one`` check the
-    length and finiteness themselves and return a nonzero code: the fast paths then take
-    the general one, which raises the library's error.
+    ``name`` is one of ``_FK1`` (``fk_one``), ``_JAC1`` (``jacobian_one``), ``_HESS1``
+    (``hessian_one``), ``_JDOT1`` (``jacobian_dot_one``); the entry point is stored in that
+    module global and returned. Each is resolved on its own, so a first ``fk`` compiles
+    only ``fk_one``. Calling an entry point skips numba's per-call type dispatch
+    (0.2-2 µs). They are compiled for ``q`` (and ``qd``) 1-D float64 arrays of any layout,
+    ``P`` the read-only packed chain, a bool frame flag and a C-contiguous float64 output.
+    An entry point does NOT check the dtype or the number of dimensions of an array (an
+    int64 q would be read as float64): the fast paths check both before calling.
+    ``fk_one``/``jacobian_one`` check the length and finiteness themselves and return a
+    nonzero code: the fast paths then take the general one, which raises the library's
+    error.
     """
-    global _FK1, _JAC1, _HESS1, _JDOT1
     import numba
+
+    from serialkin._jit import entry_point
 
     f64, Array = numba.float64, numba.types.Array
     vec, P = Array(f64, 1, "A"), Array(f64, 3, "C", readonly=True)
     flag = numba.types.boolean
-    found = []
-    for dispatcher, sig in ((K.fk_one, (vec, P, Array(f64, 2, "C"))),
-                            (K.jacobian_one, (vec, P, Array(f64, 2, "C"))),
-                            (K.hessian_one, (vec, P, flag, Array(f64, 3, "C"))),
-                            (K.jacobian_dot_one, (vec, P, vec, flag, Array(f64, 2, "C")))):
-        dispatcher.compile(sig)  # loads from numba's cache when it can
-        found.append(dispatcher.overloads[sig].entry_point)
-    _FK1, _JAC1, _HESS1, _JDOT1 = found
-    return _FK1, _JAC1, _HESS1, _JDOT1
+    dispatcher, sig = {
+        "_FK1": (K.fk_one, (vec, P, Array(f64, 2, "C"))),
+        "_JAC1": (K.jacobian_one, (vec, P, Array(f64, 2, "C"))),
+        "_HESS1": (K.hessian_one, (vec, P, flag, Array(f64, 3, "C"))),
+        "_JDOT1": (K.jacobian_dot_one, (vec, P, vec, flag, Array(f64, 2, "C"))),
+    }[name]
+    found = globals()[name] = entry_point(dispatcher, sig)
+    return found
 
 
 _SOLVE: Any = None
@@ -448,7 +451,7 @@ class Robot:
                 T = out
             else:
                 T = None
-            if T is not None and (_FK1 or _fast()[0])(q, self._P, T) == 0:
+            if T is not None and (_FK1 or _resolve("_FK1"))(q, self._P, T) == 0:
                 return T
         a = self.check_q(q, finite=False)  # the batch kernel tests finiteness as it reads
         if a.ndim == 1:
@@ -531,7 +534,7 @@ class Robot:
                 J = out
             else:
                 J = None
-            if J is not None and (_JAC1 or _fast()[1])(q, self._P, J) == 0:
+            if J is not None and (_JAC1 or _resolve("_JAC1"))(q, self._P, J) == 0:
                 return J
         in_place = out is not None and link is None and frame == "base"
         a, J, T = self._jacobians(q, frame, link, point, out if in_place else None)
@@ -620,7 +623,7 @@ class Robot:
         if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1 and len(q) == self.n \
                 and link is None and point is None and (frame == "base" or frame == "ee"):
             H = _EMPTY((6, self.n, self.n))
-            if (_HESS1 or _fast()[2])(q, self._P, frame == "ee", H):
+            if (_HESS1 or _resolve("_HESS1"))(q, self._P, frame == "ee", H):
                 return H
             raise self._nonfinite(q)
         check_choice(frame, "frame", ("base", "ee"))
@@ -666,7 +669,7 @@ class Robot:
                 and len(qd) == n and link is None and point is None \
                 and (frame == "base" or frame == "ee"):
             Jd = _EMPTY((6, n))
-            if (_JDOT1 or _fast()[3])(q, self._P, qd, frame == "ee", Jd):
+            if (_JDOT1 or _resolve("_JDOT1"))(q, self._P, qd, frame == "ee", Jd):
                 return Jd
             self.check_q(qd, "qd")  # names the non-finite argument
             raise self._nonfinite(q)

@@ -33,7 +33,7 @@ SMALL_ANGLE = 1e-3
 NEAR_PI_COS = -0.9
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _so3_log_parts(r00, r01, r02, r10, r11, r12, r20, r21, r22):
     """Rotation vector ω = θ·a of a rotation matrix given by its 9 entries (row major).
 
@@ -92,7 +92,7 @@ def so3_log_into(R, w):
     w[2] = wz
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _rotation_error_parts(A, B):
     """log(A · Bᵀ)^∨ for the upper-left 3x3 blocks of A and B (any 2-D arrays ≥ 3x3)."""
     m00 = A[0, 0] * B[0, 0] + A[0, 1] * B[0, 1] + A[0, 2] * B[0, 2]

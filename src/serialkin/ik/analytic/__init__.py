@@ -527,18 +527,18 @@ def _sort_batch(robot: Robot, res: AllSolutions, reference: object, weights: obj
 def _solve_batch(p: _Prepared, robot: Robot, T: np.ndarray, tol: float,
                  grid: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Solve targets T (N, 4, 4) on every core; (out (N, 16, n), counts (N,), conv (N, 17))."""
-    from serialkin.ik.analytic.dispatch import solve_range
+    from serialkin.ik.analytic.dispatch import for_class
     from serialkin.kinematics.parallel import run
 
     N = T.shape[0]
     out = np.zeros((N, MAX_ROWS, p.n))
     counts = np.zeros(N, dtype=np.int64)
     conv = np.zeros((N, MAX_ROWS + 1), dtype=np.int64)
-    args = (p.code, p.arm, p.prismatic3, T, p.W, p.P, p.M, p.aux, p.order, p.revolute,
+    args = (p.arm, p.prismatic3, T, p.W, p.P, p.M, p.aux, p.order, p.revolute,
             p.qlim, p.mid, p.F, p.meta, p.refine, grid, tol * p.s.scale, tol,
             REFINE_TOL * p.s.scale, REFINE_TOL, out, counts, conv)
     grain = 4 if p.code == GENERAL else 64
-    run(solve_range, args, N, grain)
+    run(for_class(p.code, p.refine).solve_range, args, N, grain)
     return out, counts, conv
 
 
@@ -567,12 +567,13 @@ def _as_poses(a: np.ndarray) -> np.ndarray:
 
 #: Fast-path entries per id(robot): (weak reference, entry point, I, D, B, output shape).
 _FAST: dict[int, tuple] = {}
-#: The compiled entry point of ``solve_packed`` (resolved on first use by :func:`_packed_entry`).
-_SOLVE_PACKED: list[Any] = []
+#: The compiled entry points of each class's ``solve_packed``, by (class code, refine) (resolved on
+#: first use by :func:`_packed_entry`).
+_SOLVE_PACKED: dict[tuple[int, bool], Any] = {}
 
 
-def _packed_entry() -> Any:
-    """The compiled entry point of :func:`~serialkin.ik.analytic.dispatch.solve_packed`.
+def _packed_entry(code: int, refine: bool) -> Any:
+    """The compiled entry point of ``for_class(code, refine).solve_packed`` (see dispatch).
 
     Calling it skips numba's type dispatch (about 1 µs with its arguments); it is
     compiled for exactly the types the fast path passes: a C-contiguous, aligned,
@@ -580,19 +581,19 @@ def _packed_entry() -> Any:
     read-only packed arrays of :func:`~serialkin.ik.analytic.dispatch.pack` and a fresh
     output.
     """
-    if not _SOLVE_PACKED:
+    if (code, refine) not in _SOLVE_PACKED:
         import numba
 
-        from serialkin.ik.analytic.dispatch import solve_packed
+        from serialkin._jit import entry_point
+        from serialkin.ik.analytic.dispatch import for_class
 
         Array = numba.types.Array
         f64, i64 = numba.float64, numba.int64
         sig = (Array(f64, 2, "C"), Array(i64, 1, "C", readonly=True),
                Array(f64, 1, "C", readonly=True), Array(numba.boolean, 1, "C", readonly=True),
                Array(f64, 2, "C"))
-        solve_packed.compile(sig)  # loads from numba's cache when it can
-        _SOLVE_PACKED.append(solve_packed.overloads[sig].entry_point)
-    return _SOLVE_PACKED[0]
+        _SOLVE_PACKED[code, refine] = entry_point(for_class(code, refine).solve_packed, sig)
+    return _SOLVE_PACKED[code, refine]
 
 
 def _fast_entry(robot: object) -> tuple:
@@ -608,7 +609,7 @@ def _fast_entry(robot: object) -> tuple:
     I, D, B = pack(p.code, p.arm, p.prismatic3, p.W, p.P, p.M, p.aux, p.order, p.revolute,
                    p.qlim, p.mid, p.F, p.meta, p.refine, DEFAULT_GRID, 1e-8 * p.s.scale, 1e-8,
                    REFINE_TOL * p.s.scale, REFINE_TOL)
-    entry = (weakref.ref(robot), _packed_entry(), I, D, B, (MAX_ROWS, p.n))
+    entry = (weakref.ref(robot), _packed_entry(p.code, p.refine), I, D, B, (MAX_ROWS, p.n))
     if len(_FAST) > 256:
         _FAST.clear()
     _FAST[id(robot)] = entry

@@ -1,16 +1,27 @@
-"""One compiled entry for every closed-form class, and its batch range kernel (numba).
+"""The compiled entries of every closed-form class, and their batch range kernels (numba).
 
-:func:`solve_into` solves one target for any recognised class (an integer ``code``),
-optionally refining every candidate branch on the true chain (nearly ideal arms, see
-:mod:`serialkin.ik.analytic.refine`); :func:`solve_range` runs it over targets
-``start..stop-1`` with the GIL released, for :func:`serialkin.kinematics.parallel.run`.
-:func:`solve_packed` is the single-call entry of ``ik_all``'s fast path: the same solve
-with the robot's read-only data packed by :func:`pack` into three arrays (a call from
-Python pays for unboxing every array argument, 50-100 ns each).
-Kernels trust their input.
+Each class (an integer ``code``) has its own three kernels, built by :func:`for_class`
+on its first use: ``solve_into`` solves one target, optionally refining every candidate
+branch on the true chain (nearly ideal arms, see :mod:`serialkin.ik.analytic.refine`);
+``solve_range`` runs it over targets ``start..stop-1`` with the GIL released, for
+:func:`serialkin.kinematics.parallel.run`; ``solve_packed`` is the single-call entry of
+``ik_all``'s fast path: the same solve with the robot's read-only data packed by
+:func:`pack` into three arrays (a call from Python pays for unboxing every array
+argument, 50-100 ns each).
+
+Why one set of kernels per class rather than one kernel branching on the code: a kernel
+compiles everything it may call, so one entry for all classes compiled every class's
+solver (and the general 6R search) at the first ``ik_all`` of any arm: 131 s cold for a
+UR5 on a quiet 2-core machine. Per class, a UR5 compiles only the UR solver. The
+kernels are copies of the templates below with the class's candidate function bound as a
+global (as :func:`serialkin.ik._kernels.compile_method` does for the IK steps), cached
+on disk under the class's name. Kernels trust their input.
 """
 
 from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -24,7 +35,7 @@ from serialkin.ik.analytic.spherical_wrist import wrist_candidates
 from serialkin.ik.analytic.subproblems import ELBOW_SLACK, finalize, rigid_error
 from serialkin.ik.analytic.ur import ur_candidates
 
-from ..._jit import njit
+from ..._jit import bind, njit
 
 #: Class codes of :func:`solve_into`.
 PLANAR, SCARA, WRIST, UR, GENERAL = 0, 1, 2, 3, 4
@@ -33,13 +44,42 @@ MAX_ROWS = GENERAL_MAX
 
 
 @njit(cache=True)
-def solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mid, F, meta,
-               check_rot, refine, grid, tol_p, tol_r, newton_p, newton_r, out, conv):
+def _wrist(T, W, P, M, aux, arm, prismatic3, order, grid, F, meta, newton_p, newton_r, slack,
+           cand):
+    """Candidates of a spherical-wrist arm (:func:`wrist_candidates`); returns the count."""
+    return wrist_candidates(T, W, P, M, aux, arm, prismatic3, slack, cand)
+
+
+@njit(cache=True)
+def _ur(T, W, P, M, aux, arm, prismatic3, order, grid, F, meta, newton_p, newton_r, slack,
+        cand):
+    """Candidates of a UR-class arm (:func:`ur_candidates`); returns the count."""
+    return ur_candidates(T, W, P, M, aux, slack, cand)
+
+
+@njit(cache=True)
+def _general(T, W, P, M, aux, arm, prismatic3, order, grid, F, meta, newton_p, newton_r, slack,
+             cand):
+    """Candidates of a general 6R (:func:`general_candidates`); returns the count.
+
+    Real solutions of a 6R come in even numbers: an odd count searches once more on a
+    grid twice as fine.
+    """
+    k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, grid, F, meta, newton_p,
+                           newton_r, cand)
+    if k % 2 == 1:
+        k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, 2 * grid, F, meta,
+                               newton_p, newton_r, cand)
+    return k
+
+
+# The templates below are copied by for_class with the class's functions bound as globals
+# (``candidates`` and ``refinable``, or ``closed``; then ``solve_into``), then compiled.
+def _solve_into(arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mid, F, meta,
+                check_rot, refine, grid, tol_p, tol_r, newton_p, newton_r, out, conv):
     """Every solution of one target into ``out`` (16, n); returns their count.
 
     Args:
-        code: class code (:data:`PLANAR`, :data:`SCARA`, :data:`WRIST`, :data:`UR`,
-            :data:`GENERAL`).
         arm: arm code of the spherical-wrist / general classes.
         prismatic3: joint 3 slides (Stanford classes).
         T: (4, 4) target pose (world).
@@ -54,7 +94,8 @@ def solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mi
         F: (n+1, 4, 4) chain transforms (verification and refinement).
         meta: (n, 5) chain joint data.
         check_rot: verify the rotation too.
-        refine: Newton-refine every candidate branch on the chain (nearly ideal arms).
+        refine: Newton-refine every candidate branch on the chain (nearly ideal arms;
+            not the general class, whose candidates are refined already).
         grid: search grid of the general class.
         tol_p: verification tolerance [m].
         tol_r: verification tolerance of the rotation entries.
@@ -68,28 +109,12 @@ def solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mi
         the number of solutions inside the limits (rows sorted lexicographically).
     """
     n = W.shape[0]
-    if code == PLANAR:
-        conv[0] = 0
-        return solve_planar(T, W, P, M, order, aux[0].copy(), aux[1].copy(), revolute, qlim,
-                            mid, F, meta, check_rot, tol_p, tol_r, out)
-    if code == SCARA:
-        conv[0] = 0
-        return solve_scara(T, W, P, M, order, aux[0].copy(), aux[1].copy(), revolute, qlim,
-                           mid, F, meta, check_rot, tol_p, tol_r, out)
     cand = np.zeros((MAX_ROWS, n))
     slack = ELBOW_SLACK if refine else 0.0  # idealised arm: elbow seeds beyond its reach
-    if code == WRIST:
-        k = wrist_candidates(T, W, P, M, aux, arm, prismatic3, slack, cand)
-    elif code == UR:
-        k = ur_candidates(T, W, P, M, aux, slack, cand)
-    else:
-        k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, grid, F, meta, newton_p,
-                               newton_r, cand)
-        if k % 2 == 1:  # real solutions of a 6R come in even numbers: search finer once
-            k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, 2 * grid, F, meta,
-                                   newton_p, newton_r, cand)
+    k = candidates(T, W, P, M, aux, arm, prismatic3, order, grid, F, meta,  # noqa: F821
+                   newton_p, newton_r, slack, cand)
     conv[0] = k
-    if refine and code != GENERAL:
+    if refinable and refine:  # noqa: F821 (bound by for_class)
         ok = np.zeros(k, dtype=np.bool_)
         refine_rows(cand, k, T, F, meta, newton_p, newton_r, ok)
         for i in range(k):
@@ -100,19 +125,26 @@ def solve_into(code, arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mi
     return finalize(cand, k, revolute, qlim, mid, F, meta, T, True, tol_p, tol_r, out)
 
 
-@njit(cache=True, nogil=True)
-def solve_range(code, arm, prismatic3, Ts, W, P, M, aux, order, revolute, qlim, mid, F, meta,
-                refine, grid, tol_p, tol_r, newton_p, newton_r, out, counts, conv, start,
-                stop):
-    """:func:`solve_into` for targets ``Ts[start:stop]`` (N, 4, 4), GIL released.
+def _solve_closed(arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mid, F, meta,
+                  check_rot, refine, grid, tol_p, tol_r, newton_p, newton_r, out, conv):
+    """:func:`_solve_into` of a planar or SCARA arm (solved and finalised by ``closed``)."""
+    conv[0] = 0
+    return closed(T, W, P, M, order, aux[0].copy(), aux[1].copy(),  # noqa: F821
+                  revolute, qlim, mid, F, meta, check_rot, tol_p, tol_r, out)
+
+
+def _solve_range(arm, prismatic3, Ts, W, P, M, aux, order, revolute, qlim, mid, F, meta,
+                 refine, grid, tol_p, tol_r, newton_p, newton_r, out, counts, conv, start,
+                 stop):
+    """``solve_into`` for targets ``Ts[start:stop]`` (N, 4, 4), GIL released.
 
     Writes ``out`` (N, 16, n), ``counts`` (N,) and ``conv`` (N, 17); the other arguments
-    as for :func:`solve_into` (rotations always verified).
+    as for :func:`_solve_into` (rotations always verified).
     """
     for i in range(start, stop):
-        counts[i] = solve_into(code, arm, prismatic3, Ts[i], W, P, M, aux, order, revolute,
-                               qlim, mid, F, meta, True, refine, grid, tol_p, tol_r, newton_p,
-                               newton_r, out[i], conv[i])
+        counts[i] = solve_into(arm, prismatic3, Ts[i], W, P, M, aux,  # noqa: F821
+                               order, revolute, qlim, mid, F, meta, True, refine, grid, tol_p,
+                               tol_r, newton_p, newton_r, out[i], conv[i])
 
 
 #: Header length of the packed integer array (see :func:`pack`).
@@ -146,9 +178,8 @@ def pack(code, arm, prismatic3, W, P, M, aux, order, revolute, qlim, mid, F, met
     return I, D, B
 
 
-@njit(cache=True)
-def solve_packed(T, I, D, B, out):
-    """:func:`solve_into` on the packed data of :func:`pack` (the fast path's entry).
+def _solve_packed(T, I, D, B, out):
+    """``solve_into`` on the packed data of :func:`pack` (the fast path's entry).
 
     One compiled call for the rigidity check and the solve (rotation verified), into
     ``out`` (16, n). Returns the number of solutions k >= 0; −1 without solving when
@@ -178,8 +209,8 @@ def solve_packed(T, I, D, B, out):
     meta = D[o:o + 5 * n].reshape((n, 5))
     refine = I[3] != 0
     conv = np.empty(MAX_ROWS + 1, dtype=np.int64)
-    k = solve_into(I[0], I[1], I[2] != 0, T, W, P, M, aux, I[_HEAD:_HEAD + I[7]], B, qlim,
-                   mid, F, meta, True, refine, I[4], D[0], D[1], D[2], D[3], out, conv)
+    k = solve_into(I[1], I[2] != 0, T, W, P, M, aux, I[_HEAD:_HEAD + I[7]], B,  # noqa: F821
+                   qlim, mid, F, meta, True, refine, I[4], D[0], D[1], D[2], D[3], out, conv)
     if refine and refined_doubtful(conv):
         return -2 - k
     return k
@@ -202,3 +233,59 @@ def refined_doubtful(conv):
     for i in range(conv[0]):
         good += conv[1 + i]
     return good % 2 == 1 or good == 0
+
+
+@dataclass(frozen=True, eq=False)
+class ClassKernels:
+    """The compiled kernels of one closed-form class (see the module docstring).
+
+    Attributes:
+        solve_into: ``solve_into(arm, prismatic3, T, W, P, M, aux, order, revolute, qlim,
+            mid, F, meta, check_rot, refine, grid, tol_p, tol_r, newton_p, newton_r, out,
+            conv) -> count`` (:func:`_solve_into`).
+        solve_range: the same over ``Ts[start:stop]``, GIL released (:func:`_solve_range`).
+        solve_packed: ``solve_packed(T, I, D, B, out)`` on :func:`pack`'s arrays.
+    """
+
+    solve_into: object
+    solve_range: object
+    solve_packed: object
+
+
+_NAMES = {PLANAR: "planar", SCARA: "scara", WRIST: "wrist", UR: "ur", GENERAL: "general"}
+
+
+@functools.cache
+def for_class(code: int, refine: bool = False) -> ClassKernels:
+    """The kernels of class ``code`` (:data:`PLANAR` ... :data:`GENERAL`), built once.
+
+    ``refine``: kernels that can refine the candidates of a nearly ideal arm (the
+    ``refine`` argument of ``solve_into`` then decides); without it, the refinement is not
+    compiled at all (13 s of a UR5's first ``ik_all``) and the argument is ignored.
+    Compilation is lazy (each kernel at its first call) and cached on disk; only the
+    solver of this class is compiled.
+    """
+    refine = bool(refine) and code not in (PLANAR, SCARA, GENERAL)
+    name = _NAMES[code] + ("_refined" if refine else "")
+    if code in (PLANAR, SCARA):
+        one = bind(_solve_closed, f"solve_into_{name}",
+                   closed=solve_planar if code == PLANAR else solve_scara)
+    else:
+        cands = {WRIST: _wrist, UR: _ur, GENERAL: _general}[code]
+        one = bind(_solve_into, f"solve_into_{name}", candidates=cands, refinable=refine)
+    one = njit(cache=True)(one)
+    return ClassKernels(
+        solve_into=one,
+        solve_range=njit(cache=True, nogil=True)(bind(_solve_range, f"solve_range_{name}",
+                                                      solve_into=one)),
+        solve_packed=njit(cache=True)(bind(_solve_packed, f"solve_packed_{name}",
+                                           solve_into=one)),
+    )
+
+
+def solve_into(code, *args):
+    """One target of class ``code``: ``for_class(code, refine).solve_into(*args)``.
+
+    ``args`` as for :func:`_solve_into` (``refine`` is its 15th).
+    """
+    return for_class(code, args[14]).solve_into(*args)

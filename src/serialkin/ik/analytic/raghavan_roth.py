@@ -160,7 +160,7 @@ def _to_coefficients(V, m):
     return C
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _eliminate_below(A, c):
     """One Gaussian elimination step: rows below c minus multiples of row c (pivot A[c, c]).
 
