@@ -8,10 +8,11 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP_RUN  := $(VENV)/.stamp-run
 STAMP_TEST := $(VENV)/.stamp-test
-STAMP_NUMBA := $(VENV)/.stamp-numba
-SOURCES := $(shell find src -name '*.py')
 
 .PHONY: run test lint bench docs browser-deps clean
+
+# The kernels the chapter report uses (`serialkin warmup --list` lists every feature).
+RUN_FEATURES := kinematics ik ik-all workspace tracking
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -25,13 +26,12 @@ $(STAMP_TEST): pyproject.toml | $(PY)
 	$(PY) -m pip install --quiet -e ".[dev,bench,docs,mesh,xacro,dist]"
 	touch $@ $(STAMP_RUN)
 
-# numba's on-disk cache only notices edits to a kernel's own file, not to the kernels it
-# calls in other modules: drop every cached kernel whenever any source file changed.
-$(STAMP_NUMBA): $(SOURCES) | $(PY)
-	find src -name '*.nbi' -delete -o -name '*.nbc' -delete
-	touch $@
-
-run: $(STAMP_RUN) $(STAMP_NUMBA)
+# `serialkin warmup` compiles the kernels into numba's on-disk cache first, one process
+# per feature on every core, with a progress bar (seconds when the cache is already
+# filled). The cache notices source edits by itself (serialkin/_jit.py: each kernel is
+# stamped with a hash of its module and of every module it imports).
+run: $(STAMP_RUN)
+	$(VENV)/bin/serialkin warmup $(RUN_FEATURES)
 	$(VENV)/bin/serialkin chapter --out out/chapter
 
 # Headless Chromium for the viewer tests and ffmpeg for MP4 animations (Debian packages).
@@ -43,7 +43,8 @@ browser-deps:
 	      chromium chromium-driver ffmpeg >/dev/null) \
 	    || echo "browser-deps: could not install chromium/ffmpeg; those tests will be skipped" )
 
-test: $(STAMP_TEST) $(STAMP_NUMBA) browser-deps
+test: $(STAMP_TEST) browser-deps
+	$(VENV)/bin/serialkin warmup --all
 	$(PY) -m pytest -n 2 --dist loadfile
 
 lint: $(STAMP_TEST)

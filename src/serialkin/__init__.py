@@ -14,6 +14,9 @@ from serialkin import errors, ik, models, spatial
 from serialkin.errors import SerialkinError
 from serialkin.ik import IKResult
 from serialkin.model import DHLink, Joint, Robot
+from serialkin.warmup import install_notice
+
+install_notice()
 
 __all__ = [
     "DHLink",

@@ -117,10 +117,12 @@ def _register() -> None:
     from serialkin.cli.reach_cmd import base_placement_cmd, reach_cmd
     from serialkin.cli.track_cmd import track_cmd
     from serialkin.cli.view_cmd import view_cmd
+    from serialkin.cli.warmup_cmd import warmup_cmd
     from serialkin.cli.workspace_cmd import workspace_cmd
 
     for command in (models_cmd, fk_cmd, jacobian_cmd, ik_cmd, compare_cmd, track_cmd,
-                    workspace_cmd, view_cmd, calibrate_cmd, reach_cmd, base_placement_cmd):
+                    workspace_cmd, view_cmd, calibrate_cmd, reach_cmd, base_placement_cmd,
+                    warmup_cmd):
         cli.add_command(command)
 
 

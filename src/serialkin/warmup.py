@@ -1,0 +1,263 @@
+"""Compile the kernels ahead of time, in parallel, into numba's on-disk cache.
+
+serialkin's kernels are compiled by numba the first time a feature is used and then
+loaded from the on-disk cache (``cache=True``) by every later process: a first call
+that has to compile takes seconds to minutes (see docs/compile-time.md), a later one
+milliseconds. :func:`warmup` pays that once, visibly: each feature's kernels are
+compiled by calling the feature's public functions in a process of their own, as many
+processes at a time as there are cores, with a progress bar and the time left. The
+command ``serialkin warmup`` calls it; ``make run`` and ``make test`` run it first.
+
+A first call that must compile prints one line to stderr, once per feature and process
+(:func:`install_notice`), unless ``SERIALKIN_QUIET_COMPILE`` is set to a non-empty
+value other than ``0``.
+
+Every feature calls only public API with the argument types users pass (one pose and
+batches, C- and Fortran-ordered arrays), so what it compiles is exactly what a user's
+first call would compile, and nothing else.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from serialkin._checks import check_choice
+
+__all__ = ["FEATURES", "Feature", "feature_of_module", "install_notice", "warmup"]
+
+
+@dataclass(frozen=True)
+class Feature:
+    """A group of kernels compiled together, by one process.
+
+    Attributes:
+        name: the name ``serialkin warmup NAME`` takes.
+        summary: what a user does that needs these kernels.
+        modules: prefixes of the ``serialkin`` modules whose kernels this is (the
+            compile notice names the feature of the kernel being compiled).
+        seconds: the measured cold compile time on a quiet 2-core machine [s] (the
+            estimate the notice and the progress bar show; docs/compile-time.md).
+        run: calls the feature's public functions (compiling what they need).
+    """
+
+    name: str
+    summary: str
+    modules: tuple[str, ...]
+    seconds: float
+    run: Callable[[], object]
+
+
+def _kinematics() -> None:
+    import serialkin as sk
+
+    for name in ("ur5", "panda"):
+        r = sk.models.get(name)
+        Q = r.random_q(300, seed=0)
+        for q in (Q[0], Q[:1].T[:, 0]):  # a contiguous and a strided configuration
+            r.fk(q)
+            r.jacobian(q)
+            r.jacobian(q, frame="ee")
+            r.hessian(q)
+            r.jacobian_dot(q, qd=np.ones(r.n))
+            r.manipulability(q)
+            r.fk_all(q)
+        r.fk(Q)
+        r.fk(np.asfortranarray(Q))
+        r.jacobian(Q)
+        r.manipulability(Q)
+
+
+def _ik() -> None:
+    import serialkin as sk
+
+    for name in ("panda", "ur5", "two_link"):
+        r = sk.models.get(name)
+        Q = r.random_q(300, seed=0)
+        T = r.fk(Q)
+        if r.n == 2:
+            r.ik(T[0, :2, 3])
+            r.ik(T[:, :2, 3])
+        else:
+            r.ik(T[0])
+            r.ik(np.asfortranarray(T[0]))
+            r.ik(T[0], q0=Q[1])
+            r.ik(T)
+
+
+def _ik_all() -> None:
+    import serialkin as sk
+
+    for name in ("ur5", "puma560", "stanford", "scara", "three_link"):
+        r = sk.models.get(name)
+        T = r.fk(r.random_q(4, seed=0))
+        r.ik_all(T[0])
+        r.ik_all(T)
+
+
+def _collision() -> None:
+    import serialkin as sk
+
+    r = sk.models.get("panda")
+    T = r.fk(r.random_q(2, seed=0))
+    r.ik(T[0], self_collision=True)
+    r.ik(T, self_collision=True)
+
+
+def _workspace() -> None:
+    import serialkin as sk
+    from serialkin.workspace import dexterous_workspace, reachable_workspace
+
+    reachable_workspace(sk.models.two_link(1.0, 0.6), 2_000, seed=0, progress=False)
+    reachable_workspace(sk.models.get("puma560"), 2_000, seed=0, progress=False)
+    dexterous_workspace(sk.models.three_link(1.0, 0.8, 0.3), orientations=4, samples=2_000,
+                        seed=0)
+
+
+def _tracking() -> None:
+    from serialkin.tracking import load_scenario
+
+    load_scenario("six_link_circle").run()
+
+
+#: The features, in the order ``serialkin warmup --all`` starts them (longest first, so
+#: that the parallel processes finish together).
+FEATURES: dict[str, Feature] = {f.name: f for f in (
+    Feature("ik-all", "every closed-form solution: robot.ik_all",
+            ("serialkin.ik.analytic",), 130.0, _ik_all),
+    Feature("ik", "numerical IK: robot.ik (default method), one pose and batches",
+            ("serialkin.ik", "serialkin.kinematics.dls", "serialkin.spatial",
+             "serialkin.model.limits"), 27.0, _ik),
+    Feature("collision", "collision-aware IK and clearance queries",
+            ("serialkin.collision", "serialkin.diffik"), 40.0, _collision),
+    Feature("tracking", "path tracking and redundancy resolution: serialkin track",
+            ("serialkin.tracking", "serialkin.redundancy"), 30.0, _tracking),
+    Feature("workspace", "workspace sampling: serialkin workspace",
+            ("serialkin.workspace",), 20.0, _workspace),
+    Feature("kinematics", "forward kinematics and Jacobians: robot.fk, robot.jacobian",
+            ("serialkin.kinematics",), 12.0, _kinematics),
+)}
+
+
+def feature_of_module(module: str) -> Feature | None:
+    """The feature whose kernels ``module`` holds (longest matching prefix), or None."""
+    best, length = None, -1
+    for f in FEATURES.values():
+        for prefix in f.modules:
+            if (module == prefix or module.startswith(prefix + ".")) and len(prefix) > length:
+                best, length = f, len(prefix)
+    return best
+
+
+def _run_one(name: str) -> float:
+    """Run feature ``name`` in this process (a worker); returns its wall time [s]."""
+    os.environ["SERIALKIN_QUIET_COMPILE"] = "1"
+    t0 = time.perf_counter()
+    FEATURES[name].run()
+    return time.perf_counter() - t0
+
+
+def warmup(features: Iterable[str] | None = None, *, jobs: int | None = None,
+           progress: bool | None = None) -> dict[str, float]:
+    """Compile the kernels of ``features`` (default: all) into numba's on-disk cache.
+
+    Each feature runs in a fresh process (``spawn``), ``jobs`` at a time (default: the
+    CPUs this process may use), longest first; features already compiled load from the
+    cache in about a second. ``progress`` (default: when stderr is a terminal) shows a
+    bar weighted by each feature's expected compile time, with the time left.
+
+    Returns:
+        the wall time [s] of each feature's process, by name.
+
+    Raises:
+        InputError: an unknown feature name (the message lists the valid ones).
+    """
+    import sys
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from multiprocessing import get_context
+
+    from tqdm.auto import tqdm
+
+    from serialkin.errors import InputError
+
+    names = list(FEATURES) if features is None else list(features)
+    for n in names:
+        check_choice(n, "feature", FEATURES)
+    if not names:
+        raise InputError("features must name at least one feature, got none")
+    names.sort(key=lambda n: list(FEATURES).index(n))
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    jobs = max(1, min(len(names), jobs or cpus or 1))
+    show = sys.stderr.isatty() if progress is None else progress
+    total = sum(FEATURES[n].seconds for n in names) / jobs
+    times: dict[str, float] = {}
+    with tqdm(total=round(total), unit="s", desc="compiling", disable=not show,
+              bar_format="{desc}: {percentage:3.0f}%|{bar}| {postfix} [{elapsed}<{remaining}]",
+              file=sys.stderr) as bar, \
+            ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
+        futures = {pool.submit(_run_one, n): n for n in names}
+        for fut in as_completed(futures):
+            n = futures[fut]
+            times[n] = fut.result()
+            bar.set_postfix_str(f"{n} {times[n]:.0f} s", refresh=False)
+            bar.update(min(bar.total - bar.n, round(FEATURES[n].seconds / jobs)))
+        bar.update(bar.total - bar.n)
+    return times
+
+
+def _quiet() -> bool:
+    return os.environ.get("SERIALKIN_QUIET_COMPILE", "") not in ("", "0")
+
+
+_NOTICE: list[object] = []
+
+
+def install_notice() -> None:
+    """Print one line to stderr when a serialkin kernel starts compiling (once per feature).
+
+    A numba event listener (``numba:compile``, which fires only when a kernel is really
+    compiled, not when it is loaded from the cache): at the outermost compile of a kernel
+    of a feature not yet announced in this process it writes, for example::
+
+        serialkin: compiling the ik kernels once (about 27 s); `serialkin warmup` does
+        this ahead of time
+
+    Silenced by ``SERIALKIN_QUIET_COMPILE=1``. Installing twice is harmless.
+    """
+    if _NOTICE:
+        return
+    import sys
+
+    from numba.core import event
+
+    announced: set[str] = set()
+
+    class _Notice(event.Listener):
+        depth = 0
+
+        def on_start(self, ev: event.Event) -> None:
+            self.depth += 1
+            if self.depth != 1 or _quiet():
+                return
+            module = getattr(ev.data["dispatcher"].py_func, "__module__", "") or ""
+            if not module.startswith("serialkin."):
+                return
+            f = feature_of_module(module)
+            name = f.name if f else module.removeprefix("serialkin.").split(".")[0]
+            if name in announced:
+                return
+            announced.add(name)
+            about = f" (about {f.seconds:.0f} s)" if f else ""
+            print(f"serialkin: compiling the {name} kernels once{about}; "
+                  f"`serialkin warmup` does this ahead of time", file=sys.stderr, flush=True)
+
+        def on_end(self, ev: event.Event) -> None:
+            self.depth -= 1
+
+    listener = _Notice()
+    event.register("numba:compile", listener)
+    _NOTICE.append(listener)
