@@ -17,3 +17,98 @@ settings.register_profile("dev", deadline=None)
 
 _default = "ci" if os.environ.get("CI") else "dev"
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", _default))
+
+
+# ------------------------------------------------- one compiled specialization per kernel
+# Every serialkin kernel is compiled once, for one set of argument types: callers
+# normalise dtype, layout and contiguity before calling (issue 27: each extra
+# specialization is seconds of someone's first call). At the end of the run, every
+# kernel this process compiled or loaded is checked; under pytest-xdist each worker
+# writes its counts to a folder the controller reads.
+_SPEC_KEY = "serialkin_specializations"
+
+
+def _specializations() -> dict[str, list[str]]:
+    """{kernel: its signatures} for every serialkin kernel with more than one."""
+    import gc
+    import re
+    import sys
+
+    if "numba" not in sys.modules:
+        return {}
+    from numba.core.dispatcher import Dispatcher
+
+    found: dict[str, list[str]] = {}
+    for obj in gc.get_objects():
+        if isinstance(obj, Dispatcher):
+            fn = obj.py_func
+            if (fn.__module__ or "").startswith("serialkin") and len(obj.signatures) > 1:
+                # compile_method's copies carry a hash of their sources: name them without
+                name = re.sub(r"_[0-9a-f]{10}[01]?$", "", f"{fn.__module__}.{fn.__qualname__}")
+                found[name] = [str(s) for s in obj.signatures]
+    return found
+
+
+def pytest_configure_node(node):  # xdist controller: one folder for the workers' reports
+    """Hand every worker the folder its specialization report goes to."""
+    node.workerinput[_SPEC_KEY] = node.config._serialkin_spec_dir
+
+
+def pytest_configure(config):
+    """Make the report folder (controller) when pytest-xdist distributes the run."""
+    import tempfile
+
+    if not hasattr(config, "workerinput"):
+        config._serialkin_spec_dir = tempfile.mkdtemp(prefix="serialkin-spec-")
+
+
+def _allowed() -> dict[str, int]:
+    """The known exceptions: {kernel: specializations allowed} (tests/kernel_specializations.txt).
+
+    A ratchet: kernels still compiled for several argument types when the check was
+    introduced (mostly read-only and writeable views of the same data, and helpers called
+    with tuples and with arrays), to be normalised one by one; no other kernel may have
+    more than one, and none may exceed its count.
+    """
+    from pathlib import Path
+
+    allowed = {}
+    for line in (Path(__file__).parent / "kernel_specializations.txt").read_text().splitlines():
+        line = line.split("#", 1)[0].strip()
+        if line:
+            name, count = line.rsplit(None, 1)
+            allowed[name] = int(count)
+    return allowed
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """Fail the run when a kernel was compiled for more signatures than allowed."""
+    import json
+    import shutil
+    from pathlib import Path
+
+    config = session.config
+    mine = _specializations()
+    if hasattr(config, "workerinput"):  # a worker: report to the controller
+        folder = Path(config.workerinput[_SPEC_KEY])
+        (folder / f"{config.workerinput['workerid']}.json").write_text(json.dumps(mine))
+        return
+    folder = Path(config._serialkin_spec_dir)
+    for f in folder.glob("*.json"):
+        for k, v in json.loads(f.read_text()).items():
+            if len(v) > len(mine.get(k, ())):
+                mine[k] = v
+    shutil.rmtree(folder, ignore_errors=True)
+    allowed = _allowed()
+    over = {k: v for k, v in mine.items() if len(v) > allowed.get(k, 1)}
+    if over:
+        lines = [f"{k}: {len(v)} specializations (allowed {allowed.get(k, 1)}): {'; '.join(v)}"
+                 for k, v in sorted(over.items())]
+        text = ("kernels compiled for more argument types than allowed (normalise their "
+                "arguments; tests/kernel_specializations.txt):\n  " + "\n  ".join(lines))
+        report = config.pluginmanager.get_plugin("terminalreporter")
+        if report:
+            report.write_line(text, red=True)
+        Path(".pytest_cache").mkdir(exist_ok=True)
+        Path(".pytest_cache/specializations.txt").write_text(text + "\n")
+        session.exitstatus = 1
