@@ -80,8 +80,9 @@ def test_fast_path_failure_equals_ordinary():
 
 
 def test_fast_path_declines_other_types_and_shapes():
-    """A pose in another layout or float type is copied into the fast path; a strided q0
-    takes the ordinary path; read-only arrays the fast one. Either way the same answer.
+    """Poses of other layouts are copied into the fast path, strided q0 goes the other way.
+
+    Read-only arrays take the fast path. Either way the answer is the same.
     """
     ur5 = models.ur5()
     T = np.ascontiguousarray(ur5.fk(ur5.random_q(seed=3)))

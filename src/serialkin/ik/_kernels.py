@@ -29,12 +29,13 @@ from the configuration ``q`` (n,) with its Jacobian ``J`` (6, n), pose error ``e
 cost ``E``, with the weighted ``Jw`` and ``r`` already in the workspace, it writes the
 step ``Δq`` into ``dq`` (n,) and returns True (False: no step possible, the attempt
 ends). A step only reads ``Jw`` and ``r``: with unit weights (every full-pose target)
-they are ``J`` and ``e`` themselves, not copies (3-4 % of a solve). It is inlined into
-the attempt loop, which is compiled without numba's reference counting (NRT: an
-incref/decref of every array the step touches, every iteration) unless
-the method is registered with ``allocates=True``: a step that allocates or copies arrays,
-itself or in a helper it calls (as :func:`_pinv_step` does), needs it. ``p`` holds the
-method's parameters (the option values named by
+they are ``J`` and ``e`` themselves, not copies (3-4 % of a solve). It is called from
+the attempt loop (a direct call LLVM may inline; not numba's IR-level inlining, which
+copied the step's IR into every loop and cost compile time), which is compiled without
+numba's reference counting (NRT: an incref/decref of every array it touches, every
+iteration) unless the method is registered with ``allocates=True``: a step that allocates
+or copies arrays, itself or in a helper it calls (as :func:`_pinv_step` does), needs
+it. ``p`` holds the method's parameters (the option values named by
 ``CompiledMethod.params``, in that order); ``ctx`` is the tuple
 ``(F, meta, Tt, w, sw, lo, hi, revolute, respect)`` (chain, target, weights and
 ``√w``, limits, whether to respect them) and ``ws`` the scratch tuple indexed by the
@@ -1114,7 +1115,7 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
     stamps = dependency_stamp(__file__) + dependency_stamp(inspect.getfile(step.py_func))
     tag = hashlib.sha1(stamps.encode()).hexdigest()[:10]
     # the attempt loop itself allocates nothing: without reference counting (NRT), which
-    # would incref/decref every array the inlined step touches, each iteration (about
+    # would incref/decref every array the loop touches, each iteration (about
     # 0.1 µs per iteration, a fifth of an lm solve), unless the step allocates
     attempt = njit(cache=True, _nrt=allocates)(_bind(_attempt, name, tag + str(int(allocates)),
                                                      step=step))
