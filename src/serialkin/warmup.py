@@ -125,21 +125,23 @@ def _tracking() -> None:
 
 
 #: The features, in the order ``serialkin warmup --all`` starts them (longest first, so
-#: that the parallel processes finish together).
+#: that the parallel processes finish together). Their ``seconds``: each feature alone in
+#: a fresh process with an empty cache (benchmarks/compile_profile.py, quiet 2-core
+#: machine); together they share kernels, so ``--all`` takes less than their sum.
 FEATURES: dict[str, Feature] = {f.name: f for f in (
     Feature("ik-all", "every closed-form solution: robot.ik_all",
-            ("serialkin.ik.analytic",), 130.0, _ik_all),
+            ("serialkin.ik.analytic",), 60.0, _ik_all),
     Feature("ik", "numerical IK: robot.ik (default method), one pose and batches",
             ("serialkin.ik", "serialkin.kinematics.dls", "serialkin.spatial",
-             "serialkin.model.limits"), 27.0, _ik),
+             "serialkin.model.limits"), 35.0, _ik),
     Feature("collision", "collision-aware IK and clearance queries",
-            ("serialkin.collision", "serialkin.diffik"), 40.0, _collision),
+            ("serialkin.collision", "serialkin.diffik"), 55.0, _collision),
     Feature("tracking", "path tracking and redundancy resolution: serialkin track",
-            ("serialkin.tracking", "serialkin.redundancy"), 30.0, _tracking),
+            ("serialkin.tracking", "serialkin.redundancy"), 16.0, _tracking),
     Feature("workspace", "workspace sampling: serialkin workspace",
-            ("serialkin.workspace",), 20.0, _workspace),
+            ("serialkin.workspace",), 13.0, _workspace),
     Feature("kinematics", "forward kinematics and Jacobians: robot.fk, robot.jacobian",
-            ("serialkin.kinematics",), 12.0, _kinematics),
+            ("serialkin.kinematics",), 22.0, _kinematics),
 )}
 
 
