@@ -41,14 +41,14 @@ REVOLUTE = 0
 PRISMATIC = 1
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _post_multiply(T, A):
     """T ← T · A for rigid transforms (last rows [0 0 0 1]), in place, no allocation."""
     for r in range(3):
         T[r, 0], T[r, 1], T[r, 2], T[r, 3] = _row_times(T[r, 0], T[r, 1], T[r, 2], T[r, 3], A)
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _apply_joint(T, meta_i, qi):
     """T ← T · M(q): rotation about / translation along the (compiled) z axis."""
     x = qi + meta_i[4]
@@ -64,7 +64,7 @@ def _apply_joint(T, meta_i, qi):
         T[r, 1] = fma(-t0, s, t1 * c)
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _row_times(t0, t1, t2, t3, A):
     """One row [t0 t1 t2 t3] of a rigid transform times the rigid transform A."""
     return (fma(t2, A[2, 0], fma(t1, A[1, 0], t0 * A[0, 0])),
@@ -73,7 +73,7 @@ def _row_times(t0, t1, t2, t3, A):
             fma(t2, A[2, 3], fma(t1, A[1, 3], fma(t0, A[0, 3], t3))))
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _sincos_banks(q, off, SC, i0, i1):
     """(sin, cos) of ``q + off`` for joints ``i0..i1-1`` into the scratch ``SC`` (2-D).
 
@@ -112,7 +112,7 @@ def _sincos_banks(q, off, SC, i0, i1):
         b += 1
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _chain_walk(q, F, kind, off, J, record, SC):
     """Walk the chain holding the pose's 12 entries in registers; return them as a tuple.
 
@@ -168,7 +168,7 @@ def _chain_walk(q, F, kind, off, J, record, SC):
     return a0, a1, a2, a3, b0, b1, b2, b3, c0, c1, c2, c3
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _store_pose(t, T):
     for k in range(12):
         T[k // 4, k % 4] = t[k]
@@ -250,7 +250,7 @@ _P2 = 6.077100506303966e-11
 _P3 = 2.0222662487959506e-21
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _sincos(x):
     """(sin x, cos x) for |x| ≤ 1e5, branch-free so loops over it vectorise (see above)."""
     kf = math.floor(fma(x, _TWO_OVER_PI, 0.5))
@@ -281,7 +281,7 @@ def _sincos(x):
     return sv, cv
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _sincos_scalar(x):
     """(sin x, cos x): :func:`_sincos`, or libm beyond |x| > 1e5 rad."""
     if abs(x) > 1e5:
@@ -359,7 +359,7 @@ def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
     return z != z
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _fk_blocks(Q, F, meta, out, start, stop):
     """Poses of ``Q[start:stop]`` into ``out`` block by block; True if a q was not finite."""
     T = np.empty((12, _BLOCK))
@@ -405,7 +405,7 @@ def fk_checked_range(Q, F, meta, out, bad, start, stop):
         bad[0] = 1
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def finite_row(q):
     """True when every entry of ``q`` (n,) is finite: the batch kernels' input check.
 
@@ -446,7 +446,7 @@ def fk_all_range(Q, F, L, meta, out, bad, start, stop):
             out[k] = math.nan
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _record_joint(J, j, T, meta_j):
     """Store joint j's world axis z_j in J[3:, j] and origin o_j in J[:3, j] (T: its frame)."""
     for r in range(3):
@@ -454,7 +454,7 @@ def _record_joint(J, j, T, meta_j):
         J[r, j] = T[r, 3]
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _finish_columns(J, kind, m, px, py, pz):
     """Turn the recorded (o_j, z_j) of the first m joints into Jacobian columns (eqs 35-36).
 
@@ -584,7 +584,7 @@ def point_jacobian_range(Q, F, L, meta, link, point, J, P, bad, start, stop):
 # ω = Σ_k w_k q̇_k.
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _cross_into(ax, ay, az, bx, by, bz, out, r, j, k, sign):
     """out[r:r+3, j, k] = sign · (a × b)."""
     out[r, j, k] = sign * (ay * bz - az * by)
@@ -668,7 +668,7 @@ def jacobian_dot_into(J, qd, R, ee, Jd):
                     Jd[r + c, j] = R[0, c] * hx + R[1, c] * hy + R[2, c] * hz
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _tool_jacobian(q, P):
     """Tool Jacobian (6, n) and rotation (3, 3) over the packed chain (single calls)."""
     n = P.shape[0] - 1
