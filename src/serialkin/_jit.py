@@ -235,22 +235,25 @@ def _locator(base: type) -> type:
     return Locator
 
 
-def _install_locators() -> None:
+def _install_locators() -> tuple[type, type]:
+    """Put serialkin's two locators first in numba's list (once); return them.
+
+    Returns ``(user-directory locator, in-tree locator)``: ``$NUMBA_CACHE_DIR`` when set,
+    else ``__pycache__`` beside the sources, as numba's own two.
+    """
     from numba.core import caching
 
     user = getattr(caching, "UserProvidedCacheLocator", None) or \
         caching._UserProvidedCacheLocator
     tree = getattr(caching, "InTreeCacheLocator", None) or caching._InTreeCacheLocator
-    impl = getattr(caching, "CacheImpl", None) or caching._CacheImpl
-    classes = impl._locator_classes
-    if not any(getattr(c, "_serialkin", False) for c in classes):
+    classes = (getattr(caching, "CacheImpl", None) or caching._CacheImpl)._locator_classes
+    if not getattr(classes[0], "_serialkin", False):  # not yet installed in this process
         mine = [_locator(user), _locator(tree)]
         for c in mine:
             c._serialkin = True
         classes[:0] = mine
+    return classes[0], classes[1]
 
 
-_install_locators()
-#: The cache locators of serialkin's kernels (for tests).
-_UserDirLocator, _InTreeLocator = (getattr(numba.core.caching, "CacheImpl", None)
-                                   or numba.core.caching._CacheImpl)._locator_classes[:2]
+#: The cache locators of serialkin's kernels.
+_UserDirLocator, _InTreeLocator = _install_locators()
