@@ -29,10 +29,12 @@ $(STAMP_TEST): pyproject.toml | $(PY)
 # `serialkin warmup` compiles the kernels into numba's on-disk cache first, one process
 # per feature on every core, with a progress bar (seconds when the cache is already
 # filled). The cache notices source edits by itself (serialkin/_jit.py: each kernel is
-# stamped with a hash of its module and of every module it imports).
+# stamped with a hash of its module and of every module it imports). The report, the
+# docs and the benchmarks compile anything left in the foreground (SERIALKIN_COMPILE=wait)
+# rather than run it as Python meanwhile: their figures are the compiled results.
 run: $(STAMP_RUN)
 	$(VENV)/bin/serialkin warmup $(RUN_FEATURES)
-	$(VENV)/bin/serialkin chapter --out out/chapter
+	SERIALKIN_COMPILE=wait $(VENV)/bin/serialkin chapter --out out/chapter
 
 # Headless Chromium for the viewer tests and ffmpeg for MP4 animations (Debian packages).
 # Failure is not fatal: those tests then skip and say why.
@@ -52,10 +54,11 @@ lint: $(STAMP_TEST)
 
 # The documentation site into site/ (strict: a warning fails); open site/index.html.
 docs: $(STAMP_TEST)
-	DISABLE_MKDOCS_2_WARNING=true NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict
+	SERIALKIN_COMPILE=wait DISABLE_MKDOCS_2_WARNING=true NO_MKDOCS_2_WARNING=1 \
+	  $(PY) -m mkdocs build --strict
 
 bench: $(STAMP_TEST)
-	$(PY) benchmarks/run_all.py
+	SERIALKIN_COMPILE=wait $(PY) benchmarks/run_all.py
 
 clean:
 	rm -rf $(VENV) out site .pytest_cache

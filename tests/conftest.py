@@ -15,6 +15,11 @@ settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True
 settings.register_profile("explore", max_examples=500, deadline=None)
 settings.register_profile("dev", deadline=None)
 
+# Kernels compile in the foreground, as numba does, so that every test sees compiled
+# results bit for bit from its first call (the default, "background", runs a kernel as
+# Python while it compiles: tests/test_background.py tests that on its own).
+os.environ.setdefault("SERIALKIN_COMPILE", "wait")
+
 _default = "ci" if os.environ.get("CI") else "dev"
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", _default))
 
@@ -40,7 +45,7 @@ def _specializations() -> dict[str, list[str]]:
 
     found: dict[str, list[str]] = {}
     for obj in gc.get_objects():
-        if isinstance(obj, Dispatcher):
+        if issubclass(type(obj), Dispatcher):  # type(): a dead weak proxy raises on isinstance
             fn = obj.py_func
             if (fn.__module__ or "").startswith("serialkin") and len(obj.signatures) > 1:
                 # compile_method's copies carry a hash of their sources: name them without

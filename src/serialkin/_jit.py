@@ -41,7 +41,10 @@ from types import FunctionType
 import numba
 from llvmlite import ir
 from numba.core import cgutils, types
+from numba.core.dispatcher import OmittedArg
 from numba.extending import intrinsic
+
+from serialkin import _background
 
 #: The fast-math flags of every serialkin kernel (see the module docstring).
 FASTMATH = frozenset({"contract"})
@@ -63,6 +66,21 @@ class _Dispatcher(numba.core.registry.CPUDispatcher):
         args = tuple(types.unliteral(a) for a in args)
         kws = {k: types.unliteral(v) for k, v in kws.items()}
         return super().get_call_template(args, kws)
+
+    def _compile_for_args(self, *args, **kws):
+        """A call from Python found no compiled version: compile, or run as Python meanwhile.
+
+        In ``background`` mode (:mod:`serialkin._background`) the kernel is queued for
+        compilation and this call runs its Python source; in ``wait`` mode, or for
+        arguments numba passes specially (keywords, omitted defaults), numba compiles it
+        here as usual.
+        """
+        if kws or _background.mode() == "wait" or \
+                any(isinstance(a, OmittedArg) for a in args):
+            return super()._compile_for_args(*args, **kws)
+        self._compilation_chain_init_hook()
+        sig = tuple(self.typeof_pyval(a) for a in args)
+        return _background.entry(self, sig, args)[0]
 
 
 def _compiled(decorated):
@@ -89,14 +107,15 @@ def njit(*args, **options):
 
 
 def entry_point(dispatcher, sig):
-    """The compiled entry point of ``dispatcher`` for exactly the argument types ``sig``.
+    """``(function, final)``: the entry point of ``dispatcher`` for exactly the types ``sig``.
 
-    Compiles that one specialization, or loads it from numba's on-disk cache, and returns
-    the compiled function itself: calling it skips numba's per-call type dispatch
-    (0.2-2 µs) but checks nothing, so callers pass exactly those types.
+    The compiled function itself (loaded from numba's on-disk cache, or compiled), with
+    ``final`` True: calling it skips numba's per-call type dispatch (0.2-2 µs) but checks
+    nothing, so callers pass exactly those types. While the kernel compiles in the
+    background (:func:`serialkin._background.entry`) it is the kernel's Python function,
+    with ``final`` False: callers keep only a final entry point and ask again next time.
     """
-    dispatcher.compile(tuple(sig))
-    return dispatcher.overloads[tuple(sig)].entry_point
+    return _background.entry(dispatcher, tuple(sig))
 
 
 def bind(template, qualname: str, **bound):
@@ -141,6 +160,8 @@ def fma(typingctx, a, b, c):
 
     return sig, codegen
 
+
+_background.PYTHON_EQUIVALENTS[id(fma)] = _background.fma_exact
 
 # ---------------------------------------------------------------- the cache's source stamp
 _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
@@ -193,12 +214,36 @@ def _imports(path: str) -> set[str]:
     return found
 
 
+_IMPORTED: dict[str, frozenset[str]] = {}
+_DIGESTS: dict[str, bytes] = {}
+
+
+def _imports_of(path: str) -> frozenset[str]:
+    """:func:`_imports` of ``path``, read once per process."""
+    found = _IMPORTED.get(path)
+    if found is None:
+        found = _IMPORTED[path] = frozenset(_imports(path))
+    return found
+
+
+def _digest(path: str) -> bytes:
+    """The sha256 of the file ``path``'s package-relative name and bytes, once per process."""
+    found = _DIGESTS.get(path)
+    if found is None:
+        with open(path, "rb") as f:
+            rel = os.path.relpath(path, _PACKAGE_DIR).encode()
+            found = _DIGESTS[path] = hashlib.sha256(rel + b"\0" + f.read()).digest()
+    return found
+
+
 def dependency_stamp(path: str) -> str:
     """A hash of the source file ``path`` and of every serialkin module it imports.
 
-    The closure over imports (see :func:`_imports`), each file's bytes hashed in a
-    fixed order; computed once per file and process. Files outside the package give
-    the hash of their own bytes.
+    The closure over imports (see :func:`_imports`), each file's digest hashed in a
+    fixed order. Each file is read and scanned once per process (numba asks for the stamp
+    of every kernel when the module defining it is imported: about 200 kernels in 60
+    files), and each stamp is computed once. Files outside the package give the hash of
+    their own bytes.
     """
     path = os.path.abspath(path)
     if path in _STAMPS:
@@ -206,14 +251,17 @@ def dependency_stamp(path: str) -> str:
     seen, todo = {path}, [path]
     inside = path.startswith(_PACKAGE_DIR + os.sep)
     while todo and inside:
-        for dep in _imports(todo.pop()):
+        for dep in _imports_of(todo.pop()):
             if dep not in seen:
                 seen.add(dep)
                 todo.append(dep)
     h = hashlib.sha256()
     for file in sorted(seen):
-        with open(file, "rb") as f:
-            h.update(os.path.relpath(file, _PACKAGE_DIR).encode() + b"\0" + f.read())
+        if inside:
+            h.update(_digest(file))
+        else:
+            with open(file, "rb") as f:
+                h.update(os.path.relpath(file, _PACKAGE_DIR).encode() + b"\0" + f.read())
     _STAMPS[path] = stamp = h.hexdigest()
     return stamp
 

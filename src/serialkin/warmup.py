@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from serialkin import _background
 from serialkin._checks import check_choice
 
 __all__ = ["FEATURES", "Feature", "feature_of_module", "install_notice", "warmup"]
@@ -158,6 +159,7 @@ def feature_of_module(module: str) -> Feature | None:
 def _run_one(name: str) -> float:
     """Run feature ``name`` in this process (a worker); returns its wall time [s]."""
     os.environ["SERIALKIN_QUIET_COMPILE"] = "1"
+    os.environ["SERIALKIN_COMPILE"] = "wait"  # compile here, not run as Python meanwhile
     t0 = time.perf_counter()
     FEATURES[name].run()
     return time.perf_counter() - t0
@@ -253,7 +255,15 @@ def install_notice() -> None:
             if name in announced:
                 return
             announced.add(name)
-            about = f" (about {f.seconds:.0f} s)" if f else ""
+            about = f"about {f.seconds:.0f} s" if f else ""
+            if _background.mode() == "background":
+                about = f" ({about}; until then they run uncompiled, slower)" if about else \
+                    " (until then they run uncompiled, slower)"
+                print(f"serialkin: compiling the {name} kernels in the background{about}; "
+                      f"`serialkin warmup` does this ahead of time", file=sys.stderr,
+                      flush=True)
+                return
+            about = f" ({about})" if about else ""
             print(f"serialkin: compiling the {name} kernels once{about}; "
                   f"`serialkin warmup` does this ahead of time", file=sys.stderr, flush=True)
 

@@ -100,6 +100,24 @@ def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
     return wrapper
 
 
+def one_shot(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """A one-shot command (fk, jacobian, ik): its small kernel calls run as Python.
+
+    Loading the first compiled kernels costs a process about half a second, more than a
+    few calls take as Python (:func:`serialkin._background.answer_first`); a command
+    with many rows loads them once its Python time passes that.
+    """
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        from serialkin._background import answer_first
+
+        with answer_first():
+            return fn(*args, **kwargs)
+
+    return wrapper
+
+
 def check_out_folder(folder: str | os.PathLike[str]) -> Path:
     """Check that ``folder`` is a writable folder or can be created, creating nothing.
 
@@ -388,6 +406,7 @@ _FK_CMD_HELP = command_help(
 @quiet_long_option
 @memory_budget_option
 @handle_errors
+@one_shot
 def fk_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frames: bool,
            degrees: bool, params: tuple[str, ...], as_json: bool, out: str | None,
            quiet: bool) -> None:
@@ -467,6 +486,7 @@ _JACOBIAN_CMD_HELP = command_help(
 @quiet_long_option
 @memory_budget_option
 @handle_errors
+@one_shot
 def jacobian_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frame: str,
                  link: int | None, point: str | None, planar: bool, task: str, degrees: bool,
                  params: tuple[str, ...], as_json: bool, out: str | None, quiet: bool) -> None:
@@ -613,6 +633,7 @@ _IK_CMD_HELP = command_help(
 @quiet_option
 @memory_budget_option
 @handle_errors
+@one_shot
 def ik_cmd(robot: str | None, targets: tuple[str, ...], target_file: str | None, method: str,
            q0: str | None, mask: str | None, tol: float | None, max_iter: int | None,
            restarts: int | None, seed: int, no_limits: bool, options: tuple[str, ...],

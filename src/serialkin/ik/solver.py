@@ -489,9 +489,10 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
     vec = Array(f64, 1, "C")
     sig = (Array(f64, 1, "C", readonly=True), Array(f64, 2, "C"), vec, numba.int64,
            numba.types.boolean, vec)
-    entry = (spec, entry_point(spec.kernel.solve_fast, sig), S, np.zeros(robot.n), (8,),
-             spec.name)
-    robot._ik_fast[method] = entry
+    function, final = entry_point(spec.kernel.solve_fast, sig)
+    entry = (spec, function, S, np.zeros(robot.n), (8,), spec.name)
+    if final:  # else its Python function while it compiles: ask again next call
+        robot._ik_fast[method] = entry
     return entry
 
 

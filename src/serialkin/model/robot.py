@@ -54,7 +54,7 @@ _JDOT1: Any = None
 
 
 def _resolve(name: str) -> Any:
-    """Compile (or load from numba's cache) the single-call kernel ``name`` on first use.
+    """The single-call kernel ``name``, compiled (or loaded from numba's cache) on first use.
 
     ``name`` is one of ``_FK1`` (``fk_one``), ``_JAC1`` (``jacobian_one``), ``_HESS1``
     (``hessian_one``), ``_JDOT1`` (``jacobian_dot_one``); the entry point is stored in that
@@ -81,7 +81,9 @@ def _resolve(name: str) -> Any:
         "_HESS1": (K.hessian_one, (vec, P, flag, Array(f64, 3, "C"))),
         "_JDOT1": (K.jacobian_dot_one, (vec, P, vec, flag, Array(f64, 2, "C"))),
     }[name]
-    found = globals()[name] = entry_point(dispatcher, sig)
+    found, final = entry_point(dispatcher, sig)
+    if final:  # else the Python function while it compiles: ask again next call
+        globals()[name] = found
     return found
 
 

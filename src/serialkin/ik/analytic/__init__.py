@@ -592,7 +592,10 @@ def _packed_entry(code: int, refine: bool) -> Any:
         sig = (Array(f64, 2, "C"), Array(i64, 1, "C", readonly=True),
                Array(f64, 1, "C", readonly=True), Array(numba.boolean, 1, "C", readonly=True),
                Array(f64, 2, "C"))
-        _SOLVE_PACKED[code, refine] = entry_point(for_class(code, refine).solve_packed, sig)
+        found, final = entry_point(for_class(code, refine).solve_packed, sig)
+        if not final:  # its Python function while it compiles: ask again next call
+            return found
+        _SOLVE_PACKED[code, refine] = found
     return _SOLVE_PACKED[code, refine]
 
 
