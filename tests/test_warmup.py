@@ -112,7 +112,8 @@ def test_an_edit_changes_the_stamps_of_its_importers_only(tmp_path, monkeypatch)
     monkeypatch.setattr(_jit, "_PACKAGE_DIR", str(pkg))
 
     def stamps():
-        monkeypatch.setattr(_jit, "_STAMPS", {})
+        for memo in ("_STAMPS", "_IMPORTED", "_DIGESTS"):  # a new process each time
+            monkeypatch.setattr(_jit, memo, {})
         return {n: _jit.dependency_stamp(str(pkg / n))
                 for n in ("base.py", "sub/mid.py", "top.py", "other.py")}
 

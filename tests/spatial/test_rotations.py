@@ -148,6 +148,15 @@ def test_axis_angle_matches_scipy_and_round_trips(qv: np.ndarray, th: float) -> 
     assert np.abs(axis_angle_to_matrix(ax2, th2) - R).max() < 1e-14
 
 
+def test_axis_angle_of_a_tiny_rotation_has_a_unit_axis() -> None:
+    """Angles whose squared components underflow (< 1e-154) still give a unit axis."""
+    for th in (8.134142396155163e-162, 1e-300, 5e-324):
+        R = axis_angle_to_matrix(np.array([0.6, 0.0, 0.8]), th)
+        ax, th2 = matrix_to_axis_angle(R)
+        assert abs(np.linalg.norm(ax) - 1.0) < 1e-15
+        assert np.abs(axis_angle_to_matrix(ax, th2) - R).max() < 1e-14
+
+
 @pytest.mark.parametrize("th", [0.0, 1e-14, 1e-9, 1e-4, np.pi - 1e-4, np.pi - 1e-9, np.pi])
 def test_axis_angle_near_0_and_pi(th: float) -> None:
     """Angles near 0 and π come back accurately (the axis up to sign at exactly π)."""

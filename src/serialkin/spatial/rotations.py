@@ -183,9 +183,14 @@ def matrix_to_axis_angle(R: object, *, check: bool = True) -> tuple[np.ndarray, 
         ``(axis, angle)`` with shapes (..., 3) and (...); the identity gives axis (0, 0, 1).
     """
     w = so3_log(R, check=check)
-    angle = np.linalg.norm(w, axis=-1)
-    safe = np.where(angle > 0.0, angle, 1.0)[..., None]
-    axis = np.where(angle[..., None] > 0.0, w / safe, np.array([0.0, 0.0, 1.0]))
+    # scaled by the largest component first: the squares of a tiny angle's components
+    # (below 1e-154) underflow, and ‖w‖ computed directly would not make a unit axis
+    big = np.abs(w).max(axis=-1, keepdims=True)
+    scaled = w / np.where(big > 0.0, big, 1.0)
+    norm = np.linalg.norm(scaled, axis=-1)
+    angle = big[..., 0] * norm
+    safe = np.where(norm > 0.0, norm, 1.0)[..., None]
+    axis = np.where(big > 0.0, scaled / safe, np.array([0.0, 0.0, 1.0]))
     return axis, angle
 
 
