@@ -180,9 +180,11 @@ _QUIET: dict[int, tuple[object, Any]] = {}
 
 
 def _compiled_object(value: object) -> bool:
-    from numba.core.dispatcher import Dispatcher
-
-    return isinstance(value, Dispatcher) or id(value) in PYTHON_EQUIVALENTS
+    """A kernel (lazy or a numba dispatcher) or an object with a Python equivalent."""
+    if id(value) in PYTHON_EQUIVALENTS or getattr(type(value), "is_kernel_proxy", False):
+        return True
+    dispatcher = sys.modules.get("numba.core.dispatcher")
+    return dispatcher is not None and isinstance(value, dispatcher.Dispatcher)
 
 
 class _Worker:
@@ -293,8 +295,25 @@ def _size(args: tuple) -> int:
     return sum(getattr(a, "size", 0) for a in args if hasattr(a, "dtype"))
 
 
-def entry(dispatcher: Any, sig: tuple, args: tuple = ()) -> tuple[Any, bool]:
+def prefers_python(args: tuple) -> bool:
+    """Whether a call with arguments ``args`` of a kernel not loaded runs as Python.
+
+    In ``python`` mode always; inside :func:`answer_first`, for at most
+    :data:`BIG_ARGUMENTS` numbers while the process has spent less than
+    :data:`LOAD_SECONDS` running kernels as Python (``background`` mode).
+    """
+    how = mode()
+    return how == "python" or (how == "background" and _ANSWER_FIRST[0] > 0
+                               and _PYTHON_SECONDS[0] < LOAD_SECONDS
+                               and _size(args) <= BIG_ARGUMENTS)
+
+
+def entry(dispatcher: Any, sig: Any, args: tuple = ()) -> tuple[Any, bool]:
     """What to call for ``dispatcher`` with argument types ``sig``: ``(function, final)``.
+
+    ``dispatcher`` is a numba dispatcher or a :class:`serialkin._jit.Kernel` (numba is
+    loaded only when the answer is not the Python function); ``sig`` a tuple of numba
+    types or a function returning one.
 
     ``final`` is True for the compiled entry point (compiled here, loaded from the
     on-disk cache, or finished by the worker) and False for the :func:`interpreted`
@@ -305,18 +324,21 @@ def entry(dispatcher: Any, sig: tuple, args: tuple = ()) -> tuple[Any, bool]:
     ``args`` (the call's arguments, if known) hold more than :data:`BIG_ARGUMENTS`
     numbers. A compile error is raised here, by the first call after the worker met it.
     """
-    sig = tuple(sig)
+    if getattr(type(dispatcher), "is_kernel_proxy", False):  # numba not loaded yet
+        if dispatcher._real is None and prefers_python(args):
+            return quietly(dispatcher), False
+        dispatcher = dispatcher.dispatcher
+    sig = tuple(sig() if callable(sig) else sig)
     done = dispatcher.overloads.get(sig)
     if done is not None:
         return done.entry_point, True
     how = mode()
     if how == "wait":
         return dispatcher.compile(sig), True
-    small = _size(args) <= BIG_ARGUMENTS
-    if how == "python" or (_ANSWER_FIRST[0] and small and _PYTHON_SECONDS[0] < LOAD_SECONDS):
+    if prefers_python(args):
         return quietly(dispatcher), False
     job = _WORKER.submit(dispatcher, sig)
-    if not job.done() and small \
+    if not job.done() and _size(args) <= BIG_ARGUMENTS \
             and (_WORKER.running > 1 or not on_disk(dispatcher, sig)):
         return quietly(dispatcher), False
     job.result()

@@ -33,58 +33,219 @@ error came out at 6.5 mm. They keep the rounding their figures were made with.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import re
+import sys
+import threading
+from collections.abc import Callable
 from types import FunctionType
-
-import numba
-from llvmlite import ir
-from numba.core import cgutils, types
-from numba.core.dispatcher import OmittedArg
-from numba.extending import intrinsic
 
 from serialkin import _background
 
 #: The fast-math flags of every serialkin kernel (see the module docstring).
 FASTMATH = frozenset({"contract"})
 
+# ------------------------------------------------------------- kernels before numba loads
+# Importing numba takes about 0.3 s, more than the rest of ``import serialkin``; a
+# command that answers with the kernels' Python (serialkin fk, a first call while
+# compiling) does not need it. So a decorated kernel is first a :class:`Kernel`, which
+# holds its Python function and options; numba is imported, and every kernel made a
+# numba dispatcher, the first time any kernel is needed compiled (:func:`load_numba`).
+_LOCK = threading.RLock()
+_KERNELS: list[Kernel] = []          # made before numba was loaded
+_BOUND: list[dict] = []              # globals of :func:`bind` copies made before
+_ON_LOAD: list[Callable[[], None]] = []
+_NUMBA: list[object] = []            # [numba] once loaded
+_Dispatcher: type = object           # numba's dispatcher class, ours (see load_numba)
 
-class _Dispatcher(numba.core.registry.CPUDispatcher):
-    """numba's dispatcher, but a call from another kernel never specialises on a literal.
 
-    numba types a constant argument in a kernel (``f(x, 0)``) as a literal
-    (``Literal[int](0)``) and compiles the callee once for that literal and once more for
-    an ``int64`` passed elsewhere: measured, ``_sincos_banks`` compiled four times and
-    ``fk_range`` twice in one process. Calls are resolved with the arguments' ordinary
-    types instead, so each kernel compiles once (a kernel that needs a compile-time
-    constant reads a module global, never an argument).
+class Kernel:
+    """A compiled kernel before numba is imported: its Python function and options.
+
+    Behaves as the numba dispatcher it becomes (:attr:`dispatcher`, made by
+    :func:`load_numba` on first need): calling it, or any attribute numba's dispatchers
+    have, loads numba first, except a call that :func:`serialkin._background.prefers_python`
+    answers with the kernel's Python. ``py_func`` is available without numba.
     """
 
-    def get_call_template(self, args, kws):
-        """The call template of numba for the non-literal types of ``args`` and ``kws``."""
-        args = tuple(types.unliteral(a) for a in args)
-        kws = {k: types.unliteral(v) for k, v in kws.items()}
-        return super().get_call_template(args, kws)
+    is_kernel_proxy = True
 
-    def _compile_for_args(self, *args, **kws):
-        """A call from Python found no compiled version: compile, or run as Python meanwhile.
+    def __init__(self, py_func: FunctionType, options: dict) -> None:
+        self._real = None
+        self.py_func = py_func
+        self.options = options
+        functools.update_wrapper(self, py_func)
 
-        In ``background`` mode (:mod:`serialkin._background`) the kernel is queued for
-        compilation and this call runs its Python source; in ``wait`` mode, or for
-        arguments numba passes specially (keywords, omitted defaults), numba compiles it
-        here as usual.
+    @property
+    def dispatcher(self):
+        """The numba dispatcher of this kernel (imports numba the first time)."""
+        if self._real is None:
+            load_numba()
+        return self._real
+
+    def __call__(self, *args, **kws):
+        if self._real is None and not kws and _background.prefers_python(args):
+            return _background.quietly(self)(*args)
+        return self.dispatcher(*args, **kws)
+
+    def __getattr__(self, name: str):
+        if name.startswith("__") or name in ("_real", "py_func", "options"):
+            raise AttributeError(name)
+        return getattr(self.dispatcher, name)
+
+    def __reduce__(self):
+        return self.dispatcher.__reduce__()
+
+    def __repr__(self) -> str:
+        return f"<serialkin kernel {self.__qualname__} ({'loaded' if self._real else 'lazy'})>"
+
+
+class _LazyIntrinsic:
+    """``fma`` before numba is loaded: calling it from Python gives :func:`fma_exact`."""
+
+    is_kernel_proxy = False
+
+    def __call__(self, a, b, c):
+        return _background.fma_exact(a, b, c)
+
+
+fma = _LazyIntrinsic()
+_LAZY_FMA = fma  # ``fma`` itself is replaced by the intrinsic when numba loads
+fma.__doc__ = """``a·b + c`` rounded once (LLVM's ``llvm.fma.f64``; one instruction with FMA3).
+
+For kernels whose results must not depend on what LLVM chooses to contract: two code
+paths that must agree bit for bit (one pose and a batch of poses) spell their fused
+operations out with this and compile with ``fastmath=False``. Arguments are cast to
+float64. A numba intrinsic once numba is loaded; in Python, :func:`fma_exact`.
+"""
+_background.PYTHON_EQUIVALENTS[id(_LAZY_FMA)] = _background.fma_exact
+
+
+def numba_loaded() -> bool:
+    """Whether numba has been imported and the kernels made dispatchers."""
+    return bool(_NUMBA)
+
+
+def on_numba_load(callback: Callable[[], None]) -> None:
+    """Call ``callback()`` once numba is loaded (now, if it is)."""
+    with _LOCK:
+        if not _NUMBA:
+            _ON_LOAD.append(callback)
+            return
+    callback()
+
+
+def load_numba() -> None:
+    """Import numba and make every :class:`Kernel` its dispatcher (once per process).
+
+    Defines what needs numba (the dispatcher class, the ``fma`` intrinsic, the cache
+    locators), then replaces every :class:`Kernel` and the lazy ``fma`` in the globals of
+    serialkin's modules and of :func:`bind` copies by the real objects, so that numba,
+    compiling a kernel, finds dispatchers and intrinsics among its globals; a
+    :class:`Kernel` kept elsewhere (in a container) forwards to its dispatcher.
+    """
+    with _LOCK:
+        if _NUMBA:
+            return
+        import numba
+
+        real_fma = _define_numba_objects()
+        for k in _KERNELS:
+            k._real = _compiled(numba.njit(**k.options)(k.py_func))
+        namespaces = [vars(m) for name, m in list(sys.modules.items())
+                      if (name == "serialkin" or name.startswith("serialkin."))
+                      and m is not None]
+        lazy_fma = _LAZY_FMA  # a local: this module's own names are replaced too
+        for names in namespaces + _BOUND:
+            for key, value in list(names.items()):
+                if type(value) is Kernel:
+                    names[key] = value._real
+                elif value is lazy_fma and key != "_LAZY_FMA":
+                    names[key] = real_fma
+        _KERNELS.clear()
+        _BOUND.clear()
+        _NUMBA.append(numba)
+        callbacks = list(_ON_LOAD)
+        _ON_LOAD.clear()
+    for callback in callbacks:
+        callback()
+
+
+def _define_numba_objects():
+    """The numba-side definitions (see :func:`load_numba`); returns the ``fma`` intrinsic."""
+    import numba
+    from llvmlite import ir
+    from numba.core import cgutils, types
+    from numba.core.dispatcher import OmittedArg
+    from numba.extending import intrinsic, typeof_impl
+
+    class _Dispatcher(numba.core.registry.CPUDispatcher):
+        """numba's dispatcher, but a call from another kernel never specialises on a literal.
+
+        numba types a constant argument in a kernel (``f(x, 0)``) as a literal
+        (``Literal[int](0)``) and compiles the callee once for that literal and once more
+        for an ``int64`` passed elsewhere: measured, ``_sincos_banks`` compiled four times
+        and ``fk_range`` twice in one process. Calls are resolved with the arguments'
+        ordinary types instead, so each kernel compiles once (a kernel that needs a
+        compile-time constant reads a module global, never an argument).
         """
-        if kws or _background.mode() == "wait" or \
-                any(isinstance(a, OmittedArg) for a in args):
-            return super()._compile_for_args(*args, **kws)
-        self._compilation_chain_init_hook()
-        sig = tuple(self.typeof_pyval(a) for a in args)
-        return _background.entry(self, sig, args)[0]
+
+        def get_call_template(self, args, kws):
+            """The call template of numba for the non-literal types of ``args`` and ``kws``."""
+            args = tuple(types.unliteral(a) for a in args)
+            kws = {k: types.unliteral(v) for k, v in kws.items()}
+            return super().get_call_template(args, kws)
+
+        def _compile_for_args(self, *args, **kws):
+            """A call from Python found no compiled version: compile, or run as Python.
+
+            In ``background`` mode (:mod:`serialkin._background`) the kernel is queued for
+            compilation and this call runs its Python source; in ``wait`` mode, or for
+            arguments numba passes specially (keywords, omitted defaults), numba compiles
+            it here as usual.
+            """
+            if kws or _background.mode() == "wait" or \
+                    any(isinstance(a, OmittedArg) for a in args):
+                return super()._compile_for_args(*args, **kws)
+            self._compilation_chain_init_hook()
+            sig = tuple(self.typeof_pyval(a) for a in args)
+            return _background.entry(self, sig, args)[0]
+
+    _Dispatcher.__module__ = __name__
+    _Dispatcher.__qualname__ = "_Dispatcher"
+    globals()["_Dispatcher"] = _Dispatcher  # pickled by reference
+
+    def fma_intrinsic(typingctx, a, b, c):
+        f64 = types.float64
+        sig = f64(a, b, c)
+
+        def codegen(context, builder, signature, args):
+            xs = [context.cast(builder, v, t, f64) for v, t in zip(args, signature.args)]
+            d = ir.DoubleType()
+            fn = cgutils.get_or_insert_function(builder.module,
+                                                ir.FunctionType(d, [d, d, d]), "llvm.fma.f64")
+            return builder.call(fn, xs)
+
+        return sig, codegen
+
+    fma_intrinsic.__name__ = fma_intrinsic.__qualname__ = "fma"
+    real_fma = intrinsic(fma_intrinsic)
+    _background.PYTHON_EQUIVALENTS[id(real_fma)] = _background.fma_exact
+
+    @typeof_impl.register(Kernel)
+    def _typeof_kernel(val, c):  # a Kernel numba meets as a value: its dispatcher's type
+        return typeof_impl(val.dispatcher, c)
+
+    globals()["_UserDirLocator"], globals()["_InTreeLocator"] = _install_locators()
+    return real_fma
 
 
 def _compiled(decorated):
-    """``decorated`` (a dispatcher or a decorator making one) as a :class:`_Dispatcher`."""
+    """``decorated`` (a dispatcher or a decorator making one) as a ``_Dispatcher``."""
+    import numba
+
     if isinstance(decorated, numba.core.registry.CPUDispatcher):
         decorated.__class__ = _Dispatcher
         return decorated
@@ -95,15 +256,44 @@ def _compiled(decorated):
     return decorate
 
 
+def _decorator(args: tuple, options: dict):
+    """``numba.njit(*args, **options)``, as a :class:`Kernel` while numba is not loaded."""
+    if _NUMBA:
+        import numba
+
+        return _compiled(numba.njit(*args, **options))
+
+    def make(fn):
+        with _LOCK:
+            if _NUMBA:  # loaded meanwhile (by another thread)
+                return _decorator((), options)(fn)
+            kernel = Kernel(fn, options)
+            _KERNELS.append(kernel)
+            return kernel
+
+    if len(args) == 1 and isinstance(args[0], FunctionType):
+        return make(args[0])
+    if args:  # an explicit signature compiles at once: numba is needed now
+        load_numba()
+        return _decorator(args, options)
+    return make
+
+
 def njit(*args, **options):
     """``numba.njit`` with ``fastmath=FASTMATH`` unless the caller sets ``fastmath``.
 
     Used exactly like ``numba.njit``: ``@njit``, ``@njit(cache=True, ...)`` or
     ``njit(signature, ...)``; the dispatcher resolves calls from other kernels without
-    literal types (:class:`_Dispatcher`).
+    literal types. Returns a :class:`Kernel` until numba is loaded.
     """
     options.setdefault("fastmath", set(FASTMATH))
-    return _compiled(numba.njit(*args, **options))
+    return _decorator(args, options)
+
+
+def njit_exact(*args, **options):
+    """``numba.njit`` without fast-math flags: every product and sum rounded on its own."""
+    options["fastmath"] = False
+    return _decorator(args, options)
 
 
 def entry_point(dispatcher, sig):
@@ -114,8 +304,9 @@ def entry_point(dispatcher, sig):
     nothing, so callers pass exactly those types. While the kernel compiles in the
     background (:func:`serialkin._background.entry`) it is the kernel's Python function,
     with ``final`` False: callers keep only a final entry point and ask again next time.
+    ``sig`` may be a function returning the types (called only when numba is needed).
     """
-    return _background.entry(dispatcher, tuple(sig))
+    return _background.entry(dispatcher, sig)
 
 
 def bind(template, qualname: str, **bound):
@@ -127,41 +318,18 @@ def bind(template, qualname: str, **bound):
     """
     g = dict(template.__globals__)
     g.update(bound)
+    with _LOCK:
+        if not _NUMBA:
+            _BOUND.append(g)  # its kernels become dispatchers when numba loads
+        else:  # a kernel kept in a container before numba loaded, bound now
+            for key, value in list(g.items()):
+                if type(value) is Kernel:
+                    g[key] = value.dispatcher
     fn = FunctionType(template.__code__, g, qualname)
     fn.__qualname__ = qualname
     fn.__doc__ = template.__doc__
     return fn
 
-
-def njit_exact(*args, **options):
-    """``numba.njit`` without fast-math flags: every product and sum rounded on its own."""
-    options["fastmath"] = False
-    return _compiled(numba.njit(*args, **options))
-
-
-@intrinsic
-def fma(typingctx, a, b, c):
-    """``a·b + c`` rounded once (LLVM's ``llvm.fma.f64``; one instruction with FMA3).
-
-    For kernels whose results must not depend on what LLVM chooses to contract: two code
-    paths that must agree bit for bit (one pose and a batch of poses) spell their fused
-    operations out with this and compile with ``fastmath=False``. Arguments are cast to
-    float64.
-    """
-    f64 = types.float64
-    sig = f64(a, b, c)
-
-    def codegen(context, builder, signature, args):
-        xs = [context.cast(builder, v, t, f64) for v, t in zip(args, signature.args)]
-        d = ir.DoubleType()
-        fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(d, [d, d, d]),
-                                            "llvm.fma.f64")
-        return builder.call(fn, xs)
-
-    return sig, codegen
-
-
-_background.PYTHON_EQUIVALENTS[id(fma)] = _background.fma_exact
 
 # ---------------------------------------------------------------- the cache's source stamp
 _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
@@ -302,6 +470,3 @@ def _install_locators() -> tuple[type, type]:
         classes[:0] = mine
     return classes[0], classes[1]
 
-
-#: The cache locators of serialkin's kernels.
-_UserDirLocator, _InTreeLocator = _install_locators()

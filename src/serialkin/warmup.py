@@ -234,6 +234,17 @@ def install_notice() -> None:
     """
     if _NOTICE:
         return
+    from serialkin._jit import numba_loaded, on_numba_load
+
+    if not numba_loaded():  # listen once numba is imported (import serialkin does not)
+        _NOTICE.append(None)
+        on_numba_load(_listen)
+        return
+    _listen()
+
+
+def _listen() -> None:
+    """Register the notice's numba event listener (numba is loaded)."""
     import sys
 
     from numba.core import event
@@ -272,4 +283,4 @@ def install_notice() -> None:
 
     listener = _Notice()
     event.register("numba:compile", listener)
-    _NOTICE.append(listener)
+    _NOTICE[:] = [listener]

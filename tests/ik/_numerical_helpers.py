@@ -54,3 +54,17 @@ def assert_fails_only_outside_limits(method, **options):
     res = robot.ik(T[:2, 3], method=method, seed=0, **options)
     assert not res.success and res.reason
     assert robot.within_limits(res.q)
+
+
+def assert_bounded_work(res, method, restarts, max_iter=None):
+    """The solve stopped within its budget (restarts, iterations).
+
+    At most ``restarts`` restarts and ``(restarts + 1) · max_iter`` iterations plus one
+    polishing attempt: what a wall-clock bound stood for (no hang, no runaway loop),
+    checked without a clock (timings live in ``benchmarks/``).
+    """
+    from serialkin.ik.registry import get_method
+
+    budget = max_iter if max_iter is not None else get_method(method).max_iter
+    assert res.restarts <= restarts
+    assert res.iterations <= (restarts + 2) * budget

@@ -104,17 +104,18 @@ def test_batch_readonly_inputs(ur5):
     assert np.array_equal(single.q, res.q[1])
 
 
-def test_large_batch_is_fast():
-    """1,000 UR5 targets solve in well under a second of kernel time once compiled."""
-    import time
+def test_large_batch_solves():
+    """1,000 UR5 targets: at least 99.9 % solved, each within its budget.
 
+    The speed of a large batch is measured by ``benchmarks/bench_ik.py``, not asserted.
+    """
     robot = models.ur5()
     _, targets = reachable(robot, 1000, seed=82)
-    robot.ik(targets[:2], seed=0)
-    t0 = time.perf_counter()
     res = robot.ik(targets, seed=0)
-    assert time.perf_counter() - t0 < 5.0
     assert res.success.mean() >= 0.999
+    from serialkin.ik.registry import get_method
+
+    assert (res.restarts <= get_method("lm").restarts).all() and np.isfinite(res.q).all()
 
 
 def test_batch_result_indexing_takes_one_integer():

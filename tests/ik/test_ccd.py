@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 import pytest
@@ -17,6 +16,7 @@ from serialkin.ik.heuristic_methods import characteristic_length
 from serialkin.spatial.pose import pose_error
 
 from ._numerical_helpers import (
+    assert_bounded_work,
     assert_fails_only_outside_limits,
     assert_solution,
     well_conditioned_q,
@@ -147,9 +147,8 @@ def test_sweep_never_increases_the_cost(seed, w_orient, name):
 def test_unreachable_target_fails_cleanly():
     """Out-of-reach targets: success False with a reason, finite q inside the limits, fast."""
     robot = models.planar(3, qlim=(-2.0, 2.0))
-    t0 = time.perf_counter()
     res = robot.ik([5.0, 1.0], method="ccd", tol=TOL, seed=0, restarts=3)
-    assert time.perf_counter() - t0 < 5.0
+    assert_bounded_work(res, "ccd", 3)
     assert not res.success
     assert "no configuration" in res.reason
     assert np.isfinite(res.q).all() and robot.within_limits(res.q)
@@ -205,9 +204,8 @@ def test_partial_position_mask():
 def test_workspace_boundary_target(target):
     """A target at full reach (stretched, singular arm) is approached without NaN or error."""
     robot = models.planar(3)
-    t0 = time.perf_counter()
     res = robot.ik(target, method="ccd", tol=TOL, seed=1, restarts=2)
-    assert time.perf_counter() - t0 < 5.0
+    assert_bounded_work(res, "ccd", 2)
     assert np.isfinite(res.q).all()
     # convergence is sublinear at the boundary (documented): millimetres, not micrometres
     assert res.position_error < 1e-2

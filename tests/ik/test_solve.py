@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -129,16 +127,13 @@ def test_same_seed_same_answer(panda):
 def test_unreachable_target_fails_cleanly(puma):
     """A target beyond the reach: success False, a reason, finite in-limit best q, bounded."""
     T = transl(3.0, 0.0, 0.5)
-    t0 = time.perf_counter()
     res = puma.ik(T, seed=0, restarts=20, max_iter=50)
-    elapsed = time.perf_counter() - t0
     assert not res.success
     assert "no configuration within" in res.reason
     assert "the target is out of reach: it is 3.04 m from joint 1" in res.reason
     assert np.isfinite(res.q).all() and puma.within_limits(res.q)
     assert res.iterations <= 21 * 50 + 50  # attempts, then the lm polish
     assert res.restarts == 20
-    assert elapsed < 5.0
     # the best attempt is a genuine attempt: closer than the reach allows is impossible
     assert res.position_error > 3.0 - 1.0
 

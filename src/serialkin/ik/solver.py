@@ -470,8 +470,6 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
     (about 0.2 µs for six arguments); it does not check dtypes, layouts or shapes, so
     :func:`_fast` does.
     """
-    import numba
-
     from serialkin._jit import entry_point
 
     if not isinstance(robot, Robot) or method not in available_methods():
@@ -485,10 +483,15 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
     cfgs = [_kernel_config(spec, tgt, DEFAULT_TOL, spec.max_iter, spec.restarts, True,
                            use, spec.options) for use in (False, True)]
     S = K.pack_fast(robot.chain.F, robot.chain.meta, a.box, cfgs[0], cfgs[1], ROTATION_TOL)
-    f64, Array = numba.float64, numba.types.Array
-    vec = Array(f64, 1, "C")
-    sig = (Array(f64, 1, "C", readonly=True), Array(f64, 2, "C"), vec, numba.int64,
-           numba.types.boolean, vec)
+
+    def sig() -> tuple:  # numba's types, imported only when the kernel is loaded
+        import numba
+
+        f64, Array = numba.float64, numba.types.Array
+        vec = Array(f64, 1, "C")
+        return (Array(f64, 1, "C", readonly=True), Array(f64, 2, "C"), vec, numba.int64,
+                numba.types.boolean, vec)
+
     function, final = entry_point(spec.kernel.solve_fast, sig)
     entry = (spec, function, S, np.zeros(robot.n), (8,), spec.name)
     if final:  # else its Python function while it compiles: ask again next call

@@ -68,19 +68,23 @@ def _resolve(name: str) -> Any:
     nonzero code: the fast paths then take the general one, which raises the library's
     error.
     """
-    import numba
-
     from serialkin._jit import entry_point
 
-    f64, Array = numba.float64, numba.types.Array
-    vec, P = Array(f64, 1, "A"), Array(f64, 3, "C", readonly=True)
-    flag = numba.types.boolean
-    dispatcher, sig = {
-        "_FK1": (K.fk_one, (vec, P, Array(f64, 2, "C"))),
-        "_JAC1": (K.jacobian_one, (vec, P, Array(f64, 2, "C"))),
-        "_HESS1": (K.hessian_one, (vec, P, flag, Array(f64, 3, "C"))),
-        "_JDOT1": (K.jacobian_dot_one, (vec, P, vec, flag, Array(f64, 2, "C"))),
-    }[name]
+    def sig() -> tuple:  # numba's types, imported only when the kernel is loaded
+        import numba
+
+        f64, Array = numba.float64, numba.types.Array
+        vec, P = Array(f64, 1, "A"), Array(f64, 3, "C", readonly=True)
+        flag = numba.types.boolean
+        return {
+            "_FK1": (vec, P, Array(f64, 2, "C")),
+            "_JAC1": (vec, P, Array(f64, 2, "C")),
+            "_HESS1": (vec, P, flag, Array(f64, 3, "C")),
+            "_JDOT1": (vec, P, vec, flag, Array(f64, 2, "C")),
+        }[name]
+
+    dispatcher = {"_FK1": K.fk_one, "_JAC1": K.jacobian_one, "_HESS1": K.hessian_one,
+                  "_JDOT1": K.jacobian_dot_one}[name]
     found, final = entry_point(dispatcher, sig)
     if final:  # else the Python function while it compiles: ask again next call
         globals()[name] = found

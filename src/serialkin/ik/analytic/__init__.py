@@ -582,16 +582,18 @@ def _packed_entry(code: int, refine: bool) -> Any:
     output.
     """
     if (code, refine) not in _SOLVE_PACKED:
-        import numba
-
         from serialkin._jit import entry_point
         from serialkin.ik.analytic.dispatch import for_class
 
-        Array = numba.types.Array
-        f64, i64 = numba.float64, numba.int64
-        sig = (Array(f64, 2, "C"), Array(i64, 1, "C", readonly=True),
-               Array(f64, 1, "C", readonly=True), Array(numba.boolean, 1, "C", readonly=True),
-               Array(f64, 2, "C"))
+        def sig() -> tuple:  # numba's types, imported only when the kernel is loaded
+            import numba
+
+            Array = numba.types.Array
+            f64, i64 = numba.float64, numba.int64
+            return (Array(f64, 2, "C"), Array(i64, 1, "C", readonly=True),
+                    Array(f64, 1, "C", readonly=True),
+                    Array(numba.boolean, 1, "C", readonly=True), Array(f64, 2, "C"))
+
         found, final = entry_point(for_class(code, refine).solve_packed, sig)
         if not final:  # its Python function while it compiles: ask again next call
             return found
