@@ -70,23 +70,29 @@ def fma_exact(a: float, b: float, c: float) -> float:
 
     The product is split exactly into ``p + e`` (Dekker's two-product with Veltkamp's
     splitting, ``p = fl(a·b)``), and ``math.fsum`` rounds ``p + e + c`` correctly, so the
-    result equals IEEE-754 ``fusedMultiplyAdd(a, b, c)`` for finite arguments whose
-    product neither overflows nor underflows below 2⁻⁹⁶⁹; otherwise ``a·b + c``.
+    result equals IEEE-754 ``fusedMultiplyAdd(a, b, c)`` when ``1e-290 < |a·b| < 1e300``,
+    ``|a|, |b| < 1e290`` and ``c`` is finite; otherwise (products near underflow or
+    overflow, NaN, ±inf) ``a·b + c``. Python 3.13's ``math.fma`` is used when present.
     """
     a, b, c = float(a), float(b), float(c)
     p = a * b
-    if not (math.isfinite(p) and math.isfinite(c)) or p == 0.0 or abs(p) > 1e300 \
-            or abs(p) < 1e-290:
+    if not (1e-290 < abs(p) < 1e300 and abs(a) < 1e290 and abs(b) < 1e290
+            and abs(c) < 1.7e308):
         return p + c
-    split = 134217729.0  # 2**27 + 1
-    t = split * a
+    t = 134217729.0 * a  # 2**27 + 1
     ah = t - (t - a)
     al = a - ah
-    t = split * b
+    t = 134217729.0 * b
     bh = t - (t - b)
     bl = b - bh
-    e = ((ah * bh - p) + ah * bl + al * bh) + al * bl
-    return math.fsum((p, e, c))
+    return _fsum((p, ((ah * bh - p) + ah * bl + al * bh) + al * bl, c))
+
+
+_fsum = math.fsum
+if hasattr(math, "fma"):  # pragma: no cover - Python >= 3.13
+    def fma_exact(a: float, b: float, c: float, _fma=math.fma) -> float:  # noqa: F811
+        """``a·b + c`` rounded once (Python's ``math.fma``; see the fallback above)."""
+        return _fma(float(a), float(b), float(c))
 
 
 _PYTHON: dict[int, tuple[object, FunctionType]] = {}
