@@ -11,6 +11,7 @@ Quick start::
 """
 
 from serialkin import errors, ik, models, spatial
+from serialkin._version import __version__ as __version__
 from serialkin.errors import SerialkinError
 from serialkin.ik import IKResult
 from serialkin.model import DHLink, Joint, Robot
@@ -29,4 +30,3 @@ __all__ = [
     "models",
     "spatial",
 ]
-__version__ = "0.1.0"

@@ -147,8 +147,8 @@ def test_ur5_self_collision_works_out_of_the_box():
 
 def test_allowed_pairs_round_trip_through_dicts_and_robot_files(tmp_path):
     """A model's allowed pairs survive to_dicts/from_dicts and a robot file; unknown names fail."""
-    from serialkin.collision.model import CollisionModel
     from serialkin.errors import InputError
+    from serialkin.model.collision_model import CollisionModel
     from serialkin.model.robotfile import load_robot_file, save_robot_file
 
     robot = models.get("ur5")

@@ -114,13 +114,25 @@ def test_fast_path_declines_other_types_and_shapes():
 
 
 def test_robot_pickles_after_fast_solves():
-    """A robot that has used the fast path pickles (its IK caches are left out) and solves alike."""
+    """A robot that has used the fast path pickles and solves alike; its entries die with it.
+
+    The solver keeps its prepared entries per robot (``solver._FAST_ENTRIES``), never on
+    the robot (issue 28): a pickled copy carries none, and a dropped robot leaves none.
+    """
+    import gc
     import pickle
+
+    from serialkin.ik import solver
 
     ur5 = models.ur5()
     T = np.ascontiguousarray(ur5.fk(ur5.random_q(seed=3)))
     ref = ur5.ik(T, seed=4)
-    assert ur5._ik_fast  # the fast path prepared its entry on the robot
+    assert solver._FAST_ENTRIES.get(ur5)  # the fast path prepared its entry
+    assert "_ik_fast" not in vars(ur5)
     copy = pickle.loads(pickle.dumps(ur5))
-    assert copy._ik_fast == {}
+    assert solver._FAST_ENTRIES.get(copy) is None
     assert _same(copy.ik(T, seed=4), ref)
+    before = len(solver._FAST_ENTRIES)
+    del copy
+    gc.collect()
+    assert len(solver._FAST_ENTRIES) == before - 1

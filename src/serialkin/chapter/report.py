@@ -391,14 +391,14 @@ def build_metadata() -> list[tuple[str, str]]:
 
     import numba
 
-    import serialkin
+    from serialkin._version import __version__
 
     try:
         from importlib.metadata import version
 
         sk_version = version("serialkin")
     except Exception:  # noqa: BLE001 - not installed: fall back to the module's attribute
-        sk_version = serialkin.__version__
+        sk_version = __version__
     commit = "not available (not a git checkout)"
     try:
         here = Path(__file__).resolve().parent

@@ -4,7 +4,8 @@
   (sphere, capsule, box, half-space);
 * :mod:`~serialkin.collision.shapes` — scene shapes (boxes, half-spaces, and the obstacles
   of :mod:`serialkin.redundancy.obstacles`);
-* :mod:`~serialkin.collision.model` — :class:`CollisionModel`, capsules per body per frame;
+* :class:`CollisionModel` — capsules per body per frame (defined in
+  :mod:`serialkin.model.collision_model`: a robot carries it);
 * :mod:`~serialkin.collision.fit` — capsules fitted to link geometry (meshes, primitives),
   with the fitting error;
 * :mod:`~serialkin.collision.robots` — fitted models of built-in robots;
@@ -20,7 +21,6 @@ from serialkin.collision.acm import (
     sampled_acm,
 )
 from serialkin.collision.fit import FitReport, ShapeFit, collision_model_from_geometry
-from serialkin.collision.model import CollisionModel
 from serialkin.collision.queries import (
     Clearance,
     in_collision,
@@ -38,6 +38,10 @@ from serialkin.collision.robots import (
 )
 from serialkin.collision.shapes import Box, HalfSpace
 from serialkin.collision.srdf import Srdf, read_srdf
+from serialkin.model.collision_model import CollisionModel
+from serialkin.model.robot import provide
+
+provide("fit_collision", collision_model_from_geometry)  # Robot.fit_collision calls it
 
 __all__ = [
     "AllowedCollisionMatrix",

@@ -22,9 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from serialkin._checks import as_generator, check_int, check_real
-from serialkin.collision.model import CollisionModel
 from serialkin.collision.srdf import Srdf, read_srdf
 from serialkin.errors import InputError, RobotDefinitionError
+from serialkin.model.collision_model import CollisionModel
 
 __all__ = ["AllowedCollisionMatrix", "acm_from_srdf", "default_acm", "sampled_acm"]
 

@@ -45,8 +45,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from serialkin._checks import check_choice, check_int, check_real
-from serialkin.collision.model import CollisionModel
 from serialkin.errors import InputError, InputTypeError, RobotDefinitionError
+from serialkin.model.collision_model import CollisionModel
 
 __all__ = ["GAP_DIRECTIONS", "FitReport", "ShapeFit", "bounding_capsule", "capsule_volume",
            "collision_model_from_geometry", "fit_points", "fit_shape", "max_gap"]

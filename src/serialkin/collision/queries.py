@@ -29,10 +29,10 @@ import numpy as np
 from serialkin._checks import check_real
 from serialkin.collision.acm import AllowedCollisionMatrix, default_acm
 from serialkin.collision.kernels import _box_sd, _segment_box_t, segment_distance
-from serialkin.collision.model import CollisionModel
 from serialkin.collision.shapes import encode_scene
 from serialkin.errors import InputError
 from serialkin.kinematics import parallel
+from serialkin.model.collision_model import CollisionModel
 
 from .._jit import njit
 

@@ -41,7 +41,7 @@ import dataclasses
 
 import numpy as np
 
-from serialkin.collision.model import CollisionModel
+from serialkin.model.collision_model import CollisionModel
 
 __all__ = ["iiwa7_collision_model", "panda_collision_model", "planar_collision_model",
            "puma560_collision_model", "scara_collision_model", "stanford_collision_model",

@@ -2,7 +2,7 @@
 
 :class:`ModelCollisionAvoidance` is the velocity-damper constraint of
 :class:`~serialkin.diffik.constraints.CollisionAvoidance` for a
-:class:`~serialkin.collision.model.CollisionModel` (the fitted capsules and spheres per
+:class:`~serialkin.model.collision_model.CollisionModel` (the fitted capsules and spheres per
 link frame that ``robot.collision`` carries, e.g. the zoo's Panda and UR5) against scene
 shapes (spheres, capsules, z-cylinders, boxes, half-spaces of
 :mod:`serialkin.collision.shapes`) and between the robot's own bodies (pairs checked by
@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from serialkin._checks import check_positive
+from serialkin._memo import PerObject
 from serialkin.collision import kernels as CK
 from serialkin.collision.queries import shapes_to_world
 from serialkin.diffik.constraints import Constraint
@@ -184,7 +185,7 @@ class ModelCollisionAvoidance(Constraint):
     Attributes:
         scene: scene shapes in the world frame (``Sphere``, ``Capsule``, ``Circle``,
             ``Box``, ``HalfSpace``), or ().
-        model: the :class:`~serialkin.collision.model.CollisionModel`; None uses the
+        model: the :class:`~serialkin.model.collision_model.CollisionModel`; None uses the
             robot's ``robot.collision``.
         acm: allowed-collision matrix for the self pairs (default: the model's default).
         self_collision: add rows for the checked self pairs.
@@ -203,7 +204,7 @@ class ModelCollisionAvoidance(Constraint):
     safety: float = 0.01
     influence: float = 0.05
     gain: float = 0.5
-    _cache: dict = field(default_factory=dict, init=False, repr=False)
+    _cache: PerObject = field(default_factory=PerObject, init=False, repr=False)
 
     is_box = False
 
@@ -219,8 +220,8 @@ class ModelCollisionAvoidance(Constraint):
                              f"{self.safety:g} m, got {self.influence:g} m")
 
     def _state(self, robot):
-        st = self._cache.get(id(robot))
-        if st is not None and st[0] is robot:
+        st = self._cache.get(robot)
+        if st is not None:
             return st
         from serialkin.collision.queries import _check_model, checked_shape_pairs
 
@@ -239,7 +240,8 @@ class ModelCollisionAvoidance(Constraint):
               np.ascontiguousarray(pa, dtype=np.int64), np.ascontiguousarray(pb, dtype=np.int64),
               np.empty((robot.n + 1, 4, 4)), np.empty((rows, robot.n)), np.empty(rows),
               np.empty(total), np.empty(rows, dtype=np.int64))
-        self._cache = {id(robot): st}
+        self._cache = PerObject()  # the latest robot's state only
+        self._cache.set(robot, st)
         self._check_base(robot, model, st)
         return st
 

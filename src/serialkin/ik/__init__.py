@@ -14,7 +14,13 @@ from serialkin.ik.analytic import classify, ik_all
 from serialkin.ik.compare import CompareTable, compare
 from serialkin.ik.registry import METHODS, MethodSpec, available_methods, register_method
 from serialkin.ik.result import IKResult
-from serialkin.ik.solver import DEFAULT_TOL, IKProblem, solve
+from serialkin.ik.solver import DEFAULT_TOL, IKProblem, _fast, solve
+from serialkin.model.robot import provide
+
+# Robot.ik and Robot.ik_all call these (the model layer imports nothing above it)
+provide("ik", solve)
+provide("ik_fast", _fast)
+provide("ik_all", ik_all)
 
 __all__ = [
     "CompareTable",

@@ -16,13 +16,13 @@ respect joint limits by clamping each joint update to its range.
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from serialkin._checks import MAX_ITERATIONS, check_int, check_positive
+from serialkin._memo import PerObject
 from serialkin.ik import ccd as _ccd
 from serialkin.ik import fabrik as _fabrik
 from serialkin.ik.registry import MethodSpec, register_method
@@ -34,14 +34,11 @@ _CLAMP = (
 )
 
 #: Per robot: characteristic length [m] (CCD orientation weight) and FABRIK plane data.
-_ROBOT_CACHE: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDictionary()
+_ROBOT_CACHE: PerObject[dict[str, Any]] = PerObject()
 
 
 def _cache(robot: Any) -> dict[str, Any]:
-    try:
-        return _ROBOT_CACHE.setdefault(robot, {})
-    except TypeError:  # not weak-referenceable: no caching
-        return {}
+    return _ROBOT_CACHE.setdefault(robot, dict)
 
 
 def characteristic_length(robot: Any) -> float:

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from serialkin._checks import MAX_ITERATIONS, ROTATION_TOL, check_int, short_repr
+from serialkin._memo import PerObject
 from serialkin.errors import InputError, InputTypeError
 from serialkin.ik import _kernels as K
 from serialkin.ik.registry import _REGISTRY, MethodSpec, available_methods, get_method
@@ -463,7 +464,7 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
 
     ``(spec, entry point of solve_fast, S, zeros (n,), the strides (8,) of a contiguous q0,
     method name)``,
-    kept in ``robot._ik_fast[method]``: ``S`` the packed constants
+    kept in ``_FAST_ENTRIES`` per robot and method: ``S`` the packed constants
     (:func:`~serialkin.ik._kernels.pack_fast`) and the compiled entry point of the
     method's ``solve_fast`` for a read-only ``S``, C (4, 4) target, C (n,) q0 and q, an
     int64 seed and a bool. Calling the entry point skips numba's per-call type dispatch
@@ -495,10 +496,13 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
     function, final = entry_point(spec.kernel.solve_fast, sig)
     entry = (spec, function, S, np.zeros(robot.n), (8,), spec.name)
     if final:  # else its Python function while it compiles: ask again next call
-        robot._ik_fast[method] = entry
+        _FAST_ENTRIES.setdefault(robot, dict)[method] = entry
     return entry
 
 
+#: The fast path's prepared entries, per robot: {method: entry} (:func:`_fast_entry`).
+_FAST_ENTRIES: PerObject[dict[str, tuple]] = PerObject()
+_NO_ENTRIES: dict[str, tuple] = {}
 _NEW = object.__new__
 _SIGN = 1 << 63
 _F64 = np.dtype(np.float64)
@@ -532,7 +536,7 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
         if target.shape != (4, 4) or target.dtype.kind != "f":
             return None
         target = np.ascontiguousarray(target, dtype=np.float64)
-    ent = robot._ik_fast.get(method)
+    ent = _FAST_ENTRIES.get(robot, _NO_ENTRIES).get(method)
     # the method's spec, looked up directly (an entry exists only once the registry has
     # been discovered): a re-registered method gets a new entry
     if ent is None or ent[0] is not _REGISTRY.get(method):

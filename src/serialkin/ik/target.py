@@ -20,12 +20,12 @@ Accepted targets:
 from __future__ import annotations
 
 import math
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
 
 from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
+from serialkin._memo import PerObject
 from serialkin.errors import InputError
 from serialkin.ik._kernels import (  # noqa: F401 (re-export)
     inside_limits,
@@ -70,7 +70,7 @@ class RobotArrays:
     box: np.ndarray
 
 
-_ARRAYS: weakref.WeakKeyDictionary[Robot, RobotArrays] = weakref.WeakKeyDictionary()
+_ARRAYS: PerObject[RobotArrays] = PerObject()
 
 
 def robot_arrays(robot: Robot) -> RobotArrays:
@@ -85,7 +85,7 @@ def robot_arrays(robot: Robot) -> RobotArrays:
         a = RobotArrays(lo=box[0], hi=box[1], slo=box[2], shi=box[3], revolute=revolute, box=box)
         for x in (a.revolute, a.box):
             x.setflags(write=False)
-        _ARRAYS[robot] = a
+        _ARRAYS.set(robot, a)
     return a
 
 

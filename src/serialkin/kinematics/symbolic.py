@@ -28,15 +28,17 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import sympy as sp
 
 from serialkin._checks import as_generator, check_choice, check_int
 from serialkin.errors import InputError, InputTypeError
-from serialkin.model.dh import DHLink
-from serialkin.model.robot import Robot
+
+if TYPE_CHECKING:  # kinematics sits below model: a Robot is read, never imported
+    from serialkin.model.dh import DHLink
+    from serialkin.model.robot import Robot
 
 PARAM_MODES = ("none", "lengths", "all")
 TASKS = ("position", "planar", "planar_pose")
@@ -399,7 +401,7 @@ def derive(robot: Robot, *, params: str = "none", simplify: bool = True,
         InputTypeError: ``robot`` is not a Robot.
         InputError: unknown ``params`` mode, or ``params`` on a robot without DH table.
     """
-    if not isinstance(robot, Robot):
+    if not all(hasattr(robot, a) for a in ("n", "joints", "dh", "convention", "chain")):
         raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
     check_choice(params, "params", PARAM_MODES)
     q = tuple(sp.Symbol(f"{q_name}_{i + 1}", real=True) for i in range(robot.n))

@@ -95,19 +95,34 @@ _SOLVE: Any = None
 _FAST_IK: Any = None
 
 
-def _ik_solve() -> tuple[Any, Any]:
-    """Resolve (once) :func:`serialkin.ik.solve` and its fast path for :meth:`Robot.ik`.
+_PROVIDED: dict[str, Any] = {}
 
-    ``ik`` sits above ``model`` in the layers, so it is imported on first use rather than
-    at import time, and not again on every call (that cost 0.5 µs per solve); the common
-    call (a pose array, ``q0`` and ``seed`` at most) goes straight to the fast path
-    without building keyword dictionaries (another 0.5 µs).
+
+def provide(name: str, function: Any) -> None:
+    """Register ``function`` as what :class:`Robot`'s method ``name`` calls.
+
+    ``Robot.ik``, ``ik_all`` and ``fit_collision`` are conveniences over functions of the
+    layers above ``model`` (``ik``, ``collision``). The model layer imports nothing above
+    it: each of those packages registers its functions here when it is imported
+    (``serialkin/ik/__init__.py``, ``serialkin/collision/__init__.py``), and importing any
+    ``serialkin`` module imports them all. Names: ``"ik"`` (:func:`serialkin.ik.solve`),
+    ``"ik_fast"`` (its fast path), ``"ik_all"``, ``"fit_collision"``.
     """
     global _SOLVE, _FAST_IK
-    from serialkin.ik.solver import _fast, solve
+    _PROVIDED[name] = function
+    if name == "ik":
+        _SOLVE = function
+    elif name == "ik_fast":
+        _FAST_IK = function
 
-    _SOLVE, _FAST_IK = solve, _fast
-    return solve, _fast
+
+def _provided(name: str) -> Any:
+    """The function registered for ``name`` (:func:`provide`)."""
+    function = _PROVIDED.get(name)
+    if function is None:  # only while serialkin itself is still being imported
+        raise RuntimeError(f"Robot.{name.removesuffix('_fast')} is provided by a serialkin "
+                           "package not imported yet: import serialkin first")
+    return function
 
 
 def _out_array(out: object, shape: tuple[int, ...]) -> np.ndarray:
@@ -147,7 +162,7 @@ class Robot:
             prismatic one (``joint_types`` holds the same as 'R'/'P').
         chain: the compiled chain arrays (:class:`~serialkin.model.chain.Chain`: ``F``,
             ``L``, ``meta``, ``packed``) that compiled kernels of other subpackages take.
-        collision: the robot's :class:`~serialkin.collision.model.CollisionModel`
+        collision: the robot's :class:`~serialkin.model.collision_model.CollisionModel`
             (capsules and spheres per link frame) or None; set with :meth:`with_collision`.
     """
 
@@ -204,16 +219,6 @@ class Robot:
         self._P = self.chain.packed
         self._qshape = (self.n,)
         self._jshape = (6, self.n)
-        #: the IK fast path's prepared entries per method (``serialkin.ik.solver._fast``),
-        #: kept here so that they live and die with the robot (never pickled: they hold
-        #: compiled entry points)
-        self._ik_fast: dict[str, tuple] = {}
-
-    def __getstate__(self) -> dict[str, Any]:
-        """The robot's state for pickling (e.g. to Dask workers), without the IK caches."""
-        state = dict(self.__dict__)
-        state["_ik_fast"] = {}
-        return state
 
     # ------------------------------------------------------------------ constructors
     @classmethod
@@ -330,7 +335,7 @@ class Robot:
         """A copy of this robot carrying ``model`` as its collision model (None removes it).
 
         Args:
-            model: a :class:`~serialkin.collision.model.CollisionModel` whose body frames
+            model: a :class:`~serialkin.model.collision_model.CollisionModel` whose body frames
                 are frames of this robot (0..n), or None.
 
         Raises:
@@ -338,7 +343,7 @@ class Robot:
             InputError: a body is fixed to a frame this robot does not have.
         """
         if model is not None:
-            from serialkin.collision.model import CollisionModel
+            from serialkin.model.collision_model import CollisionModel
 
             if not isinstance(model, CollisionModel):
                 raise InputTypeError(f"model must be a CollisionModel or None, got "
@@ -372,9 +377,7 @@ class Robot:
             InputError: the robot has no geometry of that kind.
             RobotDefinitionError: a mesh file is missing or corrupt.
         """
-        from serialkin.collision.fit import collision_model_from_geometry
-
-        model, report = collision_model_from_geometry(
+        model, report = _provided("fit_collision")(
             self, kind, max_capsules=max_capsules, loose=loose, gain=gain, merge=merge)
         return self.with_collision(model), report
 
@@ -815,10 +818,10 @@ class Robot:
         that is also collision-free (needs :attr:`collision`; see docs/ik.md).
         """
         if not options and type(target) is _NDARRAY and type(method) is str:
-            res = (_FAST_IK or _ik_solve()[1])(self, target, method, q0, seed)
+            res = (_FAST_IK or _provided("ik_fast"))(self, target, method, q0, seed)
             if res is not None:  # the common call, answered as solve would (same bits)
                 return res
-        return (_SOLVE or _ik_solve()[0])(self, target, method, q0=q0, seed=seed, **options)
+        return (_SOLVE or _provided("ik"))(self, target, method, q0=q0, seed=seed, **options)
 
     def ik_all(self, target: object, **options: Any) -> Any:
         """Every IK solution inside the limits (see :func:`serialkin.ik.analytic.ik_all`).
@@ -827,9 +830,7 @@ class Robot:
         (padded rows and a count per target). Options: ``tol``, ``all_turns``, ``free``,
         ``near_tol``, ``grid``, ``reference``, ``weights``, ``norm``, ``report``.
         """
-        from serialkin.ik.analytic import ik_all
-
-        return ik_all(self, target, **options)
+        return _provided("ik_all")(self, target, **options)
 
     # ------------------------------------------------------------------ display
     def __repr__(self) -> str:

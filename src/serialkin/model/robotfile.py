@@ -256,8 +256,8 @@ def _geometry_field(f: Field, n: int, units: tuple[str, str], resolve: Any) -> t
 
 
 def _collision_field(f: Field, n: int, length_unit: str, source: str) -> Any:
-    """The ``collision`` list as a :class:`~serialkin.collision.model.CollisionModel`."""
-    from serialkin.collision.model import CollisionModel
+    """The ``collision`` list as a :class:`~serialkin.model.collision_model.CollisionModel`."""
+    from serialkin.model.collision_model import CollisionModel
 
     lin = LENGTH_UNITS[length_unit]
     b = _bound(MAX_LENGTH, lin)
@@ -560,7 +560,7 @@ _CAPSULE_FIELDS = ("units", "source", "collision")
 
 def collision_from_dict(data: object, origin: str = "<collision model>",
                         frames: int | None = None) -> Any:
-    """A :class:`~serialkin.collision.model.CollisionModel` from a capsule-file mapping.
+    """A :class:`~serialkin.model.collision_model.CollisionModel` from a capsule-file mapping.
 
     A capsule file holds only a collision model, for robots that cannot be saved as robot
     files (a URDF robot) or to share capsules between files::
@@ -599,7 +599,7 @@ def load_collision_file(path: str | os.PathLike[str], robot: Any = None) -> Any:
         robot: if given, frames are checked against its frames 0..n.
 
     Returns:
-        The :class:`~serialkin.collision.model.CollisionModel` (metres); attach it with
+        The :class:`~serialkin.model.collision_model.CollisionModel` (metres); attach it with
         ``robot.with_collision(model)``.
 
     Raises:
@@ -618,7 +618,7 @@ def save_collision_file(model: Any, path: str | os.PathLike[str], *,
     """
     from serialkin._checks import check_choice
     from serialkin._io import write_text_atomic
-    from serialkin.collision.model import CollisionModel
+    from serialkin.model.collision_model import CollisionModel
 
     if not isinstance(model, CollisionModel):
         raise InputTypeError(f"model must be a CollisionModel, got {type(model).__name__}")

@@ -301,7 +301,7 @@ def _collision_model(robot: Robot, collision: object) -> Any:
         model = collision
     if model is None:
         return None
-    from serialkin.collision.model import CollisionModel
+    from serialkin.model.collision_model import CollisionModel
 
     if not isinstance(model, CollisionModel):
         raise InputTypeError(f"collision must be None, a bool or a CollisionModel, got "
@@ -388,7 +388,7 @@ def viewer_data(
     frame/body/a/b/radius, the checked shape ``pairs``, ``show``), ``points`` (None, or
     count, label, base64 positions and colours).
     """
-    from serialkin import __version__
+    from serialkin._version import __version__
 
     Q = _trajectory(robot, trajectory)
     P = _path_points(path_points)
@@ -504,7 +504,7 @@ def viewer_html(
         mesh_budget: most triangles of all embedded meshes together (>= 4); larger
             meshes are decimated (about 12 bytes of page per triangle).
         collision: the capsule model checked and drawn: None = :attr:`Robot.collision`
-            (if any), a :class:`~serialkin.collision.model.CollisionModel`, or False
+            (if any), a :class:`~serialkin.model.collision_model.CollisionModel`, or False
             for none (True requires the robot's own).
         acm: the :class:`~serialkin.collision.acm.AllowedCollisionMatrix` whose pairs are
             skipped (default :func:`~serialkin.collision.acm.default_acm`).

@@ -131,8 +131,8 @@ def _section_4(ctx: ReportContext) -> Section:
         rows_3.append((seed, *(np.round(np.degrees(res.q), 2)),
                        float(np.linalg.norm(three.fk(res.q)[:2, 3] - target)),
                        "yes" if res.success else "no"))
-    from serialkin import Robot
     from serialkin.model.dh import DHLink
+    from serialkin.model.robot import Robot
 
     arm = Robot.from_dh([DHLink(a=a, alpha=al, d=d) for a, al, d in zip(*ARM16)],
                         name="general 6R")
