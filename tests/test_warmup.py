@@ -52,9 +52,9 @@ def test_warmup_runs_a_feature_in_a_process_of_its_own():
 
 
 _NOTICE_SCRIPT = textwrap.dedent("""
-    from serialkin.model.limits import turn_mod, wrap_angle
+    from serialkin.model.limits import turn_mod, wrap_into
     turn_mod(7.0)      # two kernels of the same feature: one notice
-    wrap_angle(7.0, -3.2, 3.2)
+    wrap_into(7.0, -3.2, 3.2)
 """)
 
 

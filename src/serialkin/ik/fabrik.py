@@ -58,6 +58,7 @@ from serialkin.errors import NotSupportedError
 from serialkin.ik._kernels import MAX_ITER, RUNNING, stopping_test
 from serialkin.ik.ccd import _axis_point, _clamp_angle_step
 from serialkin.kinematics.kernels import fk_into, jacobian_into
+from serialkin.spatial.kernels import wrap_pi
 
 from .._jit import njit
 
@@ -110,12 +111,6 @@ def fabrik_domain(robot: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np
     e1 /= np.linalg.norm(e1)
     e2 = np.cross(a, e1)
     return a, e1, e2, sign
-
-
-@njit(cache=True)
-def _wrap(x):
-    """Angle wrapped to (−π, π]."""
-    return math.atan2(math.sin(x), math.cos(x))
 
 
 @njit(cache=True)
@@ -250,7 +245,7 @@ def fabrik_pass(q, F, meta, T_target, pos_sel, use_orient, a, e1, e2, sign, lo, 
             new = math.atan2(P[i + 1, 1] - P[i, 1], P[i + 1, 0] - P[i, 0])
         else:
             new = prev_new + (old - prev_old)  # zero-length segment: keep its joint angle
-        rel = _wrap((new - prev_new) - (old - prev_old))
+        rel = wrap_pi((new - prev_new) - (old - prev_old))
         step = _clamp_angle_step(sign[i] * rel, q[i], lo[i], hi[i])
         q[i] += step
         # the clamped joint fixes this segment's actual direction for the next one

@@ -76,7 +76,7 @@ from serialkin.ik._kernels import (
 from serialkin.ik.registry import MethodSpec, register_method
 from serialkin.kinematics.dls import dls_step_into, factored_solve_into, spd_solve_into
 from serialkin.kinematics.kernels import fk_into
-from serialkin.model.limits import wrap_angle as interval_wrap
+from serialkin.model.limits import wrap_into
 from serialkin.spatial.kernels import pose_error_into
 
 from .._jit import njit
@@ -196,7 +196,7 @@ def step_lm(q, J, e, cost, p, ctx, ws, dq):
             x = q[i] + dq[i]
             if free[i] == 0.0 or (x >= lo[i] and x <= hi[i]):
                 continue
-            if revolute[i] != 0 and not math.isnan(interval_wrap(x, lo[i], hi[i])):
+            if revolute[i] != 0 and not math.isnan(wrap_into(x, lo[i], hi[i])):
                 continue  # a 2π shift brings it inside: not blocked
             if (x < lo[i] and q[i] <= lo[i] + 1e-12) or (x > hi[i] and q[i] >= hi[i] - 1e-12):
                 free[i] = 0.0

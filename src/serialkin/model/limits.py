@@ -3,7 +3,7 @@
 Every use of joint limits in serialkin goes through this module: validation of a
 ``(lower, upper)`` pair (:func:`check_interval`), membership (:func:`inside`,
 :func:`inside_mask`), clamping (:func:`clamp`), moving an angle into the interval by
-whole turns (:func:`wrap_angle`), projection onto the interval (:func:`project`), the
+whole turns (:func:`wrap_into`), projection onto the interval (:func:`project`), the
 tidy representative of a final configuration (:func:`normalize`) and the finite box
 that random configurations are drawn from (:func:`sampling_box`).
 
@@ -171,7 +171,7 @@ def turn_mod(t):
 
 
 @njit(cache=True)
-def wrap_angle(x, lo, hi):
+def wrap_into(x, lo, hi):
     """An angle ``x + 2πk`` inside ``[lo, hi]``, or NaN when the interval holds none.
 
     ``x`` itself when it is inside; else the smallest such angle when ``lo`` is finite,
@@ -192,14 +192,14 @@ def wrap_angle(x, lo, hi):
 def project(x, lo, hi, revolute):
     """Projection of joint value ``x`` onto ``[lo, hi]``.
 
-    A revolute joint is first moved by whole turns (:func:`wrap_angle`, same pose); when
+    A revolute joint is first moved by whole turns (:func:`wrap_into`, same pose); when
     no turn brings it inside, it is set to the end nearer on the circle. A prismatic joint
     is clamped.
     """
     if x >= lo and x <= hi:
         return x
     if revolute:
-        y = wrap_angle(x, lo, hi)
+        y = wrap_into(x, lo, hi)
         if not math.isnan(y):
             return y
         y = lo + turn_mod(x - lo)  # lo and hi are finite here: y in (hi, lo + 2π)
@@ -221,7 +221,7 @@ def normalize(x, lo, hi, revolute):
     if not revolute or not abs(x) <= TIDY_MAX:
         return x
     if not (x >= lo and x <= hi):
-        y = wrap_angle(x, lo, hi)
+        y = wrap_into(x, lo, hi)
         return x if math.isnan(y) else y
     if math.isfinite(lo) and math.isfinite(hi):
         return x

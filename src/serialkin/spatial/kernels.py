@@ -34,6 +34,17 @@ NEAR_PI_COS = -0.9
 
 
 @njit(cache=True)
+def wrap_pi(x):
+    """The angle ``x`` [rad] wrapped to (−π, π]: ``((x + π) mod 2π) − π``, −π sent to π.
+
+    The compiled scalar form of :func:`serialkin.spatial.wrap_angle` (same formula, same
+    results).
+    """
+    w = (x + math.pi) % (2.0 * math.pi) - math.pi
+    return math.pi if w == -math.pi else w
+
+
+@njit(cache=True)
 def _so3_log_parts(r00, r01, r02, r10, r11, r12, r20, r21, r22):
     """Rotation vector ω = θ·a of a rotation matrix given by its 9 entries (row major).
 

@@ -46,7 +46,12 @@ GIMBAL_TOL = 1e-14
 
 
 def wrap_angle(angle: object) -> np.ndarray:
-    """Wrap angle(s) [rad] to the interval (−π, π]. Shape preserved."""
+    """Wrap angle(s) [rad] to the interval (−π, π]. Shape preserved.
+
+    ``((a + π) mod 2π) − π``, with −π sent to π; the compiled scalar form is
+    :func:`serialkin.spatial.kernels.wrap_pi`. (Moving an angle by whole turns into a
+    joint's limits is another idea: :func:`serialkin.model.limits.wrap_into`.)
+    """
     a = as_float_array(angle, "angle")
     w = np.remainder(a + np.pi, 2.0 * np.pi) - np.pi
     return np.where(w == -np.pi, np.pi, w)

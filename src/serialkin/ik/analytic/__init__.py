@@ -78,6 +78,7 @@ from serialkin.ik.analytic.structure import (
 )
 from serialkin.ik.analytic.subproblems import rigid_error
 from serialkin.model.robot import Robot
+from serialkin.spatial.rotations import wrap_angle
 
 #: Spherical-wrist classes: (arm code, joint 3 prismatic) for ``solve_spherical_wrist``.
 _WRIST_ARMS = {"puma": (0, False), "pieper_intersecting": (1, False), "stanford": (1, True),
@@ -498,7 +499,7 @@ def _with_general(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
                    REFINE_TOL * g.s.scale, REFINE_TOL, out, conv)
     rows = [r for r in sols]
     for r in out[:k]:
-        d = np.abs((np.array(rows) - r + np.pi) % (2 * np.pi) - np.pi).max(axis=1) \
+        d = np.abs(wrap_angle(np.array(rows) - r)).max(axis=1) \
             if rows else np.array([np.inf])
         if d.min() > 1e-7:
             rows.append(r)
