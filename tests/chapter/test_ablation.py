@@ -14,15 +14,10 @@ import numpy as np
 import pytest
 
 from serialkin.chapter.report import ReportContext
-from serialkin.chapter.sections.redundancy import (
-    ABLATION,
-    ablation,
-    eq48_by_hand,
-    task_activity,
-    timed_run,
-)
+from serialkin.chapter.sections.redundancy import eq48_by_hand, timed_run
 from serialkin.redundancy import clearances
 from serialkin.tracking import load_scenario
+from serialkin.tracking.analysis import ABLATION, ablation, compare_row, task_activity
 
 DEG = np.pi / 180.0
 
@@ -161,3 +156,17 @@ def test_twenty_link_timing_is_of_the_warm_kind():
     assert timing.warm and timing.n == 2 and timing.low <= timing.median <= timing.high
     again = sc.run()  # the function the report times, run twice more: the same result
     np.testing.assert_array_equal(tr.q, again.q)
+
+
+def test_compare_row_summarises_a_trajectory(runs):
+    """The library's resolver summary (tracking.analysis.compare_row) reads the trajectory."""
+    _, by = runs
+    tr = by["all tasks"].trajectory
+    row = compare_row("eq 48", tr)
+    assert row.seconds is None and row.per_point is None
+    assert row.max_error == pytest.approx(tr.max_error)
+    assert row.unreached == int((~tr.reached).sum()) == 0
+    assert row.min_clearance == pytest.approx(tr.min_clearance)
+    assert row.worst_margin == pytest.approx(tr.min_limit_margin) and row.worst_margin > 0
+    timed = compare_row("eq 48", tr, seconds=2.0)
+    assert timed.per_point == pytest.approx(2.0 / len(tr))

@@ -138,7 +138,7 @@ def test_chapter_side_by_side_reports_both_runs(tmp_path, scenario, qp_run):
     ctx = ReportContext(outdir=tmp_path, quiet=True)
     weighted, wt = redundancy.timed_run(ctx, scenario, repeat=1)
     rows = redundancy.side_by_side(ctx, scenario, weighted, wt, repeat=1)
-    w, q = rows
+    (w, _), (q, _) = rows
     assert q.min_clearance == pytest.approx(qp_run.min_clearance)
     assert q.worst_margin >= 0.0 and q.min_clearance > 0.0 and q.unreached == 0
     assert w.min_clearance == pytest.approx(weighted.min_clearance)

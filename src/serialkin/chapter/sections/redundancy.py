@@ -18,9 +18,7 @@ joint limits and collision constraints (:mod:`serialkin.diffik`).
 
 from __future__ import annotations
 
-import dataclasses
 import html
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -38,6 +36,14 @@ from serialkin.redundancy import (
 from serialkin.redundancy.multitask import smoothstep
 from serialkin.redundancy.obstacles import robot_segments
 from serialkin.tracking import load_scenario
+from serialkin.tracking.analysis import (
+    AblationRun,
+    ResolverRun,
+    ablation,
+    compare_row,
+    qp_resolver,
+    task_activity,
+)
 from serialkin.tracking.scenario import Scenario, planar_arm
 
 DEG = 180.0 / np.pi
@@ -75,15 +81,6 @@ EQ = {
     "56": r"\mathbf{J}_{s_{ci}} = \frac{\partial\mathbf{s}_{ci}}{\partial\mathbf{q}}",
 }
 
-#: Each secondary task of eq 48 and the solver setting that switches it off.
-ABLATION: tuple[tuple[str, dict[str, float]], ...] = (
-    ("all tasks", {}),
-    ("without the obstacle task", {"obstacle_weight": 0.0}),
-    ("without the joint-limit task", {"joint_limit_weight": 0.0}),
-    ("without the singularity task", {"singularity_damping": 0.0}),
-)
-
-
 # ---------------------------------------------------------------------------------- helpers
 def timed_run(ctx: ReportContext, scenario: Any, repeat: int = 5) -> tuple[Any, Timing]:
     """Run ``scenario.run()`` once untimed (warm-up: compilation, caches), then time it.
@@ -99,96 +96,6 @@ def timed_run(ctx: ReportContext, scenario: Any, repeat: int = 5) -> tuple[Any, 
     timing = ctx.timing(run, warmup=1, repeat=repeat)
     del runs[1:]  # every run gives the same trajectory; keep the warm-up's
     return runs[0], timing
-
-
-def limit_violation(robot: Any, q: np.ndarray) -> float:
-    """Largest excursion of any joint beyond its limits over all rows of q [rad]; 0 inside."""
-    lim = np.asarray(robot.qlim, dtype=float)
-    with np.errstate(invalid="ignore"):
-        over = np.maximum(q - lim[:, 1], lim[:, 0] - q)
-    over = np.where(np.isnan(over), -np.inf, over)
-    return float(max(over.max(), 0.0))
-
-
-@dataclass(frozen=True)
-class AblationRun:
-    """One run of the ablation: the scenario with some secondary tasks of eq 48 switched off.
-
-    Attributes:
-        label: e.g. "without the joint-limit task".
-        scenario: the scenario run (its resolver with the task's weight set to 0).
-        trajectory: the tracked trajectory.
-        max_joint_difference: largest |q − q_full| over steps and joints [rad].
-        min_clearance: smallest link-obstacle clearance over the path [m] (< 0: collision).
-        limit_violation: largest excursion beyond a joint limit [rad] (0: none).
-        max_error: largest tracking error [m].
-        unreached: path points missed by more than the tolerance.
-    """
-
-    label: str
-    scenario: Any
-    trajectory: Any
-    max_joint_difference: float
-    min_clearance: float
-    limit_violation: float
-    max_error: float
-    unreached: int
-
-
-def ablation(scenario: Scenario, full: Any = None) -> list[AblationRun]:
-    """Run the scenario with all tasks and with each secondary task of eq 48 switched off.
-
-    Args:
-        scenario: a scenario whose solver is a ``MultiTaskResolver``.
-        full: the trajectory of the unchanged scenario when already computed.
-
-    Returns:
-        One :class:`AblationRun` per entry of :data:`ABLATION`, the full run first.
-    """
-    out: list[AblationRun] = []
-    ref = full
-    for label, change in ABLATION:
-        if not change and ref is not None:
-            s, tr = scenario, ref
-        else:
-            s = dataclasses.replace(scenario, solver=scenario.solver.with_options(**change))
-            tr = s.run()
-        ref = tr if ref is None else ref
-        out.append(AblationRun(
-            label=label, scenario=s, trajectory=tr,
-            max_joint_difference=float(np.abs(tr.q - ref.q).max()),
-            min_clearance=tr.min_clearance, limit_violation=limit_violation(s.robot, tr.q),
-            max_error=tr.max_error, unreached=int((~tr.reached).sum())))
-    return out
-
-
-def task_activity(scenario: Scenario, trajectory: Any) -> dict[str, np.ndarray]:
-    """Weight or activity of each secondary task of eq 48 at every path point, (p,) each.
-
-    * ``obstacle``: the largest obstacle weight ``W_c · σ((d_infl − c)/d_infl)``.
-    * ``limit``: the largest eq 49 weight ``W_Li`` over the joints; ``limit_joint`` its joint
-      (1-based, 0 when no weight).
-    * ``manipulability``: w = √det(JJᵀ) of the task rows (eq 43).
-    * ``singularity``: the added damping ``λ_s = λ_s,max (1 − w/w₀)`` when w < w₀ [m].
-    """
-    res = scenario.solver
-    tr = trajectory
-    infl = np.array([o.influence for o in scenario.obstacles], dtype=float)
-    if tr.clearance.size:
-        s = (infl[None, :] - tr.clearance) / np.where(infl > 0, infl, 1.0)[None, :]
-        obst = (res.obstacle_weight * smoothstep(s)).max(axis=1)
-    else:
-        obst = np.zeros(len(tr))
-    lim = np.asarray(scenario.robot.qlim, dtype=float)
-    WL = np.array([joint_limit_weights(q, lim, buffer=res.limit_buffer,
-                                       max_weight=res.joint_limit_weight) for q in tr.q])
-    w = np.asarray(scenario.robot.manipulability(tr.q, res.task), dtype=float)
-    w0 = res.manipulability_threshold
-    sing = (res.singularity_damping * np.clip(1.0 - w / w0, 0.0, 1.0) if w0 > 0
-            else np.zeros(len(tr)))
-    return {"obstacle": obst, "limit": WL.max(axis=1),
-            "limit_joint": np.where(WL.max(axis=1) > 0, WL.argmax(axis=1) + 1, 0),
-            "manipulability": w, "singularity": sing}
 
 
 def eq48_by_hand(scenario: Scenario, q: np.ndarray, xdot: np.ndarray) -> dict[str, Any]:
@@ -807,65 +714,29 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
                    html="".join(parts))
 
 
-@dataclass(frozen=True)
-class SideBySide:
-    """One row of the eq 48 / QP comparison on the constrained 20-link scenario.
-
-    Attributes:
-        label: the run's name.
-        trajectory: the tracked trajectory.
-        timing: warm wall-clock time of the whole path.
-        max_error: largest tracking error [m].
-        unreached: points outside the tolerance.
-        min_clearance: smallest link-obstacle clearance over the path [m] (< 0: collision).
-        worst_margin: smallest distance of any joint to its nearer limit [rad] (< 0: out).
-        per_point: median time per path point [s].
-    """
-
-    label: str
-    trajectory: Any
-    timing: Timing
-    max_error: float
-    unreached: int
-    min_clearance: float
-    worst_margin: float
-    per_point: float
-
-
-def qp_resolver(scenario: Scenario):
-    """The QP settings of the side-by-side run (a :class:`~serialkin.diffik.QPResolver`).
-
-    The scenario's task and obstacles, safety distance 2 mm, damper gain 0.5, joint jumps
-    between path points bounded by 0.2 rad.
-    """
-    from serialkin.diffik.resolver import QPResolver
-
-    return QPResolver(task=scenario.path.task, obstacles=scenario.obstacles, safety=0.002,
-                      collision_gain=0.5, max_joint_step=0.2)
-
-
 def side_by_side(ctx: ReportContext, scenario: Scenario, weighted: Any, weighted_time: Timing,
-                 repeat: int = 2) -> list[SideBySide]:
-    """Eq 48 (the given run) and the QP (run here, warm-up + ``repeat`` timed) on one scenario."""
+                 repeat: int = 2) -> list[tuple[ResolverRun, Timing]]:
+    """Eq 48 (the given run) and the QP (run here, warm-up + ``repeat`` timed) on one scenario.
+
+    Rows of :func:`serialkin.tracking.analysis.compare_row`, each with the report's timing.
+    """
     from dataclasses import replace
 
     qp_scenario = replace(scenario, solver=qp_resolver(scenario), options={})
     tq, tqt = timed_run(ctx, qp_scenario, repeat=repeat)
-    out = []
-    for label, tr, t in (("weighted tasks, eq 48 (soft)", weighted, weighted_time),
-                         ("QP with hard constraints", tq, tqt)):
-        out.append(SideBySide(label, tr, t, tr.max_error, int((~tr.reached).sum()),
-                              tr.min_clearance, tr.min_limit_margin,
-                              t.median / max(len(tr), 1)))
-    return out
+    return [(compare_row("weighted tasks, eq 48 (soft)", weighted, weighted_time.median),
+             weighted_time),
+            (compare_row("QP with hard constraints", tq, tqt.median), tqt)]
 
 
-def _qp_part(ctx: ReportContext, sc: Scenario, rows: list[SideBySide]) -> Section:
+def _qp_part(ctx: ReportContext, sc: Scenario,
+             timed: list[tuple[ResolverRun, Timing]]) -> Section:
     import matplotlib.pyplot as plt
 
     from serialkin.viz import plot_motion
 
     res = qp_resolver(sc)
+    rows = [r for r, _ in timed]
     w, q = rows
     parts = [
         "<p>The weighted tasks of eq 48 make obstacles and joint limits <em>soft</em>: a "
@@ -891,7 +762,7 @@ def _qp_part(ctx: ReportContext, sc: Scenario, rows: list[SideBySide]) -> Sectio
     table = [(r.label, f"{len(r.trajectory) - r.unreached}/{len(sc.path)}", _mm(r.max_error),
               _mm(r.min_clearance), f"{r.worst_margin * DEG:.2f}",
               f"{int(r.trajectory.iterations.sum())}", f"{r.per_point * 1e3:.3g} ms",
-              r.timing.text) for r in rows]
+              t.text) for r, t in timed]
     parts.append(ctx.table(table, ["run", "reached (±5 mm)", "max tracking error [mm]",
                                    "min clearance [mm] (negative: collision)",
                                    "worst joint-limit margin [°] (negative: outside)",
