@@ -59,6 +59,7 @@ from typing import Any
 import numpy as np
 
 from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
+from serialkin._memo import PerObject
 from serialkin.errors import InputError, NoClosedFormError
 from serialkin.ik.analytic.dispatch import (
     GENERAL,
@@ -87,8 +88,7 @@ _WRIST_ARMS = {"puma": (0, False), "pieper_intersecting": (1, False), "stanford"
 __all__ = ["CLASSES", "AllSolutions", "classify", "ik_all", "sort_by_reference",
            "structure_of"]
 
-_STRUCTURES: weakref.WeakKeyDictionary[Robot, Structure | NoClosedFormError] = \
-    weakref.WeakKeyDictionary()
+_STRUCTURES: PerObject[Structure | NoClosedFormError] = PerObject()
 
 
 class _Prepared:
@@ -138,8 +138,7 @@ class _Prepared:
             a.setflags(write=False)
 
 
-_PREPARED: weakref.WeakKeyDictionary[Robot, dict[float, _Prepared]] = \
-    weakref.WeakKeyDictionary()
+_PREPARED: PerObject[dict[float, _Prepared]] = PerObject()
 
 
 def structure_of(robot: Robot) -> Structure:
@@ -156,7 +155,7 @@ def structure_of(robot: Robot) -> Structure:
             s = analyse(robot)
         except NoClosedFormError as exc:
             s = exc
-        _STRUCTURES[robot] = s
+        _STRUCTURES.set(robot, s)
     if isinstance(s, NoClosedFormError):
         raise NoClosedFormError(str(s))
     return s
@@ -180,9 +179,7 @@ def _prepared(robot: Robot, near_tol: float = 0.0) -> _Prepared:
     """
     if not isinstance(robot, Robot):
         raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
-    cache = _PREPARED.get(robot)
-    if cache is None:
-        cache = _PREPARED[robot] = {}
+    cache = _PREPARED.setdefault(robot, dict)
     p = cache.get(near_tol)
     if p is not None:
         return p
@@ -375,9 +372,7 @@ def _locked(robot: Robot, free: object) -> tuple[Robot, np.ndarray, np.ndarray]:
     idx_a = np.array(idx, dtype=np.int64)[order]
     vals_a = np.array(vals)[order]
     key = (tuple(idx_a.tolist()), tuple(vals_a.tolist()))
-    cache = _LOCKED.get(robot)
-    if cache is None:
-        cache = _LOCKED[robot] = {}
+    cache = _LOCKED.setdefault(robot, dict)
     if key in cache:
         return cache[key], idx_a, vals_a
     joints = list(robot.joints)
@@ -406,7 +401,7 @@ def _locked(robot: Robot, free: object) -> tuple[Robot, np.ndarray, np.ndarray]:
     return reduced, idx_a, vals_a
 
 
-_LOCKED: weakref.WeakKeyDictionary[Robot, dict] = weakref.WeakKeyDictionary()
+_LOCKED: PerObject[dict] = PerObject()  # per robot: {locked joints: reduced robot}
 
 
 def _insert_locked(sols: np.ndarray, idx: np.ndarray, vals: np.ndarray, n: int) -> np.ndarray:
@@ -484,7 +479,7 @@ def _with_general(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
     """
     from serialkin.ik.analytic.dispatch import solve_into
 
-    cache = _PREPARED.setdefault(robot, {})
+    cache = _PREPARED.setdefault(robot, dict)
     g = cache.get(-1.0)
     if g is None:
         try:
