@@ -694,16 +694,15 @@ def robot_from_mjcf(path_or_string: str | os.PathLike[str], base_body: str | Non
                 f"{short_repr(bodies[end].name)}")
         tool = places[sb][1] @ bodies[sb].sites[tool_site]
     name = root.get("model") or "mjcf_robot"
-    robot = Robot(joints, base=base_T, tool=tool, name=name,
-                  source=f"MJCF {source} ({bodies[path_ids[0]].name} -> {bodies[end].name}"
-                         + (f", site {tool_site}" if tool_site else "") + ")")
-    robot.link_names = tuple(link_names)
-    robot.geometry = tuple(
+    geometry = tuple(
         LinkGeometry(bodies[b].name, frame,
                      tuple(_posed(s, T) for s in bodies[b].visual),
                      tuple(_posed(s, T) for s in bodies[b].collision))
         for b, (frame, T) in sorted(places.items()))
-    return robot
+    return Robot(joints, base=base_T, tool=tool, name=name,
+                 source=f"MJCF {source} ({bodies[path_ids[0]].name} -> {bodies[end].name}"
+                        + (f", site {tool_site}" if tool_site else "") + ")",
+                 link_names=tuple(link_names), geometry=geometry)
 
 
 def _posed(shape: Shape, T: np.ndarray) -> Shape:

@@ -176,6 +176,9 @@ class Robot:
         dh: Sequence[DHLink] | None = None,
         convention: str | None = None,
         source: str = "",
+        link_names: Sequence[str] | None = None,
+        geometry: Sequence[LinkGeometry] = (),
+        collision: object = None,
     ) -> None:
         if isinstance(joints, (str, bytes, Mapping)) or not isinstance(joints, Sequence):
             raise RobotDefinitionError(
@@ -201,11 +204,12 @@ class Robot:
         self.convention = convention
         self.source = source
         #: link names (base..tip) when known, e.g. from a URDF; else None.
-        self.link_names: tuple[str, ...] | None = None
+        self.link_names: tuple[str, ...] | None = \
+            None if link_names is None else tuple(link_names)
         #: visual and collision shapes per link (:mod:`serialkin.model.geometry`)
-        self.geometry: tuple[LinkGeometry, ...] = ()
+        self.geometry: tuple[LinkGeometry, ...] = tuple(geometry)
         #: capsule/sphere collision model (:mod:`serialkin.collision`), or None
-        self.collision: Any = None
+        self.collision: Any = None if collision is None else self._checked_collision(collision)
         self.qlim = np.array([j.qlim for j in joints], dtype=float)
         self.joint_types = tuple(j.type for j in joints)
         self.revolute = np.array([t == "R" for t in self.joint_types], dtype=bool)
@@ -219,6 +223,27 @@ class Robot:
         self._P = self.chain.packed
         self._qshape = (self.n,)
         self._jshape = (6, self.n)
+        self._frozen = True
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        """A built robot is immutable: setting an attribute warns (and will raise).
+
+        Everything is given to the constructor (``link_names``, ``geometry``,
+        ``collision`` included) or changed by a copy (:meth:`with_tool`,
+        :meth:`with_base`, :meth:`with_limits`, :meth:`with_collision`). For one release
+        an assignment still works, with a DeprecationWarning.
+        """
+        if getattr(self, "_frozen", False):
+            import warnings
+
+            warnings.warn(f"Robot is immutable: setting {name!r} is deprecated and will raise "
+                          "in the next release; pass it to Robot(...) or use a with_* copy",
+                          DeprecationWarning, stacklevel=2)
+        object.__setattr__(self, name, value)
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """Unpickling sets the state without the immutability warning."""
+        self.__dict__.update(state)
 
     # ------------------------------------------------------------------ constructors
     @classmethod
@@ -320,42 +345,41 @@ class Robot:
         return robot_to_urdf(self)
 
     def _copy(self, **changes: Any) -> Robot:
-        """A new robot with some constructor arguments changed (link names, geometry kept)."""
+        """A new robot with some constructor arguments changed (the others kept)."""
         args: dict[str, Any] = dict(joints=self.joints, base=self.base, tool=self.tool,
                                     name=self.name, dh=self.dh, convention=self.convention,
                                     source=self.source)
+        args.update(link_names=self.link_names, geometry=self.geometry,
+                    collision=self.collision)
         args.update(changes)
-        robot = Robot(args.pop("joints"), **args)
-        robot.link_names = self.link_names
-        robot.geometry = self.geometry
-        robot.collision = self.collision
-        return robot
+        return Robot(args.pop("joints"), **args)
 
     def with_collision(self, model: object) -> Robot:
         """A copy of this robot carrying ``model`` as its collision model (None removes it).
 
         Args:
-            model: a :class:`~serialkin.model.collision_model.CollisionModel` whose body frames
-                are frames of this robot (0..n), or None.
+            model: a :class:`~serialkin.model.collision_model.CollisionModel` whose body
+                frames are frames of this robot (0..n), or None.
 
         Raises:
             InputTypeError: ``model`` is neither a CollisionModel nor None.
             InputError: a body is fixed to a frame this robot does not have.
         """
-        if model is not None:
-            from serialkin.model.collision_model import CollisionModel
+        return self._copy(collision=model)
 
-            if not isinstance(model, CollisionModel):
-                raise InputTypeError(f"model must be a CollisionModel or None, got "
-                                     f"{type(model).__name__} {short_repr(model)}")
-            frames = np.asarray(model.body_frames)
-            if frames.size and int(frames.max()) > self.n:
-                i = int(np.argmax(frames > self.n))
-                raise InputError(f"model body {model.body_names[i]!r} is fixed to frame "
-                                 f"{int(frames[i])} but robot {self.name!r} has frames 0..{self.n}")
-        robot = self._copy()
-        robot.collision = model
-        return robot
+    def _checked_collision(self, model: object) -> Any:
+        """``model`` if it is a CollisionModel on this robot's frames (see with_collision)."""
+        from serialkin.model.collision_model import CollisionModel
+
+        if not isinstance(model, CollisionModel):
+            raise InputTypeError(f"model must be a CollisionModel or None, got "
+                                 f"{type(model).__name__} {short_repr(model)}")
+        frames = np.asarray(model.body_frames)
+        if frames.size and int(frames.max()) > self.n:
+            i = int(np.argmax(frames > self.n))
+            raise InputError(f"model body {model.body_names[i]!r} is fixed to frame "
+                             f"{int(frames[i])} but robot {self.name!r} has frames 0..{self.n}")
+        return model
 
     def fit_collision(self, kind: str = "collision", *, max_capsules: int = 3,
                       loose: float = 1.5, gain: float = 0.8,

@@ -351,8 +351,8 @@ def robot_from_dict(data: object, origin: str = "<robot description>",
         resolve = MeshResolver(base_dir, {}, search, strict=True,
                                nowhere="nowhere: give mesh_path, or load the robot file "
                                        "from its folder")
-        robot.geometry = _geometry_field(doc["geometry"], robot.n,
-                                         (angle_unit, length_unit), resolve)
+        robot = robot._copy(geometry=_geometry_field(doc["geometry"], robot.n,
+                                                     (angle_unit, length_unit), resolve))
     elif doc["mesh_path"].present:
         doc["mesh_path"].items(max_len=1000, what="a list of folders")
     if doc["collision"].present:

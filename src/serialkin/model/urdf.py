@@ -262,16 +262,16 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
         raise RobotDefinitionError(
             f"{source}: no moving joint between {short_repr(base)} and {short_repr(tip)}"
         )
-    robot = Robot(out, tool=fixed, name=root.get("name") or "urdf_robot",
-                  source=f"URDF {source} ({base} -> {tip})")
-    robot.link_names = tuple(link_names) + ((tip,) if link_names[-1] != tip else ())
     folder = None if source == "<string>" else Path(source).resolve().parent
     places = _link_frames(base, chain, children, by_child)
     resolver = MeshResolver(folder, package_map or {}, search_path, resolve_meshes)
-    robot.geometry = tuple(
+    geometry = tuple(
         _link_geometry(el, places[el.get("name")], source, resolver)
         for el in root.findall("link") if el.get("name") in places)
-    return robot
+    return Robot(out, tool=fixed, name=root.get("name") or "urdf_robot",
+                 source=f"URDF {source} ({base} -> {tip})",
+                 link_names=tuple(link_names) + ((tip,) if link_names[-1] != tip else ()),
+                 geometry=geometry)
 
 
 def _link_frames(base: str, chain: list[_UJoint], children: dict[str, list[str]],

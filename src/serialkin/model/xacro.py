@@ -186,5 +186,4 @@ def robot_from_xacro(path_or_string: str | os.PathLike[str], base_link: str | No
         msg = str(exc)
         raise type(exc)(msg.replace("<string>", label, 1) if msg.startswith("<string>")
                         else f"{label}: {msg}") from None
-    robot.source = robot.source.replace("URDF <string>", f"xacro {source}", 1)
-    return robot
+    return robot._copy(source=robot.source.replace("URDF <string>", f"xacro {source}", 1))

@@ -74,9 +74,8 @@ def scara(
     from serialkin.collision.robots import scara_collision_model
 
     robot = Robot.from_dh(rows, "standard", name="scara", source=SCARA_SOURCE)
-    robot.collision = scara_collision_model(float(d1), float(d2), l1, l2,
-                                            (float(q3_range[0]), float(q3_range[1])))
-    return robot
+    return robot.with_collision(scara_collision_model(
+        float(d1), float(d2), l1, l2, (float(q3_range[0]), float(q3_range[1]))))
 
 
 def two_link(l1: float = 1.0, l2: float = 1.0) -> Robot:

@@ -90,8 +90,7 @@ def puma560() -> Robot:
     from serialkin.collision.robots import puma560_collision_model
 
     robot = Robot.from_dh(rows, "standard", name="puma560", source=PUMA560_SOURCE)
-    robot.collision = puma560_collision_model()  # a fresh robot: no copy needed
-    return robot
+    return robot.with_collision(puma560_collision_model())
 
 
 def stanford() -> Robot:
@@ -119,8 +118,7 @@ def stanford() -> Robot:
     from serialkin.collision.robots import stanford_collision_model
 
     robot = Robot.from_dh(rows, "standard", name="stanford", source=STANFORD_SOURCE)
-    robot.collision = stanford_collision_model()
-    return robot
+    return robot.with_collision(stanford_collision_model())
 
 
 def ur5() -> Robot:
@@ -188,5 +186,4 @@ def iiwa7() -> Robot:
     from serialkin.collision.robots import iiwa7_collision_model
 
     robot = Robot.from_dh(rows, "standard", name="iiwa7", source=IIWA7_SOURCE)
-    robot.collision = iiwa7_collision_model()
-    return robot
+    return robot.with_collision(iiwa7_collision_model())

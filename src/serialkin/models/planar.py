@@ -80,5 +80,4 @@ def planar(
     from serialkin.collision.robots import planar_collision_model
 
     robot = Robot.from_dh(rows, "standard", name=name or f"planar{n}", source=PLANAR_SOURCE)
-    robot.collision = planar_collision_model(L)  # a fresh robot: no copy needed
-    return robot
+    return robot.with_collision(planar_collision_model(L))
