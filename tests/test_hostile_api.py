@@ -118,7 +118,7 @@ def test_interval_helpers(lo, width, open_hi, x):
     hi = np.inf if open_hi else (lo + width if math.isfinite(lo) else 20.0 - width)
     if lo == -np.inf and hi == np.inf:
         hi = 5.0
-    w = L.wrap_angle(x, lo, hi)
+    w = L.wrap_into(x, lo, hi)
     if not math.isnan(w):
         assert lo <= w <= hi
         assert math.isclose(math.cos(w), math.cos(x), abs_tol=1e-9)
@@ -446,3 +446,11 @@ def test_superlinear_methods_refuse_the_longest_chains():
         sk.models.planar(300).ik([1.0, 1.0], method="powell")
     res = r.ik([0.5, 0.5], method="dls", max_iter=5, restarts=0, seed=0)
     assert res.q.shape == (1500,)
+
+
+def test_the_old_interval_wrap_name_warns():
+    from serialkin.model import limits
+
+    with pytest.warns(DeprecationWarning, match="wrap_into"):
+        old = limits.wrap_angle
+    assert old is limits.wrap_into

@@ -374,15 +374,20 @@ def models_cmd(robot: str | None, save: str | None, angle_unit: str, length_unit
 
 
 # ---------------------------------------------------------------------------- fk
-def _fk_record(robot: Any, q: np.ndarray, frames: bool) -> dict[str, Any]:
+def _fk_records(robot: Any, Q: np.ndarray, frames: bool) -> list[dict[str, Any]]:
+    """One record per row of ``Q`` (m, n), from one batched FK call (and one fk_all)."""
     from serialkin.spatial import matrix_to_rpy
 
-    T = robot.fk(q)
-    rec: dict[str, Any] = {"q": q, "T": T, "position": T[:3, 3],
-                           "rpy": matrix_to_rpy(T[:3, :3], check=False)}
-    if frames:
-        rec["frames"] = robot.fk_all(q)
-    return rec
+    T = robot.fk(Q)
+    rpy = matrix_to_rpy(T[:, :3, :3], check=False)
+    F = robot.fk_all(Q) if frames else None
+    recs: list[dict[str, Any]] = []
+    for k, q in enumerate(Q):
+        rec: dict[str, Any] = {"q": q, "T": T[k], "position": T[k, :3, 3], "rpy": rpy[k]}
+        if F is not None:
+            rec["frames"] = F[k]
+        recs.append(rec)
+    return recs
 
 
 _FK_CMD_HELP = command_help(
@@ -413,7 +418,7 @@ def fk_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frames: boo
     """Forward kinematics: the tool pose T = base·A1(q1)···An(qn)·tool (eqs 10-11)."""
     r = resolve_robot(robot, params)
     Q = read_q(r, q_texts, q_file, degrees)
-    recs = [_fk_record(r, q, frames) for q in Q]
+    recs = _fk_records(r, Q, frames)
     data = {"robot": _robot_info(r), "units": {"length": "m", "angle": "rad"},
             "results": recs}
 
@@ -667,12 +672,13 @@ def ik_cmd(robot: str | None, targets: tuple[str, ...], target_file: str | None,
     results = _solve_all(r, tgts, method, q0v, maskv, tol, max_iter, restarts, seed,
                          not no_limits, opts, quiet)
     recs = []
+    poses = r.fk(np.array([res.q for res in results]))  # one batched FK call
     for k, (tg, res) in enumerate(zip(tgts, results)):
         recs.append({"index": k + 1, "target": tg, "success": bool(res.success), "q": res.q,
                      "position_error": float(res.position_error),
                      "orientation_error": float(res.orientation_error),
                      "iterations": int(res.iterations), "restarts": int(res.restarts),
-                     "reason": str(res.reason), "T": r.fk(res.q)})
+                     "reason": str(res.reason), "T": poses[k]})
     ok = all(rec["success"] for rec in recs)
     data = {"robot": info, "method": method, "success": ok,
             "solved": sum(rec["success"] for rec in recs), "count": len(recs),

@@ -254,3 +254,15 @@ def sampling_box(lo: np.ndarray, hi: np.ndarray, half_range: np.ndarray) -> np.n
         slo = np.where(np.isfinite(lo), lo, np.minimum(-d, hi - 2 * d))
         shi = np.where(np.isfinite(hi), hi, np.maximum(d, lo + 2 * d))
     return np.stack([slo, shi], axis=-1)
+
+
+def __getattr__(name: str):
+    """``wrap_angle``: the old name of :func:`wrap_into` (warns; removed next release)."""
+    if name == "wrap_angle":
+        import warnings
+
+        warnings.warn("serialkin.model.limits.wrap_angle is renamed wrap_into (wrapping to "
+                      "(-pi, pi] is serialkin.spatial.wrap_angle)", DeprecationWarning,
+                      stacklevel=2)
+        return wrap_into
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
