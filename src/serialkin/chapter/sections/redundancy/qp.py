@@ -1,0 +1,142 @@
+"""Section 5.3: eq 48 (soft, weighted tasks) and the differential-IK QP side by side."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from serialkin.chapter.report import ReportContext, Section, Timing
+from serialkin.chapter.sections.redundancy._common import (
+    DEG,
+    _mm,
+    _phases,
+    _shade,
+    timed_run,
+)
+from serialkin.tracking.analysis import (
+    ResolverRun,
+    compare_row,
+    qp_resolver,
+)
+from serialkin.tracking.scenario import Scenario
+
+
+def side_by_side(ctx: ReportContext, scenario: Scenario, weighted: Any, weighted_time: Timing,
+                 repeat: int = 2) -> list[tuple[ResolverRun, Timing]]:
+    """Eq 48 (the given run) and the QP (run here, warm-up + ``repeat`` timed) on one scenario.
+
+    Rows of :func:`serialkin.tracking.analysis.compare_row`, each with the report's timing.
+    """
+    from dataclasses import replace
+
+    qp_scenario = replace(scenario, solver=qp_resolver(scenario), options={})
+    tq, tqt = timed_run(ctx, qp_scenario, repeat=repeat)
+    return [(compare_row("weighted tasks, eq 48 (soft)", weighted, weighted_time.median),
+             weighted_time),
+            (compare_row("QP with hard constraints", tq, tqt.median), tqt)]
+
+
+def _qp_part(ctx: ReportContext, sc: Scenario,
+             timed: list[tuple[ResolverRun, Timing]]) -> Section:
+    import matplotlib.pyplot as plt
+
+    from serialkin.viz import plot_motion
+
+    res = qp_resolver(sc)
+    rows = [r for r, _ in timed]
+    w, q = rows
+    parts = [
+        "<p>The weighted tasks of eq 48 make obstacles and joint limits <em>soft</em>: a "
+        "large weight near contact, but nothing forbids a violation when the primary task "
+        "pulls hard enough (the ablation above shows what happens when a weight is zero). "
+        "The same scenario (c) solved by differential IK as a quadratic program "
+        "(<code>serialkin.diffik</code>, docs/diffik.md): each iteration minimises "
+        + ctx.imath(r"\tfrac12\|\mathbf{J}\Delta\mathbf{q} - \mathbf{e}\|^2 + "
+                    r"\tfrac12 w_p\|\Delta\mathbf{q} - \Delta\mathbf{q}_0\|^2 + "
+                    r"\tfrac12\mu\|\Delta\mathbf{q}\|^2")
+        + " subject to hard inequalities: the joint limits "
+        + ctx.imath(r"\mathbf{q}_m - \mathbf{q} \le \Delta\mathbf{q} \le "
+                    r"\mathbf{q}_M - \mathbf{q}")
+        + f", a step cap of {res.max_step:g} rad per iteration and {res.max_joint_step:g} rad "
+        "between path points, and one linearised distance row per link-obstacle pair within "
+        "the distance of influence (velocity damper, "
+        + ctx.imath(r"\nabla d\,\Delta\mathbf{q} \ge -\xi\,\frac{d - d_s}{d_i - d_s}")
+        + f", safety distance d_s = {res.safety * 1e3:g} mm, "
+        + ctx.imath(r"\xi = " + f"{res.collision_gain:g}" + r"\,(d_i - d_s)")
+        + "), solved by a dual active-set method (Goldfarb–Idnani) compiled into the "
+        "tracking loop.</p>",
+    ]
+    table = [(r.label, f"{len(r.trajectory) - r.unreached}/{len(sc.path)}", _mm(r.max_error),
+              _mm(r.min_clearance), f"{r.worst_margin * DEG:.2f}",
+              f"{int(r.trajectory.iterations.sum())}", f"{r.per_point * 1e3:.3g} ms",
+              t.text) for r, t in timed]
+    parts.append(ctx.table(table, ["run", "reached (±5 mm)", "max tracking error [mm]",
+                                   "min clearance [mm] (negative: collision)",
+                                   "worst joint-limit margin [°] (negative: outside)",
+                                   "iterations", "time per path point",
+                                   "whole path"]))
+    ratio = q.per_point / max(w.per_point, 1e-12)
+    reach = ("both runs reach every point" if w.unreached == 0 and q.unreached == 0 else
+             f"eq 48 misses {w.unreached} and the QP {q.unreached} points")
+    hit = ("neither collides" if min(w.min_clearance, q.min_clearance) > 0 else
+           "a link enters an obstacle in " + " and ".join(
+               r.label for r in rows if r.min_clearance <= 0))
+    parts.append(
+        f"<p>Honestly: here {reach} and {hit}. Eq 48 keeps "
+        f"a wider berth ({_mm(w.min_clearance)} mm against the QP's {_mm(q.min_clearance)} mm: "
+        "its obstacle weight starts acting at the distance of influence and pushes away, "
+        "while the QP lets a link come to the safety distance and no closer) and stays "
+        f"{w.worst_margin * DEG:.1f}° inside every limit thanks to its 10 % buffer, while "
+        "the QP runs joints right up to their limits (margin 0° is allowed, beyond is "
+        "impossible). The guarantee is the difference: the QP's limits hold by "
+        "construction for any path and any weights, eq 48's only as long as its weights "
+        f"win. Time per path point: {q.per_point * 1e3:.2g} ms for the QP against "
+        f"{w.per_point * 1e3:.2g} ms for eq 48 ({ratio:.2g}×; both run their iterations in "
+        "compiled loops, the QP with a dual active-set solver compiled with numba, which "
+        "measured 5× faster here than calling DAQP from Python each iteration; the QP "
+        f"needs {int(q.trajectory.iterations.sum())} iterations against eq 48's "
+        f"{int(w.trajectory.iterations.sum())}); timings are wall-clock medians on a shared "
+        "machine.</p>")
+    phases = _phases(sc)
+    steps = np.arange(len(w.trajectory))
+    fig, axes = plt.subplots(1, 3, figsize=(12.5, 3.8))
+    for r, color in zip(rows, ("tab:blue", "tab:red")):
+        tr = r.trajectory
+        axes[0].plot(steps, tr.clearance.min(axis=1) * 1e3, color=color, label=r.label)
+        axes[1].plot(steps, tr.limit_margin.min(axis=1) * DEG, color=color, label=r.label)
+        axes[2].plot(steps, tr.errors * 1e3, color=color, label=r.label)
+    axes[0].axhline(res.safety * 1e3, color="k", lw=0.8, ls=":")
+    axes[0].set_ylabel("smallest clearance [mm] (dotted: d_s)")
+    axes[1].set_ylabel("worst joint-limit margin [°]")
+    axes[2].axhline(sc.tolerance * 1e3, color="k", lw=1)
+    axes[2].set_ylabel("tracking error [mm]")
+    for a in axes:
+        a.axhline(0, color="k", lw=1)
+        _shade(a, phases)
+        a.set_xlabel("path point")
+        a.grid(True, alpha=0.3)
+    axes[0].legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize="small")
+    fig.subplots_adjust(wspace=0.35)
+    parts.append(ctx.figure(fig, "twenty_link_qp_vs_eq48",
+                            "Eq 48 (soft, weighted) and the QP (hard constraints) on scenario "
+                            "(c): clearance, limit margin and tracking error per path point."))
+    fig, ax = plt.subplots(figsize=(7.2, 5.6))
+    plot_motion(sc.robot, q.trajectory.q, ax, path_points=sc.path.points, every=8, q0=sc.q0,
+                obstacles=sc.obstacles, influence=True, labels=True,
+                title="20-link arm tracked by the QP (hard limits and obstacles)")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    parts.append(ctx.figure(fig, "twenty_link_qp_motion",
+                            "The QP's motion between the obstacles A-D (compare Figure 12)."))
+    parts.append(ctx.reproduce(
+        "from serialkin.diffik.resolver import QPResolver\n"
+        "from serialkin.tracking import load_scenario, track\n"
+        "sc = load_scenario('twenty_link_obstacles')\n"
+        "tr = track(sc.robot, sc.path, QPResolver(task=sc.path.task, obstacles=sc.obstacles,\n"
+        "           max_joint_step=0.2), q0=sc.q0)\n"
+        "print(tr.summary())"))
+    return Section(title="5.3 Kinematically redundant manipulators",
+                   part="Weighted tasks (eq 48) against a QP with hard constraints",
+                   equations="eq 48 against the differential-IK QP",
+                   html="".join(parts))
