@@ -82,7 +82,11 @@ class ScenarioError(InputError):
 
 def planar_arm(links: int, length: float, *, name: str | None = None,
                joint_limits_deg: object = None):
-    """An n-link planar arm with equal links (standard DH: a = length, α = d = θ = 0).
+    """An n-link planar arm with equal links, as the chapter's scenarios use it.
+
+    :func:`serialkin.models.planar` (standard DH: a = length, α = d = θ = 0) with the
+    limits given in degrees and no collision model (the scenarios' obstacles are the
+    chapter's circles, not the arm's own capsules).
 
     Args:
         links: number of revolute joints.
@@ -90,17 +94,11 @@ def planar_arm(links: int, length: float, *, name: str | None = None,
         name: robot name (default ``'planar<n>'``).
         joint_limits_deg: optional (lo, hi) for every joint or (n, 2) [deg].
     """
-    from serialkin.model.robot import Robot
+    from serialkin.models import planar
 
-    rows = [{"a": float(length), "alpha": 0.0, "d": 0.0, "theta": 0.0} for _ in range(links)]
-    robot = Robot.from_dh(rows, name=name or f"planar{links}",
-                          source="equal-link planar arm (chapter section 5.3)")
-    if joint_limits_deg is not None:
-        lim = np.radians(np.asarray(joint_limits_deg, dtype=float))
-        if lim.shape == (2,):
-            lim = np.tile(lim, (links, 1))
-        robot = robot.with_limits(lim)
-    return robot
+    qlim = None if joint_limits_deg is None else \
+        np.radians(np.asarray(joint_limits_deg, dtype=float))
+    return planar(links, float(length), qlim, name=name).with_collision(None)
 
 
 _ROOT_FIELDS = {"name", "description", "robot", "q0", "q0_deg", "path", "obstacles", "solver",
