@@ -199,7 +199,7 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
                                "serialkin track twenty_link_obstacles --out out/track",
                                shell=True))
     parts.append(ctx.reproduce(
-        "from serialkin.chapter.sections.redundancy import ablation\n"
+        "from serialkin.tracking.analysis import ablation\n"
         "from serialkin.tracking import load_scenario\n"
         "for r in ablation(load_scenario('twenty_link_obstacles')): print(r.label, "
         "r.min_clearance, r.limit_violation, r.max_error)"))
