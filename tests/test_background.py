@@ -227,3 +227,21 @@ def test_mode_reads_the_environment(monkeypatch):
                             ("bogus", "background"), (" WAIT ", "wait")]:
         monkeypatch.setenv("SERIALKIN_COMPILE", value)
         assert _background.mode() == expected
+
+
+def test_an_uncompiled_entry_point_is_never_kept(tmp_path):
+    """The fast paths keep an entry point only once it is compiled (else: Python forever)."""
+    script = """
+        import numpy as np, serialkin as sk
+        from serialkin.ik import analytic, solver
+        from serialkin.model import robot as robot_module
+        r = sk.models.get("ur5")
+        T = r.fk(np.array([0.1, 0.2, 0.3, 0.4, 0.5, 0.6]))
+        for _ in range(2):
+            assert len(r.ik_all(T)) == 8 and r.ik(T, seed=0).success
+        assert analytic._FAST.get(r) is None and solver._FAST_ENTRIES.get(r) is None
+        assert robot_module._FK1 is None
+        print("ok")
+    """
+    p = _run(script, {"SERIALKIN_COMPILE": "python", "NUMBA_CACHE_DIR": str(tmp_path)})
+    assert p.returncode == 0 and p.stdout.strip().endswith("ok"), p.stderr[-2000:]

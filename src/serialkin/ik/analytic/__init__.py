@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import weakref
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Any
@@ -561,8 +560,8 @@ def _as_poses(a: np.ndarray) -> np.ndarray:
     return T
 
 
-#: Fast-path entries per id(robot): (weak reference, entry point, I, D, B, output shape).
-_FAST: dict[int, tuple] = {}
+#: Fast-path entries per robot: (robot, entry point, I, D, B, output shape).
+_FAST: PerObject[tuple] = PerObject()
 #: The compiled entry points of each class's ``solve_packed``, by (class code, refine) (resolved on
 #: first use by :func:`_packed_entry`).
 _SOLVE_PACKED: dict[tuple[int, bool], Any] = {}
@@ -600,7 +599,7 @@ def _packed_entry(code: int, refine: bool) -> Any:
 def _fast_entry(robot: object) -> tuple:
     """The fast path's cached data for ``robot`` (default ``tol``, ``near_tol``, grid).
 
-    ``(weak reference, entry point, I, D, B, (16, n))``: the packed arguments of
+    ``(None, entry point, I, D, B, (16, n))``: the packed arguments of
     :func:`~serialkin.ik.analytic.dispatch.solve_packed` and the shape of its output.
     """
     from serialkin.ik.analytic.dispatch import pack
@@ -610,10 +609,9 @@ def _fast_entry(robot: object) -> tuple:
     I, D, B = pack(p.code, p.arm, p.prismatic3, p.W, p.P, p.M, p.aux, p.order, p.revolute,
                    p.qlim, p.mid, p.F, p.meta, p.refine, DEFAULT_GRID, 1e-8 * p.s.scale, 1e-8,
                    REFINE_TOL * p.s.scale, REFINE_TOL)
-    entry = (weakref.ref(robot), _packed_entry(p.code, p.refine), I, D, B, (MAX_ROWS, p.n))
-    if len(_FAST) > 256:
-        _FAST.clear()
-    _FAST[id(robot)] = entry
+    entry = (None, _packed_entry(p.code, p.refine), I, D, B, (MAX_ROWS, p.n))
+    if (p.code, p.refine) in _SOLVE_PACKED:  # compiled: kept (else its Python, asked again)
+        _FAST.set(robot, entry)
     return entry
 
 
@@ -690,8 +688,8 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
         # float64 pose. The rigidity check and the solve are one compiled call
         # (dispatch.solve_packed) on the robot's cached packed data; the rows are the
         # ordinary path's, bit for bit.
-        entry = _FAST.get(id(robot))
-        if entry is None or entry[0]() is not robot:
+        entry = _FAST.get(robot)
+        if entry is None:
             entry = _fast_entry(robot)
         out = _EMPTY(entry[5])
         k = entry[1](target, entry[2], entry[3], entry[4], out)
