@@ -200,7 +200,6 @@ class _Worker:
         self._pool: ThreadPoolExecutor | None = None
         self._jobs: dict[tuple[int, tuple], Future] = {}
         self._lock = threading.Lock()
-        self.running = 0  # jobs submitted and not finished
 
     def submit(self, dispatcher: Any, sig: tuple) -> Future:
         """The job compiling (or loading) ``dispatcher`` for ``sig``, queued if new."""
@@ -211,16 +210,8 @@ class _Worker:
                 if self._pool is None:
                     self._pool = ThreadPoolExecutor(1, thread_name_prefix="serialkin-compile")
                     _at_exit(self)
-                self.running += 1
-                job = self._jobs[key] = self._pool.submit(self._compile, dispatcher, sig)
+                job = self._jobs[key] = self._pool.submit(dispatcher.compile, sig)
         return job
-
-    def _compile(self, dispatcher: Any, sig: tuple) -> None:
-        try:
-            dispatcher.compile(sig)
-        finally:
-            with self._lock:
-                self.running -= 1
 
     def pending(self) -> list[Future]:
         """The jobs not finished yet."""
@@ -345,7 +336,7 @@ def entry(dispatcher: Any, sig: Any, args: tuple = ()) -> tuple[Any, bool]:
         return quietly(dispatcher), False
     job = _WORKER.submit(dispatcher, sig)
     if not job.done() and _size(args) <= BIG_ARGUMENTS \
-            and (_WORKER.running > 1 or not on_disk(dispatcher, sig)):
+            and (len(_WORKER.pending()) > 1 or not on_disk(dispatcher, sig)):
         return quietly(dispatcher), False
     job.result()
     return dispatcher.overloads[sig].entry_point, True
