@@ -46,14 +46,19 @@ parameters (the option values named by
 active set ``Z`` (n, n), ``S`` (n, n), ``idx`` (n,), ``u`` (n,)). The loop then moves
 to ``q + Δq`` projected onto the joint ranges.
 
-Why one loop compiled per method (rather than a dispatch on a method code or a step
-passed as a first-class function): numba specialises a function on the dispatcher of a
-function argument but cannot cache that specialisation across processes (every import
-would recompile the loop, seconds per method), and a dispatch on an integer needs the
-loop to know every step. :func:`compile_method` instead copies the loop's Python
-functions with the step bound as a global, under a name that carries the method's name
-and a hash of the sources, so each method's loop is cached on disk like any kernel and
-the step is a direct call that LLVM inlines.
+Why the loop is compiled with its step bound (rather than a step passed as a
+first-class function): numba specialises a function on the dispatcher of a function
+argument but cannot cache that specialisation across processes (every import would
+recompile the loop, seconds per method). :func:`compile_method` instead copies the
+loop's Python functions with the step bound as a global, under a name that carries the
+method's name and a hash of the sources, so each loop is cached on disk like any kernel
+and the step is a direct call that LLVM inlines. A loop compiled per method costs its
+compile per method (7-10 s cold each, about 2 s more for each further entry), so the
+built-in methods other than the default share loops: :func:`compile_family` binds a
+step that dispatches on a member number (``p[0]``) to the members' steps, and the loop
+and its entries compile once for the whole family. A method registered later (a user's
+step) gets a loop of its own, and the default ``lm`` keeps its own, the smallest one,
+so that a first ``robot.ik`` compiles nothing else.
 
 Joint limits (``respect`` true) are intervals whose ends may be infinite
 (:mod:`serialkin.model.limits`): after every step each joint is projected onto its
@@ -81,7 +86,7 @@ from __future__ import annotations
 
 import hashlib
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -1080,6 +1085,9 @@ class CompiledMethod:
         solve_fast: ``solve_fast(S, Tt, q0, seed, use_q0, q_out) -> (status, iterations,
             position error, orientation error, restarts)``, the single call from Python
             (:func:`_solve_fast`).
+        code: None for a method compiled alone; for a member of a family
+            (:func:`compile_family`) its number, which the caller puts first in ``p``
+            (``cfg[N_LOOP]``, the parameters after it).
     """
 
     step: object
@@ -1089,6 +1097,7 @@ class CompiledMethod:
     solve_one_collision: object = None
     solve_chunk_collision: object = None
     solve_fast: object = None
+    code: int | None = None
 
 
 def _bind(template, name: str, tag: str, **bound):
@@ -1138,3 +1147,21 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
     return CompiledMethod(step=step, params=tuple(params), solve_one=one, solve_chunk=chunk,
                           solve_one_collision=one_c, solve_chunk_collision=chunk_c,
                           solve_fast=fast)
+
+
+def compile_family(family: str, dispatch, members, *,
+                   allocates: bool = False) -> dict[str, CompiledMethod]:
+    """Several methods in one compiled loop: the loop around ``dispatch``, shared.
+
+    ``dispatch`` is a step kernel that runs the step of member ``int(p[0])`` with that
+    member's parameters ``p[1:]``; ``members`` lists ``(name, step, params)`` in the
+    order of those numbers. Each member gets a :class:`CompiledMethod` with its ``code``
+    and the family's compiled entries, so the loop, its four entries and everything
+    they call compile once for all members instead of once per member (each copy of the
+    loop takes 7-10 s to compile cold on a quiet 2-core machine, its entries about 2 s
+    more each; docs/compile-time.md). ``allocates`` as :func:`compile_method`, True when
+    any member's step allocates.
+    """
+    base = compile_method(family, dispatch, (), allocates=allocates)
+    return {name: replace(base, step=step, params=tuple(params), code=i)
+            for i, (name, step, params) in enumerate(members)}

@@ -1,8 +1,13 @@
 """Jacobian-based IK methods (chapter section 5.3), registered by name.
 
 Each method is a small step kernel written here and compiled into the shared loop of
-:mod:`serialkin.ik._kernels` (:func:`~serialkin.ik._kernels.compile_method`), so adding a
-compiled method means adding its step and its :func:`register_method` call to this file.
+:mod:`serialkin.ik._kernels`: the default ``lm`` in a loop of its own
+(:func:`~serialkin.ik._kernels.compile_method`), the others in two loops shared by
+several methods (:func:`~serialkin.ik._kernels.compile_family`: :data:`PLAIN`,
+:data:`ALLOCATING`), so that they compile once for all. Adding a built-in method means
+adding its step, its line in a family and its family step's branch, and its
+:func:`_register` call, all in this file; a user's method is one step kernel and one
+:func:`register_method` call (its own loop).
 They share the skeleton of :mod:`serialkin.ik.solver`: the same
 targets, mask, tolerance, restarts and seeding. Joint limits are respected by
 projection after every step (2π shift or nearer limit for revolute joints, clamping for
@@ -69,6 +74,7 @@ from serialkin.ik._kernels import (
     _normal,
     _pinv_step,
     _transpose_times,
+    compile_family,
     compile_method,
     project_into,
     task_cost,
@@ -382,45 +388,97 @@ def step_gauss_newton(q, J, e, cost, p, ctx, ws, dq):
     return True
 
 
-def _register(name, step, params, max_iter, restarts, options, summary, *, limits=_PROJECTION,
-              linear=False, allocates=False):
-    """Register ``name`` as the step kernel ``step`` in the shared compiled loop."""
+# ---------------------------------------------------------------- the shared loops
+# The built-in methods other than the default share two compiled loops
+# (serialkin.ik._kernels.compile_family): the steps that allocate nothing, compiled
+# without reference counting, and those that allocate (an SVD or a copy). Each family
+# step runs member number p[0] with that member's parameters p[1:]; the numbers are the
+# members' places in PLAIN and ALLOCATING.
+
+#: The members of the family that allocates nothing: (name, step, parameters).
+PLAIN = (
+    ("transpose", step_transpose, ()),
+    ("dls", step_dls, (("damping", True),)),
+    ("lm_wampler", step_lm_wampler, (("damping", True),)),
+    ("lm_chan", step_lm_chan, (("damping", True),)),
+    ("lm_sugihara", step_lm_sugihara, (("damping", True),)),
+)
+#: The members of the family whose steps allocate: (name, step, parameters).
+ALLOCATING = (
+    ("pinv", step_pinv, (("max_step", False), ("rcond", False))),
+    ("sdls", step_sdls, (("max_step", False),)),
+    ("newton", step_newton, (("rcond", False),)),
+    ("gauss_newton", step_gauss_newton, (("rcond", False),)),
+)
+
+
+@njit(cache=True)
+def step_plain(q, J, e, cost, p, ctx, ws, dq):
+    """The step of member ``p[0]`` of :data:`PLAIN`, with its parameters ``p[1:]``."""
+    code = p[0]
+    r = p[1:]
+    if code == 0.0:
+        return step_transpose(q, J, e, cost, r, ctx, ws, dq)
+    if code == 1.0:
+        return step_dls(q, J, e, cost, r, ctx, ws, dq)
+    if code == 2.0:
+        return step_lm_wampler(q, J, e, cost, r, ctx, ws, dq)
+    if code == 3.0:
+        return step_lm_chan(q, J, e, cost, r, ctx, ws, dq)
+    return step_lm_sugihara(q, J, e, cost, r, ctx, ws, dq)
+
+
+@njit(cache=True)
+def step_allocating(q, J, e, cost, p, ctx, ws, dq):
+    """The step of member ``p[0]`` of :data:`ALLOCATING`, with its parameters ``p[1:]``."""
+    code = p[0]
+    r = p[1:]
+    if code == 0.0:
+        return step_pinv(q, J, e, cost, r, ctx, ws, dq)
+    if code == 1.0:
+        return step_sdls(q, J, e, cost, r, ctx, ws, dq)
+    if code == 2.0:
+        return step_newton(q, J, e, cost, r, ctx, ws, dq)
+    return step_gauss_newton(q, J, e, cost, r, ctx, ws, dq)
+
+
+_KERNELS = {
+    **compile_family("plain", step_plain, PLAIN),
+    **compile_family("allocating", step_allocating, ALLOCATING, allocates=True),
+    "lm": compile_method("lm", step_lm, (("damping", True),)),
+}
+
+
+def _register(name, max_iter, restarts, options, summary, *, limits=_PROJECTION,
+              linear=False):
+    """Register the built-in method ``name`` with its compiled loop (``_KERNELS``)."""
     register_method(MethodSpec(
         name=name, family="jacobian", summary=summary, limits=limits,
-        max_iter=max_iter, restarts=restarts, options=options,
-        kernel=compile_method(name, step, params, allocates=allocates),
+        max_iter=max_iter, restarts=restarts, options=options, kernel=_KERNELS[name],
         max_joints=None if linear else MAX_JOINTS_CUBIC,
     ))
 
 
-_register("transpose", step_transpose, (), 5000, 5, {"stall_window": 1000},
+_register("transpose", 5000, 5, {"stall_window": 1000},
           "Jacobian transpose with the Buss/Wolovich step length (slow, linear convergence)",
           linear=True)
-_register("pinv", step_pinv, (("max_step", False), ("rcond", False)), 100, 50,
-          {"max_step": 0.5, "rcond": 1e-10, "stall_window": 20},
-          "Moore-Penrose pseudoinverse step J⁺e (eq 40), steps capped at max_step",
-          allocates=True)
-_register("dls", step_dls, (("damping", True),), 200, 50, {"damping": 0.01, "stall_window": 30},
+_register("pinv", 100, 50, {"max_step": 0.5, "rcond": 1e-10, "stall_window": 20},
+          "Moore-Penrose pseudoinverse step J⁺e (eq 40), steps capped at max_step")
+_register("dls", 200, 50, {"damping": 0.01, "stall_window": 30},
           "damped least squares Jᵀ(JJᵀ+λ²I)⁻¹e with fixed damping λ (eq 46)", linear=True)
-_register("lm", step_lm, (("damping", True),), 100, 100,
+_register("lm", 100, 100,
           {"damping": 0.03, "stall_window": 5, "stall_ratio": 0.6, "polish": True},
           "Levenberg-Marquardt, damping λE adapted to the error, limit-aware (default)",
           limits=_LIMIT_AWARE)
-_register("lm_wampler", step_lm_wampler, (("damping", True),), 200, 50,
-          {"damping": 1e-4, "stall_window": 30},
+_register("lm_wampler", 200, 50, {"damping": 1e-4, "stall_window": 30},
           "Levenberg-Marquardt with constant damping λI (Wampler)")
-_register("lm_chan", step_lm_chan, (("damping", True),), 200, 50,
-          {"damping": 1.0, "stall_window": 30},
+_register("lm_chan", 200, 50, {"damping": 1.0, "stall_window": 30},
           "Levenberg-Marquardt with error-proportional damping λE (Chan-Lawrence)")
-_register("lm_sugihara", step_lm_sugihara, (("damping", True),), 200, 50,
-          {"damping": 1e-4, "stall_window": 30},
+_register("lm_sugihara", 200, 50, {"damping": 1e-4, "stall_window": 30},
           "Levenberg-Marquardt with damping E + λ (Sugihara)")
-_register("sdls", step_sdls, (("max_step", False),), 500, 30,
-          {"max_step": math.pi / 4, "stall_window": 60},
-          "selectively damped least squares by SVD (Buss & Kim)", allocates=True)
-_register("newton", step_newton, (("rcond", False),), 100, 50, {"rcond": 1e-10, "stall_window": 20},
-          "Newton-Raphson (eq 41): full pseudoinverse step with backtracking line search",
-          allocates=True)
-_register("gauss_newton", step_gauss_newton, (("rcond", False),), 100, 50,
-          {"rcond": 1e-12, "stall_window": 20},
-          "Gauss-Newton on the normal equations (JᵀJ)⁺Jᵀe, full step", allocates=True)
+_register("sdls", 500, 30, {"max_step": math.pi / 4, "stall_window": 60},
+          "selectively damped least squares by SVD (Buss & Kim)")
+_register("newton", 100, 50, {"rcond": 1e-10, "stall_window": 20},
+          "Newton-Raphson (eq 41): full pseudoinverse step with backtracking line search")
+_register("gauss_newton", 100, 50, {"rcond": 1e-12, "stall_window": 20},
+          "Gauss-Newton on the normal equations (JᵀJ)⁺Jᵀe, full step")

@@ -314,9 +314,9 @@ def _same_options(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
 def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
     """The tail ``cfg[C_WINDOW:]`` of the kernel configuration.
 
-    The loop's stagnation window, polish flag and stall ratio, then the method's own
-    parameters
-    (``spec.kernel.params``, in order).
+    The loop's stagnation window, polish flag and stall ratio, then, for a member of a
+    family of methods, its number (``spec.kernel.code``), then the method's own
+    parameters (``spec.kernel.params``, in order).
     """
     from serialkin._checks import check_positive
 
@@ -327,7 +327,11 @@ def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
             return cached[1]
     names = spec.kernel.params
     base = K.C_WINDOW
-    p = np.zeros(K.N_LOOP - base + len(names))
+    code = spec.kernel.code  # a family member: its number first (compile_family)
+    lead = 0 if code is None else 1
+    p = np.zeros(K.N_LOOP - base + lead + len(names))
+    if lead:
+        p[K.N_LOOP - base] = code
     polish = opts.get("polish", False)
     if not isinstance(polish, (bool, np.bool_)):
         raise InputTypeError(f"polish must be True or False, got {polish!r}")
@@ -340,7 +344,8 @@ def _method_params(spec: MethodSpec, opts: Mapping[str, Any]) -> np.ndarray:
                          f"{ratio!r}")
     p[K.C_STALL_RATIO - base] = ratio
     for i, (name, zero_ok) in enumerate(names):
-        p[K.N_LOOP - base + i] = check_positive(opts[name], name, allow_zero=zero_ok)
+        p[K.N_LOOP - base + lead + i] = check_positive(opts[name], name,
+                                                       allow_zero=zero_ok)
     if default:
         p.setflags(write=False)
         _PARAMS[spec.name] = (spec, p)
