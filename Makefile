@@ -12,7 +12,7 @@ STAMP_TEST := $(VENV)/.stamp-test
 .PHONY: run test lint bench docs browser-deps clean
 
 # The kernels the chapter report uses (`serialkin warmup --list` lists every feature).
-RUN_FEATURES := kinematics ik ik-all collision workspace tracking
+RUN_FEATURES := kinematics ik ik-all ik-all-general ik-methods collision workspace tracking
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)

@@ -58,7 +58,7 @@ def profile(feature: str) -> dict:
     """Compile ``feature`` in a fresh process with an empty cache; its per-kernel times."""
     with tempfile.TemporaryDirectory(prefix="serialkin-nbcache-") as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache, SERIALKIN_QUIET_COMPILE="1",
-                   OPENBLAS_NUM_THREADS="1")
+                   SERIALKIN_COMPILE="wait", OPENBLAS_NUM_THREADS="1")
         t0 = time.perf_counter()
         out = subprocess.run([sys.executable, "-c", _CHILD, feature], env=env, check=True,
                              capture_output=True, text=True).stdout

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 
+import pytest
 from hypothesis import settings
 
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
@@ -55,16 +56,64 @@ def _specializations() -> dict[str, list[str]]:
 
 
 def pytest_configure_node(node):  # xdist controller: one folder for the workers' reports
-    """Hand every worker the folder its specialization report goes to."""
+    """Hand every worker the folder its specialization report goes to and the shared one."""
     node.workerinput[_SPEC_KEY] = node.config._serialkin_spec_dir
+    node.workerinput[_SHARED_KEY] = node.config._serialkin_shared_dir
 
 
 def pytest_configure(config):
-    """Make the report folder (controller) when pytest-xdist distributes the run."""
+    """Make the report and shared folders (controller) when pytest-xdist distributes the run."""
     import tempfile
 
     if not hasattr(config, "workerinput"):
         config._serialkin_spec_dir = tempfile.mkdtemp(prefix="serialkin-spec-")
+        config._serialkin_shared_dir = tempfile.mkdtemp(prefix="serialkin-shared-")
+
+
+def pytest_unconfigure(config):
+    """Remove the shared folder at the end of the run (controller)."""
+    import shutil
+
+    if not hasattr(config, "workerinput") and hasattr(config, "_serialkin_shared_dir"):
+        shutil.rmtree(config._serialkin_shared_dir, ignore_errors=True)
+
+
+# ------------------------------------------------- work shared by the workers of one run
+# Some results are expensive and used by test files that pytest-xdist may send to
+# different workers (the chapter report, the example scripts that the docs gallery runs
+# too): each is made once per run, by whichever worker asks first, in a folder every
+# worker sees; the others wait for it under a file lock and read it.
+_SHARED_KEY = "serialkin_shared"
+
+
+@pytest.fixture(scope="session")
+def shared_once(request):
+    """``shared_once(key, make) -> Path``: the folder ``make(folder)`` filled, once per run.
+
+    The first caller of ``key`` (in any worker) runs ``make`` on an empty folder under an
+    exclusive lock; later callers wait for the lock and get the same folder. A ``make``
+    that raised leaves no result, so the next caller tries again (and fails the same way).
+    """
+    import fcntl
+    import shutil
+    from pathlib import Path
+
+    config = request.config
+    root = Path(config.workerinput[_SHARED_KEY] if hasattr(config, "workerinput")
+                else config._serialkin_shared_dir)
+
+    def once(key, make):
+        folder = root / key
+        with open(root / f"{key}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            if not (root / f"{key}.done").exists():
+                shutil.rmtree(folder, ignore_errors=True)
+                folder.mkdir()
+                make(folder)
+                (root / f"{key}.done").touch()
+        return folder
+
+    return once
 
 
 def _allowed() -> dict[str, int]:
@@ -117,3 +166,22 @@ def pytest_sessionfinish(session, exitstatus):
         Path(".pytest_cache").mkdir(exist_ok=True)
         Path(".pytest_cache/specializations.txt").write_text(text + "\n")
         session.exitstatus = 1
+
+
+@pytest.fixture(scope="session")
+def examples_ran(shared_once):
+    """The folder where every examples/*.py script ran, once per test run.
+
+    ``<folder>/<stem>`` as docs/_build/run_examples.py leaves it (``returncode``,
+    ``stdout.txt``, ``stderr.txt``, ``out/``); the example tests and the docs build's
+    gallery (tests/docs/test_site.py) both read it, so each script runs once.
+    """
+    import sys
+    from pathlib import Path
+
+    build = str(Path(__file__).resolve().parents[1] / "docs" / "_build")
+    if build not in sys.path:
+        sys.path.insert(0, build)
+    from run_examples import run_all
+
+    return shared_once("examples", run_all)

@@ -4,9 +4,10 @@
   ``__init__`` declares ``__all__`` (found by walking the package, so a package added later
   appears without editing this file). Each page lists exactly the names of ``__all__``,
   rendered by mkdocstrings from their docstrings.
-* **Examples gallery** — every ``examples/*.py`` script is run in a fresh folder
-  (``SERIALKIN_EXAMPLE_OUT``, matplotlib's Agg backend); its page shows the script's
-  docstring, the figures it wrote, what it printed and its source.
+* **Examples gallery** — every ``examples/*.py`` script is run in a fresh folder, several
+  at a time (``run_examples.py``; the test suite hands over the folder where it ran them
+  already, ``SERIALKIN_EXAMPLES_RAN``); its page shows the script's docstring, the
+  figures it wrote, what it printed and its source.
 
 Run by ``mkdocs build`` (``make docs``); the docs test runs the same build.
 """
@@ -17,7 +18,6 @@ import ast
 import html
 import importlib
 import os
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -27,9 +27,8 @@ import mkdocs_gen_files
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from api import member_block, public_packages  # noqa: E402
 from roles import plain_roles  # noqa: E402
+from run_examples import EXAMPLES, run_all  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLES = ROOT / "examples"
 #: figure types the gallery shows inline; other outputs are linked
 IMAGES = (".png", ".gif", ".svg", ".jpg")
 LINKED = (".html", ".mp4", ".urdf", ".yaml", ".json", ".tex", ".csv")
@@ -64,31 +63,31 @@ def _docstring(script: Path) -> str:
     return ast.get_docstring(ast.parse(script.read_text(encoding="utf-8"))) or ""
 
 
-def gallery_page(script: Path) -> tuple[str, str]:
-    """Run one example; write its page and outputs; return (page name, first docstring line)."""
+def gallery_page(script: Path, ran: Path) -> tuple[str, str]:
+    """Write one example's page and outputs from its run in ``ran``; return (page, summary)."""
     stem = script.stem
-    with tempfile.TemporaryDirectory() as tmp:
-        env = dict(os.environ, MPLBACKEND="Agg", SERIALKIN_EXAMPLE_OUT=tmp)
-        proc = subprocess.run([sys.executable, str(script)], cwd=tmp, env=env,
-                              capture_output=True, text=True, timeout=900)
-        if proc.returncode != 0:
-            raise RuntimeError(f"examples/{script.name} failed:\n{proc.stderr[-3000:]}")
-        outputs = sorted(p for p in Path(tmp).rglob("*") if p.is_file())
-        shown, linked = [], []
-        for p in outputs:
-            rel = p.relative_to(tmp).as_posix()
-            if p.suffix.lower() in IMAGES + LINKED:
-                with mkdocs_gen_files.open(f"gallery/{stem}/{rel}", "wb") as f:
-                    f.write(p.read_bytes())
-                (shown if p.suffix.lower() in IMAGES else linked).append(rel)
+    code = int((ran / "returncode").read_text())
+    if code != 0:
+        raise RuntimeError(f"examples/{script.name} failed:\n"
+                           f"{(ran / 'stderr.txt').read_text(encoding='utf-8')[-3000:]}")
+    tmp = ran / "out"
+    outputs = sorted(p for p in tmp.rglob("*") if p.is_file())
+    shown, linked = [], []
+    for p in outputs:
+        rel = p.relative_to(tmp).as_posix()
+        if p.suffix.lower() in IMAGES + LINKED:
+            with mkdocs_gen_files.open(f"gallery/{stem}/{rel}", "wb") as f:
+                f.write(p.read_bytes())
+            (shown if p.suffix.lower() in IMAGES else linked).append(rel)
+    stdout = (ran / "stdout.txt").read_text(encoding="utf-8")
     doc = _docstring(script)
     lines = [f"# {script.name}", "", doc, ""]
     for rel in shown:
         lines += [f"![{rel}]({stem}/{rel})", ""]
     if linked:
         lines += ["Files it writes: " + ", ".join(f"[`{r}`]({stem}/{r})" for r in linked), ""]
-    if proc.stdout.strip():
-        out = proc.stdout.strip()
+    if stdout.strip():
+        out = stdout.strip()
         lines += ["## Output", "", "```text", out[-6000:], "```", ""]
     source = script.read_text(encoding="utf-8")
     lines += ["## Source", "", f"Run it with `python examples/{script.name}`.", "",
@@ -100,7 +99,12 @@ def gallery_page(script: Path) -> tuple[str, str]:
 
 def gallery() -> None:
     """Run every example and write ``gallery/index.md`` listing them."""
-    rows = [gallery_page(s) for s in sorted(EXAMPLES.glob("*.py"))]
+    ran = os.environ.get("SERIALKIN_EXAMPLES_RAN")
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(ran) if ran else Path(tmp)
+        if not ran:
+            run_all(root, EXAMPLES)
+        rows = [gallery_page(s, root / s.stem) for s in EXAMPLES]
     index = ["# Examples", "",
              "Each script of `examples/` was run when this site was built; its page shows "
              "the figures it made, what it printed and its source. The test suite runs every "

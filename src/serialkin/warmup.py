@@ -100,6 +100,44 @@ def _ik_all() -> None:
         r.ik_all(T)
 
 
+def _ik_methods() -> None:
+    import serialkin as sk
+    from serialkin.ik import METHODS
+
+    panda = sk.models.get("panda")
+    planar = sk.models.get("three_link")  # FABRIK: chains with parallel axes
+    for name, spec in METHODS.items():
+        if name in ("lm", "analytic"):  # the ik and ik-all features
+            continue
+        r = planar if name == "fabrik" else panda
+        Q = r.random_q(3, seed=0)
+        T = r.fk(Q)
+        if r is planar:
+            T = T[:, :2, 3]  # position targets in the plane
+        r.ik(T[0], method=name, max_iter=5)
+        r.ik(T[0], method=name, q0=Q[1], max_iter=5)
+        if spec.kernel is not None:  # the compiled batch loop
+            r.ik(T, method=name, max_iter=5)
+
+
+def _ik_all_general() -> None:
+    import serialkin as sk
+    from serialkin.model.dh import DHLink
+
+    rng = np.random.default_rng(0)
+    general = sk.Robot.from_dh([DHLink(a=rng.uniform(0.05, 0.5), alpha=rng.uniform(-3, 3),
+                                       d=rng.uniform(-0.3, 0.3)) for _ in range(6)])
+    arms = [general]
+    for name in ("ur5", "puma560"):  # nearly ideal arms (a calibrated robot): refined
+        dh = sk.models.get(name).dh
+        arms.append(sk.Robot.from_dh([DHLink(a=row.a + 1e-4, alpha=row.alpha + 1e-3, d=row.d,
+                                             theta=row.theta) for row in dh], "standard"))
+    for r in arms:
+        T = r.fk(r.random_q(2, seed=0))
+        r.ik_all(T[0])
+        r.ik_all(T)
+
+
 def _collision() -> None:
     import serialkin as sk
 
@@ -132,6 +170,14 @@ def _tracking() -> None:
 FEATURES: dict[str, Feature] = {f.name: f for f in (
     Feature("ik-all", "every closed-form solution: robot.ik_all",
             ("serialkin.ik.analytic",), 60.0, _ik_all),
+    Feature("ik-all-general", "every solution of general 6R and nearly ideal (calibrated) "
+            "arms: robot.ik_all", ("serialkin.ik.analytic.general",
+                                   "serialkin.ik.analytic.raghavan_roth",
+                                   "serialkin.ik.analytic.refine"), 60.0, _ik_all_general),
+    Feature("ik-methods", "the numerical IK methods other than the default: "
+            "robot.ik(method=...)", ("serialkin.ik.jacobian_methods", "serialkin.ik.ccd",
+                                     "serialkin.ik.fabrik", "serialkin.ik.optimize"), 40.0,
+            _ik_methods),
     Feature("ik", "numerical IK: robot.ik (default method), one pose and batches",
             ("serialkin.ik", "serialkin.kinematics.dls", "serialkin.spatial",
              "serialkin.model.limits"), 35.0, _ik),

@@ -1,4 +1,4 @@
-"""The chapter report, built once per test session and shared by the tests that read it."""
+"""The chapter report, built once per test run and shared by the tests that read it."""
 
 from __future__ import annotations
 
@@ -6,10 +6,13 @@ import pytest
 
 
 @pytest.fixture(scope="session")
-def built_report(tmp_path_factory):
-    """(output folder, report.html text) of one full build of the chapter report."""
+def built_report(shared_once):
+    """(output folder, report.html text) of one full build of the chapter report.
+
+    Built once per run, also when pytest-xdist sends the files that read it to different
+    workers (``shared_once`` in tests/conftest.py).
+    """
     from serialkin.chapter.report import build_report
 
-    out = tmp_path_factory.mktemp("chapter")
-    path = build_report(out, quiet=True)
-    return out, path.read_text(encoding="utf-8")
+    out = shared_once("chapter-report", lambda folder: build_report(folder, quiet=True))
+    return out, (out / "report.html").read_text(encoding="utf-8")

@@ -31,11 +31,15 @@ pytest.importorskip("mkdocstrings_handlers.python")
 
 
 @pytest.fixture(scope="module")
-def site(tmp_path_factory):
-    """The site built in strict mode; the build's output is in the failure message."""
+def site(tmp_path_factory, examples_ran):
+    """The site built in strict mode; the build's output is in the failure message.
+
+    Its gallery reads the examples' runs of this test run (``examples_ran``) rather than
+    running every script a second time.
+    """
     out = tmp_path_factory.mktemp("site")
     env = dict(os.environ, DISABLE_MKDOCS_2_WARNING="true", NO_MKDOCS_2_WARNING="1",
-               PYTHONPATH=str(ROOT / "src"))
+               PYTHONPATH=str(ROOT / "src"), SERIALKIN_EXAMPLES_RAN=str(examples_ran))
     proc = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "-d", str(out)],
                           cwd=ROOT, env=env, capture_output=True, text=True, timeout=1200)
     warnings = [ln for ln in (proc.stdout + proc.stderr).splitlines()

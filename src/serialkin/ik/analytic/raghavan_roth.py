@@ -473,6 +473,11 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
         (:data:`MULTIPLE_TOL`; the k solutions found so far are in ``out``): in both
         cases the caller searches instead.
     """
+    # fresh C arrays, as Wr, Pr and Minv are: the caller's may be read-only views, and
+    # _rr_split would compile twice (11 s cold each) for the two kinds of arrays
+    Wf = W.copy()
+    Pf = P.copy()
+    Mf = M.copy()
     Minv = inv_rigid(M)
     Wr = np.empty((6, 3))  # the reversed chain: joint j is joint 7 − j about the line
     Pr = np.empty((6, 3))  # (−R_Mᵀ w, M⁻¹ p), tool pose M⁻¹, target T⁻¹
@@ -484,7 +489,7 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
     for attempt in range(6):  # eliminated joint 6, 5, 4 of the chain, then of its reversal
         e = 5 - attempt % 3
         if attempt < 3:
-            k = _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out)
+            k = _rr_split(T, Wf, Pf, Mf, reverse, e, F, meta, tol_p, tol_r, out)
         else:
             k = _rr_split(T, Wr, Pr, Minv, not reverse, e, F, meta, tol_p, tol_r, out)
         if k == NEAR_SPECIAL:  # near a special class: no split is trusted, search
