@@ -16,6 +16,7 @@ import hashlib
 import os
 import re
 import socket
+import stat
 import tempfile
 import time
 from pathlib import Path
@@ -33,10 +34,34 @@ def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
     one. Parent folders are created. Stale temporary files of earlier, killed writes of
     the same target are removed first (see the module docstring).
 
+    Only regular files are replaced. A symbolic link is followed on purpose: the file it
+    points to is replaced and the link kept (a dangling link's target is created). A
+    character device or a FIFO (``/dev/null``, ``/dev/stdout``, a named pipe) is written
+    through, never replaced. A folder, a block device or a socket is refused.
+
     Raises:
-        OutputError: the folder cannot be created or written (the message names the path).
+        OutputError: the folder cannot be created or written, or the path is a folder, a
+            block device or a socket (the message names the path).
     """
     out = Path(path)
+    if os.path.islink(out):
+        out = Path(os.path.realpath(out))  # replace the link's target, keep the link
+    try:
+        mode = os.stat(out).st_mode
+    except OSError:
+        mode = None  # a new file (or one we cannot see: the write below says why)
+    if mode is not None and not stat.S_ISREG(mode):
+        if stat.S_ISCHR(mode) or stat.S_ISFIFO(mode):
+            try:
+                with open(out, "wb") as f:  # write through: a device is never replaced
+                    f.write(data)
+            except OSError as exc:
+                raise OutputError(f"cannot write {str(out)!r}: {exc.strerror or exc}") \
+                    from exc
+            return out
+        kind = "a folder" if stat.S_ISDIR(mode) else "not a regular file"
+        raise OutputError(f"cannot write {str(out)!r}: it is {kind}; serialkin writes "
+                          "regular files, devices and pipes only")
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
         remove_stale_temporaries(out)

@@ -158,9 +158,13 @@ def _workspace() -> None:
 
 
 def _tracking() -> None:
-    from serialkin.tracking import load_scenario
+    from serialkin.tracking import load_scenario, track
+    from serialkin.tracking.analysis import qp_resolver
 
     load_scenario("six_link_circle").run()
+    sc = load_scenario("twenty_link_obstacles")  # weighted tasks with obstacles (eq 48)
+    sc.run()
+    track(sc.robot, sc.path, qp_resolver(sc), q0=sc.q0)  # the QP with hard constraints
 
 
 #: The features, in the order ``serialkin warmup --all`` starts them (longest first, so

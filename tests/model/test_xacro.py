@@ -73,7 +73,7 @@ def test_unknown_package_is_named():
 
 
 @pytest.mark.parametrize("body, pattern", [
-    ("<link name='${undefined_thing}'/>", "xacro failed.*undefined_thing"),
+    ("<link name='${undefined_thing}'/>", "expression 'undefined_thing': unknown name"),
     ("<xacro:bogus_macro/>", "xacro failed.*bogus_macro"),
     ("<link name='a'>", "xacro failed"),
     ("<link name='$(arg missing)'/>", "xacro failed.*missing"),

@@ -17,6 +17,7 @@ from typing import Any
 import click
 import numpy as np
 
+from serialkin._checks import short_repr
 from serialkin.cli.io import (
     EXIT_NOT_REACHED,
     CLIError,
@@ -87,6 +88,7 @@ def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
+            refuse_output_over_input(kwargs)
             return fn(*args, **kwargs)
         except PASS_THROUGH:
             raise
@@ -98,6 +100,49 @@ def handle_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
             raise cli_error(exc) from exc
 
     return wrapper
+
+
+#: The options of the subcommands that name files or folders they write.
+OUTPUT_OPTIONS = {"out": "--out", "report": "--report", "save": "--save", "urdf": "--urdf"}
+
+
+def _paths(value: Any) -> list[str]:
+    """The strings of an option value (one, or several for a repeatable option)."""
+    if isinstance(value, str):
+        return [value]
+    if isinstance(value, list | tuple):
+        return [v for v in value if isinstance(v, str)]
+    return []
+
+
+def _same(a: str, b: str) -> bool:
+    """Whether paths ``a`` and ``b`` name one file (links followed; b exists)."""
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, ValueError):
+        return False
+
+
+def refuse_output_over_input(params: dict[str, Any]) -> None:
+    """Refuse, before any work, an output option that names a file the command reads.
+
+    Every other option or argument that names an existing file is an input; an output
+    (:data:`OUTPUT_OPTIONS`) naming the same file (also through a link or another
+    spelling) would overwrite it: CLIError naming both.
+    """
+    for key, flag in OUTPUT_OPTIONS.items():
+        for out in _paths(params.get(key)):
+            if not os.path.lexists(out):
+                continue
+            for name, value in params.items():
+                if name in OUTPUT_OPTIONS:
+                    continue
+                for path in _paths(value):
+                    if path and os.path.isfile(path) and _same(out, path):
+                        raise CLIError(
+                            f"{flag} {short_repr(out, 120)} is the file read as "
+                            f"{name.replace('_', '-')} ({short_repr(path, 120)}): writing "
+                            "would destroy the input; choose another output path")
 
 
 def one_shot(fn: Callable[..., Any]) -> Callable[..., Any]:
