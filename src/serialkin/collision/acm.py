@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from serialkin._checks import as_generator, check_int, check_real
+from serialkin._checks import as_generator, check_int, check_real, short_repr
 from serialkin.collision.srdf import Srdf, read_srdf
 from serialkin.errors import InputError, RobotDefinitionError
 from serialkin.model.collision_model import CollisionModel
@@ -59,7 +59,8 @@ class AllowedCollisionMatrix:
         for a, b in pairs:
             for x in (a, b):
                 if x not in index:
-                    raise InputError(f"unknown body {x!r}; bodies: {', '.join(self.body_names)}")
+                    raise InputError(f"unknown body {short_repr(x, 80)}; bodies: "
+                                     f"{', '.join(self.body_names)}")
             m[index[a], index[b]] = m[index[b], index[a]] = True
         return AllowedCollisionMatrix(self.body_names, m)
 
@@ -111,7 +112,8 @@ def acm_from_srdf(model: CollisionModel, srdf: Srdf | str | os.PathLike[str],
         for x in (a, b):
             if x not in known and x not in skip:
                 raise RobotDefinitionError(
-                    f"{s.source}: disable_collisions names link {x!r}, which is not a body of "
+                    f"{s.source}: disable_collisions names link {short_repr(x, 80)}, which "
+                    "is not a body of "
                     f"the collision model; bodies: {', '.join(model.body_names)} (a link "
                     "without capsules, such as a finger off the chain, can be given in "
                     "skip_links)")

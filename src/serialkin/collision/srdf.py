@@ -16,6 +16,7 @@ import math
 import os
 from dataclasses import dataclass
 
+from serialkin._checks import short_repr
 from serialkin.errors import RobotDefinitionError
 from serialkin.model.urdf import _read_xml
 
@@ -42,7 +43,7 @@ class Srdf:
             return dict(self.group_states[name])
         except KeyError:
             raise RobotDefinitionError(
-                f"{self.source}: no group_state named {name!r}; group states: "
+                f"{self.source}: no group_state named {short_repr(name, 80)}; group states: "
                 f"{', '.join(self.group_states) or '(none)'}") from None
 
 
@@ -61,7 +62,7 @@ def read_srdf(path_or_string: str | os.PathLike[str]) -> Srdf:
         if not a or not b:
             raise RobotDefinitionError(
                 f"{source}: disable_collisions #{k + 1} must name link1 and link2, got "
-                f"link1={a!r}, link2={b!r}")
+                f"link1={short_repr(a, 80)}, link2={short_repr(b, 80)}")
         disabled.append((a, b, el.get("reason", "")))
     states: dict[str, dict[str, float]] = {}
     for el in root.findall("group_state"):
@@ -75,8 +76,9 @@ def read_srdf(path_or_string: str | os.PathLike[str]) -> Srdf:
                 v = math.nan
             if not math.isfinite(v):
                 raise RobotDefinitionError(
-                    f"{source}: group_state {name!r}, joint {j.get('name')!r}: value must be "
-                    f"a finite number, got {text!r}")
+                    f"{source}: group_state {short_repr(name, 80)}, joint "
+                    f"{short_repr(j.get('name'), 80)}: value must be a finite number, got "
+                    f"{short_repr(text, 80)}")
             values[j.get("name", "")] = v
         states[name] = values
     return Srdf(tuple(disabled), states, source)

@@ -419,12 +419,16 @@ def solve(
             and tol is None and max_iter is None and restarts is None and respect_limits is True
             and scene is None and self_collision is False and acm is None
             and type(margin) is float and margin == 0.0):
-        res = _fast(robot, target, method, q0, seed)
-        if res is not None:
-            return res
-    spec = get_method(method)
+        if isinstance(robot, Robot):
+            res = _fast(robot, target, method, q0, seed)
+            if res is not None:
+                return res
     if not isinstance(robot, Robot):
-        raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+        hint = (f" (a model name: serialkin.models.get({short_repr(robot, 40)}) builds it)"
+                if isinstance(robot, str) else "")
+        raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__} "
+                             f"{short_repr(robot, 40)}{hint}")
+    spec = get_method(method)
     if spec.max_joints is not None and robot.n > spec.max_joints:
         scalable = [m for m in available_methods() if get_method(m).max_joints is None
                     and get_method(m).family != "analytic"]

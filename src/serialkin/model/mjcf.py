@@ -70,7 +70,12 @@ import numpy as np
 
 from serialkin._checks import short_repr
 from serialkin._files import MAX_NUMBER, parse_xml, read_bytes
-from serialkin.errors import NotSupportedError, RobotDefinitionError
+from serialkin.errors import (
+    BudgetError,
+    InputTypeError,
+    NotSupportedError,
+    RobotDefinitionError,
+)
 from serialkin.model.geometry import Box, Capsule, Cylinder, LinkGeometry, Mesh, Shape, Sphere
 from serialkin.model.joint import Joint
 from serialkin.model.urdf import _floats
@@ -84,6 +89,13 @@ _UNSUPPORTED_ELEMENTS = {"replicate", "attach", "composite", "flexcomp"}
 _DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)
 #: Deepest nesting of ``<include>`` files.
 MAX_INCLUDE_DEPTH = 16
+#: Most ``<include>`` elements expanded in one model (4 files each including the next 4
+#: times would expand 4¹² times).
+MAX_INCLUDES = 1_000
+#: Most elements of a model once its includes are expanded.
+MAX_ELEMENTS = 2_000_000
+#: Deepest nesting of elements (bodies in bodies): the reader walks bodies recursively.
+MAX_ELEMENT_DEPTH = 300
 
 
 # ------------------------------------------------------------------------------ maths
@@ -491,39 +503,96 @@ class _Reader:
 
 
 # ------------------------------------------------------------------------------ files
+def _depth_checked(root: ET.Element, source: str) -> ET.Element:
+    """``root``, or BudgetError when its elements nest deeper than :data:`MAX_ELEMENT_DEPTH`."""
+    todo = [(root, 1)]
+    while todo:
+        el, depth = todo.pop()
+        if depth > MAX_ELEMENT_DEPTH:
+            raise BudgetError(f"{source}: elements nest more than {MAX_ELEMENT_DEPTH} levels "
+                              "deep (bodies in bodies); serialkin reads at most that")
+        todo.extend((child, depth + 1) for child in el)
+    return root
+
+
 def _read_file(path: Path) -> ET.Element:
-    if not path.exists():
-        raise RobotDefinitionError(f"MJCF file {short_repr(str(path))} does not exist")
+    try:
+        exists = path.exists()
+    except OSError as exc:  # a name longer than the system allows, a loop of links
+        raise RobotDefinitionError(f"MJCF file {short_repr(str(path), 120)}: "
+                                   f"{exc.strerror or exc}") from None
+    if not exists:
+        raise RobotDefinitionError(f"MJCF file {short_repr(str(path), 120)} does not exist")
     data = read_bytes(path, what="MJCF file", error=RobotDefinitionError)
-    return parse_xml(data, str(path), error=RobotDefinitionError)
+    return _depth_checked(parse_xml(data, str(path), error=RobotDefinitionError), str(path))
 
 
-def _expand_includes(el: ET.Element, folder: Path, source: str, stack: tuple[str, ...]) -> None:
-    """Replace every ``<include file>`` below ``el`` by the children of that file's root."""
-    k = 0
-    while k < len(el):
-        child = el[k]
-        if child.tag != "include":
-            _expand_includes(child, folder, source, stack)
-            k += 1
-            continue
-        file = child.get("file")
-        if not file:
-            raise RobotDefinitionError(f"{source}: an <include> has no file attribute")
-        path = (folder / file).resolve()
-        if str(path) in stack or len(stack) >= MAX_INCLUDE_DEPTH:
+class _Includes:
+    """The budget of one model's include expansion: includes and elements so far."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder.resolve()
+        self.includes = 0
+        self.elements = 0
+
+    def inside(self, path: Path, source: str, file: str) -> None:
+        """Raise unless ``path`` (links followed) lies inside the model's folder."""
+        if path != self.folder and self.folder not in path.parents:
             raise RobotDefinitionError(
-                f"{source}: <include file={file!r}> includes itself or nests more than "
-                f"{MAX_INCLUDE_DEPTH} files deep")
-        sub = _read_file(path)
-        if sub.tag != "mujoco":
-            raise RobotDefinitionError(
-                f"{path}: an included file's root must be <mujoco>, got <{sub.tag}>")
-        _expand_includes(sub, folder, str(path), (*stack, str(path)))
-        el.remove(child)
-        for j, item in enumerate(list(sub)):
-            el.insert(k + j, item)
-        k += len(sub)
+                f"{source}: <include file={short_repr(file, 120)}> leaves the model's folder "
+                f"{short_repr(str(self.folder), 120)}; includes are read only inside it")
+
+    def count(self, sub: ET.Element, source: str) -> None:
+        self.includes += 1
+        if self.includes > MAX_INCLUDES:
+            raise BudgetError(f"{source}: more than {MAX_INCLUDES} <include> expansions (files "
+                              "that include each other many times)")
+        self.elements += sum(1 for _ in sub.iter())
+        if self.elements > MAX_ELEMENTS:
+            raise BudgetError(f"{source}: the includes expand to more than {MAX_ELEMENTS} "
+                              "elements")
+
+
+def _expand_includes(el: ET.Element, budget: _Includes, source: str,
+                     stack: tuple[str, ...]) -> None:
+    """Replace every ``<include file>`` below ``el`` by the children of that file's root.
+
+    The elements are walked with a stack (any depth); only the include files recurse,
+    at most :data:`MAX_INCLUDE_DEPTH` deep.
+    """
+    todo = [el]
+    while todo:
+        node = todo.pop()
+        k = 0
+        while k < len(node):
+            child = node[k]
+            if child.tag != "include":
+                todo.append(child)
+                k += 1
+                continue
+            file = child.get("file")
+            if not file:
+                raise RobotDefinitionError(f"{source}: an <include> has no file attribute")
+            try:
+                path = (budget.folder / file).resolve()
+            except (OSError, RuntimeError) as exc:
+                raise RobotDefinitionError(f"{source}: <include file={short_repr(file, 120)}>"
+                                           f": {exc}") from None
+            budget.inside(path, source, file)
+            if str(path) in stack or len(stack) >= MAX_INCLUDE_DEPTH:
+                raise RobotDefinitionError(
+                    f"{source}: <include file={short_repr(file, 120)}> includes itself or "
+                    f"nests more than {MAX_INCLUDE_DEPTH} files deep")
+            sub = _read_file(path)
+            if sub.tag != "mujoco":
+                raise RobotDefinitionError(
+                    f"{path}: an included file's root must be <mujoco>, got <{sub.tag}>")
+            budget.count(sub, source)
+            _expand_includes(sub, budget, str(path), (*stack, str(path)))
+            node.remove(child)
+            for j, item in enumerate(list(sub)):
+                node.insert(k + j, item)
+            k += len(sub)
 
 
 # --------------------------------------------------------------------------- the chain
@@ -598,6 +667,12 @@ def robot_from_mjcf(path_or_string: str | os.PathLike[str], base_body: str | Non
     """
     from serialkin.model.robot import Robot
 
+    for name, value in (("base_body", base_body), ("end_body", end_body),
+                        ("tool_site", tool_site)):
+        if value is not None and not isinstance(value, str):
+            raise InputTypeError(f"{name} must be a body or site name (str) or None, got "
+                                 f"{type(value).__name__} {short_repr(value)}")
+
     text = os.fspath(path_or_string)
     if isinstance(text, bytes):
         text = text.decode()
@@ -611,7 +686,9 @@ def robot_from_mjcf(path_or_string: str | os.PathLike[str], base_body: str | Non
     if root.tag != "mujoco":
         raise RobotDefinitionError(
             f"{source}: the root element must be <mujoco>, got <{root.tag}>")
-    _expand_includes(root, folder or Path.cwd(), source, (source,))
+    _depth_checked(root, source)
+    _expand_includes(root, _Includes(folder or Path.cwd()), source, (source,))
+    _depth_checked(root, source)  # included files nest inside their <include>
     reader = _Reader(root, source, folder, resolve_meshes)
     bodies = reader.bodies
 

@@ -282,7 +282,8 @@ def expand_xacro(path_or_string: str | os.PathLike[str], *,
     is_text = text.lstrip().startswith("<")
     source = "<string>" if is_text else text
     if not is_text and not Path(text).is_file():
-        raise RobotDefinitionError(f"xacro file {short_repr(text)} does not exist")
+        what = "is a folder, not a xacro file" if Path(text).is_dir() else "does not exist"
+        raise RobotDefinitionError(f"xacro file {short_repr(text)} {what}")
     find = _package_finder(package_map or {}, search_path, xacro.substitution_args._eval_find)
     roots = [Path.cwd().resolve() if is_text else Path(text).resolve().parent]
     roots += [Path(os.fspath(v)).resolve() for v in (package_map or {}).values()]

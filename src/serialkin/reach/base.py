@@ -28,7 +28,13 @@ from typing import Any
 import numpy as np
 
 from serialkin._budget import check_allocation
-from serialkin._checks import as_float_array, check_int, check_positive, check_transform
+from serialkin._checks import (
+    as_float_array,
+    check_int,
+    check_positive,
+    check_real,
+    check_transform,
+)
 from serialkin.errors import InputError, InputTypeError
 from serialkin.model.robot import Robot
 from serialkin.reach.chunk import restart_seed, voxel_starts
@@ -132,6 +138,7 @@ def base_placement(robot: Robot, tasks: object, *, resolution: float = 0.1, yaws
         raise InputError("base_placement places a spatial robot on a floor plane; "
                          f"{robot.name!r} is planar")
     T = _task_poses(tasks)
+    floor_z = check_real(floor_z, "floor_z", max_abs=1e6, unit="m")
     res = check_positive(resolution, "resolution")
     yaws = check_int(yaws, "yaws", minimum=1)
     seed = check_int(seed, "seed", minimum=0, maximum=2**63 - 1)

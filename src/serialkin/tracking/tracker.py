@@ -34,7 +34,13 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import MAX_ITERATIONS, check_choice, check_int, check_positive
+from serialkin._checks import (
+    MAX_ITERATIONS,
+    check_choice,
+    check_int,
+    check_positive,
+    short_repr,
+)
 from serialkin.diffik.resolver import QPResolver
 from serialkin.errors import InputError, InputTypeError
 from serialkin.kinematics import kernels as K
@@ -267,6 +273,10 @@ def track(
             step = lambda k, q: state.solve(targets[k], q)  # noqa: E731
         elif isinstance(solver, str):
             label = f"IK method {solver!r}"
+            if ik_options is not None and (not isinstance(ik_options, Mapping) or not all(
+                    isinstance(k, str) for k in ik_options)):
+                raise InputTypeError("ik_options must be a mapping of robot.ik option names "
+                                     f"(str) to values, got {short_repr(ik_options, 80)}")
             opts = dict(ik_options or {})
             opts.setdefault("max_iter", budget)
             opts.setdefault("tol", conv)

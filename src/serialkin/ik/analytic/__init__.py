@@ -57,7 +57,13 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
+from serialkin._checks import (
+    ROTATION_TOL,
+    as_float_array,
+    check_positive,
+    check_transform,
+    short_repr,
+)
 from serialkin._memo import PerObject
 from serialkin.errors import InputError, NoClosedFormError
 from serialkin.ik.analytic.dispatch import (
@@ -360,11 +366,16 @@ def _locked(robot: Robot, free: object) -> tuple[Robot, np.ndarray, np.ndarray]:
     for key, value in free.items():
         if isinstance(key, bool) or not isinstance(key, (int, np.integer)) \
                 or not 0 <= int(key) < robot.n:
+            shown = short_repr(int(key) if isinstance(key, np.integer) else key, 40)
             raise InputError(f"free: joint index must be an int in 0..{robot.n - 1}, got "
-                             f"{key!r}")
-        v = float(np.asarray(value, dtype=float))
+                             f"{shown}")
+        try:
+            v = float(np.asarray(value, dtype=float))
+        except (TypeError, ValueError):
+            v = math.nan
         if not math.isfinite(v):
-            raise InputError(f"free[{key}] must be a finite joint value, got {value!r}")
+            raise InputError(f"free[{int(key)}] must be a finite joint value [rad or m], got "
+                             f"{short_repr(value, 40)}")
         idx.append(int(key))
         vals.append(v)
     order = np.argsort(idx)
