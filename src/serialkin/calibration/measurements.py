@@ -43,7 +43,7 @@ SIGMA_POSITION = 1e-4
 SIGMA_ROTATION = 1e-3
 _QUAT = ("quat_w", "quat_x", "quat_y", "quat_z")
 #: Largest measurement file read [bytes].
-MAX_MEASUREMENT_BYTES = 256 * 1024 * 1024
+MAX_MEASUREMENT_BYTES = 64 * 1024 * 1024  # about 500,000 rows of a 7-joint arm
 
 
 @dataclass(frozen=True, eq=False)

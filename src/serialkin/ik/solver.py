@@ -29,6 +29,7 @@ Both follow the same semantics:
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -437,6 +438,14 @@ def solve(
             f"cost per iteration grows faster than the number of joints); robot "
             f"{short_repr(robot.name)} has {robot.n}: use one of {', '.join(scalable)}"
         )
+    shape = getattr(target, "shape", None)
+    if shape is not None and len(shape) >= 2:  # before parse_target copies a batch
+        from serialkin._budget import check_allocation
+
+        # per target: its copy (16), q (n) and the kernel's info: refused before allocation
+        count = math.prod(shape[:-1]) // (4 if shape[-2:] == (4, 4) else 1)
+        check_allocation("the IK batch (targets and results)",
+                         (count, robot.n + K.N_INFO + 16), 8, setting="target")
     tgt = parse_target(robot, target, mask)
     if tgt.kind not in spec.targets:
         raise InputError(

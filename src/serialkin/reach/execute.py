@@ -41,6 +41,9 @@ CHUNK_VOXELS = 512
 
 #: Seconds to wait for a Dask scheduler to answer.
 CONNECT_TIMEOUT = 5.0
+#: Most worker processes of a local cluster per core of this machine (more only share
+#: the same cores and multiply the memory; a larger cluster runs on other machines).
+LOCAL_WORKERS_PER_CORE = 4
 
 _DIST_HINT = 'the Dask executor needs the extra: pip install "serialkin[dist]"'
 
@@ -64,10 +67,30 @@ def connect(address: str, timeout: float = CONNECT_TIMEOUT) -> Any:
         InputError: no answer within ``timeout`` (the address and the time are named),
             or Dask is not installed (the extra to install is named).
     """
+    import threading
+
     timeout = check_positive(timeout, "timeout")
     dd = _distributed()
+    # Dask's own timeout covers opening the connection, not a peer that accepts it and
+    # never answers the handshake: the whole connection runs in a daemon thread that is
+    # abandoned when the time is up, so the promised timeout holds for every stage.
+    box: dict[str, Any] = {}
+
+    def attempt() -> None:
+        try:
+            box["client"] = dd.Client(address, timeout=timeout)
+        except BaseException as exc:  # noqa: BLE001 - handed to the caller below
+            box["error"] = exc
+
+    worker = threading.Thread(target=attempt, name="serialkin-dask-connect", daemon=True)
+    worker.start()
+    worker.join(timeout + 1.0)
     try:
-        return dd.Client(address, timeout=timeout)
+        if worker.is_alive():
+            raise TimeoutError(f"no complete answer in {timeout:g} s")
+        if "error" in box:
+            raise box["error"]
+        return box["client"]
     except (OSError, TimeoutError, ValueError) as exc:
         raise InputError(f"the Dask scheduler {address!r} did not answer within "
                          f"{timeout:g} s ({type(exc).__name__}: {exc}); check the address "
@@ -90,12 +113,21 @@ def local_cluster(workers: int, threads_per_worker: int = 1,
     do not each start a thread per core and fight over them.
 
     Raises:
-        InputError: workers or cores_per_worker < 1, or Dask is not installed.
+        InputError: workers or cores_per_worker < 1, more workers than
+            :data:`LOCAL_WORKERS_PER_CORE` per core of this machine (at least 4), or Dask
+            is not installed.
     """
+    cores = (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+             else os.cpu_count()) or 1
+    most = max(4, LOCAL_WORKERS_PER_CORE * cores)
     workers = check_int(workers, "workers", minimum=1)
+    if workers > most:
+        raise InputError(f"workers={workers}: a local cluster runs at most {most} worker "
+                         f"processes on this machine's {cores} core(s) "
+                         f"({LOCAL_WORKERS_PER_CORE} per core); more would only share the "
+                         "same cores. A larger cluster runs on other machines: connect to "
+                         "its scheduler (--scheduler ADDRESS)")
     if cores_per_worker is None:
-        cores = (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
-                 else os.cpu_count()) or 1
         cores_per_worker = max(1, cores // workers)
     share = str(check_int(cores_per_worker, "cores_per_worker", minimum=1))
     dd = _distributed()
