@@ -204,7 +204,7 @@ def run_job(job: ReachJob, *, out: str | Path | None = None, resume: bool = Fals
     results: dict[int, dict[str, Any]] = {}
     if folder is not None and resume:
         for c in sorted(store.done_chunks(folder, C)):
-            r = store.read_chunk(folder, c, *job.chunk_range(c))
+            r = store.read_chunk(folder, c, *job.chunk_range(c), job.orientations)
             if r is not None:
                 results[c] = r
     pending = [c for c in range(C) if c not in results]

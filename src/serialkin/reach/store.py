@@ -19,6 +19,8 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import warnings
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -69,13 +71,21 @@ def open_folder(folder: str | Path, settings: dict[str, Any], resume: bool) -> P
             raise InputError(f"{str(path)!r} already holds a reachability map; pass "
                              "resume=True (--resume) to continue it, or choose another folder")
         try:
+            if not man.is_file():
+                raise ValueError("not a regular file")
             old = json.loads(man.read_text(encoding="utf-8"))
-            old_settings = old["settings"]
+            if not isinstance(old, dict):
+                raise ValueError(f"a JSON {type(old).__name__}, expected an object")
             if old.get("format") != FORMAT:
-                raise ValueError(f"format {old.get('format')!r}, expected {FORMAT!r}")
-        except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise InputError(f"cannot resume {str(path)!r}: unreadable {MANIFEST}: "
-                             f"{exc}") from exc
+                raise ValueError(f"format {str(old.get('format'))[:60]!r}, expected {FORMAT!r}")
+            old_settings = old.get("settings")
+            if not isinstance(old_settings, dict):
+                raise ValueError(f"'settings' is {type(old_settings).__name__}, expected an "
+                                 "object")
+        except (OSError, ValueError, UnicodeDecodeError, RecursionError) as exc:
+            raise InputError(f"cannot resume {str(path)!r}: {MANIFEST} is not a map manifest "
+                             f"({str(exc)[:160]}); remove the folder or choose another") \
+                from None
         diff = _differences(old_settings, json.loads(json.dumps(settings)))
         if diff:
             raise InputError(f"cannot resume {str(path)!r}: it was written with other "
@@ -95,20 +105,71 @@ def write_chunk(folder: Path, result: dict[str, Any]) -> Path:
     return write_bytes_atomic(chunk_path(folder, int(result["chunk"])), buf.getvalue())
 
 
-def read_chunk(folder: Path, c: int, start: int, stop: int) -> dict[str, Any] | None:
-    """Chunk c's result if its file is there and whole (covering start..stop), else None."""
+#: Most solutions of one orientation (closed-form IK of a 6R arm).
+MAX_SOLUTIONS = 16
+
+
+def _chunk_problem(z: Any, start: int, stop: int, orientations: int) -> str | None:
+    """What is wrong with a chunk file's arrays (None: nothing), checked value by value."""
+    if set(z.files) != {"start", "stop", "seconds", *FIELDS}:
+        return f"arrays {sorted(z.files)}, expected {sorted({'start', 'stop', 'seconds', *FIELDS})}"
+    for key in ("start", "stop", "seconds"):
+        if z[key].shape != () or z[key].dtype.kind not in "iuf":
+            return f"{key!r} is not a number"
+    if int(z["start"]) != start or int(z["stop"]) != stop:
+        return (f"it covers voxels {int(z['start'])}..{int(z['stop'])}, not this chunk's "
+                f"{start}..{stop}")
+    seconds = float(z["seconds"])
+    if not (np.isfinite(seconds) and seconds >= 0):
+        return f"its time {seconds!r} s is not a finite duration"
+    a = {}
+    for key, dtype in FIELDS.items():
+        v = z[key]
+        if v.dtype != np.dtype(dtype) or v.shape != (stop - start,):
+            return f"{key!r} is {v.dtype} {v.shape}, expected {np.dtype(dtype)} ({stop - start},)"
+        a[key] = v
+    reached, sols = a["reached"], a["solutions"]
+    if reached.min(initial=0) < 0 or reached.max(initial=0) > orientations:
+        return f"'reached' outside 0..{orientations} (the orientations sampled)"
+    if (sols < reached).any() or (sols > MAX_SOLUTIONS * reached).any():
+        return "'solutions' below 'reached' or above 16 per reached orientation"
+    lo, mean, hi = (a[f"manipulability_{k}"] for k in ("min", "mean", "max"))
+    if not all(np.isfinite(m).all() and (m >= 0).all() for m in (lo, mean, hi)):
+        return "a manipulability that is negative or not finite"
+    tol = 1e-9 * np.maximum(1.0, hi)
+    some = reached > 0
+    if ((lo > mean + tol) | (mean > hi + tol))[some].any():
+        return "manipulability statistics out of order (min <= mean <= max)"
+    if ((lo != 0) | (mean != 0) | (hi != 0))[~some].any():
+        return "a manipulability where nothing is reached"
+    return None
+
+
+def read_chunk(folder: Path, c: int, start: int, stop: int,
+               orientations: int) -> dict[str, Any] | None:
+    """Chunk c's result if its file is there, whole and valid, else None.
+
+    A chunk file is data from disk, never trusted: every array is checked (its dtype and
+    shape, ``start..stop`` equal to the chunk's, 0 <= reached <= ``orientations``,
+    reached <= solutions <= 16·reached, manipulabilities finite, non-negative, ordered,
+    and 0 where nothing is reached). A file that fails is reported by a
+    :class:`RuntimeWarning` naming it and the reason, and None is returned: the chunk is
+    computed again. Never unpickled (``allow_pickle=False``).
+    """
     p = chunk_path(folder, c)
     if not p.exists():
         return None
     try:
         with np.load(p, allow_pickle=False) as z:
-            if int(z["start"]) != start or int(z["stop"]) != stop:
-                return None
-            out: dict[str, Any] = {k: np.asarray(z[k]) for k in FIELDS}
-            out["seconds"] = float(z["seconds"])
-    except (OSError, KeyError, ValueError, EOFError):
-        return None
-    if any(out[k].shape != (stop - start,) for k in FIELDS):
+            problem = _chunk_problem(z, start, stop, orientations)
+            out: dict[str, Any] = {} if problem else {k: np.asarray(z[k]) for k in FIELDS}
+            if not problem:
+                out["seconds"] = float(z["seconds"])
+    except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        problem = f"unreadable ({type(exc).__name__}: {str(exc)[:80]})"
+    if problem:
+        warnings.warn(f"{p}: {problem}; the chunk is computed again", RuntimeWarning,
+                      stacklevel=2)
         return None
     out.update(chunk=c, start=start, stop=stop)
     return out
