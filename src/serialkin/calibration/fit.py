@@ -236,10 +236,63 @@ def _calibrate(model: ErrorModel, measurements: Measurements, loss: str, loss_sc
     if not np.isfinite(params).all():
         params = p0.copy()
     e1, _ = errors(model, measurements, params)
+    if success:
+        doubt = implausible(model, params, e1)
+        if doubt:
+            success, reason = False, doubt
     return CalibrationResult(success=success, reason=reason, model=model, params=params,
                              std_errors=std, identifiability=ident,
                              robot=model.calibrated_robot(params), errors_before=e0,
                              errors_after=e1, iterations=nfev)
+
+
+#: A fitted length may move by at most this fraction of the robot's size.
+MOVE_LIMIT = 1.0
+#: A fitted joint-axis angle may move by at most this much [rad] (base and tool rotations
+#: are free: the measurement frame and the marker may sit at any angle).
+ANGLE_LIMIT = math.pi / 4
+#: The RMS position residual after the fit may be at most this fraction of the robot's
+#: size (1 cm on a 1 m arm: far above any real measurement noise).
+RESIDUAL_LIMIT = 0.01
+_CAUSES = ("are the positions in metres (not millimetres), is it the right robot, and are "
+           "the joint columns q1..qn in the robot's joint order and in radians?")
+
+
+def robot_size(robot: Robot) -> float:
+    """The robot's size [m]: the farthest joint frame or tool from the base at q = 0 (≥ 0.1)."""
+    frames = robot.fk_all(np.zeros(robot.n))[..., :3, 3]
+    tip = robot.fk(np.zeros(robot.n))[:3, 3]
+    base = robot.base[:3, 3]
+    d = max(float(np.linalg.norm(frames - base, axis=-1).max(initial=0.0)),
+            float(np.linalg.norm(tip - base)))
+    return max(0.1, d)
+
+
+def implausible(model: ErrorModel, params: np.ndarray, errors_after: np.ndarray) -> str:
+    """Why a converged fit cannot describe this robot ('' when it can).
+
+    A length moved by more than :data:`MOVE_LIMIT` × the robot's size, a joint axis turned
+    by more than :data:`ANGLE_LIMIT`, or an RMS position residual after the fit above
+    :data:`RESIDUAL_LIMIT` × the size: the measurements then belong to other units, another
+    robot or another joint order (the message says so).
+    """
+    size = robot_size(model.robot)
+    moved = params - model.nominal
+    for k, par in enumerate(model.parameters):
+        if par.unit == "m" and abs(moved[k]) > MOVE_LIMIT * size:
+            return (f"the fit moved {par.name!r} by {moved[k]:.4g} m, more than the robot's "
+                    f"size ({size:.3g} m): the measurements do not fit this robot; " + _CAUSES)
+        if par.unit == "rad" and par.group not in ("base", "tool") \
+                and abs(moved[k]) > ANGLE_LIMIT:
+            return (f"the fit turned {par.name!r} by {math.degrees(moved[k]):.3g}°: the "
+                    "measurements do not fit this robot; " + _CAUSES)
+    if errors_after.shape[1] >= 3:
+        rms = float(np.sqrt(np.mean(np.sum(errors_after[:, :3] ** 2, axis=1))))
+        if rms > RESIDUAL_LIMIT * size:
+            return (f"the RMS position error after the fit is {rms * 1e3:.4g} mm, large "
+                    f"against the robot's size ({size:.3g} m): the measurements do not fit "
+                    "this robot; " + _CAUSES)
+    return ""
 
 
 def _standard_errors(J: np.ndarray, r: np.ndarray) -> np.ndarray:

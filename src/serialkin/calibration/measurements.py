@@ -237,6 +237,14 @@ def read_measurements(path: str | os.PathLike[str], robot: Robot, *,
     a = np.array(rows)
     col = {h: i for i, h in enumerate(header)}
     q = a[:, [col[f"q{i + 1}"] for i in range(robot.n)]]
+    revolute = robot.revolute
+    wild = np.abs(q[:, revolute]) > 2 * math.pi + 1e-9
+    if wild.any():  # radians are read: 90 means 90 rad, fourteen turns
+        i, j = np.argwhere(wild)[0]
+        joint = int(np.flatnonzero(revolute)[j])
+        raise InputError(f"{label}, line {lines[i]}, column 'q{joint + 1}': "
+                         f"{q[i, np.flatnonzero(revolute)[j]]:.6g} rad is more than a full turn; "
+                         "joint values are read in radians (are these degrees?)")
     pos = a[:, [col["x"], col["y"], col["z"]]]
     w = a[:, col["weight"]] if "weight" in col else None
     if w is not None and not (w > 0).all():
