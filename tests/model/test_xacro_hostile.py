@@ -173,3 +173,10 @@ def test_exponential_macros_hit_the_budget():
     with pytest.raises(BudgetError, match="macro calls"):
         Robot.from_xacro(_doc(body))
     assert time.process_time() - t0 < 120.0  # bounded work, not a timing target
+
+
+def test_a_path_longer_than_the_system_allows_is_named():
+    """A xacro path of 5,000 characters raises RobotDefinitionError, shortened, not OSError."""
+    with pytest.raises(RobotDefinitionError) as info:
+        Robot.from_xacro("/tmp/" + "a" * 5000 + ".xacro")
+    assert len(str(info.value)) < 400

@@ -50,7 +50,7 @@ _LOCK = threading.Lock()
 _EXTRA = 'xacro files need the xacro processor: pip install "serialkin[xacro]"'
 #: Most macro calls one expansion may make (a macro calling itself twice, 40 levels
 #: deep, would make 2⁴⁰).
-MAX_MACRO_CALLS = 200_000
+MAX_MACRO_CALLS = 50_000
 #: Longest expanded document [characters].
 MAX_OUTPUT = 50_000_000
 #: A ROS package name: letters, digits, ``_ . -``, no path separators.
@@ -281,9 +281,15 @@ def expand_xacro(path_or_string: str | os.PathLike[str], *,
     text = os.fspath(path_or_string)
     is_text = text.lstrip().startswith("<")
     source = "<string>" if is_text else text
-    if not is_text and not Path(text).is_file():
-        what = "is a folder, not a xacro file" if Path(text).is_dir() else "does not exist"
-        raise RobotDefinitionError(f"xacro file {short_repr(text)} {what}")
+    if not is_text:
+        try:
+            is_file, is_dir = Path(text).is_file(), Path(text).is_dir()
+        except OSError as exc:  # a name longer than the system allows, a loop of links
+            raise RobotDefinitionError(f"xacro file {short_repr(text, 120)}: "
+                                       f"{exc.strerror or exc}") from None
+        if not is_file:
+            what = "is a folder, not a xacro file" if is_dir else "does not exist"
+            raise RobotDefinitionError(f"xacro file {short_repr(text, 120)} {what}")
     find = _package_finder(package_map or {}, search_path, xacro.substitution_args._eval_find)
     roots = [Path.cwd().resolve() if is_text else Path(text).resolve().parent]
     roots += [Path(os.fspath(v)).resolve() for v in (package_map or {}).values()]
