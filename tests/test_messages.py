@@ -70,3 +70,16 @@ def test_a_huge_link_name_in_an_srdf_is_not_echoed():
     name = "x" * 10_000_000
     srdf = f"<robot name='p'><disable_collisions link1='{name}' link2='panda_link1'/></robot>"
     _raises(lambda: acm_from_srdf(panda.collision, srdf), RobotDefinitionError, "xxx")
+
+
+def test_dh_angles_beyond_a_turn_read_as_radians_are_refused(tmp_path):
+    """A robot file with alpha: 90 in radians is refused, naming the field and the units."""
+    from serialkin.model.robotfile import load_robot_file
+
+    rows = ("dh:\n  - {a: 0.5, alpha: 0, d: 0, theta: 0}\n"
+            "  - {a: 0.3, alpha: 90, d: 0, theta: 0}\n")
+    f = tmp_path / "arm.yaml"
+    f.write_text("name: arm\nunits: {angle: rad, length: m}\n" + rows)
+    _raises(lambda: load_robot_file(f), RobotDefinitionError, r"dh\[1\]\.alpha.*degrees")
+    f.write_text("name: arm\nunits: {angle: deg, length: m}\n" + rows)
+    assert load_robot_file(f).n == 2

@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 import serialkin as sk
 from serialkin import Robot, models
 from serialkin.errors import InputError, NoClosedFormError
-from serialkin.ik.analytic import CLASSES, classify, ik_all
+from serialkin.ik.analytic import CLASSES, AllSolutions, classify, ik_all
 from serialkin.model.dh import DHLink, standard_to_modified
 from serialkin.spatial import make_transform, rotx, roty, rotz
 
@@ -764,11 +764,13 @@ def test_packed_entry_equals_solve_into():
             odd = p.refine and conv[1:conv[0] + 1].sum() % 2 == 1
             assert k1 >= 1
             packed = for_class(p.code, p.refine).solve_packed
-            assert packed(T, I, D, B, out2) == (-2 - k1 if odd else k1)
+            conv2 = np.zeros(MAX_ROWS + 1, dtype=np.int64)
+            assert packed(T, I, D, B, out2, conv2) == (-2 - k1 if odd else k1)
+            np.testing.assert_array_equal(conv2, conv)
             assert np.array_equal(out1, out2)
         bad = T.copy()
         bad[0, 0] += 1e-9
-        assert for_class(p.code, p.refine).solve_packed(bad, I, D, B, out2) == -1
+        assert for_class(p.code, p.refine).solve_packed(bad, I, D, B, out2, conv2) == -1
 
 
 def test_subproblem_cosines_match_angles():
@@ -811,3 +813,31 @@ def test_sp4_cosines_match_angles():
             th, cs, sn = out6[i], out6[2 + 2 * i], out6[3 + 2 * i]
             assert abs(cs - math.cos(th)) < 1e-14 and abs(sn - math.sin(th)) < 1e-14
             assert abs(a @ rotation(w, th) @ b - c) < 1e-12
+
+
+def test_ik_all_returns_one_type_for_one_target_and_a_batch():
+    """ik_all gives an AllSolutions for one pose and for a batch; one pose's acts as its rows."""
+    import pickle
+
+    ur5 = models.ur5()
+    Q = ur5.random_q(3, seed=4)
+    T = ur5.fk(Q)
+    one, many = ur5.ik_all(T[0]), ur5.ik_all(T)
+    assert isinstance(one, AllSolutions) and isinstance(many, AllSolutions)
+    rows = np.asarray(one)
+    assert rows.shape == (one.count, 6) == one.shape and len(one) == one.count >= 1
+    np.testing.assert_array_equal(one[0], rows[0])
+    assert [r.tolist() for r in one] == rows.tolist() == one.tolist()
+    np.testing.assert_array_equal(one - Q[0], rows - Q[0])
+    turns = (one - Q[0] + np.pi) % (2 * np.pi) - np.pi  # arithmetic on the rows
+    assert np.min(np.abs(turns).max(axis=1)) < 1e-9  # the generating q is a row (mod 2π)
+    np.testing.assert_array_equal(many.solutions(0), rows)
+    assert one.branches == many.branches[0]
+    np.testing.assert_array_equal(one.converged, many.converged[0])
+    slow = ur5.ik_all(np.asfortranarray(T[0]))  # the ordinary path: same record
+    assert slow.branches == one.branches and slow.kind == one.kind == "ur"
+    np.testing.assert_array_equal(slow.converged, one.converged)
+    with pytest.raises(AttributeError, match="immutable"):
+        one.q = rows
+    np.testing.assert_array_equal(pickle.loads(pickle.dumps(one)), rows)
+    assert str(one) == str(rows) and "AllSolutions(kind='ur'" in repr(one)

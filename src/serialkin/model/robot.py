@@ -700,7 +700,8 @@ class Robot:
         if type(q) is _NDARRAY and type(qd) is _NDARRAY and q.dtype is _F64 \
                 and qd.dtype is _F64 and q.ndim == 1 and qd.ndim == 1 and len(q) == n \
                 and len(qd) == n and link is None and point is None \
-                and (frame == "base" or frame == "ee"):
+                and (frame == "base" or frame == "ee") and qd.flags.c_contiguous:
+            # (a strided qd takes the batch path, which copies it: one compiled layout)
             Jd = _EMPTY((6, n))
             if (_JDOT1 or _resolve("_JDOT1"))(q, self._P, qd, frame == "ee", Jd):
                 return Jd

@@ -170,6 +170,11 @@ def dh_rows_from_field(f: Field, *, angle_unit: str = "rad", length_unit: str = 
         d = row["d"].number(lo=-bl, hi=bl, unit=length_unit) * lin
         alpha = row["alpha"].number(lo=-ba, hi=ba, unit=angle_unit) * ang
         theta = row["theta"].number(lo=-ba, hi=ba, unit=angle_unit) * ang
+        for key, value in (("alpha", alpha), ("theta", theta)):
+            if abs(value) > 2 * math.pi + 1e-9:  # a fixed angle beyond a turn: degrees?
+                raise row[key].expected(
+                    f"an angle of at most one turn (2π) in {angle_unit} (are these degrees? "
+                    "declare them with units: {angle: deg})")
         qunit, qfac = (angle_unit, ang) if jtype == "R" else (length_unit, lin)
         qlim = (_limits(row["qlim"], qfac, qunit) if row["qlim"].present
                 else (-math.inf, math.inf))

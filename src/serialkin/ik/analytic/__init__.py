@@ -52,7 +52,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -314,43 +314,142 @@ NEAR_TOL = 0.05
 REFINE_TOL = 1e-12
 
 
-@dataclass(frozen=True, eq=False)
-class AllSolutions:
-    """Every IK solution of a batch of targets (``ik_all`` on (..., 4, 4) targets).
+_NEW = object.__new__
+_PUT = object.__setattr__
+
+
+class AllSolutions(np.lib.mixins.NDArrayOperatorsMixin):
+    """Every IK solution of one target or of a batch of targets (what ``ik_all`` returns).
+
+    It is also an array: its solutions ``q``. For one target that is the (k, n) array of
+    rows, so ``len(sols)``, ``sols[0]``, ``for row in sols``, ``np.asarray(sols)``,
+    arithmetic (``sols - q``), comparisons and the array's attributes and methods
+    (``sols.shape``, ``sols.tolist()``) work as on the rows; for a batch the same applies
+    to the padded ``q`` (..., k_max, n). Immutable.
 
     Attributes:
-        q: (..., k_max, n) joint values [rad / m]; row j of target i is a solution for
-            j < ``count[i]`` and zero padding after it (never NaN).
-        count: (...,) int, number of solutions of each target (0: unreachable, or only
-            outside the joint limits).
-        branches: (...,) int, candidate branches the solver produced (before the limit
-            filter and de-duplication).
-        converged: (..., 16) bool, per candidate branch whether its Newton refinement
-            on the true model converged to 1e-12 (always True for exact classes, where
-            no refinement is needed; False beyond ``branches``).
+        q: (k, n) joint values [rad / m] of one target's solutions (k >= 0: 0 means
+            unreachable, or reachable only outside the joint limits); for a batch
+            (..., k_max, n): row j of target i is a solution for j < ``count[i]``, zero
+            padding after it (never NaN).
+        count: k for one target (int); for a batch (...,) int, the number of solutions
+            of each target.
+        branches: candidate branches the solver produced (before the limit filter and
+            de-duplication): an int, or (...,) for a batch.
+        converged: (16,) bool, or (..., 16) for a batch: per candidate branch whether its
+            Newton refinement on the true model converged to 1e-12 (always True for
+            exact classes, where no refinement is needed; False beyond ``branches``).
         kind: the structure class solved (a key of :data:`CLASSES`, or
             ``'general_6r'``).
         mode: ``'exact'`` (closed form of the exact class), ``'near'`` (the arm is within
             the tolerance of ``kind``: solved for the idealised axes, every branch refined
             on the true model) or ``'general'`` (Raghavan–Roth elimination or the 2-D
             search of :mod:`serialkin.ik.analytic.general`).
-        continuous: (..., k_max) bool, with ``report=True``: solution j of target i lies
-            on a continuous family of solutions (a singular target: the row is one
-            representative, :func:`~serialkin.ik.analytic.singular.continuous_family`);
-            None when not computed.
+        continuous: with ``report=True``: (k,) bool, or (..., k_max) for a batch,
+            solution j lies on a continuous family of solutions (a singular target: the
+            row is one representative,
+            :func:`~serialkin.ik.analytic.singular.continuous_family`); None when not
+            computed.
     """
 
-    q: np.ndarray
-    count: np.ndarray
-    branches: np.ndarray
-    converged: np.ndarray
-    kind: str
-    mode: str
-    continuous: np.ndarray | None = None
+    __slots__ = ("q", "count", "_conv", "kind", "mode", "continuous")
 
-    def solutions(self, index: int | tuple[int, ...]) -> np.ndarray:
+    def __init__(self, q: np.ndarray, count: object, branches: object, converged: object,
+                 kind: str, mode: str, continuous: np.ndarray | None = None) -> None:
+        conv = np.concatenate([np.asarray(branches, dtype=np.int64)[..., None],
+                               np.asarray(converged).astype(np.int64)], axis=-1)
+        self._set(q, count, conv, kind, mode, continuous)
+
+    def _set(self, q, count, conv, kind, mode, continuous) -> None:
+        put = object.__setattr__
+        put(self, "q", q)
+        put(self, "count", count)
+        put(self, "_conv", conv)  # (..., 17) as the kernels fill it: branches, converged
+        put(self, "kind", kind)
+        put(self, "mode", mode)
+        put(self, "continuous", continuous)
+
+    @staticmethod
+    def _of(q: np.ndarray, count: object, conv: np.ndarray, kind: str, mode: str,
+            continuous: np.ndarray | None = None) -> AllSolutions:
+        """From the kernels' (..., 17) convergence record (no conversion: the fast path)."""
+        self = _NEW(AllSolutions)
+        _PUT(self, "q", q)
+        _PUT(self, "count", count)
+        _PUT(self, "_conv", conv)
+        _PUT(self, "kind", kind)
+        _PUT(self, "mode", mode)
+        _PUT(self, "continuous", continuous)
+        return self
+
+    def replaced(self, **changes: object) -> AllSolutions:
+        """A copy with some of ``q``, ``count``, ``continuous`` replaced."""
+        values = {"q": self.q, "count": self.count, "continuous": self.continuous}
+        values.update(changes)
+        return AllSolutions._of(values["q"], values["count"], self._conv, self.kind,
+                                self.mode, values["continuous"])
+
+    @property
+    def branches(self) -> object:
+        """Candidate branches the solver produced: an int, or (...,) for a batch."""
+        b = self._conv[..., 0]
+        return int(b) if b.ndim == 0 else b
+
+    @property
+    def converged(self) -> np.ndarray:
+        """(16,) or (..., 16) bool: per candidate branch whether its refinement converged."""
+        return self._conv[..., 1:] != 0
+
+    def solutions(self, index: int | tuple[int, ...] = ()) -> np.ndarray:
         """The (count, n) solutions of one target (an index into the batch dimensions)."""
+        if np.ndim(self.count) == 0:
+            return self.q
         return self.q[index][: int(self.count[index])]
+
+    # ------------------------------------------------------------ the array it also is
+    def __setattr__(self, name: str, value: object) -> None:
+        raise AttributeError(f"AllSolutions is immutable (cannot set {name!r}); use "
+                             ".replaced(...)")
+
+    def __array__(self, dtype: object = None, copy: object = None) -> np.ndarray:
+        if copy:
+            return np.array(self.q, dtype=dtype, copy=True)
+        return self.q if dtype is None else self.q.astype(dtype, copy=False)
+
+    def __array_ufunc__(self, ufunc: np.ufunc, method: str, *inputs: object,
+                        **kwargs: object) -> object:
+        inputs = tuple(x.q if isinstance(x, AllSolutions) else x for x in inputs)
+        if "out" in kwargs:
+            kwargs["out"] = tuple(x.q if isinstance(x, AllSolutions) else x
+                                  for x in kwargs["out"])
+        return getattr(ufunc, method)(*inputs, **kwargs)
+
+    def __len__(self) -> int:
+        return len(self.q)
+
+    def __getitem__(self, index: object) -> object:
+        return self.q[index]
+
+    def __iter__(self):
+        return iter(self.q)
+
+    def __getattr__(self, name: str) -> object:
+        if name.startswith("_") or name == "q":  # not an array attribute (or unpickling)
+            raise AttributeError(name)
+        return getattr(self.q, name)
+
+    def __reduce__(self) -> tuple:
+        return (AllSolutions._of, (self.q, self.count, self._conv, self.kind, self.mode,
+                                   self.continuous))
+
+    def __str__(self) -> str:
+        return str(self.q)
+
+    def __repr__(self) -> str:
+        q = np.array2string(self.q, separator=", ", prefix="    q=")
+        return (f"AllSolutions(kind={self.kind!r}, mode={self.mode!r}, count="
+                f"{self.count if np.ndim(self.count) == 0 else self.count.tolist()},\n"
+                f"    q={q})")
 
 
 def _locked(robot: Robot, free: object) -> tuple[Robot, np.ndarray, np.ndarray]:
@@ -526,8 +625,8 @@ def _sort_batch(robot: Robot, res: AllSolutions, reference: object, weights: obj
                                                 norm=norm, return_order=True)
             if cont is not None:
                 cont[i, :k] = cont[i, :k][order]
-    return replace(res, q=q.reshape(res.q.shape),
-                   continuous=None if cont is None else cont.reshape(res.continuous.shape))
+    return res.replaced(q=q.reshape(res.q.shape),
+                        continuous=None if cont is None else cont.reshape(res.continuous.shape))
 
 
 def _solve_batch(p: _Prepared, robot: Robot, T: np.ndarray, tol: float,
@@ -598,7 +697,8 @@ def _packed_entry(code: int, refine: bool) -> Any:
             f64, i64 = numba.float64, numba.int64
             return (Array(f64, 2, "C"), Array(i64, 1, "C", readonly=True),
                     Array(f64, 1, "C", readonly=True),
-                    Array(numba.boolean, 1, "C", readonly=True), Array(f64, 2, "C"))
+                    Array(numba.boolean, 1, "C", readonly=True), Array(f64, 2, "C"),
+                    Array(i64, 1, "C"))
 
         found, final = entry_point(for_class(code, refine).solve_packed, sig)
         if not final:  # its Python function while it compiles: ask again next call
@@ -610,8 +710,9 @@ def _packed_entry(code: int, refine: bool) -> Any:
 def _fast_entry(robot: object) -> tuple:
     """The fast path's cached data for ``robot`` (default ``tol``, ``near_tol``, grid).
 
-    ``(None, entry point, I, D, B, (16, n))``: the packed arguments of
-    :func:`~serialkin.ik.analytic.dispatch.solve_packed` and the shape of its output.
+    ``(None, entry point, I, D, B, (16, n), kind, mode)``: the packed arguments of
+    :func:`~serialkin.ik.analytic.dispatch.solve_packed`, the shape of its output and the
+    class solved.
     """
     from serialkin.ik.analytic.dispatch import pack
     from serialkin.ik.analytic.general import DEFAULT_GRID
@@ -620,13 +721,18 @@ def _fast_entry(robot: object) -> tuple:
     I, D, B = pack(p.code, p.arm, p.prismatic3, p.W, p.P, p.M, p.aux, p.order, p.revolute,
                    p.qlim, p.mid, p.F, p.meta, p.refine, DEFAULT_GRID, 1e-8 * p.s.scale, 1e-8,
                    REFINE_TOL * p.s.scale, REFINE_TOL)
-    entry = (None, _packed_entry(p.code, p.refine), I, D, B, (MAX_ROWS, p.n))
+    entry = (None, _packed_entry(p.code, p.refine), I, D, B, (MAX_ROWS, p.n), p.s.kind,
+             p.mode)
     if (p.code, p.refine) in _SOLVE_PACKED:  # compiled: kept (else its Python, asked again)
         _FAST.set(robot, entry)
     return entry
 
 
 _EMPTY = np.empty
+_ZEROS = np.zeros
+_ALL = AllSolutions._of
+_CONV = MAX_ROWS + 1  # the kernels' convergence record: branches, then one flag per branch
+_I64 = np.int64
 _NDARRAY = np.ndarray
 _F64 = np.dtype(np.float64)
 _SHAPE44 = (4, 4)
@@ -639,7 +745,7 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
            free: Mapping[int, float] | None = None, near_tol: float = NEAR_TOL,
            grid: int | None = None, reference: object = None, weights: object = None,
            norm: str = "l2", report: bool = False,
-           **options: Any) -> np.ndarray | AllSolutions:
+           **options: Any) -> AllSolutions:
     """Every inverse-kinematics solution inside the joint limits (section 4.1).
 
     Which solver runs is decided from the joint axes (never the name):
@@ -655,7 +761,7 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
     Args:
         robot: the robot.
         target: (4, 4) tool pose in the world frame (base and tool transforms included),
-            or a batch (..., 4, 4) (then an :class:`AllSolutions` is returned); on a
+            or a batch (..., 4, 4); on a
             planar arm whose axes are along the world z axis also ``(x, y)`` [m] (2R) or
             ``(x, y, φ)`` [m, m, rad], φ the heading ``atan2(R[1, 0], R[0, 0])`` of the
             tool x axis; on such a SCARA ``(x, y, z, φ)``; on an R R P arm a position
@@ -675,15 +781,15 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
             :func:`sort_by_reference`); without it rows are sorted lexicographically.
         weights: (n,) weights of the distance to ``reference``.
         norm: 'l2' (weighted Euclidean) or 'linf' (weighted max) distance.
-        report: return an :class:`AllSolutions` for a single target too, with the
-            per-branch convergence and, per solution, whether it lies on a continuous
-            family (a singular target).
+        report: also say, per solution, whether it lies on a continuous family (a
+            singular target; ``AllSolutions.continuous``).
         **options: none other are accepted (an unknown name raises InputError).
 
     Returns:
-        one target: (k, n) array of joint values [rad / m], k >= 0 (k = 0: unreachable,
-        or reachable only outside the joint limits), rows unique; a batch (or
-        ``report=True``): an :class:`AllSolutions`.
+        :class:`AllSolutions`, for one target or a batch. For one target it is also the
+        (k, n) array of its rows [rad / m], k >= 0 (k = 0: unreachable, or reachable only
+        outside the joint limits), rows unique: ``len``, indexing, iteration and
+        ``np.asarray`` give the rows.
 
     Raises:
         NoClosedFormError: no solver applies (not 6 joints and of no class), or the target
@@ -703,13 +809,15 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
         if entry is None:
             entry = _fast_entry(robot)
         out = _EMPTY(entry[5])
-        k = entry[1](target, entry[2], entry[3], entry[4], out)
+        conv = _ZEROS(_CONV, _I64)  # False beyond the branches
+        k = entry[1](target, entry[2], entry[3], entry[4], out, conv)
         if k >= 0:
-            return out[:k]
+            return _ALL(out[:k], k, conv, entry[6], entry[7])
         if k < -1:  # a nearly ideal arm whose refined branches are doubtful
             from serialkin.ik.analytic.general import DEFAULT_GRID
 
-            return _with_general(robot, target, out[:-2 - k], _TOL, DEFAULT_GRID)
+            rows = _with_general(robot, target, out[:-2 - k], _TOL, DEFAULT_GRID)
+            return _ALL(rows, rows.shape[0], conv, entry[6], entry[7])
         # k == -1: not rigid to 1e-13; the ordinary path checks, projects or raises
     if options:
         raise InputError(f"unknown option(s) for ik_all: {', '.join(sorted(options))}; "
@@ -721,18 +829,16 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
         reduced, idx, vals = _locked(robot, free)
         res = ik_all(reduced, target, tol=tol, all_turns=all_turns, near_tol=near_tol,
                      grid=grid, report=report)
-        if isinstance(res, AllSolutions):
-            q = _insert_locked(res.q, idx, vals, robot.n)
-            q[np.arange(q.shape[-2]) >= np.asarray(res.count)[..., None]] = 0.0  # padding
-            full = replace(res, q=q)
+        q = _insert_locked(res.q, idx, vals, robot.n)
+        if np.ndim(res.count) == 0:  # one target
             if reference is not None:
-                full = _sort_batch(robot, full, reference, weights, norm)
-            return full
-        full_rows = _insert_locked(res, idx, vals, robot.n)
+                q = sort_by_reference(robot, q, reference, weights=weights, norm=norm)
+            return res.replaced(q=q)
+        q[np.arange(q.shape[-2]) >= np.asarray(res.count)[..., None]] = 0.0  # padding
+        full = res.replaced(q=q)
         if reference is not None:
-            full_rows = sort_by_reference(robot, full_rows, reference, weights=weights,
-                                          norm=norm)
-        return full_rows
+            full = _sort_batch(robot, full, reference, weights, norm)
+        return full
     near_tol = check_positive(near_tol, "near_tol", allow_zero=True)
     p = _prepared(robot, near_tol)
     tol = check_positive(tol, "tol")
@@ -752,8 +858,6 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
         T = _as_poses(a.reshape(-1, 4, 4))
         out, counts, conv = _solve_batch(p, robot, T, tol, grid)
         kmax = int(counts.max(initial=0))
-        branches = conv[:, 0]
-        converged = conv[:, 1:].astype(bool)
         cont = None
         if report:
             cont = np.zeros((T.shape[0], kmax), dtype=bool)
@@ -770,9 +874,8 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
                     counts[i] = min(len(rows), MAX_ROWS)
                     out[i, :counts[i]] = rows[:MAX_ROWS]
             kmax = int(counts.max(initial=0))
-        res = AllSolutions(out[:, :kmax].reshape(lead + (kmax, p.n)), counts.reshape(lead),
-                           branches.reshape(lead), converged.reshape(lead + (MAX_ROWS,)),
-                           p.s.kind, p.mode, cont)
+        res = _ALL(out[:, :kmax].reshape(lead + (kmax, p.n)), counts.reshape(lead),
+                   conv.reshape(lead + (MAX_ROWS + 1,)), p.s.kind, p.mode, cont)
         if reference is not None:
             res = _sort_batch(robot, res, reference, weights, norm)
         return res
@@ -794,9 +897,8 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
         sols = _expand_turns(sols, p.revolute, p.qlim)
     if reference is not None:
         sols = sort_by_reference(robot, sols, reference, weights=weights, norm=norm)
+    cont = None
     if report:
         cont = np.array([check_rot and p.n == 6 and continuous_family(robot, T, row)
                          for row in sols], dtype=bool)
-        return AllSolutions(sols.copy(), np.array(sols.shape[0]), np.array(conv[0]),
-                            conv[1:].astype(bool), p.s.kind, p.mode, cont)
-    return sols
+    return _ALL(sols, sols.shape[0], conv, p.s.kind, p.mode, cont)

@@ -178,14 +178,15 @@ def pack(code, arm, prismatic3, W, P, M, aux, order, revolute, qlim, mid, F, met
     return I, D, B
 
 
-def _solve_packed(T, I, D, B, out):
+def _solve_packed(T, I, D, B, out, conv):
     """``solve_into`` on the packed data of :func:`pack` (the fast path's entry).
 
     One compiled call for the rigidity check and the solve (rotation verified), into
-    ``out`` (16, n). Returns the number of solutions k >= 0; −1 without solving when
-    T (4, 4) is not a rigid transform to 1e-13 (the caller then checks it, projects the
-    rotation or raises); ``−2 − k`` when the arm is refined (nearly ideal) and its branches
-    are doubtful (:func:`refined_doubtful`; the caller then adds the general search's rows).
+    ``out`` (16, n) and ``conv`` (17,) (as :func:`_solve_into`). Returns the number of
+    solutions k >= 0; −1 without solving when T (4, 4) is not a rigid transform to 1e-13
+    (the caller then checks it, projects the rotation or raises); ``−2 − k`` when the arm
+    is refined (nearly ideal) and its branches are doubtful (:func:`refined_doubtful`;
+    the caller then adds the general search's rows).
     """
     if rigid_error(T) > 1e-13:
         return -1
@@ -208,7 +209,6 @@ def _solve_packed(T, I, D, B, out):
     o += 16 * (n + 1)
     meta = D[o:o + 5 * n].reshape((n, 5))
     refine = I[3] != 0
-    conv = np.empty(MAX_ROWS + 1, dtype=np.int64)
     k = solve_into(I[1], I[2] != 0, T, W, P, M, aux, I[_HEAD:_HEAD + I[7]], B,  # noqa: F821
                    qlim, mid, F, meta, True, refine, I[4], D[0], D[1], D[2], D[3], out, conv)
     if refine and refined_doubtful(conv):
@@ -244,7 +244,7 @@ class ClassKernels:
             mid, F, meta, check_rot, refine, grid, tol_p, tol_r, newton_p, newton_r, out,
             conv) -> count`` (:func:`_solve_into`).
         solve_range: the same over ``Ts[start:stop]``, GIL released (:func:`_solve_range`).
-        solve_packed: ``solve_packed(T, I, D, B, out)`` on :func:`pack`'s arrays.
+        solve_packed: ``solve_packed(T, I, D, B, out, conv)`` on :func:`pack`'s arrays.
     """
 
     solve_into: object
