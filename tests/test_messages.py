@@ -83,3 +83,26 @@ def test_dh_angles_beyond_a_turn_read_as_radians_are_refused(tmp_path):
     _raises(lambda: load_robot_file(f), RobotDefinitionError, r"dh\[1\]\.alpha.*degrees")
     f.write_text("name: arm\nunits: {angle: deg, length: m}\n" + rows)
     assert load_robot_file(f).n == 2
+
+
+def test_urdf_rpy_beyond_a_turn_is_refused():
+    """A URDF origin rpy of 90 (degrees where radians are read) names the joint and the units."""
+    from serialkin import Robot
+
+    urdf = ("<robot name='r'><link name='a'/><link name='b'/>"
+            "<joint name='j1' type='revolute'><parent link='a'/><child link='b'/>"
+            "<origin xyz='0 0 0.1' rpy='0 90 0'/><axis xyz='0 0 1'/>"
+            "<limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>")
+    _raises(lambda: Robot.from_urdf(urdf), RobotDefinitionError, r"j1.*rpy.*degrees")
+
+
+def test_cli_q_beyond_a_turn_and_the_limits_suggests_degrees():
+    """serialkin fk ur5 --q 90,0,0,0,0,0 (radians read) is refused with a hint to --degrees."""
+    from click.testing import CliRunner
+
+    from serialkin.cli.main import cli
+
+    res = CliRunner().invoke(cli, ["fk", "ur5", "--q", "90,0,0,0,0,0"])
+    assert res.exit_code == 2 and "--degrees" in res.output
+    assert CliRunner().invoke(cli, ["fk", "ur5", "--q", "90,0,0,0,0,0", "--degrees"]
+                              ).exit_code == 0

@@ -246,6 +246,14 @@ def read_q(robot: Any, q_texts: tuple[str, ...], q_file: str | None, degrees: bo
         Q = np.vstack([Q, read_csv_rows(q_file, "q", robot.n)])
     if Q.shape[0] == 0:
         Q = np.zeros((1, robot.n))
+    if not degrees:  # radians are read: a value beyond a turn and the limits is a slip
+        lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
+        wild = robot.revolute & (np.abs(Q) > 2 * np.pi + 1e-9) & ((Q < lo) | (Q > hi))
+        if wild.any():
+            i, j = np.argwhere(wild)[0]
+            raise CLIError(f"--q: joint {j + 1} = {Q[i, j]:g} rad is beyond a full turn and "
+                           f"its limits [{lo[j]:g}, {hi[j]:g}]; values are radians (for "
+                           "degrees add --degrees)")
     return Q * _angle_factor(robot, degrees)
 
 

@@ -74,6 +74,10 @@ def _origin(el: ET.Element | None, where: str) -> np.ndarray:
         return np.eye(4)
     xyz = _floats(el.get("xyz"), 3, (0.0, 0.0, 0.0), f"{where} <origin xyz>", MAX_NUMBER)
     rpy = _floats(el.get("rpy"), 3, (0.0, 0.0, 0.0), f"{where} <origin rpy>", MAX_NUMBER)
+    if (np.abs(rpy) > 2 * np.pi + 1e-6).any():  # URDF angles are radians
+        raise RobotDefinitionError(
+            f"{where} <origin rpy>: {' '.join(f'{v:g}' for v in rpy)} has an angle beyond a "
+            "full turn; URDF angles are radians (are these degrees?)")
     return make_transform(rpy_to_matrix(rpy), xyz)
 
 
