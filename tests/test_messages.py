@@ -97,7 +97,7 @@ def test_urdf_rpy_beyond_a_turn_is_refused():
 
 
 def test_cli_q_beyond_a_turn_and_the_limits_suggests_degrees():
-    """serialkin fk ur5 --q 90,0,0,0,0,0 (radians read) is refused with a hint to --degrees."""
+    """The CLI refuses --q 90,0,0,0,0,0 (radians read) on a UR5, with a hint to --degrees."""
     from click.testing import CliRunner
 
     from serialkin.cli.main import cli
