@@ -106,3 +106,14 @@ def test_cli_q_beyond_a_turn_and_the_limits_suggests_degrees():
     assert res.exit_code == 2 and "--degrees" in res.output
     assert CliRunner().invoke(cli, ["fk", "ur5", "--q", "90,0,0,0,0,0", "--degrees"]
                               ).exit_code == 0
+
+
+def test_scenario_q0_beyond_a_turn_suggests_q0_deg(tmp_path):
+    """A scenario's q0 of 90 (radians read) is refused, naming q0 and q0_deg."""
+    from serialkin.tracking import load_scenario
+    from serialkin.tracking.scenario import ScenarioError
+
+    f = tmp_path / "s.yaml"
+    f.write_text("name: s\nrobot: {planar: {links: 2, length: 0.8}}\nq0: [90, 10]\n"
+                 "path: {type: points, points: [[1.0, 0.2], [1.1, 0.3]]}\n")
+    _raises(lambda: load_scenario(f), ScenarioError, r"q0.*q0_deg")

@@ -382,6 +382,9 @@ def scenario_from_dict(data: object, source: str = "<dict>",
                 a = np.full(n, float(a))
             if a.shape != (n,):
                 raise qf.fail(f"must have {n} values (one per joint), got shape {a.shape}")
+            if key == "q0" and (np.abs(a[robot.revolute]) > 2 * math.pi + 1e-9).any():
+                raise qf.fail("has a revolute joint value beyond a full turn; q0 is in "
+                              "radians (for degrees write q0_deg)")
             q0 = a * scale
     path = _path(doc["path"], robot, q0)
     obs_f = doc["obstacles"]
