@@ -824,21 +824,8 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
                          "accepted: tol, all_turns, free, near_tol, grid, reference, "
                          "weights, norm, report")
     if free is not None:
-        if not isinstance(robot, Robot):
-            raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
-        reduced, idx, vals = _locked(robot, free)
-        res = ik_all(reduced, target, tol=tol, all_turns=all_turns, near_tol=near_tol,
-                     grid=grid, report=report)
-        q = _insert_locked(res.q, idx, vals, robot.n)
-        if np.ndim(res.count) == 0:  # one target
-            if reference is not None:
-                q = sort_by_reference(robot, q, reference, weights=weights, norm=norm)
-            return res.replaced(q=q)
-        q[np.arange(q.shape[-2]) >= np.asarray(res.count)[..., None]] = 0.0  # padding
-        full = res.replaced(q=q)
-        if reference is not None:
-            full = _sort_batch(robot, full, reference, weights, norm)
-        return full
+        return _ik_all_locked(robot, target, free, tol, all_turns, near_tol, grid, reference,
+                              weights, norm, report)
     near_tol = check_positive(near_tol, "near_tol", allow_zero=True)
     p = _prepared(robot, near_tol)
     tol = check_positive(tol, "tol")
@@ -847,38 +834,71 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
 
         grid = DEFAULT_GRID
     if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 4 <= grid <= 2000:
-        raise InputError(f"grid must be an int in 4..2000, got {grid!r}")
+        raise InputError(f"grid must be an int in 4..2000, got {short_repr(grid, 40)}")
     grid = int(grid)
     a = target if type(target) is np.ndarray else as_float_array(target, "target")
     if a.ndim >= 3 and a.shape[-2:] == (4, 4):
         if all_turns:
             raise InputError("all_turns applies to one target; for a batch, call ik_all per "
                              "target with all_turns=True")
-        lead = a.shape[:-2]
-        T = _as_poses(a.reshape(-1, 4, 4))
-        out, counts, conv = _solve_batch(p, robot, T, tol, grid)
-        kmax = int(counts.max(initial=0))
-        cont = None
-        if report:
-            cont = np.zeros((T.shape[0], kmax), dtype=bool)
-            for i in range(T.shape[0]):
-                for j in range(int(counts[i])):
-                    cont[i, j] = continuous_family(robot, T[i], out[i, j])
-            cont = cont.reshape(lead + (kmax,))
-        if p.mode == "near":  # doubtful refined branches: general search too
-            from serialkin.ik.analytic.dispatch import refined_doubtful
-
-            for i in range(T.shape[0]):
-                if refined_doubtful(conv[i]):
-                    rows = _with_general(robot, T[i], out[i, :counts[i]], tol, grid)
-                    counts[i] = min(len(rows), MAX_ROWS)
-                    out[i, :counts[i]] = rows[:MAX_ROWS]
-            kmax = int(counts.max(initial=0))
-        res = _ALL(out[:, :kmax].reshape(lead + (kmax, p.n)), counts.reshape(lead),
-                   conv.reshape(lead + (MAX_ROWS + 1,)), p.s.kind, p.mode, cont)
+        res = _ik_all_batch(p, robot, a, tol, grid, report)
         if reference is not None:
             res = _sort_batch(robot, res, reference, weights, norm)
         return res
+    return _ik_all_one(p, robot, a, tol, grid, all_turns, reference, weights, norm, report)
+
+
+def _ik_all_locked(robot: Robot, target: object, free: object, tol: float, all_turns: bool,
+                   near_tol: float, grid: int | None, reference: object, weights: object,
+                   norm: str, report: bool) -> AllSolutions:
+    """:func:`ik_all` with the joints of ``free`` locked: the reduced robot's rows, refilled."""
+    if not isinstance(robot, Robot):
+        raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    reduced, idx, vals = _locked(robot, free)
+    res = ik_all(reduced, target, tol=tol, all_turns=all_turns, near_tol=near_tol,
+                 grid=grid, report=report)
+    q = _insert_locked(res.q, idx, vals, robot.n)
+    if np.ndim(res.count) == 0:  # one target
+        if reference is not None:
+            q = sort_by_reference(robot, q, reference, weights=weights, norm=norm)
+        return res.replaced(q=q)
+    q[np.arange(q.shape[-2]) >= np.asarray(res.count)[..., None]] = 0.0  # padding
+    full = res.replaced(q=q)
+    if reference is not None:
+        full = _sort_batch(robot, full, reference, weights, norm)
+    return full
+
+
+def _ik_all_batch(p: Any, robot: Robot, a: np.ndarray, tol: float, grid: int,
+                  report: bool) -> AllSolutions:
+    """:func:`ik_all` of a batch of poses ``a`` (..., 4, 4) on the prepared structure ``p``."""
+    lead = a.shape[:-2]
+    T = _as_poses(a.reshape(-1, 4, 4))
+    out, counts, conv = _solve_batch(p, robot, T, tol, grid)
+    kmax = int(counts.max(initial=0))
+    cont = None
+    if report:
+        cont = np.zeros((T.shape[0], kmax), dtype=bool)
+        for i in range(T.shape[0]):
+            for j in range(int(counts[i])):
+                cont[i, j] = continuous_family(robot, T[i], out[i, j])
+        cont = cont.reshape(lead + (kmax,))
+    if p.mode == "near":  # doubtful refined branches: general search too
+        from serialkin.ik.analytic.dispatch import refined_doubtful
+
+        for i in range(T.shape[0]):
+            if refined_doubtful(conv[i]):
+                rows = _with_general(robot, T[i], out[i, :counts[i]], tol, grid)
+                counts[i] = min(len(rows), MAX_ROWS)
+                out[i, :counts[i]] = rows[:MAX_ROWS]
+        kmax = int(counts.max(initial=0))
+    return _ALL(out[:, :kmax].reshape(lead + (kmax, p.n)), counts.reshape(lead),
+                conv.reshape(lead + (MAX_ROWS + 1,)), p.s.kind, p.mode, cont)
+
+
+def _ik_all_one(p: Any, robot: Robot, a: np.ndarray, tol: float, grid: int, all_turns: bool,
+                reference: object, weights: object, norm: str, report: bool) -> AllSolutions:
+    """:func:`ik_all` of one target ``a`` (a pose, or a planar / position target)."""
     T, check_rot = _parse_target(p, robot, a)
     from serialkin.ik.analytic.dispatch import solve_into
 
