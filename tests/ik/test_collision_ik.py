@@ -255,7 +255,9 @@ def test_nearest_into_property(q, ref, lo, width):
     hi = lo + width
     q = min(max(q, lo), hi)
     out = np.array([q])
-    K.nearest_into(out, np.array([ref]), np.array([lo]), np.array([hi]), np.array([1.0]), True)
+    box = np.array([[lo], [hi], [1.0]])  # read-only rows, as the solver's limit box
+    box.setflags(write=False)
+    K.nearest_into(out, np.array([ref]), box[0], box[1], box[2], True)
     x = out[0]
     assert lo <= x <= hi
     k = (x - q) / (2 * np.pi)

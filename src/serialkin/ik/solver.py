@@ -614,13 +614,13 @@ def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray 
         q0k = q0 if q0 is not None and q0.flags.writeable else (
             np.zeros(n) if q0 is None else q0.copy())
         spec.kernel.solve_one(F, meta, Tt, box, q0k, cfg, seed64, q, info)
-        return _result_single(robot, tgt, spec, q, info, tol, respect)
+        return _from_info(robot, tgt, spec, q, info, tol, respect)
     N = Tt.shape[0]
     Q = np.empty((N, n))
     info = np.empty((N, K.N_INFO))
     Q0 = np.zeros((N, n)) if q0 is None else np.array(q0, dtype=np.float64, order="C")
     _run_chunks(spec.kernel.solve_chunk, F, meta, Tt, box, Q0, cfg, seed64, Q, info)
-    return _result_batch(robot, tgt, spec, Q, info, tol, respect)
+    return _from_info(robot, tgt, spec, Q, info, tol, respect)
 
 
 @dataclass(frozen=True, eq=False)
@@ -748,13 +748,7 @@ def _solve_collision(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray
         q0k = np.zeros(n) if q0 is None else np.array(q0, dtype=np.float64)
         spec.kernel.solve_one_collision(F, L, meta, Tt, box, q0k, cfg, seed64, *coll.arrays,
                                         coll.ccfg, q, info)
-        ok = bool(info[K.I_SUCCESS] > 0.5 and (not respect or info[K.I_INSIDE] > 0.5))
-        pair = _pair_names(coll, info)
-        reason = "" if ok else _collision_reason(robot, coll, Tt, q, info, pair, tol, tgt.kind,
-                                                 respect, tgt.weights)
-        return IKResult.make(q, ok, int(info[K.I_ITERATIONS]), float(info[K.I_POS_ERR]),
-                             float(info[K.I_ORI_ERR]), reason, int(info[K.I_RESTARTS]),
-                             spec.name, float(info[K.I_CLEARANCE]), pair)
+        return _from_info(robot, tgt, spec, q, info, tol, respect, coll)
     N = Tt.shape[0]
     Q = np.empty((N, n))
     info = np.empty((N, K.N_INFO))
@@ -762,19 +756,7 @@ def _solve_collision(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray
     parallel.run(spec.kernel.solve_chunk_collision,
                  (F, L, meta, Tt, box, Q0, cfg, seed64, *coll.arrays, coll.ccfg, Q, info),
                  N, grain=4)
-    ok = info[:, K.I_SUCCESS] > 0.5
-    if respect:  # honest_success's guard, evaluated by the kernel
-        ok &= info[:, K.I_INSIDE] > 0.5
-    pairs = np.array([_pair_names(coll, info[k]) for k in range(N)], dtype=str).reshape(N, 2)
-    reasons = np.array(
-        ["" if ok[k] else _collision_reason(robot, coll, Tt[k], Q[k], info[k], tuple(pairs[k]),
-                                            tol, tgt.kind, respect, tgt.weights)
-         for k in range(N)], dtype=object).astype(str)
-    return IKResult(q=Q, success=ok, iterations=info[:, K.I_ITERATIONS].astype(np.int64),
-                    position_error=info[:, K.I_POS_ERR].copy(),
-                    orientation_error=info[:, K.I_ORI_ERR].copy(), reason=reasons,
-                    restarts=info[:, K.I_RESTARTS].astype(np.int64), method=spec.name,
-                    clearance=info[:, K.I_CLEARANCE].copy(), closest_pair=pairs)
+    return _from_info(robot, tgt, spec, Q, info, tol, respect, coll)
 
 
 def _run_chunks(solve_chunk: Any, F: np.ndarray, meta: np.ndarray, Tt: np.ndarray, box: np.ndarray,
@@ -847,36 +829,51 @@ def honest_success(robot: Robot, q: np.ndarray, ok: bool, respect: bool) -> bool
                                 LIMIT_TOL))
 
 
-def _result_single(robot: Robot, tgt: Target, spec: MethodSpec, q: np.ndarray,
-                   info: np.ndarray, tol: float, respect: bool) -> IKResult:
-    # the final guard of honest_success, evaluated by the kernel (info[I_INSIDE])
-    ok = bool(info[K.I_SUCCESS] > 0.5 and (not respect or info[K.I_INSIDE] > 0.5))
-    pe, oe = float(info[K.I_POS_ERR]), float(info[K.I_ORI_ERR])
-    its, used = int(info[K.I_ITERATIONS]), int(info[K.I_RESTARTS])
-    reason = "" if ok else failure_reason(
-        pe, oe, tol, used + 1, its, tgt.kind,
-        failure_hint(robot, q, tgt.weights, respect, tgt.T))
-    return IKResult.make(q, ok, its, pe, oe, reason, used, spec.name)
+def _from_info(robot: Robot, tgt: Target, spec: MethodSpec, Q: np.ndarray, info: np.ndarray,
+               tol: float, respect: bool, coll: _Collision | None = None) -> IKResult:
+    """The one builder of a compiled solve's :class:`IKResult`, from the kernels' records.
 
-
-def _result_batch(robot: Robot, tgt: Target, spec: MethodSpec, Q: np.ndarray,
-                  info: np.ndarray, tol: float, respect: bool) -> IKResult:
-    # the final guard of honest_success, evaluated by the kernel (info[:, I_INSIDE])
-    ok = info[:, K.I_SUCCESS] > 0.5
+    ``Q`` (n,) or (N, n) holds the configurations and ``info`` (N_INFO,) or (N, N_INFO)
+    the kernels' records (the ``I_*`` indices of :mod:`serialkin.ik._kernels`), one per
+    target: a single result for one target, arrays for a batch. A success needs the
+    kernel's success flag and, with ``respect``, q inside the limits (the final guard of
+    :func:`honest_success`, evaluated by the kernel). Each failure gets its sentence
+    (:func:`failure_reason`, or with the collision check ``coll`` the closest pair's);
+    with ``coll`` the clearance and closest pair are filled too.
+    """
+    single = info.ndim == 1
+    rec = info.reshape(-1, K.N_INFO)
+    Qs = Q.reshape(-1, Q.shape[-1])
+    Ts = tgt.T.reshape(-1, 4, 4)
+    ok = rec[:, K.I_SUCCESS] > 0.5
     if respect:
-        ok &= info[:, K.I_INSIDE] > 0.5
-    its = info[:, K.I_ITERATIONS].astype(np.int64)
-    used = info[:, K.I_RESTARTS].astype(np.int64)
-    pe, oe = info[:, K.I_POS_ERR].copy(), info[:, K.I_ORI_ERR].copy()
+        ok &= rec[:, K.I_INSIDE] > 0.5
+    its = rec[:, K.I_ITERATIONS].astype(np.int64)
+    used = rec[:, K.I_RESTARTS].astype(np.int64)
+    pe, oe = rec[:, K.I_POS_ERR].copy(), rec[:, K.I_ORI_ERR].copy()
+    pairs = None if coll is None else [_pair_names(coll, rec[k]) for k in range(len(rec))]
+
+    def reason(k: int) -> str:
+        if coll is not None:
+            return _collision_reason(robot, coll, Ts[k], Qs[k], rec[k], pairs[k], tol,
+                                     tgt.kind, respect, tgt.weights)
+        return failure_reason(pe[k], oe[k], tol, used[k] + 1, its[k], tgt.kind,
+                              failure_hint(robot, Qs[k], tgt.weights, respect, Ts[k]))
+
     failed = np.flatnonzero(~ok)
-    said = [failure_reason(pe[k], oe[k], tol, used[k] + 1, its[k], tgt.kind,
-                           failure_hint(robot, Q[k], tgt.weights, respect, tgt.T[k]))
-            for k in failed]  # a sentence for each failure only
+    said = [reason(int(k)) for k in failed]  # a sentence for each failure only
+    extra = {} if coll is None else {"clearance": rec[:, K.I_CLEARANCE].copy(),
+                                     "closest_pair": np.array(pairs, dtype=str).reshape(-1, 2)}
+    if single:
+        if coll is not None:
+            extra = {"clearance": float(extra["clearance"][0]), "closest_pair": pairs[0]}
+        return IKResult.make(Q, bool(ok[0]), int(its[0]), float(pe[0]), float(oe[0]),
+                             said[0] if said else "", int(used[0]), spec.name, **extra)
     # the str array np.array(list of N str) makes, without building it from N objects
-    reasons = np.zeros(Q.shape[0], dtype=f"<U{max(map(len, said), default=1) or 1}")
+    reasons = np.zeros(Qs.shape[0], dtype=f"<U{max(map(len, said), default=1) or 1}")
     reasons[failed] = said
     return IKResult(q=Q, success=ok, iterations=its, position_error=pe, orientation_error=oe,
-                    reason=reasons, restarts=used, method=spec.name)
+                    reason=reasons, restarts=used, method=spec.name, **extra)
 
 
 def _problem(robot: Robot, T: np.ndarray, tgt: Target, tol: float, respect: bool) -> IKProblem:
