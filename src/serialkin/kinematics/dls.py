@@ -50,7 +50,18 @@ __all__ = [
 
 @njit(cache=True)
 def chol_factor_into(A, m):
-    """Cholesky factor ``A = L Lᵀ`` of the leading m×m block of A, L written in its lower part.
+    """Cholesky factor ``A = L Lᵀ`` of the leading m×m block of A, in place.
+
+    The one storage of serialkin's Cholesky factors: the lower triangle of L with the
+    reciprocals ``1/L_jj`` on the diagonal (:func:`factored_solve_into`,
+    :func:`lower_solve_into` and :func:`lower_t_solve_into` read it). The substitutions
+    then multiply where a plain solve divides, and the only divisions left, one per
+    column, are off the dependency chain of the rows below (about 10-20 % faster for the
+    6×6 and 7×7 systems of IK, measured on a loaded machine). The factorisation is
+    latency-bound (one pivot waits for the previous one), so each pivot ``L_jj² = s`` is
+    found from the previous one through a division only (``s' = u − t²/s``, with
+    ``t = L_{j+1,j}·L_jj``) and ``1/L_jj = √s · (1/s)`` lets the square root and the
+    division overlap: 126 → 98 ns for a 7×7 solve.
 
     Args:
         A: (≥m, ≥m) symmetric matrix (only the lower triangle is read; overwritten by L).
@@ -58,75 +69,6 @@ def chol_factor_into(A, m):
 
     Returns:
         True, or False when the block is not positive definite (A partly overwritten).
-    """
-    for j in range(m):
-        s = A[j, j]
-        for k in range(j):
-            s -= A[j, k] * A[j, k]
-        if not s > 0.0:
-            return False
-        d = math.sqrt(s)
-        A[j, j] = d
-        for i in range(j + 1, m):
-            t = A[i, j]
-            for k in range(j):
-                t -= A[i, k] * A[j, k]
-            A[i, j] = t / d
-    return True
-
-
-@njit(cache=True)
-def lower_solve_into(L, b, x, m):
-    """Forward substitution: solve ``L x = b`` (m,), L lower triangular; x may alias b."""
-    for i in range(m):
-        t = b[i]
-        for k in range(i):
-            t -= L[i, k] * x[k]
-        x[i] = t / L[i, i]
-
-
-@njit(cache=True)
-def lower_t_solve_into(L, b, x, m):
-    """Back substitution: solve ``Lᵀ x = b`` (m,), L lower triangular; x may alias b."""
-    for i in range(m - 1, -1, -1):
-        t = b[i]
-        for k in range(i + 1, m):
-            t -= L[k, i] * x[k]
-        x[i] = t / L[i, i]
-
-
-@njit(cache=True)
-def chol_solve_into(L, b, x, m):
-    """Solve ``L Lᵀ x = b`` (m,) with the factor L of :func:`chol_factor_into`; x may alias b."""
-    lower_solve_into(L, b, x, m)
-    lower_t_solve_into(L, x, x, m)
-
-
-@njit(cache=True)
-def spd_solve_into(A, b, x, m):
-    """Solve ``A x = b`` for the leading m×m block of the SPD matrix A (destroyed).
-
-    Cholesky ``A = L Lᵀ``, then ``L y = b`` and ``Lᵀ x = y``. For speed the factor is
-    stored with the reciprocals ``1/L_jj`` on the diagonal (the factorisation itself never
-    reads L's diagonal back): the substitutions multiply where a plain solve divides, and
-    the only divisions left, one per column, are off the dependency chain of the rows
-    below (about 10-20 % faster than :func:`chol_factor_into` + :func:`chol_solve_into`
-    for the 6×6 and 7×7 systems of IK, measured on a loaded machine); the result agrees
-    with them to rounding. The factorisation is latency-bound (one pivot waits for the
-    previous one), so each pivot ``L_jj² = s`` is found from the previous one through a
-    division only (``s' = u − t²/s``, with ``t = L_{j+1,j}·L_jj``) and ``1/L_jj =
-    √s · (1/s)`` lets the square root and the division overlap: 126 → 98 ns for a 7×7
-    solve.
-
-    Args:
-        A: (≥m, ≥m) symmetric positive definite matrix (only the lower triangle is read);
-            overwritten (its lower triangle by L with inverted diagonal).
-        b: (≥m,) right-hand side.
-        x: (≥m,) output (may alias b).
-        m: size of the system.
-
-    Returns:
-        True, or False when A is not positive definite (x not written).
     """
     s = A[0, 0] if m > 0 else 1.0  # the pivot L_jj², j = 0
     for j in range(m):
@@ -151,29 +93,68 @@ def spd_solve_into(A, b, x, m):
             for k in range(j):
                 t -= A[i, k] * A[j, k]
             A[i, j] = t * r
-    factored_solve_into(A, b, x, m)
     return True
 
 
 @njit(cache=True)
-def factored_solve_into(L, b, x, m):
-    """Solve ``L Lᵀ x = b`` with the factor :func:`spd_solve_into` leaves in its ``A``.
+def lower_solve_into(L, b, x, m):
+    """Forward substitution: solve ``L x = b`` (m,) with a factor of :func:`chol_factor_into`.
 
-    ``L`` (≥m, ≥m): the lower triangle of L with the reciprocals ``1/L_jj`` on the
-    diagonal; ``b`` (≥m,) right-hand side; ``x`` (≥m,) output, which may alias b.
-    Forward ``L y = b``, then backward ``Lᵀ x = y``: another right-hand side for an
-    already factored matrix (e.g. columns of A⁻¹) costs these O(m²) substitutions only.
+    L lower triangular with the reciprocals of its diagonal stored; x may alias b.
     """
     for i in range(m):
         t = b[i]
         for k in range(i):
             t -= L[i, k] * x[k]
         x[i] = t * L[i, i]
+
+
+@njit(cache=True)
+def lower_t_solve_into(L, b, x, m):
+    """Back substitution: solve ``Lᵀ x = b`` (m,) with a factor of :func:`chol_factor_into`.
+
+    L lower triangular with the reciprocals of its diagonal stored; x may alias b.
+    """
     for i in range(m - 1, -1, -1):
-        t = x[i]
+        t = b[i]
         for k in range(i + 1, m):
             t -= L[k, i] * x[k]
         x[i] = t * L[i, i]
+
+
+@njit(cache=True)
+def chol_solve_into(L, b, x, m):
+    """Solve ``L Lᵀ x = b`` (m,) with the factor L of :func:`chol_factor_into`; x may alias b."""
+    lower_solve_into(L, b, x, m)
+    lower_t_solve_into(L, x, x, m)
+
+
+@njit(cache=True)
+def spd_solve_into(A, b, x, m):
+    """Solve ``A x = b`` for the leading m×m block of the SPD matrix A (destroyed).
+
+    :func:`chol_factor_into` (``A = L Lᵀ``, L left in A), then ``L y = b`` and
+    ``Lᵀ x = y``; the result agrees with numpy's solve to rounding.
+
+    Args:
+        A: (≥m, ≥m) symmetric positive definite matrix (only the lower triangle is read);
+            overwritten by its factor.
+        b: (≥m,) right-hand side.
+        x: (≥m,) output (may alias b).
+        m: size of the system.
+
+    Returns:
+        True, or False when A is not positive definite (x not written).
+    """
+    if not chol_factor_into(A, m):
+        return False
+    chol_solve_into(A, b, x, m)
+    return True
+
+
+#: :func:`chol_solve_into` under the name the IK steps use for solving again with the
+#: factor :func:`spd_solve_into` leaves in its ``A`` (one function, two names).
+factored_solve_into = chol_solve_into
 
 
 @njit(cache=True)
