@@ -704,63 +704,14 @@ def robot_from_mjcf(path_or_string: str | os.PathLike[str], base_body: str | Non
         end = reader.sites[tool_site]
     else:
         end = _pick_end(bodies, base, source)
-    path_ids = [end]
-    while path_ids[-1] != base:
-        parent = bodies[path_ids[-1]].parent
-        if parent < 0:
-            raise RobotDefinitionError(
-                f"{source}: end body {short_repr(bodies[end].name)} is not below base body "
-                f"{short_repr(bodies[base].name)}")
-        path_ids.append(parent)
-    path_ids.reverse()
-
-    base_T = np.eye(4)
-    chain_bodies = path_ids[1:]
-    if base == 0 and chain_bodies and any(j.type == "free" for j in bodies[chain_bodies[0]].joints):
-        first = bodies[chain_bodies[0]]
-        if len(first.joints) != 1:
-            raise RobotDefinitionError(
-                f"{source}: body {short_repr(first.name)} has a free joint and other joints")
-        base_T = first.T  # a floating base: its pose in the file
-        chain_bodies = chain_bodies[1:]
-        path_ids = path_ids[1:]
-    joints: list[Joint] = []
-    link_names = [bodies[path_ids[0]].name]
-    places: dict[int, tuple[int, np.ndarray]] = {path_ids[0]: (0, np.eye(4))}
-    pending = np.eye(4)
-    for b in chain_bodies:
-        body = bodies[b]
-        pending = pending @ body.T
-        for k, j in enumerate(body.joints):
-            label = f"joint {short_repr(j.name)}" if j.name else f"a joint of body {body.name!r}"
-            if j.type in ("ball", "free"):
-                raise NotSupportedError(
-                    f"{source}: {label} on the chain (body {short_repr(body.name)}) is a "
-                    f"{j.type} joint; only hinge and slide joints are supported"
-                    + (" (a free joint only on the floating base directly below the world)"
-                       if j.type == "free" else ""))
-            jtype = "R" if j.type == "hinge" else "P"
-            joints.append(Joint(axis=j.axis, type=jtype, origin=pending @ _transform(p=j.pos),
-                                post=_transform(p=-j.pos), offset=-j.ref, qlim=j.qlim,
-                                name=j.name))
-            pending = np.eye(4)
-            last = k == len(body.joints) - 1
-            link_names.append(body.name if last else f"{body.name}#{k + 1}")
-        places[b] = (len(joints), pending)
+    path_ids, base_T = _chain_path(bodies, base, end, source)
+    joints, link_names, places = _chain_joints(bodies, path_ids, source)
     if not joints:
         raise RobotDefinitionError(
             f"{source}: no hinge or slide joint between {short_repr(bodies[path_ids[0]].name)} "
             f"and {short_repr(bodies[end].name)}")
     n = len(joints)
-    # bodies welded (no joints) to a chain body share its frame
-    todo = list(places)
-    while todo:
-        b = todo.pop()
-        frame, T = places[b]
-        for c in bodies[b].children:
-            if c not in places and not bodies[c].joints:
-                places[c] = (frame, T @ bodies[c].T)
-                todo.append(c)
+    _weld(bodies, places)
     tool = places[end][1]
     if tool_site is not None:
         sb = reader.sites[tool_site]
@@ -780,6 +731,79 @@ def robot_from_mjcf(path_or_string: str | os.PathLike[str], base_body: str | Non
                  source=f"MJCF {source} ({bodies[path_ids[0]].name} -> {bodies[end].name}"
                         + (f", site {tool_site}" if tool_site else "") + ")",
                  link_names=tuple(link_names), geometry=geometry)
+
+
+def _chain_path(bodies: list[_Body], base: int, end: int, source: str
+                ) -> tuple[list[int], np.ndarray]:
+    """The bodies from ``base`` to ``end`` and the base pose (a floating base's is skipped).
+
+    A free joint on the body directly below the world is a floating base: that body's pose
+    in the file becomes the robot's base, and the chain starts at it.
+    """
+    path_ids = [end]
+    while path_ids[-1] != base:
+        parent = bodies[path_ids[-1]].parent
+        if parent < 0:
+            raise RobotDefinitionError(
+                f"{source}: end body {short_repr(bodies[end].name)} is not below base body "
+                f"{short_repr(bodies[base].name)}")
+        path_ids.append(parent)
+    path_ids.reverse()
+    base_T = np.eye(4)
+    if base == 0 and len(path_ids) > 1 \
+            and any(j.type == "free" for j in bodies[path_ids[1]].joints):
+        first = bodies[path_ids[1]]
+        if len(first.joints) != 1:
+            raise RobotDefinitionError(
+                f"{source}: body {short_repr(first.name)} has a free joint and other joints")
+        base_T = first.T  # a floating base: its pose in the file
+        path_ids = path_ids[1:]
+    return path_ids, base_T
+
+
+def _chain_joints(bodies: list[_Body], path_ids: list[int], source: str
+                  ) -> tuple[list[Joint], list[str], dict[int, tuple[int, np.ndarray]]]:
+    """The chain's joints, its link names, and each chain body's (frame, pose in it).
+
+    Joint i moves the body frame by ``Tr(p)·M(q − ref)·Tr(−p)`` (module docstring): the
+    body's pose and what is left of the previous body's go into the joint's origin.
+    """
+    joints: list[Joint] = []
+    link_names = [bodies[path_ids[0]].name]
+    places: dict[int, tuple[int, np.ndarray]] = {path_ids[0]: (0, np.eye(4))}
+    pending = np.eye(4)
+    for b in path_ids[1:]:
+        body = bodies[b]
+        pending = pending @ body.T
+        for k, j in enumerate(body.joints):
+            label = f"joint {short_repr(j.name)}" if j.name else f"a joint of body {body.name!r}"
+            if j.type in ("ball", "free"):
+                raise NotSupportedError(
+                    f"{source}: {label} on the chain (body {short_repr(body.name)}) is a "
+                    f"{j.type} joint; only hinge and slide joints are supported"
+                    + (" (a free joint only on the floating base directly below the world)"
+                       if j.type == "free" else ""))
+            jtype = "R" if j.type == "hinge" else "P"
+            joints.append(Joint(axis=j.axis, type=jtype, origin=pending @ _transform(p=j.pos),
+                                post=_transform(p=-j.pos), offset=-j.ref, qlim=j.qlim,
+                                name=j.name))
+            pending = np.eye(4)
+            last = k == len(body.joints) - 1
+            link_names.append(body.name if last else f"{body.name}#{k + 1}")
+        places[b] = (len(joints), pending)
+    return joints, link_names, places
+
+
+def _weld(bodies: list[_Body], places: dict[int, tuple[int, np.ndarray]]) -> None:
+    """Add to ``places`` the bodies welded (no joints) to a chain body: they share its frame."""
+    todo = list(places)
+    while todo:
+        b = todo.pop()
+        frame, T = places[b]
+        for c in bodies[b].children:
+            if c not in places and not bodies[c].joints:
+                places[c] = (frame, T @ bodies[c].T)
+                todo.append(c)
 
 
 def _posed(shape: Shape, T: np.ndarray) -> Shape:
