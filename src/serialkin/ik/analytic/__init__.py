@@ -824,8 +824,9 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
                          "accepted: tol, all_turns, free, near_tol, grid, reference, "
                          "weights, norm, report")
     if free is not None:
-        return _ik_all_locked(robot, target, free, tol, all_turns, near_tol, grid, reference,
-                              weights, norm, report)
+        solve = {"tol": tol, "all_turns": all_turns, "near_tol": near_tol, "grid": grid,
+                 "report": report}
+        return _ik_all_locked(robot, target, free, (reference, weights, norm), solve)
     near_tol = check_positive(near_tol, "near_tol", allow_zero=True)
     p = _prepared(robot, near_tol)
     tol = check_positive(tol, "tol")
@@ -848,15 +849,18 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
     return _ik_all_one(p, robot, a, tol, grid, all_turns, reference, weights, norm, report)
 
 
-def _ik_all_locked(robot: Robot, target: object, free: object, tol: float, all_turns: bool,
-                   near_tol: float, grid: int | None, reference: object, weights: object,
-                   norm: str, report: bool) -> AllSolutions:
-    """:func:`ik_all` with the joints of ``free`` locked: the reduced robot's rows, refilled."""
+def _ik_all_locked(robot: Robot, target: object, free: object, order: tuple,
+                   solve: dict[str, Any]) -> AllSolutions:
+    """:func:`ik_all` with the joints of ``free`` locked: the reduced robot's rows, refilled.
+
+    ``order`` is ``(reference, weights, norm)`` of the sorting, ``solve`` the options of
+    the reduced robot's solve.
+    """
     if not isinstance(robot, Robot):
         raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    reference, weights, norm = order
     reduced, idx, vals = _locked(robot, free)
-    res = ik_all(reduced, target, tol=tol, all_turns=all_turns, near_tol=near_tol,
-                 grid=grid, report=report)
+    res = ik_all(reduced, target, **solve)
     q = _insert_locked(res.q, idx, vals, robot.n)
     if np.ndim(res.count) == 0:  # one target
         if reference is not None:
