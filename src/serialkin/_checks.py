@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import difflib
 import itertools
+import math
 import reprlib
 from collections.abc import Iterable, Mapping, Sequence
 
@@ -284,6 +285,19 @@ def check_int(value: object, name: str, *, minimum: int = 0, maximum: int | None
         tail = f" {hint}" if hint else ""
         raise InputError(f"{name} must be <= {maximum}, got {short_repr(value)}.{tail}")
     return int(value)
+
+
+#: Largest angle read as radians before it looks like degrees: a full turn, plus rounding.
+TURN_LIMIT = 2 * math.pi + 1e-6
+
+
+def beyond_a_turn(values: object) -> np.ndarray:
+    """Where ``|value|`` exceeds a full turn (:data:`TURN_LIMIT`) [rad], element-wise.
+
+    A fixed angle or joint value read in radians that large is most likely in degrees:
+    the readers refuse it and say so (the caller names the field and the unit to use).
+    """
+    return np.abs(np.asarray(values, dtype=float)) > TURN_LIMIT
 
 
 def check_real(value: object, name: str, *, max_abs: float | None = None,

@@ -46,12 +46,9 @@ def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
     out = Path(path)
     if os.path.islink(out):
         out = Path(os.path.realpath(out))  # replace the link's target, keep the link
-    try:
-        mode = os.stat(out).st_mode
-    except OSError:
-        mode = None  # a new file (or one we cannot see: the write below says why)
+    mode = _mode(out)
     if mode is not None and not stat.S_ISREG(mode):
-        if stat.S_ISCHR(mode) or stat.S_ISFIFO(mode):
+        if _is_stream(mode):
             try:
                 with open(out, "wb") as f:  # write through: a device is never replaced
                     f.write(data)
@@ -84,6 +81,24 @@ def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
             pass
         raise
     return out
+
+
+def _mode(path: str | Path) -> int | None:
+    """``st_mode`` of ``path`` (links followed), or None when it cannot be seen."""
+    try:
+        return os.stat(path).st_mode
+    except OSError:
+        return None  # a new file (or one we cannot see: a write says why)
+
+
+def _is_stream(mode: int) -> bool:
+    return stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)
+
+
+def written_through(path: str | Path) -> bool:
+    """Whether ``path`` is a character device or a FIFO, which writes go through to."""
+    mode = _mode(path)
+    return mode is not None and _is_stream(mode)
 
 
 def write_text_atomic(path: str | Path, text: str) -> Path:

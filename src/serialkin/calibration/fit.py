@@ -28,7 +28,7 @@ from serialkin.calibration.jacobian import errors, whitened
 from serialkin.calibration.measurements import Measurements
 from serialkin.calibration.models import ErrorModel, error_model
 from serialkin.errors import InputError, InputTypeError
-from serialkin.model.robot import Robot
+from serialkin.model.robot import Robot, robot_scale
 
 #: Loss functions of ``scipy.optimize.least_squares`` accepted by :func:`calibrate`.
 LOSSES = ("linear", "huber", "soft_l1", "cauchy", "arctan")
@@ -258,16 +258,6 @@ _CAUSES = ("are the positions in metres (not millimetres), is it the right robot
            "the joint columns q1..qn in the robot's joint order and in radians?")
 
 
-def robot_size(robot: Robot) -> float:
-    """The robot's size [m]: the farthest joint frame or tool from the base at q = 0 (≥ 0.1)."""
-    frames = robot.fk_all(np.zeros(robot.n))[..., :3, 3]
-    tip = robot.fk(np.zeros(robot.n))[:3, 3]
-    base = robot.base[:3, 3]
-    d = max(float(np.linalg.norm(frames - base, axis=-1).max(initial=0.0)),
-            float(np.linalg.norm(tip - base)))
-    return max(0.1, d)
-
-
 def implausible(model: ErrorModel, params: np.ndarray, errors_after: np.ndarray) -> str:
     """Why a converged fit cannot describe this robot ('' when it can).
 
@@ -276,7 +266,7 @@ def implausible(model: ErrorModel, params: np.ndarray, errors_after: np.ndarray)
     :data:`RESIDUAL_LIMIT` × the size: the measurements then belong to other units, another
     robot or another joint order (the message says so).
     """
-    size = robot_size(model.robot)
+    size = robot_scale(model.robot)
     moved = params - model.nominal
     for k, par in enumerate(model.parameters):
         if par.unit == "m" and abs(moved[k]) > MOVE_LIMIT * size:

@@ -31,7 +31,13 @@ from pathlib import Path
 
 import numpy as np
 
-from serialkin._checks import as_float_array, check_choice, check_positive, short_repr
+from serialkin._checks import (
+    as_float_array,
+    beyond_a_turn,
+    check_choice,
+    check_positive,
+    short_repr,
+)
 from serialkin.errors import InputError
 from serialkin.model.robot import Robot
 
@@ -238,7 +244,7 @@ def read_measurements(path: str | os.PathLike[str], robot: Robot, *,
     col = {h: i for i, h in enumerate(header)}
     q = a[:, [col[f"q{i + 1}"] for i in range(robot.n)]]
     revolute = robot.revolute
-    wild = np.abs(q[:, revolute]) > 2 * math.pi + 1e-9
+    wild = beyond_a_turn(q[:, revolute])
     if wild.any():  # radians are read: 90 means 90 rad, fourteen turns
         i, j = np.argwhere(wild)[0]
         joint = int(np.flatnonzero(revolute)[j])

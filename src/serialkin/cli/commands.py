@@ -17,7 +17,7 @@ from typing import Any
 import click
 import numpy as np
 
-from serialkin._checks import short_repr
+from serialkin._checks import beyond_a_turn, short_repr
 from serialkin.cli.io import (
     EXIT_NOT_REACHED,
     CLIError,
@@ -248,7 +248,7 @@ def read_q(robot: Any, q_texts: tuple[str, ...], q_file: str | None, degrees: bo
         Q = np.zeros((1, robot.n))
     if not degrees:  # radians are read: a value beyond a turn and the limits is a slip
         lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
-        wild = robot.revolute & (np.abs(Q) > 2 * np.pi + 1e-9) & ((Q < lo) | (Q > hi))
+        wild = robot.revolute & beyond_a_turn(Q) & ((Q < lo) | (Q > hi))
         if wild.any():
             i, j = np.argwhere(wild)[0]
             raise CLIError(f"--q: joint {j + 1} = {Q[i, j]:g} rad is beyond a full turn and "

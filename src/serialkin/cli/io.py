@@ -22,6 +22,7 @@ import click
 import numpy as np
 
 from serialkin._checks import short_repr
+from serialkin._io import written_through
 
 #: Exit code of a run whose inputs were wrong (bad file, robot, option): also click's
 #: exit code for usage errors.
@@ -252,17 +253,6 @@ def csv_text(header: Sequence[str], rows: np.ndarray | Sequence[Sequence[float]]
     return "\n".join(lines) + "\n"
 
 
-def _is_stream(path: Path) -> bool:
-    """Whether ``path`` is a character device or a FIFO (written through, never replaced)."""
-    import stat
-
-    try:
-        mode = os.stat(path).st_mode
-    except OSError:
-        return False
-    return stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)
-
-
 def write_output(path: str | os.PathLike[str], data: dict[str, Any],
                  csv: tuple[Sequence[str], np.ndarray] | None = None) -> Path:
     """Write results to ``path``: JSON for ``.json``, CSV for ``.csv`` (when ``csv`` given).
@@ -272,7 +262,7 @@ def write_output(path: str | os.PathLike[str], data: dict[str, Any],
     """
     p = Path(path)
     suffix = p.suffix.lower()
-    if suffix == ".json" or _is_stream(p):  # a device or pipe (/dev/stdout): JSON
+    if suffix == ".json" or written_through(p):  # a device or pipe (/dev/stdout): JSON
         return write_text_atomic(p, dumps_json(data))
     if suffix == ".csv" and csv is not None:
         return write_text_atomic(p, csv_text(*csv))

@@ -80,7 +80,7 @@ from serialkin.ik._kernels import (
     task_cost,
 )
 from serialkin.ik.registry import MethodSpec, register_method
-from serialkin.kinematics.dls import dls_step_into, factored_solve_into, spd_solve_into
+from serialkin.kinematics.dls import chol_solve_into, dls_step_into, spd_solve_into
 from serialkin.kinematics.kernels import fk_into
 from serialkin.model.limits import wrap_into
 from serialkin.spatial.kernels import pose_error_into
@@ -211,7 +211,7 @@ def step_lm(q, J, e, cost, p, ctx, ws, dq):
                 for j in range(n):
                     z[j] = 0.0
                 z[i] = 1.0
-                factored_solve_into(A, z, z, n)  # A⁻¹ e_i
+                chol_solve_into(A, z, z, n)  # A⁻¹ e_i
                 k += 1
                 changed = True
         if not changed:

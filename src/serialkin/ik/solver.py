@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from serialkin._budget import check_allocation
 from serialkin._checks import MAX_ITERATIONS, ROTATION_TOL, check_int, short_repr
 from serialkin._memo import PerObject
 from serialkin.errors import InputError, InputTypeError
@@ -440,8 +441,6 @@ def solve(
         )
     shape = getattr(target, "shape", None)
     if shape is not None and len(shape) >= 2:  # before parse_target copies a batch
-        from serialkin._budget import check_allocation
-
         # per target: its copy (16), q (n) and the kernel's info: refused before allocation
         count = math.prod(shape[:-1]) // (4 if shape[-2:] == (4, 4) else 1)
         check_allocation("the IK batch (targets and results)",

@@ -53,8 +53,9 @@ def chol_factor_into(A, m):
     """Cholesky factor ``A = L Lᵀ`` of the leading m×m block of A, in place.
 
     The one storage of serialkin's Cholesky factors: the lower triangle of L with the
-    reciprocals ``1/L_jj`` on the diagonal (:func:`factored_solve_into`,
-    :func:`lower_solve_into` and :func:`lower_t_solve_into` read it). The substitutions
+    reciprocals ``1/L_jj`` on the diagonal (:func:`chol_solve_into`,
+    :func:`lower_solve_into` and :func:`lower_t_solve_into` read it; so does a solve
+    again with the factor :func:`spd_solve_into` leaves in its ``A``). The substitutions
     then multiply where a plain solve divides, and the only divisions left, one per
     column, are off the dependency chain of the rows below (about 10-20 % faster for the
     6×6 and 7×7 systems of IK, measured on a loaded machine). The factorisation is
@@ -150,11 +151,6 @@ def spd_solve_into(A, b, x, m):
         return False
     chol_solve_into(A, b, x, m)
     return True
-
-
-#: :func:`chol_solve_into` under the name the IK steps use for solving again with the
-#: factor :func:`spd_solve_into` leaves in its ``A`` (one function, two names).
-factored_solve_into = chol_solve_into
 
 
 @njit(cache=True)

@@ -524,7 +524,7 @@ def _read_file(path: Path) -> ET.Element:
     if not exists:
         raise RobotDefinitionError(f"MJCF file {short_repr(str(path), 120)} does not exist")
     data = read_bytes(path, what="MJCF file", error=RobotDefinitionError)
-    return _depth_checked(parse_xml(data, str(path), error=RobotDefinitionError), str(path))
+    return parse_xml(data, str(path), error=RobotDefinitionError)
 
 
 class _Includes:
@@ -686,9 +686,10 @@ def robot_from_mjcf(path_or_string: str | os.PathLike[str], base_body: str | Non
     if root.tag != "mujoco":
         raise RobotDefinitionError(
             f"{source}: the root element must be <mujoco>, got <{root.tag}>")
-    _depth_checked(root, source)
+    # the expansion walks elements without recursion; the reader then recurses into
+    # bodies, so the depth is checked once, on the whole expanded model
     _expand_includes(root, _Includes(folder or Path.cwd()), source, (source,))
-    _depth_checked(root, source)  # included files nest inside their <include>
+    _depth_checked(root, source)
     reader = _Reader(root, source, folder, resolve_meshes)
     bodies = reader.bodies
 

@@ -862,3 +862,22 @@ class Robot:
         types = "".join(self.joint_types)
         conv = f", {self.convention} DH" if self.convention else ""
         return f"Robot({self.name!r}, n={self.n}, joints={types}{conv})"
+
+
+def robot_scale(robot: Robot) -> float:
+    """Return a length scale of the robot [m]: an upper bound on its reach from the base.
+
+    The tool lies within ``Σ_{i>=1} |t(F[i])|`` plus the prismatic travel of the first
+    joint's frame (eq 11: ``T = F[0]·M_1·F[1]···M_n·F[n]``), where ``t`` is the
+    translation; a prismatic joint adds its largest finite limit (1 m when unlimited).
+    At least 1e-3. Used to size frame triads, markers and views, and to judge a calibration's
+    parameter changes and residuals.
+    """
+    F = robot.chain.F
+    total = float(np.linalg.norm(F[1:, :3, 3], axis=-1).sum())
+    for i, revolute in enumerate(robot.revolute):
+        if not revolute:
+            lim = np.abs(robot.qlim[i])
+            finite = lim[np.isfinite(lim)]
+            total += float(finite.max()) if finite.size else 1.0
+    return max(total, 1e-3)

@@ -58,7 +58,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import MAX_JOINT_VALUE, MAX_JOINTS, MAX_LENGTH, short_repr
+from serialkin._checks import MAX_JOINT_VALUE, MAX_JOINTS, MAX_LENGTH, beyond_a_turn, short_repr
 from serialkin._files import Field, load_document
 from serialkin.errors import InputTypeError, RobotDefinitionError
 from serialkin.model.dh import CONVENTIONS, DHLink
@@ -171,7 +171,7 @@ def dh_rows_from_field(f: Field, *, angle_unit: str = "rad", length_unit: str = 
         alpha = row["alpha"].number(lo=-ba, hi=ba, unit=angle_unit) * ang
         theta = row["theta"].number(lo=-ba, hi=ba, unit=angle_unit) * ang
         for key, value in (("alpha", alpha), ("theta", theta)):
-            if abs(value) > 2 * math.pi + 1e-9:  # a fixed angle beyond a turn: degrees?
+            if beyond_a_turn(value):  # a fixed angle beyond a turn: degrees?
                 raise row[key].expected(
                     f"an angle of at most one turn (2π) in {angle_unit} (are these degrees? "
                     "declare them with units: {angle: deg})")

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from serialkin._checks import short_repr
+from serialkin._checks import beyond_a_turn, short_repr
 from serialkin._files import MAX_NUMBER, parse_xml
 from serialkin.errors import NotSupportedError, RobotDefinitionError
 from serialkin.model.geometry import Box, Capsule, Cylinder, LinkGeometry, Mesh, Shape, Sphere
@@ -74,7 +74,7 @@ def _origin(el: ET.Element | None, where: str) -> np.ndarray:
         return np.eye(4)
     xyz = _floats(el.get("xyz"), 3, (0.0, 0.0, 0.0), f"{where} <origin xyz>", MAX_NUMBER)
     rpy = _floats(el.get("rpy"), 3, (0.0, 0.0, 0.0), f"{where} <origin rpy>", MAX_NUMBER)
-    if (np.abs(rpy) > 2 * np.pi + 1e-6).any():  # URDF angles are radians
+    if beyond_a_turn(rpy).any():  # URDF angles are radians
         raise RobotDefinitionError(
             f"{where} <origin rpy>: {' '.join(f'{v:g}' for v in rpy)} has an angle beyond a "
             "full turn; URDF angles are radians (are these degrees?)")

@@ -161,10 +161,6 @@ def _sandboxed(xacro, find, roots: list[Path]) -> Iterator[_Sandbox]:
     """Route xacro's evaluation, file access and macro calls through a :class:`_Sandbox`."""
     sa = xacro.substitution_args
     box = _Sandbox(xacro, find, roots)
-    saved = {(xacro, "safe_eval"), (xacro, "abs_filename_spec"), (xacro, "parse"),
-             (xacro, "handle_macro_call"), (sa, "_eval"), (sa, "_eval_find")}
-    saved = {(mod, name): getattr(mod, name) for mod, name in saved}
-    saved_find = sa._eval_dict.get("find")
     abs_spec, parse, macro_call = xacro.abs_filename_spec, xacro.parse, xacro.handle_macro_call
 
     def safe_eval(expr, globals, locals=None):
@@ -205,17 +201,18 @@ def _sandboxed(xacro, find, roots: list[Path]) -> Iterator[_Sandbox]:
                                   "macros expand without end, or exponentially)")
         return macro_call(node, macros, symbols)
 
-    xacro.safe_eval = safe_eval
-    xacro.abs_filename_spec = checked_spec
-    xacro.parse = checked_parse
-    xacro.handle_macro_call = counted_macro_call
-    sa._eval = eval_substitution
-    sa._eval_find = box.find
+    patches = [(xacro, "safe_eval", safe_eval), (xacro, "abs_filename_spec", checked_spec),
+               (xacro, "parse", checked_parse), (xacro, "handle_macro_call", counted_macro_call),
+               (sa, "_eval", eval_substitution), (sa, "_eval_find", box.find)]
+    saved = [(mod, name, getattr(mod, name)) for mod, name, _ in patches]
+    saved_find = sa._eval_dict.get("find")
+    for mod, name, value in patches:
+        setattr(mod, name, value)
     sa._eval_dict["find"] = box.find
     try:
         yield box
     finally:
-        for (mod, name), value in saved.items():
+        for mod, name, value in saved:
             setattr(mod, name, value)
         sa._eval_dict["find"] = saved_find
 

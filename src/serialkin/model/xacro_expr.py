@@ -52,7 +52,8 @@ class XacroExpressionError(RobotDefinitionError):
     """A xacro expression uses something other than data and arithmetic, or is malformed."""
 
 
-def _checked_int_pow(base, exp):
+def _pow(base, exp):
+    """``base ** exp``, refusing an integer power beyond :data:`MAX_INT_BITS` before computing."""
     if isinstance(base, int) and isinstance(exp, int) and exp > 0 and abs(base) > 1:
         bits = exp * math.log2(abs(base))
         if bits > MAX_INT_BITS:
@@ -60,10 +61,6 @@ def _checked_int_pow(base, exp):
                               f"would have about {bits:.3g} bits, more than the "
                               f"{MAX_INT_BITS} an expression may produce")
     return base ** exp
-
-
-def _pow(base, exp):
-    return _checked_int_pow(base, exp)
 
 
 #: The functions an expression may call (also as ``math.NAME``).

@@ -51,7 +51,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import MAX_ITERATIONS, MAX_JOINTS, MAX_LENGTH, short_repr
+from serialkin._checks import MAX_ITERATIONS, MAX_JOINTS, MAX_LENGTH, beyond_a_turn, short_repr
 from serialkin._files import MAX_ITEMS, Field, load_document
 from serialkin.errors import InputError, InputTypeError, SerialkinError
 from serialkin.model.tasks import TARGET_TASKS, get_task
@@ -382,7 +382,7 @@ def scenario_from_dict(data: object, source: str = "<dict>",
                 a = np.full(n, float(a))
             if a.shape != (n,):
                 raise qf.fail(f"must have {n} values (one per joint), got shape {a.shape}")
-            if key == "q0" and (np.abs(a[robot.revolute]) > 2 * math.pi + 1e-9).any():
+            if key == "q0" and beyond_a_turn(a[robot.revolute]).any():
                 raise qf.fail("has a revolute joint value beyond a full turn; q0 is in "
                               "radians (for degrees write q0_deg)")
             q0 = a * scale

@@ -27,6 +27,7 @@ import numpy as np
 
 from serialkin._checks import as_float_array, check_positive
 from serialkin.errors import InputError, InputTypeError
+from serialkin.model.robot import robot_scale  # noqa: F401  (public here too)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -94,24 +95,6 @@ def joint_positions(robot: Robot, q: object) -> np.ndarray:
     T = robot.fk_all(a)[..., 1:, :, :]
     Linv = np.linalg.inv(robot.chain.L[1:])
     return (T @ Linv)[..., :3, 3]
-
-
-def robot_scale(robot: Robot) -> float:
-    """Return a length scale of the robot [m]: an upper bound on its reach from the base.
-
-    The tool lies within ``Σ_{i>=1} |t(F[i])|`` plus the prismatic travel of the first
-    joint's frame (eq 11: ``T = F[0]·M_1·F[1]···M_n·F[n]``), where ``t`` is the
-    translation; a prismatic joint adds its largest finite limit (1 m when unlimited).
-    At least 1e-3. Used to size frame triads, markers and views.
-    """
-    F = robot.chain.F
-    total = float(np.linalg.norm(F[1:, :3, 3], axis=-1).sum())
-    for i, revolute in enumerate(robot.revolute):
-        if not revolute:
-            lim = np.abs(robot.qlim[i])
-            finite = lim[np.isfinite(lim)]
-            total += float(finite.max()) if finite.size else 1.0
-    return max(total, 1e-3)
 
 
 def is_3d_axes(ax: Any) -> bool:

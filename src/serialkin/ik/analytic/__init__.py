@@ -356,18 +356,12 @@ class AllSolutions(np.lib.mixins.NDArrayOperatorsMixin):
 
     def __init__(self, q: np.ndarray, count: object, branches: object, converged: object,
                  kind: str, mode: str, continuous: np.ndarray | None = None) -> None:
+        # (..., 17) as the kernels fill it: branches, then a flag per branch
         conv = np.concatenate([np.asarray(branches, dtype=np.int64)[..., None],
                                np.asarray(converged).astype(np.int64)], axis=-1)
-        self._set(q, count, conv, kind, mode, continuous)
-
-    def _set(self, q, count, conv, kind, mode, continuous) -> None:
-        put = object.__setattr__
-        put(self, "q", q)
-        put(self, "count", count)
-        put(self, "_conv", conv)  # (..., 17) as the kernels fill it: branches, converged
-        put(self, "kind", kind)
-        put(self, "mode", mode)
-        put(self, "continuous", continuous)
+        for name, value in zip(self.__slots__, (q, count, conv, kind, mode, continuous),
+                               strict=True):
+            _PUT(self, name, value)
 
     @staticmethod
     def _of(q: np.ndarray, count: object, conv: np.ndarray, kind: str, mode: str,
