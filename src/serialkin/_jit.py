@@ -198,6 +198,10 @@ def _define_numba_objects():
             kws = {k: types.unliteral(v) for k, v in kws.items()}
             return super().get_call_template(args, kws)
 
+        def compile(self, sig):
+            """Compile ``sig`` at this kernel's optimisation level (:func:`opt_level`)."""
+            return _at_opt_level(self.py_func, super().compile, sig)
+
         def _compile_for_args(self, *args, **kws):
             """A call from Python found no compiled version: compile, or run as Python.
 
@@ -257,13 +261,26 @@ def _compiled(decorated):
 
 
 def _decorator(args: tuple, options: dict):
-    """``numba.njit(*args, **options)``, as a :class:`Kernel` while numba is not loaded."""
+    """``numba.njit(*args, **options)``, as a :class:`Kernel` while numba is not loaded.
+
+    ``options["hot"]`` (serialkin's own option, not numba's) marks the kernel for
+    LLVM's ``-O3`` (see :func:`opt_level`).
+    """
+    hot = options.pop("hot", False)
+    given = bool(args) and isinstance(args[0], FunctionType)
+    if hot and given:
+        _mark_hot(args[0])
     if _NUMBA:
         import numba
 
-        return _compiled(numba.njit(*args, **options))
+        made = numba.njit(*args, **options)
+        if hot and not given:
+            return _compiled(lambda fn: made(_mark_hot(fn)))
+        return _compiled(made)
 
     def make(fn):
+        if hot:
+            _mark_hot(fn)
         with _LOCK:
             if _NUMBA:  # loaded meanwhile (by another thread)
                 return _decorator((), options)(fn)
@@ -275,8 +292,66 @@ def _decorator(args: tuple, options: dict):
         return make(args[0])
     if args:  # an explicit signature compiles at once: numba is needed now
         load_numba()
-        return _decorator(args, options)
+        return _decorator(args, dict(options, hot=hot))
     return make
+
+
+# ------------------------------------------------------------------ optimisation levels
+#: LLVM's optimisation level of the kernels marked ``hot`` (the ones the warm-speed goals
+#: name: forward kinematics, Jacobians, the default IK method's loop) and of all others.
+HOT_OPT, OPT = 3, 2
+_COMPILING = threading.local()
+
+
+def _mark_hot(fn: FunctionType) -> FunctionType:
+    """Mark the Python function ``fn`` of a kernel for :data:`HOT_OPT`; return it."""
+    fn._serialkin_hot = True
+    return fn
+
+
+def opt_level(py_func: FunctionType) -> int:
+    """The LLVM optimisation level a kernel is compiled at (``-O2`` or ``-O3``).
+
+    ``-O3`` (:data:`HOT_OPT`) for kernels declared ``njit(..., hot=True)``; ``-O2``
+    (:data:`OPT`) for every other. Measured on a quiet 2-core machine (the ``ik-all``
+    feature's kernels, fresh cache): 71 s to compile at ``-O3``, 48 s at ``-O2``, the same
+    warm speed within the machine's noise for ``ik_all`` (UR5 5.5–7.8 µs at ``-O3``,
+    5.7–8.2 µs at ``-O2``); FK and the ``lm`` IK loop lose 15–40 % at ``-O2``, so they
+    stay at ``-O3`` (docs/compile-time.md). ``NUMBA_OPT`` set in the environment wins.
+    """
+    return HOT_OPT if getattr(py_func, "_serialkin_hot", False) else OPT
+
+
+def _at_opt_level(py_func: FunctionType, compile_: Callable, sig):
+    """``compile_(sig)`` with numba's optimisation level set for the kernel ``py_func``.
+
+    A kernel compiled for its own sake (called from Python) gets ``opt_level(py_func)``; a
+    callee compiled while another kernel compiles gets its caller's level (the caller
+    optimises it again, with that level, when it links it), except a ``hot`` kernel,
+    always ``-O3``: what a user calls directly stays as fast whichever feature compiled
+    it first. Set only while numba's compiler lock is held, so no other compile (a user's
+    own kernels, another thread's) sees it. ``NUMBA_OPT`` in the environment turns this
+    off.
+    """
+    if "NUMBA_OPT" in os.environ:
+        return compile_(sig)
+    outer = getattr(_COMPILING, "level", None)
+    level = opt_level(py_func) if outer is None or getattr(py_func, "_serialkin_hot", False) \
+        else outer
+    if level == outer:
+        return compile_(sig)
+    from numba.core import config
+    from numba.core.compiler_lock import global_compiler_lock
+
+    with global_compiler_lock:
+        saved = config.OPT
+        config.OPT = type(saved)(level)
+        _COMPILING.level = level
+        try:
+            return compile_(sig)
+        finally:
+            _COMPILING.level = outer
+            config.OPT = saved
 
 
 def njit(*args, **options):

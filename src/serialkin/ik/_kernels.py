@@ -84,6 +84,7 @@ unreachable target returns the closest pose found.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 from dataclasses import dataclass, replace
@@ -1110,13 +1111,14 @@ def _bind(template, name: str, tag: str, **bound):
 
 
 def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *,
-                   allocates: bool = False) -> CompiledMethod:
+                   allocates: bool = False, hot: bool = False) -> CompiledMethod:
     """The shared loop around the step kernel ``step`` (an ``@njit`` function), for ``name``.
 
     ``params`` names the options the step reads (see :class:`CompiledMethod`);
     ``allocates`` must be True when the step, or a helper it calls, allocates arrays (the
     attempt loop and the per-target loop around it are then compiled with reference
-    counting, about 0.1 µs slower per iteration and 0.35 µs per target). Compilation is
+    counting, about 0.1 µs slower per iteration and 0.35 µs per target); ``hot`` compiles
+    the loop at ``-O3`` (:func:`serialkin._jit.opt_level`: the default method). Compilation is
     lazy (at the first call) and cached on disk; the cache entry's name holds a hash of
     this module's and the step's module's sources and of everything they import
     (:func:`serialkin._jit.dependency_stamp`), so editing any of them recompiles.
@@ -1128,22 +1130,22 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
     # the attempt loop itself allocates nothing: without reference counting (NRT), which
     # would incref/decref every array the loop touches, each iteration (about
     # 0.1 µs per iteration, a fifth of an lm solve), unless the step allocates
-    attempt = njit(cache=True, _nrt=allocates)(_bind(_attempt, name, tag + str(int(allocates)),
-                                                     step=step))
+    compiled = functools.partial(njit, cache=True, hot=hot)
+    attempt = compiled(_nrt=allocates)(_bind(_attempt, name, tag + str(int(allocates)),
+                                             step=step))
     # a function of its own, without reference counting unless the step allocates: it
     # allocates nothing (the workspace comes from its callers), and with NRT the views it
     # unpacks from the workspace and slices from cfg and box cost an atomic increment
     # and decrement each, per target (about 0.35 µs of a Panda target's 0.7 µs outside
     # its iterations)
-    one_in = njit(cache=True, _nrt=allocates)(_bind(_solve_one_in, name,
-                                                    tag + str(int(allocates)),
-                                                    attempt_loop=attempt))
-    one = njit(cache=True)(_bind(_solve_one, name, tag, solve_one_in=one_in))
-    chunk = njit(cache=True, nogil=True)(_bind(_solve_chunk, name, tag, solve_one_in=one_in))
-    one_c = njit(cache=True)(_bind(_solve_one_collision, name, tag, attempt_loop=attempt))
-    chunk_c = njit(cache=True, nogil=True)(_bind(_solve_chunk_collision, name, tag,
-                                                 solve_one_collision=one_c))
-    fast = njit(cache=True)(_bind(_solve_fast, name, tag, solve_one_in=one_in))
+    one_in = compiled(_nrt=allocates)(_bind(_solve_one_in, name, tag + str(int(allocates)),
+                                            attempt_loop=attempt))
+    one = compiled()(_bind(_solve_one, name, tag, solve_one_in=one_in))
+    chunk = compiled(nogil=True)(_bind(_solve_chunk, name, tag, solve_one_in=one_in))
+    one_c = compiled()(_bind(_solve_one_collision, name, tag, attempt_loop=attempt))
+    chunk_c = compiled(nogil=True)(_bind(_solve_chunk_collision, name, tag,
+                                         solve_one_collision=one_c))
+    fast = compiled()(_bind(_solve_fast, name, tag, solve_one_in=one_in))
     return CompiledMethod(step=step, params=tuple(params), solve_one=one, solve_chunk=chunk,
                           solve_one_collision=one_c, solve_chunk_collision=chunk_c,
                           solve_fast=fast)

@@ -445,7 +445,7 @@ def step_allocating(q, J, e, cost, p, ctx, ws, dq):
 _KERNELS = {
     **compile_family("plain", step_plain, PLAIN),
     **compile_family("allocating", step_allocating, ALLOCATING, allocates=True),
-    "lm": compile_method("lm", step_lm, (("damping", True),)),
+    "lm": compile_method("lm", step_lm, (("damping", True),), hot=True),
 }
 
 

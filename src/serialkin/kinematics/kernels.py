@@ -41,14 +41,14 @@ REVOLUTE = 0
 PRISMATIC = 1
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _post_multiply(T, A):
     """T ← T · A for rigid transforms (last rows [0 0 0 1]), in place, no allocation."""
     for r in range(3):
         T[r, 0], T[r, 1], T[r, 2], T[r, 3] = _row_times(T[r, 0], T[r, 1], T[r, 2], T[r, 3], A)
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _apply_joint(T, meta_i, qi):
     """T ← T · M(q): rotation about / translation along the (compiled) z axis."""
     x = qi + meta_i[4]
@@ -64,7 +64,7 @@ def _apply_joint(T, meta_i, qi):
         T[r, 1] = fma(-t0, s, t1 * c)
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _row_times(t0, t1, t2, t3, A):
     """One row [t0 t1 t2 t3] of a rigid transform times the rigid transform A."""
     return (fma(t2, A[2, 0], fma(t1, A[1, 0], t0 * A[0, 0])),
@@ -73,7 +73,7 @@ def _row_times(t0, t1, t2, t3, A):
             fma(t2, A[2, 3], fma(t1, A[1, 3], fma(t0, A[0, 3], t3))))
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _sincos_banks(q, off, SC, i0, i1):
     """(sin, cos) of ``q + off`` for joints ``i0..i1-1`` into the scratch ``SC`` (2-D).
 
@@ -112,7 +112,7 @@ def _sincos_banks(q, off, SC, i0, i1):
         b += 1
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _chain_walk(q, F, kind, off, J, record, SC):
     """Walk the chain holding the pose's 12 entries in registers; return them as a tuple.
 
@@ -168,7 +168,7 @@ def _chain_walk(q, F, kind, off, J, record, SC):
     return a0, a1, a2, a3, b0, b1, b2, b3, c0, c1, c2, c3
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _store_pose(t, T):
     for k in range(12):
         T[k // 4, k % 4] = t[k]
@@ -178,7 +178,7 @@ def _store_pose(t, T):
     T[3, 3] = 1.0
 
 
-@njit(cache=True, fastmath=False)
+@njit(cache=True, hot=True, fastmath=False)
 def fk_into(q, F, meta, T):
     """End-effector pose (eq 11) into ``T`` (4, 4) for one configuration ``q`` (n,)."""
     _store_pose(_chain_walk(q, F, meta[:, 3], meta[:, 4], T, False, T), T)
@@ -196,7 +196,7 @@ def fk_into(q, F, meta, T):
 # and call), which took ``robot.fk(q)`` from 0.53 to 0.40 µs (UR5, Panda).
 
 
-@njit(cache=True, fastmath=False, _nrt=False)
+@njit(cache=True, hot=True, fastmath=False, _nrt=False)
 def fk_one(q, P, T):
     """End-effector pose into ``T`` (4, 4) over the packed chain.
 
@@ -214,7 +214,7 @@ def fk_one(q, P, T):
     return 0
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, hot=True, _nrt=False)
 def jacobian_one(q, P, J):
     """Geometric Jacobian (eqs 33-36) into ``J`` (6, n) over the packed chain.
 
@@ -250,7 +250,7 @@ _P2 = 6.077100506303966e-11
 _P3 = 2.0222662487959506e-21
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _sincos(x):
     """(sin x, cos x) for |x| ≤ 1e5, branch-free so loops over it vectorise (see above)."""
     kf = math.floor(fma(x, _TWO_OVER_PI, 0.5))
@@ -281,7 +281,7 @@ def _sincos(x):
     return sv, cv
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _sincos_scalar(x):
     """(sin x, cos x): :func:`_sincos`, or libm beyond |x| > 1e5 rad."""
     if abs(x) > 1e5:
@@ -289,7 +289,7 @@ def _sincos_scalar(x):
     return _sincos(x)
 
 
-@njit(cache=True, fastmath=False)
+@njit(cache=True, hot=True, fastmath=False)
 def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
     """Poses of configurations ``Q[k0:k0+B]`` into ``out``; True if a q was NaN or ±inf.
 
@@ -359,7 +359,7 @@ def _fk_block(Q, F, meta, out, k0, B, T, X, c, s):
     return z != z
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _fk_blocks(Q, F, meta, out, start, stop):
     """Poses of ``Q[start:stop]`` into ``out`` block by block; True if a q was not finite."""
     T = np.empty((12, _BLOCK))
@@ -382,7 +382,7 @@ def _fk_blocks(Q, F, meta, out, start, stop):
 # cores (dynamic scheduling: see there why not ``prange``).
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, hot=True, nogil=True)
 def fk_range(Q, F, meta, out, start, stop):
     """End-effector poses of ``Q[start:stop]`` (Q (N, n)) into ``out`` (N, 4, 4).
 
@@ -392,7 +392,7 @@ def fk_range(Q, F, meta, out, start, stop):
     _fk_blocks(Q, F, meta, out, start, stop)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, hot=True, nogil=True)
 def fk_checked_range(Q, F, meta, out, bad, start, stop):
     """:func:`fk_range`, setting ``bad[0] = 1`` (bad: int64 (1,)) if a q is not finite.
 
@@ -405,7 +405,7 @@ def fk_checked_range(Q, F, meta, out, bad, start, stop):
         bad[0] = 1
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def finite_row(q):
     """True when every entry of ``q`` (n,) is finite: the batch kernels' input check.
 
@@ -418,7 +418,7 @@ def finite_row(q):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, hot=True)
 def fk_all_into(q, F, L, meta, out):
     """Every link frame 0..n (base to last link, without the tool) into ``out`` (n+1, 4, 4)."""
     n = meta.shape[0]
@@ -431,7 +431,7 @@ def fk_all_into(q, F, L, meta, out):
         _post_multiply(T, F[i + 1])
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, hot=True, nogil=True)
 def fk_all_range(Q, F, L, meta, out, bad, start, stop):
     """Link frames of ``Q[start:stop]`` (Q (N, n)) into ``out`` (N, n+1, 4, 4).
 
@@ -446,7 +446,7 @@ def fk_all_range(Q, F, L, meta, out, bad, start, stop):
             out[k] = math.nan
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _record_joint(J, j, T, meta_j):
     """Store joint j's world axis z_j in J[3:, j] and origin o_j in J[:3, j] (T: its frame)."""
     for r in range(3):
@@ -454,7 +454,7 @@ def _record_joint(J, j, T, meta_j):
         J[r, j] = T[r, 3]
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _finish_columns(J, kind, m, px, py, pz):
     """Turn the recorded (o_j, z_j) of the first m joints into Jacobian columns (eqs 35-36).
 
@@ -480,7 +480,7 @@ def _finish_columns(J, kind, m, px, py, pz):
             J[2, j] = zx * dy - zy * dx
 
 
-@njit(cache=True)
+@njit(cache=True, hot=True)
 def jacobian_into(q, F, meta, J, T):
     """Geometric Jacobian at the end-effector, base frame (eqs 33-36).
 
@@ -493,7 +493,7 @@ def jacobian_into(q, F, meta, J, T):
     _finish_columns(J, meta[:, 3], meta.shape[0], t[3], t[7], t[11])
 
 
-@njit(cache=True)
+@njit(cache=True, hot=True)
 def joint_axes_into(q, F, meta, P, W):
     """World origin ``P[i]`` (3,) and unit axis ``W[i]`` (3,) of every joint i at ``q``.
 
@@ -509,7 +509,7 @@ def joint_axes_into(q, F, meta, P, W):
         _post_multiply(T, F[i + 1])
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, hot=True, nogil=True)
 def jacobian_range(Q, F, meta, J, T, bad, start, stop):
     """Geometric Jacobians (N, 6, n) and poses (N, 4, 4) of ``Q[start:stop]`` (Q (N, n)).
 
@@ -524,7 +524,7 @@ def jacobian_range(Q, F, meta, J, T, bad, start, stop):
             T[k] = math.nan
 
 
-@njit(cache=True)
+@njit(cache=True, hot=True)
 def point_jacobian_into(q, F, L, meta, link, point, J, p_out):
     """Jacobian of a point fixed to link frame ``link`` (0..n), base frame.
 
@@ -548,7 +548,7 @@ def point_jacobian_into(q, F, L, meta, link, point, J, p_out):
     _finish_columns(J, meta[:, 3], link, p_out[0], p_out[1], p_out[2])
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, hot=True, nogil=True)
 def point_jacobian_range(Q, F, L, meta, link, point, J, P, bad, start, stop):
     """Point Jacobians (N, 6, n) and point positions (N, 3) of ``Q[start:stop]``.
 
@@ -584,7 +584,7 @@ def point_jacobian_range(Q, F, L, meta, link, point, J, P, bad, start, stop):
 # ω = Σ_k w_k q̇_k.
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _cross_into(ax, ay, az, bx, by, bz, out, r, j, k, sign):
     """out[r:r+3, j, k] = sign · (a × b)."""
     out[r, j, k] = sign * (ay * bz - az * by)
@@ -592,7 +592,7 @@ def _cross_into(ax, ay, az, bx, by, bz, out, r, j, k, sign):
     out[r + 2, j, k] = sign * (ax * by - ay * bx)
 
 
-@njit(cache=True)
+@njit(cache=True, hot=True)
 def hessian_into(J, R, ee, H):
     """Hessian ``H`` (6, n, n), ``H[:, j, k] = ∂J[:, j]/∂q_k``, of a base-frame Jacobian J (6, n).
 
@@ -625,7 +625,7 @@ def hessian_into(J, R, ee, H):
                         H[r + c, j, k] = R[0, c] * hx + R[1, c] * hy + R[2, c] * hz
 
 
-@njit(cache=True)
+@njit(cache=True, hot=True)
 def jacobian_dot_into(J, qd, R, ee, Jd):
     """Time derivative ``Jd`` (6, n) of a base-frame Jacobian J (6, n) at joint rates qd (n,).
 
@@ -668,7 +668,7 @@ def jacobian_dot_into(J, qd, R, ee, Jd):
                     Jd[r + c, j] = R[0, c] * hx + R[1, c] * hy + R[2, c] * hz
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, hot=True, forceinline=True)
 def _tool_jacobian(q, P):
     """Tool Jacobian (6, n) and rotation (3, 3) over the packed chain (single calls)."""
     n = P.shape[0] - 1
@@ -683,7 +683,7 @@ def _tool_jacobian(q, P):
     return J, R
 
 
-@njit(cache=True)
+@njit(cache=True, hot=True)
 def hessian_one(q, P, ee, H):
     """:func:`hessian_into` of the tool Jacobian at one ``q`` (packed chain); False on NaN q."""
     for i in range(q.shape[0]):
@@ -694,7 +694,7 @@ def hessian_one(q, P, ee, H):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, hot=True)
 def jacobian_dot_one(q, P, qd, ee, Jd):
     """:func:`jacobian_dot_into` of the tool Jacobian at one ``q`` (packed chain); False on NaN."""
     for i in range(q.shape[0]):
@@ -705,14 +705,14 @@ def jacobian_dot_one(q, P, qd, ee, Jd):
     return True
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, hot=True, nogil=True)
 def hessian_range(J, R, ee, H, start, stop):
     """:func:`hessian_into` for items ``start..stop-1`` of J (N, 6, n), R (N, 3, 3) into H."""
     for k in range(start, stop):
         hessian_into(J[k], R[k], ee, H[k])
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, hot=True, nogil=True)
 def jacobian_dot_range(J, Qd, R, ee, Jd, start, stop):
     """:func:`jacobian_dot_into` for items ``start..stop-1`` of J (N, 6, n), Qd (N, n)."""
     for k in range(start, stop):

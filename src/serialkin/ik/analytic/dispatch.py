@@ -43,21 +43,21 @@ PLANAR, SCARA, WRIST, UR, GENERAL = 0, 1, 2, 3, 4
 MAX_ROWS = GENERAL_MAX
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _wrist(T, W, P, M, aux, arm, prismatic3, order, grid, F, meta, newton_p, newton_r, slack,
            cand):
     """Candidates of a spherical-wrist arm (:func:`wrist_candidates`); returns the count."""
     return wrist_candidates(T, W, P, M, aux, arm, prismatic3, slack, cand)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _ur(T, W, P, M, aux, arm, prismatic3, order, grid, F, meta, newton_p, newton_r, slack,
         cand):
     """Candidates of a UR-class arm (:func:`ur_candidates`); returns the count."""
     return ur_candidates(T, W, P, M, aux, slack, cand)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _general(T, W, P, M, aux, arm, prismatic3, order, grid, F, meta, newton_p, newton_r, slack,
              cand):
     """Candidates of a general 6R (:func:`general_candidates`); returns the count.
@@ -273,7 +273,7 @@ def for_class(code: int, refine: bool = False) -> ClassKernels:
     else:
         cands = {WRIST: _wrist, UR: _ur, GENERAL: _general}[code]
         one = bind(_solve_into, f"solve_into_{name}", candidates=cands, refinable=refine)
-    one = njit(cache=True)(one)
+    one = njit(cache=True, inline="always")(one)
     return ClassKernels(
         solve_into=one,
         solve_range=njit(cache=True, nogil=True)(bind(_solve_range, f"solve_range_{name}",

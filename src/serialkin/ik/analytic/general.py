@@ -68,7 +68,7 @@ KNOWN_RADIUS = 1e-4
 DEFAULT_GRID = 24
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def general_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r, out):
     """Every solution of a general 6R arm into ``out`` (16, 6).
 
