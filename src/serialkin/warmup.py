@@ -172,27 +172,27 @@ def _tracking() -> None:
 #: a fresh process with an empty cache (benchmarks/compile_profile.py, quiet 2-core
 #: machine); together they share kernels, so ``--all`` takes less than their sum.
 FEATURES: dict[str, Feature] = {f.name: f for f in (
-    Feature("ik-all", "every closed-form solution: robot.ik_all",
-            ("serialkin.ik.analytic",), 60.0, _ik_all),
     Feature("ik-all-general", "every solution of general 6R and nearly ideal (calibrated) "
             "arms: robot.ik_all", ("serialkin.ik.analytic.general",
                                    "serialkin.ik.analytic.raghavan_roth",
-                                   "serialkin.ik.analytic.refine"), 60.0, _ik_all_general),
+                                   "serialkin.ik.analytic.refine"), 70.0, _ik_all_general),
+    Feature("ik-all", "every closed-form solution: robot.ik_all",
+            ("serialkin.ik.analytic",), 50.0, _ik_all),
     Feature("ik-methods", "the numerical IK methods other than the default: "
             "robot.ik(method=...)", ("serialkin.ik.jacobian_methods", "serialkin.ik.ccd",
-                                     "serialkin.ik.fabrik", "serialkin.ik.optimize"), 40.0,
+                                     "serialkin.ik.fabrik", "serialkin.ik.optimize"), 45.0,
             _ik_methods),
+    Feature("tracking", "path tracking and redundancy resolution: serialkin track",
+            ("serialkin.tracking", "serialkin.redundancy"), 32.0, _tracking),
+    Feature("collision", "collision-aware IK and clearance queries",
+            ("serialkin.collision", "serialkin.diffik"), 18.0, _collision),
     Feature("ik", "numerical IK: robot.ik (default method), one pose and batches",
             ("serialkin.ik", "serialkin.kinematics.dls", "serialkin.spatial",
-             "serialkin.model.limits"), 35.0, _ik),
-    Feature("collision", "collision-aware IK and clearance queries",
-            ("serialkin.collision", "serialkin.diffik"), 55.0, _collision),
-    Feature("tracking", "path tracking and redundancy resolution: serialkin track",
-            ("serialkin.tracking", "serialkin.redundancy"), 16.0, _tracking),
-    Feature("workspace", "workspace sampling: serialkin workspace",
-            ("serialkin.workspace",), 13.0, _workspace),
+             "serialkin.model.limits"), 12.0, _ik),
     Feature("kinematics", "forward kinematics and Jacobians: robot.fk, robot.jacobian",
-            ("serialkin.kinematics",), 22.0, _kinematics),
+            ("serialkin.kinematics",), 5.0, _kinematics),
+    Feature("workspace", "workspace sampling: serialkin workspace",
+            ("serialkin.workspace",), 2.0, _workspace),
 )}
 
 
