@@ -874,22 +874,31 @@ def _solve_fast(S, Tt, q0, seed, use_q0, q_out):
 
 # ---------------------------------------------------------------- collision-aware solves
 @njit(cache=True)
-def _clearance(q, F, L, meta, frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1, pair):
+def _clearance(q, chain, model, near):
     """Clearance [m] of configuration q and its closest pair.
 
-    ``pair`` (5,) as :func:`serialkin.collision.queries.clearance_at` writes it.
+    ``chain = (F, L, meta, frames)``: the chain's arrays and the (n+1, 4, 4) frames it
+    fills; ``model = (sf, A, B, rad, sb, pa, pb, scene)``: the collision model's flat
+    arrays, the checked pairs and the encoded scene (k, 16); ``near = (W0, W1, pair)``:
+    two (m, 3) work arrays and ``pair`` (5,), written as
+    :func:`serialkin.collision.queries.clearance_at` writes it.
     """
+    F, L, meta, frames = chain
+    sf, A, B, rad, sb, pa, pb, scene = model
+    W0, W1, pair = near
     fk_all_into(q, F, L, meta, frames)
     return clearance_at(frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1, pair)
 
 
 @njit(cache=True)
-def _push_out(q, d, margin, J, sw, lo, hi, revolute, respect, F, L, meta, frames, sf, A, B,
-              rad, sb, pa, pb, scene, W0, W1, pair, g, qn, Jw, M6, y6, v6, dq):
+def _push_out(q, d, margin, J, sw, joints, chain, model, near, work):
     """One push-out step from q (n,), which reaches the target with clearance ``d < margin``.
 
     q is moved in place. Returns False when the clearance does not depend on q (nothing
-    to push).
+    to push). ``J`` (6, n) is the task Jacobian at q, ``sw`` (6,) the square roots of the
+    task weights; ``joints = (lo, hi, revolute, respect)``; ``chain``, ``model`` and
+    ``near`` as for :func:`_clearance`; ``work = (g, qn, Jw, M6, y6, v6, dq)``: work arrays
+    of shapes (n,), (n,), (6, n), (6, 6), (6,), (6,), (n,).
 
     The gradient ``g = ∂d/∂q`` of the closest pair's distance (``pair``, as left by the
     last :func:`_clearance`; forward differences, step :data:`PUSH_H`) is
@@ -902,6 +911,11 @@ def _push_out(q, d, margin, J, sw, lo, hi, revolute, respect, F, L, meta, frames
     ``margin + PUSH_EXTRA``, with max |Δq_i| ≤ :data:`PUSH_MAX`; q is then projected onto
     the joint ranges when ``respect``.
     """
+    lo, hi, revolute, respect = joints
+    F, L, meta, frames = chain
+    sf, A, B, rad, sb, pa, pb, scene = model
+    W0, W1, pair = near
+    g, qn, Jw, M6, y6, v6, dq = work
     n = q.shape[0]
     gg = 0.0
     for j in range(n):
@@ -958,6 +972,12 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
     is ≥ the margin. Arguments as ``solve_one`` plus the collision model's flat arrays
     (``sf`` shape frames, ``A``, ``B``, ``rad``, ``sb`` shape bodies), the checked pairs,
     the scene (k, 16) and ``ccfg`` (:data:`N_CCFG`,).
+
+    One piece (over 80 lines) on purpose: the restarts, the push-out steps and the
+    best-hit bookkeeping share a dozen mutable locals, and each compiled level split off
+    would link and re-optimise the attempt loop again (seconds of compile per level,
+    docs/compile-time.md); the steps it takes are functions of their own
+    (:func:`_clearance`, :func:`_push_out`, the bound ``attempt_loop``).
     """
     n = meta.shape[0]
     (w, p, lo, hi, slo, shi, revolute, tol, max_iter, restarts, respect, use_q0, window,
@@ -976,6 +996,11 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
     M6 = np.empty((6, 6))
     y6 = np.empty(6)
     v6 = np.empty(6)
+    chain = (F, L, meta, frames)
+    model = (sf, A, B, rad, sb, pa, pb, scene)
+    near = (W0, W1, pair)
+    work = (g, qn, Jw, M6, y6, v6, dq)
+    joints = (lo, hi, revolute, respect)
     hit_q = np.empty(n)
     hit_e = np.empty(6)
     hit_d = -np.inf
@@ -1018,7 +1043,7 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
                 q_out[:] = q
                 be[:] = e
             continue
-        d = _clearance(q, F, L, meta, frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1, pair)
+        d = _clearance(q, chain, model, near)
         for push in range(pushes + 1):
             if d >= margin:
                 break
@@ -1027,9 +1052,8 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
                 hit_q[:] = q
                 hit_e[:] = e
                 have_hit = True
-            if push == pushes or not _push_out(
-                    q, d, margin, J, sw, lo, hi, revolute, respect, F, L, meta, frames, sf,
-                    A, B, rad, sb, pa, pb, scene, W0, W1, pair, g, qn, Jw, M6, y6, v6, dq):
+            if push == pushes or not _push_out(q, d, margin, J, sw, joints, chain, model, near,
+                                               work):
                 break
             its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
                                          respect, p, window, ratio, tol, max_iter, q, J, T,
@@ -1038,8 +1062,7 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
             if not ok or not math.isfinite(cost):
                 ok = False
                 break
-            d = _clearance(q, F, L, meta, frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1,
-                           pair)
+            d = _clearance(q, chain, model, near)
         if ok and d >= margin:
             success = True
             best_cost = cost
@@ -1056,7 +1079,7 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
                                                Jn, best_cost)
         total += its
     _tidy(q_out, q0, use_q0, lo, hi, revolute, respect)
-    d = _clearance(q_out, F, L, meta, frames, sf, A, B, rad, sb, pa, pb, scene, W0, W1, pair)
+    d = _clearance(q_out, chain, model, near)
     _write_info(info, success and d >= margin, total, be, w, used, best_cost, q_out, lo, hi, d)
     for k in range(5):
         info[I_PAIR + k] = pair[k]
