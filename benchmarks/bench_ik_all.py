@@ -157,6 +157,15 @@ def _general_arm(seed: int) -> Robot:
                                  d=rng.uniform(-0.3, 0.3)) for _ in range(6)], name="general")
 
 
+def _wrist_first_arm() -> Robot:
+    """A Pieper arm read from the tool end: axes 1, 2, 3 meet in one point (issue 30.4)."""
+    h = 0.5 * np.pi
+    return Robot.from_dh([DHLink(a=0.0, alpha=-h, d=0.35), DHLink(a=0.0, alpha=h, d=0.0),
+                          DHLink(a=0.0, alpha=-h, d=0.3), DHLink(a=0.4, alpha=0.0, d=0.05),
+                          DHLink(a=0.05, alpha=h, d=0.1), DHLink(a=0.3, alpha=-0.4, d=0.08)],
+                         name="wrist first")
+
+
 def bench_per_pose(n_batch: int, repeat: int) -> None:
     """Per pose, single call and batched, for exact, nearly ideal and general arms (14.1)."""
     print(f"\nper pose, single call and batched ({n_batch} targets, all cores via "
@@ -164,9 +173,10 @@ def bench_per_pose(n_batch: int, repeat: int) -> None:
     print(f"{'arm':18s} {'mode':8s} {'single us':>22s} {'single CPU us':>24s} "
           f"{'batched us/pose':>16s} {'batched CPU us/pose':>20s} {'#sol':>5s}")
     rng = np.random.default_rng(0)
-    arms = [(models.ur5(), 10.0, 3.0), (models.puma560(), 10.0, 3.0),
-            (_perturbed(models.ur5(), rng), None, None), (_general_arm(3), 200.0, None)]
-    for robot, goal_single, goal_batch in arms:
+    arms = [(models.ur5(), 10.0, 3.0, "14.1"), (models.puma560(), 10.0, 3.0, "14.1"),
+            (_perturbed(models.ur5(), rng), None, None, "14.1"),
+            (_general_arm(3), 200.0, None, "14.1"), (_wrist_first_arm(), 20.0, None, "30.4")]
+    for robot, goal_single, goal_batch, goal_id in arms:
         Q = robot.random_q(n_batch, seed=1)
         T = np.ascontiguousarray(robot.fk(Q))
         res = ik_all(robot, T)
@@ -182,7 +192,7 @@ def bench_per_pose(n_batch: int, repeat: int) -> None:
         print(f"{robot.name:18s} {res.mode:8s} {single.fmt(1):>22s} {cpu_s:>24s} "
               f"{per:16.2f} {per_cpu:20.2f} {res.count.mean():5.1f}")
         if goal_single is not None:
-            record("14.1", f"ik_all single, {robot.name} ({res.mode}), all solutions",
+            record(goal_id, f"ik_all single, {robot.name} ({res.mode}), all solutions",
                    single.median, "us", f"<= {goal_single:g}", single.median <= goal_single)
         if goal_batch is not None:
             record("14.1", f"ik_all batched per pose, {robot.name} ({res.mode})", per, "us",

@@ -32,7 +32,7 @@ from serialkin.ik.analytic.planar import solve_planar
 from serialkin.ik.analytic.refine import refine_rows
 from serialkin.ik.analytic.scara import solve_scara
 from serialkin.ik.analytic.spherical_wrist import wrist_candidates
-from serialkin.ik.analytic.subproblems import ELBOW_SLACK, finalize, rigid_error
+from serialkin.ik.analytic.subproblems import ELBOW_SLACK, finalize, inv_rigid, rigid_error
 from serialkin.ik.analytic.ur import ur_candidates
 
 from ..._jit import bind, njit
@@ -43,17 +43,46 @@ PLANAR, SCARA, WRIST, UR, GENERAL = 0, 1, 2, 3, 4
 MAX_ROWS = GENERAL_MAX
 
 
+@njit(cache=True)
+def _unreverse(cand, k):
+    """Rows ``cand[:k]`` of a reversed chain's solutions as the robot's: columns reversed.
+
+    The reversed chain's joint j is the robot's joint n + 1 − j with the same angle
+    (:func:`serialkin.ik.analytic.structure.reversed_lines`). Returns k.
+    """
+    n = cand.shape[1]
+    for i in range(k):
+        for j in range(n // 2):
+            t = cand[i, j]
+            cand[i, j] = cand[i, n - 1 - j]
+            cand[i, n - 1 - j] = t
+    return k
+
+
 @njit(cache=True, inline="always")
 def _wrist(T, W, P, M, aux, arm, prismatic3, order, grid, F, meta, newton_p, newton_r, slack,
            cand):
-    """Candidates of a spherical-wrist arm (:func:`wrist_candidates`); returns the count."""
+    """Candidates of a spherical-wrist arm (:func:`wrist_candidates`); returns the count.
+
+    ``order`` is ``[1]`` when W, P, M are the reversed chain's (the wrist at the base):
+    it solves ``T⁻¹`` and the rows are reversed back.
+    """
+    if order.shape[0] > 0 and order[0] == 1:
+        k = wrist_candidates(inv_rigid(T), W, P, M, aux, arm, prismatic3, slack, cand)
+        return _unreverse(cand, k)
     return wrist_candidates(T, W, P, M, aux, arm, prismatic3, slack, cand)
 
 
 @njit(cache=True, inline="always")
 def _ur(T, W, P, M, aux, arm, prismatic3, order, grid, F, meta, newton_p, newton_r, slack,
         cand):
-    """Candidates of a UR-class arm (:func:`ur_candidates`); returns the count."""
+    """Candidates of a UR-class arm (:func:`ur_candidates`); returns the count.
+
+    ``order`` as for :func:`_wrist` (``[1]``: parallel axes 3, 4, 5 and intersecting
+    axes 1, 2, solved on the reversed chain).
+    """
+    if order.shape[0] > 0 and order[0] == 1:
+        return _unreverse(cand, ur_candidates(inv_rigid(T), W, P, M, aux, slack, cand))
     return ur_candidates(T, W, P, M, aux, slack, cand)
 
 
@@ -87,7 +116,8 @@ def _solve_into(arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mid, F,
         P: (n, 3) joint points [m].
         M: (4, 4) tool pose at q = 0.
         aux: class data.
-        order: class joint indices.
+        order: class joint indices; ``[1]`` for a spherical-wrist or UR arm recognised on
+            its reversed chain (W, P, M then that chain's; see :func:`_wrist`).
         revolute: (n,) joint kinds.
         qlim: (n, 2) joint limits.
         mid: (n,) wrapping centres.

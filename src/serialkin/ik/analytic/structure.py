@@ -38,7 +38,7 @@ reported as not recognised, with the measured deviation in the message.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -85,6 +85,9 @@ class Structure:
         planar_z: every joint axis is parallel to the world z axis, so planar targets
             (x, y), (x, y, φ) and SCARA targets (x, y, z, φ) are meaningful.
         scale: characteristic length of the robot [m] (for tolerances).
+        reversed: the class was recognised on the reversed chain (:func:`reversed_lines`:
+            the wrist or the parallel axes at the base); ``W``, ``P``, ``M`` are that
+            chain's, whose joint j is joint n + 1 − j, and the solver solves ``T⁻¹``.
     """
 
     kind: str
@@ -96,6 +99,7 @@ class Structure:
     order: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     planar_z: bool = False
     scale: float = 1.0
+    reversed: bool = False
 
 
 def joint_lines(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -294,9 +298,42 @@ def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons,
     return Structure(kind, W, P, M, rev, aux, none, False, scale)
 
 
+def reversed_lines(W: np.ndarray, P: np.ndarray, M: np.ndarray) -> tuple:
+    """The joint lines ``(W', P', M')`` of the reversed chain of ``(W, P, M)``.
+
+    ``T⁻¹ = M⁻¹·e_n⁻¹···e_1⁻¹`` (PoE, ``e_i = exp([S_i] q_i)``) is the chain whose joint j
+    is joint n + 1 − j about the line ``(−R_Mᵀ w, M⁻¹ p)``, with the same angle, and
+    whose tool pose at q = 0 is ``M⁻¹``: ``fk'(q[::-1]) = fk(q)⁻¹``. W, P (n, 3), M (4, 4).
+    """
+    Minv = np.linalg.inv(M)
+    Wr = np.ascontiguousarray(-(W[::-1] @ M[:3, :3]))
+    Pr = np.ascontiguousarray(P[::-1] @ Minv[:3, :3].T + Minv[:3, 3])
+    return Wr, Pr, Minv
+
+
 def _six_dof(robot, W, P, M, rev, scale, ltol, atol) -> Structure:
+    """The closed-form class of a 6-joint arm, found forward or on its reversed chain.
+
+    A reversed arm (three intersecting axes at the base, or parallel axes 3, 4, 5 with
+    intersecting axes 1, 2) is solved in closed form on ``T⁻¹`` (:func:`reversed_lines`).
+    """
     types = "".join(robot.joint_types)
-    reasons = []
+    reasons: list[str] = []
+    found = _six_dof_lines(W, P, M, rev, types, scale, ltol, atol, reasons)
+    if found is not None:
+        return found
+    Wr, Pr, Mr = reversed_lines(W, P, M)
+    found = _six_dof_lines(Wr, Pr, Mr, rev, types[::-1], scale, ltol, atol, [])
+    if found is not None:
+        return replace(found, reversed=True, order=np.ones(1, dtype=np.int64))
+    raise _fail(robot, "; ".join(reasons) + "; nor does the reversed chain (joints 6 to 1)")
+
+
+def _six_dof_lines(W, P, M, rev, types, scale, ltol, atol, reasons) -> Structure | None:
+    """The class of the 6-joint chain of lines W, P, M (joint kinds ``types``), or None.
+
+    None when no class fits; the reasons are appended to ``reasons``.
+    """
     # ------------------------------------------------ spherical wrist (axes 4, 5, 6)
     wrist = None
     if types[3:] != "RRR":
@@ -337,7 +374,7 @@ def _six_dof(robot, W, P, M, rev, scale, ltol, atol) -> Structure:
                 return Structure("ur", W, P, M, rev, aux, np.zeros(0, np.int64), False, scale)
         else:
             reasons.append("axes 2, 3, 4 are not parallel")
-    raise _fail(robot, "; ".join(reasons))
+    return None
 
 
 #: Arm codes of the 3R arm in front of axis 4 (as ``spherical_wrist.arm_positions``).
@@ -376,9 +413,7 @@ def general_structure(robot: Robot) -> Structure:
             raise _fail(robot, f"axes {i + 1} and {i + 2} coincide: the arm is redundant "
                                "(infinitely many solutions)")
     reasons: list[str] = []
-    Minv = np.linalg.inv(M)
-    Wr = -(W[::-1] @ M[:3, :3])
-    Pr = P[::-1] @ Minv[:3, :3].T + Minv[:3, 3]
+    Wr, Pr, Minv = reversed_lines(W, P, M)
     found = []
     for reversed_, (Wc, Pc, Mc) in ((0, (W, P, M)), (1, (Wr, Pr, Minv))):
         options = sorted(((_point_line_distance(Pc[3] + t * Wc[3], Pc[2], Wc[2]), t)
