@@ -108,6 +108,7 @@ def main(argv: list[str] | None = None) -> int:
         print("skipped: example-robot-data is not installed (pip install -e '.[bench]')")
         return 0
     from serialkin.model.mesh import clear_mesh_cache
+    from serialkin.viz import Scene, ViewerOptions
     from serialkin.viz.viewer import MESH_BUDGET, viewer_html
 
     print(header())
@@ -129,13 +130,14 @@ def main(argv: list[str] | None = None) -> int:
 
                     def cold(r=robot, m=meshes):
                         clear_mesh_cache()
-                        return viewer_html(r, meshes=m)
+                        return viewer_html(Scene(r), ViewerOptions(meshes=m))
 
                     t_cold = wall_s(cold, args.repeat)
-                    t_warm = wall_s(lambda r=robot, m=meshes: viewer_html(r, meshes=m),
+                    t_warm = wall_s(lambda r=robot, m=meshes: viewer_html(
+                        Scene(r), ViewerOptions(meshes=m)),
                                     args.repeat)
                     page = Path(tmp) / f"{name}_{meshes}.html"
-                    text = viewer_html(robot, meshes=meshes)
+                    text = viewer_html(Scene(robot), ViewerOptions(meshes=meshes))
                     page.write_text(text, encoding="utf-8")
                     mb = len(text.encode("utf-8")) / 1e6
                     t_open = browser.open_s(page, args.repeat) if browser.driver else None

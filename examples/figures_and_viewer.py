@@ -19,6 +19,8 @@ matplotlib.use("Agg")
 
 from serialkin.tracking import load_scenario  # noqa: E402
 from serialkin.viz import (  # noqa: E402
+    AnimationOptions,
+    Scene,
     ffmpeg_available,
     save_animation,
     tracking_figure,
@@ -37,14 +39,15 @@ fig = tracking_figure(trajectory, scenario.robot, obstacles=scenario.obstacles,
 fig.savefig(out / "twenty_link_tracking.png", dpi=90)
 
 path_xy = trajectory.targets[:, :2, 3]
-save_animation(scenario.robot, trajectory.q, out / "twenty_link.gif", path_points=path_xy,
-               obstacles=scenario.obstacles, max_frames=40, dpi=60)
+animation = AnimationOptions(max_frames=40, dpi=60)
+save_animation(scenario.robot, trajectory.q, out / "twenty_link.gif", animation,
+               path_points=path_xy, obstacles=scenario.obstacles)
 if ffmpeg_available():
-    save_animation(scenario.robot, trajectory.q, out / "twenty_link.mp4",
-                   path_points=path_xy, obstacles=scenario.obstacles, max_frames=40, dpi=60)
+    save_animation(scenario.robot, trajectory.q, out / "twenty_link.mp4", animation,
+                   path_points=path_xy, obstacles=scenario.obstacles)
 
-page = write_viewer(scenario.robot, out / "twenty_link_viewer.html", trajectory=trajectory.q,
-                    path_points=path_xy, obstacles=scenario.obstacles,
-                    title="serialkin: 20-link arm between four obstacles")
+scene = Scene(scenario.robot, trajectory=trajectory.q, path_points=path_xy,
+              obstacles=scenario.obstacles, title="serialkin: 20-link arm between four obstacles")
+page = write_viewer(scene, out / "twenty_link_viewer.html")
 print("wrote", *sorted(p.name for p in out.iterdir()))
 print("open", page.resolve().as_uri())

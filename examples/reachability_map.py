@@ -31,7 +31,7 @@ from serialkin import models  # noqa: E402
 from serialkin.reach import base_placement, load_map, reachability_map  # noqa: E402
 from serialkin.reach.plot import plot_base_placement, plot_map_slice, point_layer  # noqa: E402
 from serialkin.spatial import make_transform  # noqa: E402
-from serialkin.viz import write_viewer  # noqa: E402
+from serialkin.viz import Scene, write_viewer  # noqa: E402
 
 out = Path(os.environ.get("SERIALKIN_EXAMPLE_OUT") or tempfile.mkdtemp(prefix="serialkin_"))
 out.mkdir(parents=True, exist_ok=True)
@@ -86,7 +86,7 @@ plt.close(fig)
 
 # --- 3. The viewer's point layer ---------------------------------------------------------------
 points, colours = point_layer(m, min_index=0.25)
-write_viewer(ur5, out / "ur5_reach_viewer.html", points=points, point_colors=colours,
-             points_label="reachability index ≥ 0.25")
+write_viewer(Scene(ur5, points=points, point_colors=colours,
+                   points_label="reachability index ≥ 0.25"), out / "ur5_reach_viewer.html")
 print(f"\nviewer: {len(points)} voxel centres coloured by index (open ur5_reach_viewer.html)")
 print("wrote", ", ".join(sorted(p.name for p in out.iterdir())), "to", out)

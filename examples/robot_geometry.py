@@ -32,7 +32,7 @@ import numpy as np  # noqa: E402
 
 import serialkin as sk  # noqa: E402
 from serialkin.collision import default_acm, sampled_acm, self_clearance  # noqa: E402
-from serialkin.viz import write_viewer  # noqa: E402
+from serialkin.viz import Scene, ViewerOptions, write_viewer  # noqa: E402
 
 out = Path(os.environ.get("SERIALKIN_EXAMPLE_OUT") or tempfile.mkdtemp(prefix="serialkin_"))
 out.mkdir(parents=True, exist_ok=True)
@@ -130,8 +130,8 @@ fig.tight_layout()
 fig.savefig(out / "ur5_capsules.png", dpi=80)
 plt.close(fig)
 
-write_viewer(ur5, out / "ur5_meshes_viewer.html", mesh_budget=20000, show_collision=True,
-             acm=acm, q=[0.0, -1.2, 1.5, -0.3, 1.2, 0.0])
+write_viewer(Scene(ur5, q=[0.0, -1.2, 1.5, -0.3, 1.2, 0.0], acm=acm),
+             out / "ur5_meshes_viewer.html", ViewerOptions(mesh_budget=20000, show_collision=True))
 size = (out / "ur5_meshes_viewer.html").stat().st_size
 print(f"viewer with meshes (at most 20,000 triangles) and capsules: {size / 1e6:.1f} MB")
 print("\nwrote", ", ".join(sorted(p.name for p in out.iterdir())), "to", out)

@@ -10,7 +10,12 @@ from PIL import Image
 
 from serialkin.redundancy import Circle
 from serialkin.tracking.scenario import planar_arm
-from serialkin.viz import animate_trajectory, plot_joint_trajectories, plot_motion
+from serialkin.viz import (
+    AnimationOptions,
+    animate_trajectory,
+    plot_joint_trajectories,
+    plot_motion,
+)
 from serialkin.viz.trajectory import joint_index_ticks
 
 
@@ -54,7 +59,7 @@ def test_blitted_gif_frames_follow_the_motion():
     """Each GIF frame shows the arm of its configuration: frames differ, first ≠ last."""
     robot = planar_arm(3, 0.1)
     Q = np.linspace([0.0, 0.0, 0.0], [1.5, 0.5, 0.5], 6)
-    data = animate_trajectory(robot, Q, max_frames=6, dpi=40, figsize=(3.0, 3.0))
+    data = animate_trajectory(robot, Q, AnimationOptions(max_frames=6, dpi=40, figsize=(3.0, 3.0)))
     im = Image.open(io.BytesIO(data))
     frames = []
     for k in range(im.n_frames):

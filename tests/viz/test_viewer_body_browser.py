@@ -15,7 +15,7 @@ import pytest
 
 from serialkin import models
 from serialkin.collision import self_clearance
-from serialkin.viz.viewer import write_viewer
+from serialkin.viz.viewer import Scene, write_viewer
 from tests._browser import start_chromium
 from tests.erd import urdf as erd_urdf
 from tests.viz._body import SHAPES, body_robot
@@ -69,7 +69,7 @@ def test_shapes_drawn_follow_the_sliders_and_toggles(driver, tmp_path):
     """Every visual shape is drawn at fk_all[frame]·origin after slider moves; toggles hide it."""
     robot = body_robot(tmp_path)
     P = np.random.default_rng(0).uniform(-0.5, 0.5, (200, 3))
-    page = write_viewer(robot, tmp_path / "body.html", points=P, points_label="cloud")
+    page = write_viewer(Scene(robot, points=P, points_label="cloud"), tmp_path / "body.html")
     _load(driver, page)
     d = _drawn(driver)
     assert (d["shapes"], d["meshes"], d["primitives"]) == (5, 1, 4)
@@ -98,7 +98,7 @@ def test_folded_panda_highlights_the_pair_self_clearance_reports(driver, tmp_pat
     """Sliding the Panda into a folded pose: the page's closest pair and distance are Python's."""
     panda = models.panda()
     model = panda.collision
-    page = write_viewer(panda, tmp_path / "panda.html", q=READY)
+    page = write_viewer(Scene(panda, q=READY), tmp_path / "panda.html")
     _load(driver, page)
     clear = driver.execute_script("return window.serialkin.clearance()")
     ref = self_clearance(panda, model, READY)
@@ -135,7 +135,7 @@ def test_panda_meshes_drawn_and_turn_red(driver, tmp_path):
     robot, _ = Robot.from_urdf(str(path), "panda_link0", "panda_hand",
                                package_map={"example-robot-data": Path(path).parents[3]},
                                resolve_meshes=True).fit_collision()
-    page = write_viewer(robot, tmp_path / "panda.html", q=READY)
+    page = write_viewer(Scene(robot, q=READY), tmp_path / "panda.html")
     _load(driver, page)
     d = _drawn(driver)
     assert d["meshes"] == 9 and d["skeleton"] is False and 0 < d["triangles"] <= 60_000

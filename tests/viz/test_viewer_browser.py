@@ -15,7 +15,7 @@ import pytest
 
 from serialkin import Joint, Robot
 from serialkin.viz.plot import robot_points
-from serialkin.viz.viewer import write_viewer
+from serialkin.viz.viewer import Scene, write_viewer
 from tests._browser import start_chromium as _start
 
 pytestmark = pytest.mark.browser
@@ -53,7 +53,7 @@ def _general_robot():
 
 
 def _load(driver, tmp_path, robot, **kwargs):
-    page = write_viewer(robot, tmp_path / f"{robot.name}.html", **kwargs)
+    page = write_viewer(Scene(robot, **kwargs), tmp_path / f"{robot.name}.html")
     driver.get_log("browser")  # drop what earlier pages logged
     driver.get(page.resolve().as_uri())
     deadline = time.monotonic() + 30

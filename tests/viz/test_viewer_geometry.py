@@ -17,7 +17,14 @@ from serialkin import models
 from serialkin.collision import acm_from_srdf, default_acm, self_clearance
 from serialkin.collision.queries import checked_shape_pairs
 from serialkin.errors import InputError, RobotDefinitionError
-from serialkin.viz.viewer import MESH_BUDGET, _encode_mesh, viewer_data, viewer_html
+from serialkin.viz.viewer import (
+    MESH_BUDGET,
+    Scene,
+    ViewerOptions,
+    _encode_mesh,
+    viewer_data,
+    viewer_html,
+)
 from tests.erd import urdf as erd_urdf
 from tests.viz._body import SHAPES, body_robot
 
@@ -71,7 +78,7 @@ def test_wide_meshes_use_32_bit_indices():
 
 def test_shapes_posed_in_their_frames(body):
     """Every visual shape reaches the page with its link, kind, frame and origin exactly."""
-    data = viewer_data(body)
+    data = viewer_data(Scene(body))
     assert [(s["link"], s["kind"]) for s in data["shapes"]] == SHAPES
     expected = [(lg.frame, s) for lg in body.geometry for s in lg.visual]
     for sh, (frame, shape) in zip(data["shapes"], expected, strict=True):
@@ -88,7 +95,7 @@ def test_mesh_embedded_with_scale_and_all_triangles(body):
     """A mesh under the budget keeps its triangles; decoded vertices are the scaled file's."""
     from serialkin.model.mesh import load_mesh
 
-    data = viewer_data(body)
+    data = viewer_data(Scene(body))
     (m,) = data["meshes"]
     shape = next(s for lg in body.geometry for s in lg.visual if s.name == "ball")
     ref = load_mesh(shape.geometry.filename, shape.geometry.scale)
@@ -104,15 +111,15 @@ def test_mesh_embedded_with_scale_and_all_triangles(body):
 
 def test_budget_decimates_all_meshes_together(body):
     """With a small budget the embedded meshes hold at most that many triangles in all."""
-    data = viewer_data(body, mesh_budget=100)
+    data = viewer_data(Scene(body), ViewerOptions(mesh_budget=100))
     assert 0 < sum(m["faces"] for m in data["meshes"]) <= 100
     with pytest.raises(InputError, match="mesh_budget"):
-        viewer_data(body, mesh_budget=2)
+        ViewerOptions(mesh_budget=2)
 
 
 def test_no_meshes_keeps_primitives(body):
     """meshes=False leaves the mesh out but keeps the primitive shapes."""
-    data = viewer_data(body, meshes=False)
+    data = viewer_data(Scene(body), ViewerOptions(meshes=False))
     assert data["meshes"] == []
     assert [s["kind"] for s in data["shapes"]] == [k for _, k in SHAPES if k != "mesh"]
 
@@ -127,16 +134,16 @@ def test_unresolved_mesh_names_link_and_path(tmp_path):
     with pytest.raises(RobotDefinitionError,
                        match=r"link 'LINK1' visual mesh: package://bodypkg/meshes/ball\.stl"
                              r".*package_map="):
-        viewer_data(robot)
-    assert [s["kind"] for s in viewer_data(robot, meshes=False)["shapes"]] == \
-        ["box", "cylinder", "capsule", "sphere"]
+        viewer_data(Scene(robot))
+    data = viewer_data(Scene(robot), ViewerOptions(meshes=False))
+    assert [s["kind"] for s in data["shapes"]] == ["box", "cylinder", "capsule", "sphere"]
 
 
 def test_link_and_label_markup_escaped(tmp_path):
     """A link name and a points label with markup stay inert in the page and round-trip."""
     evil = "</script><script>alert(1)</script>"
     robot = body_robot(tmp_path, link1=evil)
-    page = viewer_html(robot, points=np.zeros((2, 3)), points_label=evil)
+    page = viewer_html(Scene(robot, points=np.zeros((2, 3)), points_label=evil))
     assert evil not in page
     data = _page_data(page)
     assert data["shapes"][1]["link"] == evil and data["points"]["label"] == evil
@@ -146,7 +153,7 @@ def test_collision_pairs_are_the_checked_pairs():
     """The page checks exactly the shape pairs self_clearance checks (default and SRDF ACM)."""
     panda = models.panda()
     model = panda.collision
-    col = viewer_data(panda)["collision"]
+    col = viewer_data(Scene(panda))["collision"]
     pa, pb = checked_shape_pairs(model, default_acm(model))
     assert col["pairs"] == np.stack([pa, pb], axis=1).tolist()
     np.testing.assert_array_equal(col["frame"], model.shape_frame)
@@ -155,7 +162,8 @@ def test_collision_pairs_are_the_checked_pairs():
     srdf = erd_urdf("panda_description/srdf/panda.srdf")
     if srdf is not None:
         acm = acm_from_srdf(model, srdf)
-        fewer = viewer_data(panda, acm=acm, show_collision=True)["collision"]
+        fewer = viewer_data(Scene(panda, acm=acm),
+                            ViewerOptions(show_collision=True))["collision"]
         pa2, _ = checked_shape_pairs(model, acm)
         assert len(fewer["pairs"]) == len(pa2) <= len(pa) and fewer["show"] is True
     assert self_clearance(panda, model, FOLDED).distance < 0  # the browser test's premise
@@ -163,36 +171,37 @@ def test_collision_pairs_are_the_checked_pairs():
 
 def test_collision_options_refused_when_meaningless(spatial4):
     """show_collision or acm without a model, or a model on missing frames, raise InputError."""
-    assert viewer_data(spatial4)["collision"] is None
-    assert viewer_data(models.panda(), collision=False)["collision"] is None
+    assert viewer_data(Scene(spatial4))["collision"] is None
+    assert viewer_data(Scene(models.panda(), collision=False))["collision"] is None
     with pytest.raises(InputError, match="no collision model"):
-        viewer_data(spatial4, show_collision=True)
+        viewer_data(Scene(spatial4), ViewerOptions(show_collision=True))
     with pytest.raises(InputError, match="no collision model"):
-        viewer_data(spatial4, collision=True)
+        Scene(spatial4, collision=True)
     with pytest.raises(InputError, match="acm"):
-        viewer_data(spatial4, acm=default_acm(models.panda().collision))
+        Scene(spatial4, acm=default_acm(models.panda().collision))
     with pytest.raises(InputError, match="frames 0..4"):
-        viewer_data(spatial4, collision=models.panda().collision)
+        Scene(spatial4, collision=models.panda().collision)
 
 
 def test_points_layer_encoded():
     """Points decode to float32 positions and 8-bit colours; bad shapes and ranges raise."""
     P = np.random.default_rng(1).normal(size=(50, 3))
     C = np.random.default_rng(2).uniform(size=(50, 3))
-    pts = viewer_data(models.planar(3), points=P, point_colors=C, points_label="reach")["points"]
+    scene = Scene(models.planar(3), points=P, point_colors=C, points_label="reach")
+    pts = viewer_data(scene)["points"]
     got = np.frombuffer(base64.b64decode(pts["positions"]), dtype="<f4").reshape(-1, 3)
     np.testing.assert_array_equal(got, P.astype(np.float32))
     rgb = np.frombuffer(base64.b64decode(pts["colors"]), dtype="u1").reshape(-1, 3)
     assert np.abs(rgb / 255 - C).max() <= 0.5 / 255 + 1e-12
     assert pts["count"] == 50 and pts["label"] == "reach"
     with pytest.raises(InputError, match="points"):
-        viewer_data(models.planar(3), points=np.zeros((4, 2)))
+        Scene(models.planar(3), points=np.zeros((4, 2)))
     with pytest.raises(InputError, match="point_colors"):
-        viewer_data(models.planar(3), points=P, point_colors=C[:5])
+        Scene(models.planar(3), points=P, point_colors=C[:5])
     with pytest.raises(InputError, match=r"point_colors must be in \[0, 1\]"):
-        viewer_data(models.planar(3), points=P, point_colors=2 * C)
+        Scene(models.planar(3), points=P, point_colors=2 * C)
     with pytest.raises(InputError, match="without points"):
-        viewer_data(models.planar(3), point_colors=C)
+        Scene(models.planar(3), point_colors=C)
 
 
 def test_panda_with_meshes_within_five_megabytes():
@@ -206,7 +215,7 @@ def test_panda_with_meshes_within_five_megabytes():
     robot = Robot.from_urdf(str(path), "panda_link0", "panda_hand",
                             package_map={"example-robot-data": Path(path).parents[3]},
                             resolve_meshes=True)
-    page = viewer_html(robot)
+    page = viewer_html(Scene(robot))
     data = _page_data(page)
     assert sum(s["kind"] == "mesh" for s in data["shapes"]) == 9
     assert sum(m["faces"] for m in data["meshes"]) <= MESH_BUDGET

@@ -159,71 +159,28 @@ def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
              points_file: str | None, points_label: str | None, params: tuple[str, ...],
              as_json: bool, quiet: bool) -> None:
     """Write the interactive viewer page (and open it with --open)."""
-    from serialkin.cli.io import read_csv_rows
-    from serialkin.viz.viewer import write_viewer
-
-    obstacles: tuple[Any, ...] = ()
-    path_points = None
-    Q = None
-    if scenario is not None:
-        from serialkin.tracking import load_scenario
-
-        sc = load_scenario(scenario)
-        r = resolve_robot(robot, params) if robot is not None else sc.robot
-        obstacles = tuple(sc.obstacles)
+    r, sc = _view_robot(robot, scenario, params, packages, mesh_paths)
+    obstacles = tuple(sc.obstacles) if sc is not None else ()
+    if sc is not None:
         title = title or sc.name
-    elif robot is None:
-        raise CLIError("missing ROBOT (or --scenario): " + ROBOT_HELP)
-    elif packages or mesh_paths:
-        r = _urdf_with_meshes(robot, params, packages, mesh_paths)
-    else:
-        r = resolve_robot(robot, params)
     # every input is checked before the scenario runs and before the page is written
     q = parse_numbers(q_text, "--q", r.n) * _angle_factor(r, degrees) if q_text else None
     if Path(out).is_dir():
         raise CLIError(f"--out {out}: is a folder; give the page's file name (.html)")
     check_out_folder(Path(out).parent)
-    if trajectory is not None:
-        Q, pts = _load_trajectory(trajectory, r)
-        path_points = pts
-    elif scenario is not None:
-        traj = sc.run()
-        Q, path_points = traj.q, traj.targets[:, :3, 3]
-    fitted = False
-    if show_collision and r.collision is None:
-        if not any(lg.collision for lg in r.geometry):
-            raise CLIError(f"--collision: robot {short_repr(r.name)} has no collision model "
-                           "and no collision geometry to fit one to")
-        r, _ = r.fit_collision()  # bounding capsules of the links' collision shapes
-        fitted = True
-    acm = None
-    if srdf is not None:
-        if r.collision is None:
-            raise CLIError(f"--srdf: robot {short_repr(r.name)} has no collision model to "
-                           "check")
-        from serialkin.collision import acm_from_srdf
-
-        acm = acm_from_srdf(r.collision, srdf)
-    points = colors = None
-    if points_file is not None:
-        rows = read_csv_rows(points_file, "points", (3, 6))
-        points = rows[:, :3]
-        colors = rows[:, 3:] if rows.shape[1] == 6 else None
-        points_label = points_label if points_label is not None else Path(points_file).name
-    elif points_label is not None:
-        raise CLIError("--points-label needs --points FILE")
+    Q, path_points = _view_motion(r, sc, trajectory)
+    r, fitted = _with_collision(r, show_collision)
+    acm = _srdf_acm(r, srdf)
+    points, colors, points_label = _point_layer(points_file, points_label)
     ensure_dir(Path(out).parent)
-    try:
-        path = write_viewer(r, out, q=q, trajectory=Q, path_points=path_points,
-                            obstacles=obstacles or None, title=title, meshes=meshes,
-                            mesh_budget=_MESH_BUDGET if mesh_budget is None else mesh_budget,
-                            acm=acm, show_collision=show_collision, points=points,
-                            point_colors=colors, points_label=points_label or "points")
-    except SerialkinError as exc:
-        if "visual mesh" in str(exc):
-            raise CLIError(f"{exc} (on the command line: --package NAME=FOLDER or --mesh-path "
-                           "FOLDER, or --no-meshes)") from exc
-        raise
+    from serialkin.viz.scene import Scene, ViewerOptions
+
+    scene = Scene(r, q=q, trajectory=Q, path_points=path_points, obstacles=obstacles,
+                  acm=acm, points=points, point_colors=colors,
+                  points_label=points_label or "points", title=title)
+    options = ViewerOptions(meshes=meshes, show_collision=show_collision,
+                            mesh_budget=_MESH_BUDGET if mesh_budget is None else mesh_budget)
+    path = _write_page(scene, out, options)
     info = {"file": str(path), "robot": r.name, "n": r.n,
             "frames": int(Q.shape[0]) if Q is not None else 0,
             "collision": r.collision is not None, "capsules_fitted": fitted,
@@ -233,8 +190,92 @@ def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
     elif not quiet:
         click.echo(f"wrote {path}")
     if open_browser:
-        import webbrowser
+        _open_page(path)
 
-        if not webbrowser.open(Path(path).resolve().as_uri()):
-            click.echo(f"could not open a browser; open {Path(path).resolve()} by hand",
-                       err=True)
+
+def _view_robot(robot: str | None, scenario: str | None, params: tuple[str, ...],
+                packages: tuple[str, ...], mesh_paths: tuple[str, ...]) -> tuple[Any, Any]:
+    """The robot shown and the scenario (None without --scenario)."""
+    if scenario is not None:
+        from serialkin.tracking import load_scenario
+
+        sc = load_scenario(scenario)
+        return (resolve_robot(robot, params) if robot is not None else sc.robot), sc
+    if robot is None:
+        raise CLIError("missing ROBOT (or --scenario): " + ROBOT_HELP)
+    if packages or mesh_paths:
+        return _urdf_with_meshes(robot, params, packages, mesh_paths), None
+    return resolve_robot(robot, params), None
+
+
+def _view_motion(r: Any, sc: Any, trajectory: str | None,
+                 ) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Joint values (p, n) and path points (p, 3): from --trajectory, else the scenario's run."""
+    if trajectory is not None:
+        return _load_trajectory(trajectory, r)
+    if sc is not None:
+        traj = sc.run()
+        return traj.q, traj.targets[:, :3, 3]
+    return None, None
+
+
+def _with_collision(r: Any, show_collision: bool) -> tuple[Any, bool]:
+    """The robot, with capsules fitted to its collision geometry when --collision needs them.
+
+    Returns the robot and whether capsules were fitted.
+    """
+    if not show_collision or r.collision is not None:
+        return r, False
+    if not any(lg.collision for lg in r.geometry):
+        raise CLIError(f"--collision: robot {short_repr(r.name)} has no collision model "
+                       "and no collision geometry to fit one to")
+    fitted, _ = r.fit_collision()  # bounding capsules of the links' collision shapes
+    return fitted, True
+
+
+def _srdf_acm(r: Any, srdf: str | None) -> Any:
+    """The allowed-collision matrix of --srdf for the robot's collision model, or None."""
+    if srdf is None:
+        return None
+    if r.collision is None:
+        raise CLIError(f"--srdf: robot {short_repr(r.name)} has no collision model to "
+                       "check")
+    from serialkin.collision import acm_from_srdf
+
+    return acm_from_srdf(r.collision, srdf)
+
+
+def _point_layer(points_file: str | None, points_label: str | None,
+                 ) -> tuple[np.ndarray | None, np.ndarray | None, str | None]:
+    """Positions (N, 3) [m], colours (N, 3) or None and the label of --points."""
+    if points_file is None:
+        if points_label is not None:
+            raise CLIError("--points-label needs --points FILE")
+        return None, None, None
+    from serialkin.cli.io import read_csv_rows
+
+    rows = read_csv_rows(points_file, "points", (3, 6))
+    colors = rows[:, 3:] if rows.shape[1] == 6 else None
+    label = points_label if points_label is not None else Path(points_file).name
+    return rows[:, :3], colors, label
+
+
+def _write_page(scene: Any, out: str, options: Any) -> Path:
+    """Write the page; a visual mesh that cannot be read gets the command line's hint."""
+    from serialkin.viz.viewer import write_viewer
+
+    try:
+        return write_viewer(scene, out, options)
+    except SerialkinError as exc:
+        if "visual mesh" in str(exc):
+            raise CLIError(f"{exc} (on the command line: --package NAME=FOLDER or --mesh-path "
+                           "FOLDER, or --no-meshes)") from exc
+        raise
+
+
+def _open_page(path: Path) -> None:
+    """Open the written page in a web browser, or say where it is."""
+    import webbrowser
+
+    if not webbrowser.open(Path(path).resolve().as_uri()):
+        click.echo(f"could not open a browser; open {Path(path).resolve()} by hand", err=True)

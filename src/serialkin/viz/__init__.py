@@ -4,9 +4,12 @@
   otherwise), obstacles and target paths (matplotlib).
 - :mod:`serialkin.viz.trajectory` — joint trajectories (the chapter's Figure 9), tracking
   error and obstacle clearance along a path.
-- :mod:`serialkin.viz.animate` — a trajectory as a GIF (Pillow) or MP4 (ffmpeg).
+- :mod:`serialkin.viz.animate` — a trajectory as a GIF (Pillow) or MP4 (ffmpeg), drawn as
+  :class:`~serialkin.viz.animate.AnimationOptions` say.
 - :mod:`serialkin.viz.viewer` — a self-contained HTML page with the robot in 3D (three.js,
   embedded), joint sliders and forward kinematics computed in the page.
+- :mod:`serialkin.viz.scene` — what the page shows (:class:`~serialkin.viz.scene.Scene`)
+  and how it draws the robot's body (:class:`~serialkin.viz.scene.ViewerOptions`).
 
 The submodules import matplotlib lazily; ``import serialkin.viz`` itself is cheap.
 """
@@ -29,9 +32,12 @@ _EXPORTS = {
     "plot_motion": "trajectory",
     "clearance_along": "trajectory",
     "tracking_figure": "trajectory",
+    "AnimationOptions": "animate",
     "animate_trajectory": "animate",
     "save_animation": "animate",
     "ffmpeg_available": "animate",
+    "Scene": "scene",
+    "ViewerOptions": "scene",
     "viewer_html": "viewer",
     "viewer_data": "viewer",
     "write_viewer": "viewer",

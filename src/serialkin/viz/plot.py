@@ -239,29 +239,39 @@ def plot_robot(
     line = _mechanism_points(robot, qv) if mechanism else pts
     ax.plot(*line[:, :dims].T, "-", color=color, alpha=alpha, lw=linewidth, label=label,
             gid=LINKS_GID, solid_capstyle="round")
-    ms = float(markersize)
-    if ms > 0:
-        ax.plot(*joints[:, :dims].T, "o", color=color, alpha=alpha, ms=ms, mfc="white",
-                mew=0.3 * ms, gid=JOINTS_GID)
-        ax.plot(*pts[:1, :dims].T, "s", color="0.2", alpha=alpha, ms=1.33 * ms,
-                gid="serialkin-base")
-        ax.plot(*pts[-1:, :dims].T, "o", color=color, alpha=alpha, ms=0.67 * ms,
-                gid="serialkin-tool")
+    _draw_markers(ax, pts[:, :dims], joints[:, :dims], color, alpha, float(markersize))
     if frames:
         Ts = list(robot.fk_all(qv)) + [robot.fk(qv)]
         for i, T in enumerate(Ts):
             _draw_triad(ax, T, tri, two_d, alpha, f"{FRAMES_GID}-{i}")
+    _finish_robot_axes(ax, two_d, pts, 0.1 * scale)
+    return ax
+
+
+def _draw_markers(ax: Any, pts: np.ndarray, joints: np.ndarray, color: Any, alpha: float,
+                  ms: float) -> None:
+    """Joint markers on their axes, the base square and the tool dot (none when ``ms`` = 0).
+
+    ``pts`` is the skeleton (n+2, d) and ``joints`` the joint positions (n, d), d = 2 or 3.
+    """
+    if not ms > 0:
+        return
+    ax.plot(*joints.T, "o", color=color, alpha=alpha, ms=ms, mfc="white", mew=0.3 * ms,
+            gid=JOINTS_GID)
+    ax.plot(*pts[:1].T, "s", color="0.2", alpha=alpha, ms=1.33 * ms, gid="serialkin-base")
+    ax.plot(*pts[-1:].T, "o", color=color, alpha=alpha, ms=0.67 * ms, gid="serialkin-tool")
+
+
+def _finish_robot_axes(ax: Any, two_d: bool, pts: np.ndarray, margin: float) -> None:
+    """Equal scale around the skeleton ``pts`` (n+2, 3) [m] and axis labels in metres."""
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
     if two_d:
         ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
         ax.autoscale_view()
     else:
-        _set_equal_3d(ax, pts, 0.1 * scale)
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
+        _set_equal_3d(ax, pts, margin)
         ax.set_zlabel("z [m]")
-    return ax
 
 
 def _draw_triad(ax: Any, T: np.ndarray, size: float, two_d: bool, alpha: float, gid: str) -> None:

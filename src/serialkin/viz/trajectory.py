@@ -107,21 +107,9 @@ def plot_joint_trajectories(
         as plotted (degrees for revolute joints when ``degrees``). More than 10 joints get
         a colour bar (viridis, joint index) instead of a legend.
     """
-    import matplotlib as mpl
-
-    names = joint_names
-    if hasattr(q, "q"):
-        names = names or tuple(getattr(q, "joint_names", ()) or ()) or None
-        q = q.q
-    Q = as_float_array(q, "q", ndim=2)
+    Q, names = _joint_values(q, robot, joint_names)
     p, n = Q.shape
-    if robot is not None and robot.n != n:
-        raise InputError(f"q has {n} columns but robot {robot.name!r} has {robot.n} joints")
     types = robot.joint_types if robot is not None else ("R",) * n
-    names = list(names or (robot.joint_names if robot is not None else
-                           [f"q{i + 1}" for i in range(n)]))
-    if len(names) != n:
-        raise InputError(f"joint_names must have {n} names, got {len(names)}")
     x, default_xlabel = _x_axis(t, p)
     ax = ax if ax is not None else _new_axes()
     colours = _colours(n)
@@ -130,39 +118,77 @@ def plot_joint_trajectories(
         ax.plot(x, Q[:, i] * scale[i], color=colours[i], lw=1.4, label=names[i],
                 gid=f"serialkin-joint-{i}")
     if limits and robot is not None:
-        seen: set[tuple[float, Any]] = set()
-        for i in range(n):
-            for v in robot.qlim[i]:
-                if not np.isfinite(v):
-                    continue
-                key = (round(float(v * scale[i]), 12), colours[i] if n <= 10 else None)
-                if key in seen:
-                    continue
-                seen.add(key)
-                ax.axhline(v * scale[i], color=colours[i] if n <= 10 else "0.4", ls="--",
-                           lw=0.9, alpha=0.8, gid="serialkin-limit")
-    has_p = "P" in types
-    if degrees and not has_p:
-        ylabel = "joint angle [deg]"
-    elif degrees:
-        ylabel = "joint value [deg (R), m (P)]"
-    else:
-        ylabel = "joint value [rad (R), m (P)]" if has_p else "joint angle [rad]"
+        _draw_joint_limits(ax, robot.qlim, scale, colours)
     ax.set_xlabel(xlabel or default_xlabel)
-    ax.set_ylabel(ylabel)
+    ax.set_ylabel(_joint_ylabel(types, degrees))
     if title:
         ax.set_title(title)
     ax.grid(True, alpha=0.3)
     if p > 1:
         ax.set_xlim(x[0], x[-1])
+    _joint_key(ax, n)
+    return ax
+
+
+def _joint_values(q: object, robot: Robot | None,
+                  joint_names: Sequence[str] | None) -> tuple[np.ndarray, list[str]]:
+    """The (p, n) joint values and the n names: given, the trajectory's, the robot's or q1..qn."""
+    names = joint_names
+    if hasattr(q, "q"):
+        names = names or tuple(getattr(q, "joint_names", ()) or ()) or None
+        q = q.q
+    Q = as_float_array(q, "q", ndim=2)
+    n = Q.shape[1]
+    if robot is not None and robot.n != n:
+        raise InputError(f"q has {n} columns but robot {robot.name!r} has {robot.n} joints")
+    names = list(names or (robot.joint_names if robot is not None else
+                           [f"q{i + 1}" for i in range(n)]))
+    if len(names) != n:
+        raise InputError(f"joint_names must have {n} names, got {len(names)}")
+    return Q, names
+
+
+def _draw_joint_limits(ax: Any, qlim: np.ndarray, scale: np.ndarray,
+                       colours: list[Any]) -> None:
+    """Dashed lines at the finite limits (n, 2) × ``scale``, each value (and colour) once.
+
+    Up to 10 joints the lines take their joint's colour; beyond, one grey.
+    """
+    n = len(colours)
+    seen: set[tuple[float, Any]] = set()
+    for i in range(n):
+        for v in qlim[i]:
+            if not np.isfinite(v):
+                continue
+            key = (round(float(v * scale[i]), 12), colours[i] if n <= 10 else None)
+            if key in seen:
+                continue
+            seen.add(key)
+            ax.axhline(v * scale[i], color=colours[i] if n <= 10 else "0.4", ls="--",
+                       lw=0.9, alpha=0.8, gid="serialkin-limit")
+
+
+def _joint_ylabel(types: Sequence[str], degrees: bool) -> str:
+    """The y-axis label naming the units of the joint types drawn."""
+    has_p = "P" in types
+    if degrees and not has_p:
+        return "joint angle [deg]"
+    if degrees:
+        return "joint value [deg (R), m (P)]"
+    return "joint value [rad (R), m (P)]" if has_p else "joint angle [rad]"
+
+
+def _joint_key(ax: Any, n: int) -> None:
+    """A legend right of the axes for up to 10 joints, else a colour bar of the joint index."""
+    import matplotlib as mpl
+
     if n <= 10:
         outside_legend(ax, ncol=2 if n > 5 else 1)
-    else:
-        norm = mpl.colors.Normalize(vmin=1, vmax=n)
-        sm = mpl.cm.ScalarMappable(norm=norm, cmap="viridis")
-        bar = ax.figure.colorbar(sm, ax=ax, label="joint index")
-        bar.set_ticks(joint_index_ticks(n))
-    return ax
+        return
+    norm = mpl.colors.Normalize(vmin=1, vmax=n)
+    sm = mpl.cm.ScalarMappable(norm=norm, cmap="viridis")
+    bar = ax.figure.colorbar(sm, ax=ax, label="joint index")
+    bar.set_ticks(joint_index_ticks(n))
 
 
 def joint_index_ticks(n: int) -> list[int]:
@@ -413,11 +439,7 @@ def plot_motion(
     Q = robot.check_q(q, "q")
     if Q.ndim != 2 or Q.shape[0] == 0:
         raise InputError(f"q must have shape (p, {robot.n}) with p >= 1, got {Q.shape}")
-    p = Q.shape[0]
-    step = max(1, p // 12) if every is None else check_int(every, "every", minimum=1)
-    idx = list(range(0, p, step))
-    if idx[-1] != p - 1:
-        idx.append(p - 1)
+    idx = _pose_indices(Q.shape[0], every)
     colours = mpl.colormaps[cmap](np.linspace(0.35, 1.0, len(idx)))
     for j, k in enumerate(idx):
         last = j == len(idx) - 1
@@ -426,29 +448,37 @@ def plot_motion(
                         alpha=0.9)
     if q0 is not None:
         start = robot_points(robot, robot.check_q(q0, "q0"))
-        if is_3d_axes(ax):
-            ax.plot(start[:, 0], start[:, 1], start[:, 2], "--o", color="tab:red", lw=1.4,
-                    ms=2.5, label="start pose q0", gid="serialkin-start")
-        else:
-            ax.plot(start[:, 0], start[:, 1], "--o", color="tab:red", lw=1.4, ms=2.5,
-                    label="start pose q0", gid="serialkin-start")
+        _plot_points(ax, start, "--o", color="tab:red", lw=1.4, ms=2.5,
+                     label="start pose q0", gid="serialkin-start")
     if obstacles is not None:
         plot_obstacles(ax, obstacles, influence=influence, labels=labels)
     if path_points is not None:
         plot_path(ax, path_points, linewidth=3.0)
     if trace:
-        P = robot_points(robot, Q)[:, -1, :]
-        if is_3d_axes(ax):
-            ax.plot(P[:, 0], P[:, 1], P[:, 2], "-", color="tab:orange", lw=1.0,
-                    label="end-effector trace", gid="serialkin-trace")
-        else:
-            ax.plot(P[:, 0], P[:, 1], "-", color="tab:orange", lw=1.0,
-                    label="end-effector trace", gid="serialkin-trace")
+        _plot_points(ax, robot_points(robot, Q)[:, -1, :], "-", color="tab:orange", lw=1.0,
+                     label="end-effector trace", gid="serialkin-trace")
     if title:
         ax.set_title(title)
     if path_points is not None or trace or q0 is not None:
         outside_legend(ax)
     return ax
+
+
+def _pose_indices(p: int, every: int | None) -> list[int]:
+    """Indices of the poses drawn: every ``every``-th of ``p`` (default about 12), and the last."""
+    step = max(1, p // 12) if every is None else check_int(every, "every", minimum=1)
+    idx = list(range(0, p, step))
+    if idx[-1] != p - 1:
+        idx.append(p - 1)
+    return idx
+
+
+def _plot_points(ax: Any, P: np.ndarray, fmt: str, **style: Any) -> None:
+    """Draw the points ``P`` (k, 3) [m] as a line: x, y, z on 3D axes, x, y on 2D axes."""
+    if is_3d_axes(ax):
+        ax.plot(P[:, 0], P[:, 1], P[:, 2], fmt, **style)
+    else:
+        ax.plot(P[:, 0], P[:, 1], fmt, **style)
 
 
 # ---------------------------------------------------------------------- all together

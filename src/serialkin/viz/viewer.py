@@ -26,12 +26,12 @@ vertex ``p`` of a shape is drawn at ``fk_all(q)[f] · origin · p``. Boxes, cyli
 spheres and capsules become three.js geometries; mesh files are loaded with
 :func:`serialkin.model.mesh.load_mesh` (the ``mesh`` extra), decimated
 (:func:`serialkin.model.mesh.decimate`) so that all meshes together hold at most
-``mesh_budget`` triangles (each mesh gets a share proportional to its own triangle count;
-a mesh used by several links counts once), and embedded compactly: vertex positions
-quantised to 16 bits per coordinate over the mesh's bounding box (error at most half a step,
-``extent / 131070``, about 2 µm for a 0.3 m link) and triangle indices as 16- or 32-bit
-integers, both base64 of little-endian arrays; normals are computed in the page. A robot
-without geometry keeps the skeleton of cylinders.
+``ViewerOptions.mesh_budget`` triangles (each mesh gets a share proportional to its own
+triangle count; a mesh used by several links counts once), and embedded compactly: vertex
+positions quantised to 16 bits per coordinate over the mesh's bounding box (error at most
+half a step, ``extent / 131070``, about 2 µm for a 0.3 m link) and triangle indices as 16-
+or 32-bit integers, both base64 of little-endian arrays; normals are computed in the page.
+A robot without geometry keeps the skeleton of cylinders.
 
 **Self-collision in the page.** With a collision model (:attr:`Robot.collision`, capsules
 and spheres per body, :mod:`serialkin.collision`) the page can draw the capsules (a toggle)
@@ -43,9 +43,19 @@ collides when ``dist(A_s B_s, A_t B_t) − r_s − r_t < 0`` (segment–segment 
 :func:`serialkin.collision.self_clearance` computes it). The bodies of a colliding pair are
 drawn red (their capsules and the visual shapes of the links of the same name).
 
-**Point layer.** ``points`` (N, 3) [m] with RGB ``point_colors`` (N, 3) in [0, 1] are drawn
-as a point cloud with a toggle named by ``points_label`` (e.g. a reachability map):
-positions as float32, colours as 8-bit, base64.
+**Point layer.** A scene's ``points`` (N, 3) [m] with RGB ``point_colors`` (N, 3) in [0, 1]
+are drawn as a point cloud with a toggle named by ``points_label`` (e.g. a reachability
+map): positions as float32, colours as 8-bit, base64.
+
+**Calling it.** What the page shows is one :class:`~serialkin.viz.scene.Scene`, how the
+body is drawn one :class:`~serialkin.viz.scene.ViewerOptions`::
+
+    write_viewer(Scene(robot, trajectory=Q, obstacles=obstacles), "robot.html",
+                 ViewerOptions(meshes=False))
+
+The old form, the robot first and the fields as keywords
+(``write_viewer(robot, "robot.html", trajectory=Q, meshes=False)``), still works for one
+release and warns (:class:`DeprecationWarning`).
 
 Lengths are in metres, angles in radians.
 """
@@ -56,29 +66,34 @@ import base64
 import html
 import json
 import re
-from collections.abc import Iterable
+import warnings
+from dataclasses import fields
 from functools import cache
 from importlib import resources
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from serialkin._checks import as_float_array, check_int, short_repr
+from serialkin._checks import as_float_array, short_repr
 from serialkin._io import write_text_atomic
 from serialkin.errors import InputError, InputTypeError
-from serialkin.viz.plot import as_obstacle, robot_points, robot_scale
+from serialkin.model.robot import Robot
+from serialkin.viz.plot import Obstacle, robot_points, robot_scale
+from serialkin.viz.scene import MESH_BUDGET, Scene, ViewerOptions
 
-if TYPE_CHECKING:
-    from serialkin.model.robot import Robot
-
-__all__ = ["MESH_BUDGET", "THREE_REVISION", "viewer_data", "viewer_html", "write_viewer"]
+__all__ = [
+    "MESH_BUDGET",
+    "THREE_REVISION",
+    "Scene",
+    "ViewerOptions",
+    "viewer_data",
+    "viewer_html",
+    "write_viewer",
+]
 
 #: three.js release embedded in the page (``viz/assets/three.module.min.js``).
 THREE_REVISION = "170"
-#: Default largest number of triangles of all visual meshes embedded in a page together
-#: (about 12 bytes each in the file: the Panda's ten meshes in about 0.8 MB).
-MESH_BUDGET = 60_000
 #: Fewest triangles a decimated mesh keeps.
 _MIN_MESH_FACES = 16
 #: Colour of a visual shape without its own (RGBA in [0, 1]).
@@ -101,37 +116,11 @@ def _library() -> str:
     return text
 
 
-def _trajectory(robot: Robot, trajectory: object) -> np.ndarray | None:
-    if trajectory is None:
-        return None
-    Q = robot.check_q(trajectory, "trajectory")
-    if Q.ndim != 2 or Q.shape[0] == 0:
-        raise InputError(
-            f"trajectory must have shape (k, {robot.n}) with k >= 1, got {Q.shape}"
-        )
-    return Q
-
-
-def _path_points(path_points: object) -> np.ndarray | None:
-    if path_points is None:
-        return None
-    P = as_float_array(path_points, "path_points", ndim=2)
-    if P.shape[1] not in (2, 3):
-        raise InputError(f"path_points must have shape (k, 2) or (k, 3), got {P.shape}")
-    if P.shape[1] == 2:
-        P = np.hstack([P, np.zeros((P.shape[0], 1))])
-    return P
-
-
-def _initial_q(robot: Robot, q: object, Q: np.ndarray | None) -> np.ndarray:
-    if q is not None:
-        qv = robot.check_q(q)
-        if qv.ndim != 1:
-            raise InputError(f"q must be one configuration of shape ({robot.n},), got {qv.shape}")
-        return qv
-    if Q is not None:
-        return Q[0].copy()
-    return np.clip(np.zeros(robot.n), robot.qlim[:, 0], robot.qlim[:, 1])
+def _path3(P: np.ndarray | None) -> np.ndarray | None:
+    """The target path (k, 3) [m]: 2D points get z = 0."""
+    if P is None or P.shape[1] == 3:
+        return P
+    return np.hstack([P, np.zeros((P.shape[0], 1))])
 
 
 def _slider_limits(robot: Robot, scale: float, qs: np.ndarray) -> list[list[float]]:
@@ -288,32 +277,6 @@ def _load_visual_mesh(link: str, g: Any) -> Any:
     return welded(m)
 
 
-def _collision_model(robot: Robot, collision: object) -> Any:
-    """The collision model drawn: the robot's (None), none (False) or the one given."""
-    if collision is False:
-        return None
-    if collision is None or collision is True:
-        model = robot.collision
-        if model is None and collision is True:
-            raise InputError(f"robot {short_repr(robot.name)} has no collision model "
-                             "(Robot.collision is None); pass collision=CollisionModel(...)")
-    else:
-        model = collision
-    if model is None:
-        return None
-    from serialkin.model.collision_model import CollisionModel
-
-    if not isinstance(model, CollisionModel):
-        raise InputTypeError(f"collision must be None, a bool or a CollisionModel, got "
-                             f"{type(model).__name__}")
-    if len(model.body_frames) and int(model.body_frames.max()) > robot.n:
-        i = int(np.argmax(model.body_frames > robot.n))
-        raise InputError(f"collision body {short_repr(model.body_names[i])} is fixed to frame "
-                         f"{int(model.body_frames[i])}, but robot {short_repr(robot.name)} "
-                         f"has frames 0..{robot.n}")
-    return model
-
-
 def _collision_data(model: Any, acm: object) -> dict[str, Any]:
     """Capsules (frame, body, ends, radius) and the checked shape pairs for the page."""
     from serialkin.collision.queries import checked_shape_pairs
@@ -332,48 +295,219 @@ def _collision_data(model: Any, acm: object) -> dict[str, Any]:
     }
 
 
-def _points_data(points: object, point_colors: object, label: object) -> dict[str, Any] | None:
-    """The point layer: positions float32 and colours uint8, base64; None without points."""
-    if points is None:
-        if point_colors is not None:
-            raise InputError("point_colors given without points")
+def _collision_page(scene: Scene, show: bool) -> dict[str, Any] | None:
+    """The page's collision block (capsules, checked pairs, shown at first?) or None."""
+    model = scene.collision_model
+    if model is None:
+        if show:
+            raise InputError(f"show_collision=True but robot {short_repr(scene.robot.name)} "
+                             "has no collision model (Robot.collision is None)")
         return None
-    P = as_float_array(points, "points", ndim=2)
-    if P.shape[1] != 3:
-        raise InputError(f"points must have shape (N, 3), got {P.shape}")
-    if point_colors is None:
-        C = np.tile([0.1, 0.45, 0.85], (P.shape[0], 1))
-    else:
-        C = as_float_array(point_colors, "point_colors", ndim=2)
-        if C.shape != P.shape:
-            raise InputError(f"point_colors must have shape {P.shape} (RGB per point), "
-                             f"got {C.shape}")
-        if C.size and (C.min() < 0.0 or C.max() > 1.0):
-            raise InputError(f"point_colors must be in [0, 1], got values in "
-                             f"[{C.min():.3g}, {C.max():.3g}]")
-    if not isinstance(label, str):
-        raise InputTypeError(f"points_label must be a string, got {short_repr(label)}")
-    return {"count": int(P.shape[0]), "label": label, "positions": _b64(P.astype("<f4")),
-            "colors": _b64(np.rint(C * 255).astype("u1"))}
+    data = _collision_data(model, scene.acm)
+    data["show"] = bool(show)
+    return data
 
 
-def viewer_data(
-    robot: Robot,
-    q: object = None,
-    trajectory: object = None,
-    path_points: object = None,
-    obstacles: Iterable[object] | None = None,
-    title: str | None = None,
-    *,
-    meshes: bool = True,
-    mesh_budget: int = MESH_BUDGET,
-    collision: object = None,
-    acm: object = None,
-    show_collision: bool = False,
-    points: object = None,
-    point_colors: object = None,
-    points_label: str = "points",
-) -> dict[str, Any]:
+def _points_data(scene: Scene) -> dict[str, Any] | None:
+    """The point layer: positions float32 and colours uint8, base64; None without points."""
+    P = scene.points
+    if P is None:
+        return None
+    C = np.tile([0.1, 0.45, 0.85], (P.shape[0], 1)) if scene.point_colors is None \
+        else scene.point_colors
+    return {"count": int(P.shape[0]), "label": scene.points_label,
+            "positions": _b64(P.astype("<f4")), "colors": _b64(np.rint(C * 255).astype("u1"))}
+
+
+# ---------------------------------------------------------------------- the page's data
+def _chain_data(robot: Robot) -> dict[str, Any]:
+    """The robot's chain arrays, joint names, types and limits (None where unlimited)."""
+    return {
+        "n": robot.n,
+        "F": robot.chain.F.tolist(),
+        "L": robot.chain.L.tolist(),
+        "meta": robot.chain.meta.tolist(),
+        "joint_names": list(robot.joint_names),
+        "joint_types": list(robot.joint_types),
+        "qlim": [[float(v) if np.isfinite(v) else None for v in row] for row in robot.qlim],
+    }
+
+
+def _obstacle_data(o: Obstacle) -> dict[str, Any]:
+    """One obstacle for the page: kind, centre, radius, height, capsule ends [m]."""
+    return {
+        "kind": o.kind,
+        "center": o.center.tolist(),
+        "radius": o.radius,
+        "height": o.height,
+        "a": None if o.a is None else o.a.tolist(),
+        "b": None if o.b is None else o.b.tolist(),
+    }
+
+
+def _link_sizes(robot: Robot, q0: np.ndarray, scale: float) -> dict[str, float]:
+    """Radii [m] of the skeleton's link and joint cylinders, from the typical link length."""
+    seg = np.linalg.norm(np.diff(robot_points(robot, q0), axis=0), axis=1)
+    seg = seg[seg > 1e-9]
+    typical = float(np.median(seg)) if seg.size else scale
+    return {"link_radius": min(0.018 * scale, 0.1 * typical),
+            "joint_radius": min(0.032 * scale, 0.2 * typical)}
+
+
+def _framing(scene: Scene, qs: np.ndarray, P: np.ndarray | None,
+             scale: float) -> tuple[float, dict[str, Any]]:
+    """The ground height [m] under the robot, path and obstacles, and the camera on all."""
+    planar = scene.robot.is_planar
+    frame_pts = [robot_points(scene.robot, qs).reshape(-1, 3)]
+    if P is not None:
+        frame_pts.append(P)
+    frame_pts.extend(o.extent_points() for o in scene.obstacles)
+    allpts = np.vstack(frame_pts)
+    ground_z = float(allpts[:, 2].min()) - (0.002 * scale if planar else 0.0)
+    if scene.points is not None and scene.points.shape[0]:  # framed, not under the grid
+        allpts = np.vstack([allpts, scene.points])
+    return ground_z, _view(allpts, planar, scale)
+
+
+def _page_data(scene: Scene, options: ViewerOptions) -> dict[str, Any]:
+    """The JSON document of :func:`viewer_data` for a checked scene and options."""
+    from serialkin._version import __version__
+
+    robot = scene.robot
+    Q = scene.trajectory
+    P = _path3(scene.path_points)
+    q0 = scene.initial_q
+    cdata = _collision_page(scene, options.show_collision)
+    bodies = {} if cdata is None else {nm: i for i, nm in enumerate(cdata["bodies"])}
+    shapes, mesh_data = _visual_data(robot, options.meshes, options.mesh_budget, bodies)
+    scale = robot_scale(robot)
+    qs = q0[None] if Q is None else np.vstack([q0[None], Q])
+    ground_z, view = _framing(scene, qs, P, scale)
+    return {
+        "version": __version__,
+        "name": robot.name,
+        "title": scene.title if scene.title is not None else f"serialkin viewer: {robot.name}",
+        **_chain_data(robot),
+        "slider_limits": _slider_limits(robot, scale, qs),
+        "q": q0.tolist(),
+        "trajectory": None if Q is None else Q.tolist(),
+        "path_points": None if P is None else P.tolist(),
+        "obstacles": [_obstacle_data(o) for o in scene.obstacles],
+        "planar": robot.is_planar,
+        "scale": scale,
+        "sizes": _link_sizes(robot, q0, scale),
+        "ground_z": ground_z,
+        "view": view,
+        "shapes": shapes,
+        "meshes": mesh_data,
+        "collision": cdata,
+        "points": _points_data(scene),
+    }
+
+
+def _json_for_script(data: dict[str, Any]) -> str:
+    """JSON safe to embed in a raw-text <script> element (no '<' characters at all)."""
+    return json.dumps(data, allow_nan=False, separators=(",", ":")).replace("<", "\\u003c")
+
+
+def _subtitle(robot: Robot, data: dict[str, Any]) -> str:
+    """The line under the page title: joints, their kinds, DH convention, trajectory size."""
+    subtitle = f"{robot.n} joints ({''.join(robot.joint_types)})"
+    if robot.convention:
+        subtitle += f", {robot.convention} DH"
+    if data["trajectory"] is not None:
+        subtitle += f", trajectory of {len(data['trajectory'])} configurations"
+    return subtitle
+
+
+def _page(scene: Scene, options: ViewerOptions) -> str:
+    """The HTML text of :func:`viewer_html` for a checked scene and options."""
+    data = _page_data(scene, options)
+    viewer_js = _asset("viewer.js")
+    if "</script" in viewer_js.lower():
+        raise RuntimeError("viewer.js must not contain '</script'")
+    values = {
+        "TITLE": html.escape(data["title"]),
+        "SUBTITLE": html.escape(_subtitle(scene.robot, data)),
+        "VERSION": html.escape(data["version"]),
+        "CSS": _asset("viewer.css"),
+        "DATA": _json_for_script(data),
+        "THREE": _library(),
+        "THREE_REVISION": THREE_REVISION,
+        "VIEWER_JS": viewer_js,
+    }
+    # one pass: substituted text is never scanned again for placeholders
+    return re.sub(r"\{\{([A-Z_]+)\}\}", lambda m: values[m.group(1)], _asset("viewer.html"))
+
+
+# ---------------------------------------------------------------------- the call forms
+#: The deprecated form's positional parameters after ``robot`` (after ``robot, path`` for
+#: :func:`write_viewer`).
+_OLD_POSITIONAL = ("q", "trajectory", "path_points", "obstacles", "title")
+#: How each function is called now, for the deprecation message.
+_NEW_FORM = {
+    "viewer_data": "viewer_data(Scene(robot, ...), ViewerOptions(...))",
+    "viewer_html": "viewer_html(Scene(robot, ...), ViewerOptions(...))",
+    "write_viewer": "write_viewer(Scene(robot, ...), path, ViewerOptions(...))",
+}
+
+
+def _scene_and_options(func: str, scene: object, options: object, old_args: tuple,
+                       old_keywords: dict[str, Any]) -> tuple[Scene, ViewerOptions]:
+    """The scene and options of a call: given (new form) or built from the old arguments.
+
+    The old form, a :class:`~serialkin.Robot` first and the scene's and options' fields
+    as arguments, builds them and warns (:class:`DeprecationWarning`).
+    """
+    if isinstance(scene, Scene):
+        if old_args or old_keywords:
+            extra = (", ".join(f"{k}=" for k in sorted(old_keywords)) if old_keywords
+                     else f"{len(old_args)} more positional argument(s)")
+            raise InputTypeError(f"{func}() takes a Scene and a ViewerOptions, got a Scene "
+                                 f"and also {extra}; put them in the Scene or the "
+                                 "ViewerOptions")
+        if options is None:
+            return scene, ViewerOptions()
+        if not isinstance(options, ViewerOptions):
+            raise InputTypeError(f"options must be a ViewerOptions or None, got "
+                                 f"{type(options).__name__} {short_repr(options)}")
+        return scene, options
+    if not isinstance(scene, Robot):
+        raise InputTypeError(f"scene must be a Scene, got {type(scene).__name__} "
+                             f"{short_repr(scene)}")
+    positional = (options, *old_args) if old_args or options is not None else ()
+    return _from_old_form(func, scene, positional, old_keywords)
+
+
+def _from_old_form(func: str, robot: Robot, args: tuple,
+                   keywords: dict[str, Any]) -> tuple[Scene, ViewerOptions]:
+    """Build the scene and options from the deprecated arguments, with a warning."""
+    if len(args) > len(_OLD_POSITIONAL):
+        raise InputTypeError(f"{func}() takes at most {len(_OLD_POSITIONAL)} positional "
+                             f"arguments after the robot ({', '.join(_OLD_POSITIONAL)}), got "
+                             f"{len(args)}")
+    given = dict(zip(_OLD_POSITIONAL, args, strict=False))
+    twice = sorted(given.keys() & keywords.keys())
+    if twice:
+        raise InputTypeError(f"{func}() got {twice[0]!r} both by position and by name")
+    given.update(keywords)
+    scene_names = [f.name for f in fields(Scene) if f.name != "robot"]
+    option_names = [f.name for f in fields(ViewerOptions)]
+    unknown = sorted(set(given) - set(scene_names) - set(option_names))
+    if unknown:
+        raise InputTypeError(f"{func}() got unknown argument(s) {', '.join(unknown)}; "
+                             f"expected Scene fields ({', '.join(scene_names)}) or "
+                             f"ViewerOptions fields ({', '.join(option_names)})")
+    warnings.warn(f"{func}(robot, ...) with the scene's and options' fields as arguments "
+                  f"is deprecated and will be removed in the next release; call "
+                  f"{_NEW_FORM[func]}", DeprecationWarning, stacklevel=4)
+    scene = Scene(robot, **{k: v for k, v in given.items() if k in scene_names})
+    return scene, ViewerOptions(**{k: v for k, v in given.items() if k in option_names})
+
+
+# ---------------------------------------------------------------------- public functions
+def viewer_data(scene: Scene, options: ViewerOptions | None = None, *old_args: object,
+                **old_keywords: object) -> dict[str, Any]:
     """The JSON document the page is built from (see :func:`viewer_html` for arguments).
 
     Keys: ``n``, ``name``, ``F``/``L`` ((n+1) row-major 4x4 lists), ``meta`` (n rows
@@ -388,204 +522,75 @@ def viewer_data(
     frame/body/a/b/radius, the checked shape ``pairs``, ``show``), ``points`` (None, or
     count, label, base64 positions and colours).
     """
-    from serialkin._version import __version__
-
-    Q = _trajectory(robot, trajectory)
-    P = _path_points(path_points)
-    q0 = _initial_q(robot, q, Q)
-    obs = [as_obstacle(o, f"obstacles[{i}]") for i, o in enumerate(obstacles or ())]
-    mesh_budget = check_int(mesh_budget, "mesh_budget", minimum=4)
-    model = _collision_model(robot, collision)
-    if acm is not None and model is None:
-        raise InputError("acm given but there is no collision model to check")
-    cdata = None if model is None else _collision_data(model, acm)
-    if cdata is not None:
-        cdata["show"] = bool(show_collision)
-    elif show_collision:
-        raise InputError(f"show_collision=True but robot {short_repr(robot.name)} has no "
-                         "collision model (Robot.collision is None)")
-    bodies = {} if model is None else {nm: i for i, nm in enumerate(model.body_names)}
-    shapes, mesh_data = _visual_data(robot, bool(meshes), mesh_budget, bodies)
-    pdata = _points_data(points, point_colors, points_label)
-    scale = robot_scale(robot)
-    qs = q0[None] if Q is None else np.vstack([q0[None], Q])
-    pts = robot_points(robot, qs).reshape(-1, 3)
-    planar = robot.is_planar
-    frame_pts = [pts]
-    if P is not None:
-        frame_pts.append(P)
-    frame_pts.extend(o.extent_points() for o in obs)
-    allpts = np.vstack(frame_pts)
-    ground_z = float(allpts[:, 2].min()) - (0.002 * scale if planar else 0.0)
-    if pdata is not None and pdata["count"]:  # framed by the camera, not under the grid
-        allpts = np.vstack([allpts, as_float_array(points, "points", ndim=2)])
-    qlim = [[float(v) if np.isfinite(v) else None for v in row] for row in robot.qlim]
-    seg = np.linalg.norm(np.diff(robot_points(robot, q0), axis=0), axis=1)
-    seg = seg[seg > 1e-9]
-    typical = float(np.median(seg)) if seg.size else scale
-    sizes = {"link_radius": min(0.018 * scale, 0.1 * typical),
-             "joint_radius": min(0.032 * scale, 0.2 * typical)}
-    return {
-        "version": __version__,
-        "name": robot.name,
-        "title": title if title is not None else f"serialkin viewer: {robot.name}",
-        "n": robot.n,
-        "F": robot.chain.F.tolist(),
-        "L": robot.chain.L.tolist(),
-        "meta": robot.chain.meta.tolist(),
-        "joint_names": list(robot.joint_names),
-        "joint_types": list(robot.joint_types),
-        "qlim": qlim,
-        "slider_limits": _slider_limits(robot, scale, qs),
-        "q": q0.tolist(),
-        "trajectory": None if Q is None else Q.tolist(),
-        "path_points": None if P is None else P.tolist(),
-        "obstacles": [
-            {
-                "kind": o.kind,
-                "center": o.center.tolist(),
-                "radius": o.radius,
-                "height": o.height,
-                "a": None if o.a is None else o.a.tolist(),
-                "b": None if o.b is None else o.b.tolist(),
-            }
-            for o in obs
-        ],
-        "planar": planar,
-        "scale": scale,
-        "sizes": sizes,
-        "ground_z": ground_z,
-        "view": _view(allpts, planar, scale),
-        "shapes": shapes,
-        "meshes": mesh_data,
-        "collision": cdata,
-        "points": pdata,
-    }
+    scene, options = _scene_and_options("viewer_data", scene, options, old_args, old_keywords)
+    return _page_data(scene, options)
 
 
-def _json_for_script(data: dict[str, Any]) -> str:
-    """JSON safe to embed in a raw-text <script> element (no '<' characters at all)."""
-    return json.dumps(data, allow_nan=False, separators=(",", ":")).replace("<", "\\u003c")
-
-
-def viewer_html(
-    robot: Robot,
-    q: object = None,
-    trajectory: object = None,
-    path_points: object = None,
-    obstacles: Iterable[object] | None = None,
-    title: str | None = None,
-    *,
-    meshes: bool = True,
-    mesh_budget: int = MESH_BUDGET,
-    collision: object = None,
-    acm: object = None,
-    show_collision: bool = False,
-    points: object = None,
-    point_colors: object = None,
-    points_label: str = "points",
-) -> str:
+def viewer_html(scene: Scene, options: ViewerOptions | None = None, *old_args: object,
+                **old_keywords: object) -> str:
     """The interactive viewer page as an HTML string (self-contained, works offline).
 
+    Example::
+
+        page = viewer_html(Scene(robot, trajectory=Q, path_points=path),
+                           ViewerOptions(meshes=False))
+
     Args:
-        robot: the robot to show.
-        q: initial configuration (n,) [rad / m]; default the trajectory's first row, else
-            zeros clipped into the joint limits.
-        trajectory: (k, n) configurations to play back (play button and frame slider); the
-            end effector's trace along it is drawn.
-        path_points: (k, 2) or (k, 3) target path [m], drawn as a green polyline
-            (2D points get z = 0).
-        obstacles: obstacle objects or dicts (see :func:`serialkin.viz.plot.as_obstacle`):
-            spheres, vertical cylinders, capsules.
-        title: page title (default "serialkin viewer: <robot name>").
-        meshes: draw the visual mesh files of :attr:`Robot.geometry` (needs the ``mesh``
-            extra when there are any); False draws only the primitive shapes, or the
-            skeleton of cylinders when there are none.
-        mesh_budget: most triangles of all embedded meshes together (>= 4); larger
-            meshes are decimated (about 12 bytes of page per triangle).
-        collision: the capsule model checked and drawn: None = :attr:`Robot.collision`
-            (if any), a :class:`~serialkin.model.collision_model.CollisionModel`, or False
-            for none (True requires the robot's own).
-        acm: the :class:`~serialkin.collision.acm.AllowedCollisionMatrix` whose pairs are
-            skipped (default :func:`~serialkin.collision.acm.default_acm`).
-        show_collision: capsules visible when the page opens (a toggle in the page).
-        points: (N, 3) positions [m] drawn as a toggled point cloud.
-        point_colors: (N, 3) RGB in [0, 1] per point (default one blue).
-        points_label: the point layer's name in the page.
+        scene: what the page shows: the robot, its configuration or (k, n) trajectory
+            [rad / m], the target path and obstacles [m], the collision model and the
+            point layer (see :class:`~serialkin.viz.scene.Scene`).
+        options: how the robot's body is drawn: visual meshes, their triangle budget,
+            capsules shown at first (see :class:`~serialkin.viz.scene.ViewerOptions`;
+            None: the defaults).
+        *old_args: deprecated: the old form ``viewer_html(robot, q, trajectory,
+            path_points, obstacles, title)`` (builds the scene; warns).
+        **old_keywords: deprecated: the old keywords (the fields of ``Scene`` and
+            ``ViewerOptions``) after a robot; they build the scene and options and a
+            :class:`DeprecationWarning` names the new form. Removed in the next release.
 
     Returns:
         The HTML text (about 0.7 MB of three.js, plus about 12 bytes per mesh triangle
         and 20 per point).
 
     Raises:
-        InputError: a configuration with the wrong number of joints or non-finite values,
-            a path of the wrong shape, a malformed obstacle, a collision model on frames
-            the robot does not have, points or colours of the wrong shape or range.
+        InputTypeError: ``scene`` is not a Scene (nor, in the old form, a Robot),
+            ``options`` is not a ViewerOptions, unknown old keywords.
+        InputError: ``show_collision`` without a collision model; in the old form, what
+            :class:`~serialkin.viz.scene.Scene` raises.
         RobotDefinitionError: a visual mesh file that is missing or corrupt (the message
             names the link and the file).
         NotSupportedError: mesh files to draw but trimesh is not installed (the message
             names the extra).
     """
-    data = viewer_data(robot, q=q, trajectory=trajectory, path_points=path_points,
-                       obstacles=obstacles, title=title,
-                       meshes=meshes, mesh_budget=mesh_budget, collision=collision, acm=acm,
-                       show_collision=show_collision, points=points,
-                       point_colors=point_colors, points_label=points_label)
-    kinds = "".join(robot.joint_types)
-    subtitle = f"{robot.n} joints ({kinds})"
-    if robot.convention:
-        subtitle += f", {robot.convention} DH"
-    if data["trajectory"] is not None:
-        subtitle += f", trajectory of {len(data['trajectory'])} configurations"
-    viewer_js = _asset("viewer.js")
-    if "</script" in viewer_js.lower():
-        raise RuntimeError("viewer.js must not contain '</script'")
-    values = {
-        "TITLE": html.escape(data["title"]),
-        "SUBTITLE": html.escape(subtitle),
-        "VERSION": html.escape(data["version"]),
-        "CSS": _asset("viewer.css"),
-        "DATA": _json_for_script(data),
-        "THREE": _library(),
-        "THREE_REVISION": THREE_REVISION,
-        "VIEWER_JS": viewer_js,
-    }
-    # one pass: substituted text is never scanned again for placeholders
-    return re.sub(r"\{\{([A-Z_]+)\}\}", lambda m: values[m.group(1)], _asset("viewer.html"))
+    scene, options = _scene_and_options("viewer_html", scene, options, old_args, old_keywords)
+    return _page(scene, options)
 
 
-def write_viewer(
-    robot: Robot,
-    path: str | Path,
-    q: object = None,
-    trajectory: object = None,
-    path_points: object = None,
-    obstacles: Iterable[object] | None = None,
-    title: str | None = None,
-    *,
-    meshes: bool = True,
-    mesh_budget: int = MESH_BUDGET,
-    collision: object = None,
-    acm: object = None,
-    show_collision: bool = False,
-    points: object = None,
-    point_colors: object = None,
-    points_label: str = "points",
-) -> Path:
+def write_viewer(scene: Scene, path: str | Path, options: ViewerOptions | None = None,
+                 *old_args: object, **old_keywords: object) -> Path:
     """Write the viewer page (see :func:`viewer_html`) to ``path``, atomically.
 
     The file is written to a temporary file in the same folder and renamed, so an
-    interrupted run never leaves a truncated page. Parent folders are created. The
-    keyword arguments are those of :func:`viewer_html`.
+    interrupted run never leaves a truncated page. Parent folders are created.
+
+    Args:
+        scene: what the page shows (see :func:`viewer_html`).
+        path: the HTML file to write.
+        options: how the robot's body is drawn (None: the defaults).
+        *old_args: deprecated: the old form ``write_viewer(robot, path, q, trajectory,
+            path_points, obstacles, title)`` (warns).
+        **old_keywords: deprecated: the old keywords after a robot (warns; see
+            :func:`viewer_html`).
 
     Returns:
         The path written.
+
+    Raises:
+        OutputError: the folder cannot be created or the file cannot be written; and
+            what :func:`viewer_html` raises.
     """
-    text = viewer_html(robot, q=q, trajectory=trajectory, path_points=path_points,
-                       obstacles=obstacles, title=title,
-                       meshes=meshes, mesh_budget=mesh_budget, collision=collision, acm=acm,
-                       show_collision=show_collision, points=points,
-                       point_colors=point_colors, points_label=points_label)
+    scene, options = _scene_and_options("write_viewer", scene, options, old_args,
+                                        old_keywords)
     out = Path(path)
-    write_text_atomic(out, text)
+    write_text_atomic(out, _page(scene, options))
     return out
