@@ -16,7 +16,7 @@ import sympy as sp
 
 from serialkin import models
 from serialkin.chapter.report import Html, ReportContext, Section, format_number
-from serialkin.kinematics.symbolic import derive
+from serialkin.kinematics.symbolic import SymbolicKinematics, derive
 from serialkin.model.dh import link_transform, standard_to_modified
 from serialkin.model.robot import Robot
 
@@ -205,39 +205,34 @@ def _latex_q(q: np.ndarray) -> str:
             rf"{{{q[2]:.2f}}}\,\text{{m}},\ {{{q[3] / DEG:.0f}}}^\circ)")
 
 
-def _section_3_2_1(ctx: ReportContext) -> Section:
-    """Section 3.2.1: the SCARA example (Table 1, eqs 13-18)."""
-    parts: list[str] = []
-    robot = models.scara(**SCARA_PARAMS)
-    q = SCARA_Q
-    s = _symbols()
-    parts.append(
+def _table1_part(ctx: ReportContext, robot: Robot) -> str:
+    """Table 1 as printed (symbols) and as built (numbers, joint types, limits)."""
+    table1 = [("L_1", "0", "d_1", "q_1"), ("L_2", "0", "0", "q_2"),
+              ("0", r"\pi", "d_2 + q_3", "0"), ("0", "0", "0", "q_4")]
+    return (
         "<h3>Table 1</h3><p>The chapter's SCARA (RRPR) in standard DH, built by "
         "<code>serialkin.models.scara()</code>. The chapter gives no numbers; this report "
         "uses d1 = {d1} m, d2 = {d2} m, L1 = {l1} m, L2 = {l2} m.</p>".format(**SCARA_PARAMS)
+        + ctx.table(
+            [(str(i + 1), *(Html(ctx.imath(c)) for c in row)) for i, row in enumerate(table1)],
+            ["link", *(Html(ctx.imath(h)) for h in ("a_i", r"\alpha_i", "d_i", r"\vartheta_i"))])
+        + "<p>As built (numbers, joint type and limits):</p>" + ctx.table(
+            [(i + 1, r.a, r.alpha, r.d, r.theta, r.type, f"[{r.qlim[0]:.4g}, {r.qlim[1]:.4g}]")
+             for i, r in enumerate(robot.dh)],
+            ["link", "a [m]", "α [rad]", "d [m]", "θ [rad]", "type", "limits"])
     )
-    table1 = [("L_1", "0", "d_1", "q_1"), ("L_2", "0", "0", "q_2"),
-              ("0", r"\pi", "d_2 + q_3", "0"), ("0", "0", "0", "q_4")]
-    parts.append(ctx.table(
-        [(str(i + 1), *(Html(ctx.imath(c)) for c in row)) for i, row in enumerate(table1)],
-        ["link", *(Html(ctx.imath(h)) for h in ("a_i", r"\alpha_i", "d_i", r"\vartheta_i"))]))
-    parts.append("<p>As built (numbers, joint type and limits):</p>" + ctx.table(
-        [(i + 1, r.a, r.alpha, r.d, r.theta, r.type, f"[{r.qlim[0]:.4g}, {r.qlim[1]:.4g}]")
-         for i, r in enumerate(robot.dh)],
-        ["link", "a [m]", "α [rad]", "d [m]", "θ [rad]", "type", "limits"]))
 
-    # --- symbolic eqs 13-18 ----------------------------------------------------------------
-    kin = scara_symbolic(robot)
+
+def _symbolic_part(ctx: ReportContext, kin: SymbolicKinematics) -> str:
+    """Eqs 13-16 (the link matrices) and eqs 17-18 (their product), derived by sympy."""
     labels = ("13", "14-15", "16", "16")
-    parts.append(
+    return (
         "<h3>Link matrices, symbolic (eqs 13-16)</h3><p>Derived by "
         "<code>serialkin.kinematics.symbolic.derive(scara, params='lengths')</code> from the "
         "DH matrix of section 3.2 and simplified:</p>"
         + "".join(ctx.eq(rf"{{}}^{{{i}}}\mathbf{{A}}_{{{i + 1}}} = {sp.latex(M)}", labels[i])
                   for i, M in enumerate(kin.A))
-    )
-    parts.append(
-        "<h3>End-effector transform (eqs 17-18)</h3><p>Eq 17 is printed as "
+        + "<h3>End-effector transform (eqs 17-18)</h3><p>Eq 17 is printed as "
         + ctx.imath(r"{}^{0}\mathbf{T}_4 = {}^{0}\mathbf{A}_2\,{}^{1}\mathbf{A}_2\,"
                     r"{}^{2}\mathbf{A}_3\,{}^{3}\mathbf{A}_4")
         + "; the ERRATA corrects the first factor:</p>"
@@ -251,7 +246,11 @@ def _section_3_2_1(ctx: ReportContext) -> Section:
         + " and the tool z axis points down (row 3 of the rotation is (0, 0, −1)).</p>"
     )
 
-    # --- numeric ----------------------------------------------------------------------------
+
+def _evaluated_part(ctx: ReportContext, robot: Robot, q: np.ndarray,
+                    kin: SymbolicKinematics) -> str:
+    """The link matrices at ``q``, and the kernel's pose against the products and sympy."""
+    s = _symbols()
     A_num = [link_transform(r, qi, "standard") for r, qi in zip(robot.dh, q, strict=True)]
     T_prod = A_num[0] @ A_num[1] @ A_num[2] @ A_num[3]
     T_fk = robot.fk(q)
@@ -262,7 +261,7 @@ def _section_3_2_1(ctx: ReportContext) -> Section:
     misprint = (A_num[0] @ A_num[1]) @ A_num[1] @ A_num[2] @ A_num[3]
     rows = [(Html(ctx.imath(rf"{{}}^{{{i}}}\mathbf{{A}}_{{{i + 1}}}")), ctx.matrix(M))
             for i, M in enumerate(A_num)]
-    parts.append(
+    return (
         "<h3>Evaluated at " + ctx.imath(_latex_q(q)) + "</h3>"
         + ctx.table(rows, ["matrix", "value"])
         + "<p>" + ctx.imath(r"{}^{0}\mathbf{T}_4")
@@ -278,6 +277,16 @@ def _section_3_2_1(ctx: ReportContext) -> Section:
         + "<p>The printed eq 17 (with 0A2 in place of 0A1) gives a different pose; the "
         "corrected product agrees with the kernel to rounding.</p>"
     )
+
+
+def _section_3_2_1(ctx: ReportContext) -> Section:
+    """Section 3.2.1: the SCARA example (Table 1, eqs 13-18)."""
+    robot = models.scara(**SCARA_PARAMS)
+    q = SCARA_Q
+    parts = [_table1_part(ctx, robot)]
+    kin = scara_symbolic(robot)
+    parts.append(_symbolic_part(ctx, kin))
+    parts.append(_evaluated_part(ctx, robot, q, kin))
     parts.append(_figure_scara(ctx, robot, q))
     parts.append(_figure_frames(ctx, robot, q))
     parts.append(ctx.reproduce(

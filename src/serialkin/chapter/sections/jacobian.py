@@ -234,21 +234,24 @@ def _analytic_vs_geometric(ctx: ReportContext) -> str:
     )
 
 
-def _section_5_2(ctx: ReportContext, two: Robot, three: Robot) -> Section:
-    parts: list[str] = [
+def _columns_part(ctx: ReportContext) -> str:
+    """Eqs 33-35: the Jacobian by columns and the column of a revolute joint."""
+    return (
         ctx.eq(r"\mathbf{J} = \begin{bmatrix}\mathbf{J}_v\\ \mathbf{J}_\omega\end{bmatrix} = "
                r"\begin{bmatrix}\mathbf{J}_{v1} & \cdots & \mathbf{J}_{vn}\\ "
-               r"\mathbf{J}_{\omega 1} & \cdots & \mathbf{J}_{\omega n}\end{bmatrix}", "33"),
-        ctx.eq(r"\mathbf{v} = \mathbf{J}_{v1}\dot{q}_1 + \ldots + \mathbf{J}_{vn}\dot{q}_n,"
-               r"\qquad \boldsymbol{\omega} = \mathbf{J}_{\omega 1}\dot{q}_1 + \ldots + "
-               r"\mathbf{J}_{\omega n}\dot{q}_n", "34"),
-        "<p>Column i for a revolute joint:</p>",
-        ctx.eq(r"\begin{bmatrix}\mathbf{J}_{vi}\\ \mathbf{J}_{\omega i}\end{bmatrix} = "
-               r"\begin{bmatrix}{}^{0}\mathbf{z}_{i-1}\times({}^{0}\mathbf{p}_n - "
-               r"{}^{0}\mathbf{p}_{i-1})\\ {}^{0}\mathbf{z}_{i-1}\end{bmatrix}", "35"),
-    ]
+               r"\mathbf{J}_{\omega 1} & \cdots & \mathbf{J}_{\omega n}\end{bmatrix}", "33")
+        + ctx.eq(r"\mathbf{v} = \mathbf{J}_{v1}\dot{q}_1 + \ldots + \mathbf{J}_{vn}\dot{q}_n,"
+                 r"\qquad \boldsymbol{\omega} = \mathbf{J}_{\omega 1}\dot{q}_1 + \ldots + "
+                 r"\mathbf{J}_{\omega n}\dot{q}_n", "34")
+        + "<p>Column i for a revolute joint:</p>"
+        + ctx.eq(r"\begin{bmatrix}\mathbf{J}_{vi}\\ \mathbf{J}_{\omega i}\end{bmatrix} = "
+                 r"\begin{bmatrix}{}^{0}\mathbf{z}_{i-1}\times({}^{0}\mathbf{p}_n - "
+                 r"{}^{0}\mathbf{p}_{i-1})\\ {}^{0}\mathbf{z}_{i-1}\end{bmatrix}", "35")
+    )
 
-    # --- two-link geometric Jacobian, eqs 37-38 -------------------------------------------
+
+def _two_link_part(ctx: ReportContext, two: Robot) -> str:
+    """Eqs 37-38: the two-link Jacobian derived by sympy, against the kernel and FK."""
     kin2 = _renamed(two)
     Jg = kin2.geometric_jacobian()
     L1, L2 = TWO_LINK
@@ -260,7 +263,7 @@ def _section_5_2(ctx: ReportContext, two: Robot, three: Robot) -> Section:
     ])
     J2 = two.jacobian(TWO_LINK_Q)
     f_sym = kin2.lambdify(Jg)
-    parts.append(
+    return (
         "<h3>The two-link arm (Figure 7, eqs 37-38)</h3>"
         + ctx.eq(r"\mathbf{J}(\mathbf{q}) = \begin{bmatrix}\mathbf{z}_0\times(\mathbf{p}_2 - "
                  r"\mathbf{p}_0) & \mathbf{z}_1\times(\mathbf{p}_2 - \mathbf{p}_1)\\ "
@@ -282,10 +285,10 @@ def _section_5_2(ctx: ReportContext, two: Robot, three: Robot) -> Section:
         "position task only the first two rows are kept "
         "(<code>robot.jacobian_planar(q)</code>).</p>"
     )
-    parts.append(_prismatic_column(ctx))
-    parts.append(_analytic_vs_geometric(ctx))
 
-    # --- manipulability, eq 43 --------------------------------------------------------------
+
+def _manipulability_part(ctx: ReportContext, two: Robot, three: Robot) -> str:
+    """Eq 43 and the condition number on the planar arms, the PUMA 560 and the Panda."""
     rows = []
     for name, robot, q, task in (
         ("two-link", two, TWO_LINK_Q, "planar"),
@@ -300,7 +303,9 @@ def _section_5_2(ctx: ReportContext, two: Robot, three: Robot) -> Section:
         w = robot.manipulability(q, task=task)
         c = robot.condition_number(q, task=task)
         rows.append((name, task, f"{w:.4g}", "∞" if not np.isfinite(c) else f"{c:.4g}"))
-    parts.append(
+    L1, L2 = TWO_LINK
+    q2 = TWO_LINK_Q[1]
+    return (
         "<h3>Rank, singularities and manipulability</h3><p>Where J loses rank the arm is "
         "singular. The manipulability of section 5.3,</p>"
         + ctx.eq(r"H(\mathbf{q}) = \sqrt{\det\left(\mathbf{J}(\mathbf{q})\mathbf{J}^T"
@@ -311,13 +316,24 @@ def _section_5_2(ctx: ReportContext, two: Robot, three: Robot) -> Section:
         + f" = {L1 * L2 * abs(np.sin(q2)):.4g} m² at the sample q.</p>"
         + ctx.table(rows, ["robot, configuration", "task rows", "w", "condition number"])
     )
-    parts.append(_figure_mechanisms(ctx, two, three))
-    parts.append(_figure_manipulability(ctx, two))
-    parts.append(ctx.reproduce(
-        'serialkin jacobian two_link --q "30, 60" --degrees --param l1=1.0 --param l2=0.7\n'
-        'serialkin jacobian scara --q "30, -45, -0.05, 60" --degrees '
-        '--param d1=0.4 --param d2=0.1 --param l1=0.35 --param l2=0.30\n'
-        'serialkin jacobian puma560 --q "0.3, -0.6, 0.9, 0.4, -0.7, 1.1"', shell=True))
+
+
+def _section_5_2(ctx: ReportContext, two: Robot, three: Robot) -> Section:
+    """Section 5.2: the geometric Jacobian (eqs 33-38), J_A against J, eq 43, two figures."""
+    parts = [
+        _columns_part(ctx),
+        _two_link_part(ctx, two),
+        _prismatic_column(ctx),
+        _analytic_vs_geometric(ctx),
+        _manipulability_part(ctx, two, three),
+        _figure_mechanisms(ctx, two, three),
+        _figure_manipulability(ctx, two),
+        ctx.reproduce(
+            'serialkin jacobian two_link --q "30, 60" --degrees --param l1=1.0 --param l2=0.7\n'
+            'serialkin jacobian scara --q "30, -45, -0.05, 60" --degrees '
+            '--param d1=0.4 --param d2=0.1 --param l1=0.35 --param l2=0.30\n'
+            'serialkin jacobian puma560 --q "0.3, -0.6, 0.9, 0.4, -0.7, 1.1"', shell=True),
+    ]
     return Section(title="5.2 Geometric Jacobian",
                    equations="eqs 33-38 (36 on the SCARA), J_A vs J on the PUMA 560, eq 43",
                    html="".join(parts))

@@ -110,13 +110,14 @@ def _figure(R_q: np.ndarray, q: float, T1: np.ndarray, p1: np.ndarray) -> object
     return fig
 
 
-def build(ctx: ReportContext) -> Section:
-    """Compute section 2's examples and return the report section."""
-    parts: list[str] = []
-    alpha, beta, gamma = 30 * DEG, 45 * DEG, 60 * DEG
-
-    # --- eqs 4-6 -----------------------------------------------------------------------
-    parts.append(
+def _elementary_part(ctx: ReportContext, elem: dict[str, np.ndarray],
+                     angles: tuple[float, float, float]) -> str:
+    """Eqs 4-6 as printed, and ``rotx``/``roty``/``rotz`` against the printed matrices."""
+    rows = []
+    for (axis, R), t in zip(elem.items(), angles, strict=True):
+        dev = np.abs(R - _printed_elementary(axis, t)).max()
+        rows.append((f"R{axis}({t / DEG:.0f}°)", ctx.matrix(R), f"{dev:.1e}"))
+    return (
         "<h3>Elementary rotations (eqs 4-6)</h3><p>The chapter's rotations about x, y and z:</p>"
         + ctx.eq(r"\mathbf{R}_x = \begin{bmatrix}1 & 0 & 0\\ 0 & \cos\alpha & -\sin\alpha"
                  r"\\ 0 & \sin\alpha & \cos\alpha\end{bmatrix}", "4")
@@ -127,28 +128,19 @@ def build(ctx: ReportContext) -> Section:
         + "<p>Evaluated at " + ctx.imath(r"\alpha = 30^\circ,\ \beta = 45^\circ,\ "
                                          r"\gamma = 60^\circ")
         + " by <code>rotx</code>, <code>roty</code>, <code>rotz</code>; the last column is "
-        "the largest deviation from the matrix typed from the chapter.</p>")
-    rows = []
-    elem = {"x": rotx(alpha), "y": roty(beta), "z": rotz(gamma)}
-    for (axis, R), t in zip(elem.items(), (alpha, beta, gamma), strict=True):
-        dev = np.abs(R - _printed_elementary(axis, t)).max()
-        rows.append((f"R{axis}({t / DEG:.0f}°)", ctx.matrix(R), f"{dev:.1e}"))
-    parts.append(ctx.table(rows, ["rotation", "matrix", "|R − printed|"]))
+        "the largest deviation from the matrix typed from the chapter.</p>"
+        + ctx.table(rows, ["rotation", "matrix", "|R − printed|"])
+    )
 
-    # --- composition, eqs 1-3, eqs 8-9 -------------------------------------------------
-    R = rotz(gamma) @ roty(beta) @ rotx(alpha)
-    R_other = rotx(alpha) @ roty(beta) @ rotz(gamma)
-    p1 = np.array([0.3, 0.2, 0.1])
-    o = np.array([0.5, 0.4, 0.3])
-    T = make_transform(R, o)
-    pr_eq8 = R @ p1 + o
-    pr_eq9 = (T @ np.append(p1, 1.0))[:3]
-    Tinv = inv_transform(T)
+
+def _change_of_frame_part(ctx: ReportContext, R: np.ndarray, R_other: np.ndarray,
+                          p1: np.ndarray) -> str:
+    """Eqs 1-3: R's entries as scalar products of unit vectors, checked one by one."""
     # eqs 1-3: unit vectors of frame 1 expressed in r are R's columns; R_jk = e_j · u_k
     units = [R[:, k] for k in range(3)]
     dots = np.array([[np.eye(3)[j] @ units[k] for k in range(3)] for j in range(3)])
     p_eq1 = sum(p1[k] * units[k] for k in range(3))
-    parts.append(
+    return (
         "<h3>Change of frame (eqs 1-3)</h3><p>A vector written in the unit vectors of the "
         "reference frame and of frame 1,</p>"
         + ctx.eq(r"\mathbf{p} = p_{xr}\mathbf{i}_r + p_{yr}\mathbf{j}_r + p_{zr}\mathbf{k}_r"
@@ -176,6 +168,16 @@ def build(ctx: ReportContext) -> Section:
         + ctx.imath(r"\max|\mathbf{R}_z\mathbf{R}_y\mathbf{R}_x - "
                     r"\mathbf{R}_x\mathbf{R}_y\mathbf{R}_z|")
         + f" = {np.abs(R - R_other).max():.4f}.</p>"
+    )
+
+
+def _homogeneous_part(ctx: ReportContext, T: np.ndarray, p1: np.ndarray) -> str:
+    """Eqs 8-9: one point mapped by R p₁ + o and by T, and T⁻¹ mapping it back."""
+    o = T[:3, 3]
+    pr_eq8 = T[:3, :3] @ p1 + o
+    pr_eq9 = (T @ np.append(p1, 1.0))[:3]
+    Tinv = inv_transform(T)
+    return (
         "<h3>Rotation and translation (eqs 8-9)</h3>"
         + ctx.eq(r"\begin{bmatrix}x_r\\ y_r\\ z_r\end{bmatrix} = \mathbf{R}\begin{bmatrix}"
                  r"x_1\\ y_1\\ z_1\end{bmatrix} + \begin{bmatrix}p_x\\ p_y\\ p_z\end{bmatrix}",
@@ -196,19 +198,24 @@ def build(ctx: ReportContext) -> Section:
         f"{np.abs((Tinv @ np.append(pr_eq9, 1.0))[:3] - p1).max():.1e}.</p>"
     )
 
-    # --- eq 7 ----------------------------------------------------------------------------
+
+def _orthonormality_part(ctx: ReportContext, elem: dict[str, np.ndarray], R: np.ndarray,
+                         T: np.ndarray) -> str:
+    """Eq 7 checked on every matrix above and on 10,000 random compositions."""
     rng = np.random.default_rng(2024)
     many = rpy_to_matrix(rng.uniform(-np.pi, np.pi, size=(10000, 3)))
     checks = [("Rx(30°)", elem["x"]), ("Ry(45°)", elem["y"]), ("Rz(60°)", elem["z"]),
               ("Rz Ry Rx", R), ("rotation block of T", T[:3, :3]),
               ("10,000 random rpy compositions (seed 2024)", many)]
-    parts.append(
+    return (
         "<h3>Orthonormality (eq 7)</h3>"
         + ctx.eq(r"\mathbf{R}^T\mathbf{R} = \mathbf{I}_3,\qquad \det\mathbf{R} = 1", "7")
         + ctx.table([(name, *_orthonormality(M)) for name, M in checks],
                     ["matrix", "max |RᵀR − I₃|", "max |det R − 1|"], fmt="{:.1e}"))
 
-    # --- conversion table ------------------------------------------------------------------
+
+def _representations_part(ctx: ReportContext, R: np.ndarray) -> str:
+    """R in every orientation representation, converted back, and two singular points."""
     rpy = matrix_to_rpy(R)
     zyz = matrix_to_zyz(R)
     axis, angle = matrix_to_axis_angle(R)
@@ -233,19 +240,21 @@ def build(ctx: ReportContext) -> Section:
     conv_rows.append(("quaternion of a half turn about (0, 0.6, 0.8): w = 0, angle π",
                       format_vector(q_half),
                       f"{np.abs(quaternion_to_matrix(q_half) - half).max():.1e}"))
-    parts.append(
+    return (
         "<h3>Orientation representations</h3><p>The rotation R above in every representation "
         "(serialkin.spatial), and the error of converting back to a matrix. The last two rows "
         "are at singular points of a representation.</p>"
         + ctx.table(conv_rows, ["representation", "value", "max |R(value) − R|"])
     )
 
-    # --- SE(3) exp/log and pose error ------------------------------------------------------
+
+def _twist_part(ctx: ReportContext, T: np.ndarray) -> str:
+    """The twist coordinates of T (SE(3) log and exp) and the IK solvers' pose error."""
     xi = se3_log(T)
     T2 = trotz(0.1) @ T
     e = pose_error(T, T2)
     d, th = pose_distance(T, T2)
-    parts.append(
+    return (
         "<h3>Twist coordinates and pose error</h3>"
         "<p>The twist " + ctx.imath(r"\boldsymbol{\xi} = [\mathbf{v}; \boldsymbol{\omega}]")
         + " with " + ctx.imath(r"\exp(\boldsymbol{\xi}) = \mathbf{T}") + " is ξ = "
@@ -258,16 +267,38 @@ def build(ctx: ReportContext) -> Section:
         f" angle {float(th):.4f} rad. Every IK solver drives this 6-vector to zero.</p>"
     )
 
-    # --- figure ------------------------------------------------------------------------------
+
+def _frames_part(ctx: ReportContext, T: np.ndarray, p1: np.ndarray) -> str:
+    """The figure of the rotated frames and the snippet that reproduces eqs 8-9."""
     q = 30 * DEG
-    parts.append(ctx.figure(_figure(rotz(q), q, T, p1), "rigid_motion_frames",
-                            "Rotated frames computed by serialkin: (a) the chapter's Figure 2, a "
-                            "frame rotated by q = 30° about z_r; (b) the frame T of eq 9 "
-                            "(Rz(60°)Ry(45°)Rx(30°), origin o) and the point p."))
-    parts.append(ctx.reproduce(
-        "import numpy as np\n"
-        "from serialkin.spatial import rotx, roty, rotz, make_transform, inv_transform\n"
-        "R = rotz(np.radians(60)) @ roty(np.radians(45)) @ rotx(np.radians(30))\n"
-        "T = make_transform(R, [0.5, 0.4, 0.3])                      # eq 9\n"
-        "print(T @ [0.3, 0.2, 0.1, 1.0], inv_transform(T) @ T)          # eq 8, T⁻¹T = I"))
+    return (
+        ctx.figure(_figure(rotz(q), q, T, p1), "rigid_motion_frames",
+                   "Rotated frames computed by serialkin: (a) the chapter's Figure 2, a "
+                   "frame rotated by q = 30° about z_r; (b) the frame T of eq 9 "
+                   "(Rz(60°)Ry(45°)Rx(30°), origin o) and the point p.")
+        + ctx.reproduce(
+            "import numpy as np\n"
+            "from serialkin.spatial import rotx, roty, rotz, make_transform, inv_transform\n"
+            "R = rotz(np.radians(60)) @ roty(np.radians(45)) @ rotx(np.radians(30))\n"
+            "T = make_transform(R, [0.5, 0.4, 0.3])                      # eq 9\n"
+            "print(T @ [0.3, 0.2, 0.1, 1.0], inv_transform(T) @ T)          # eq 8, T⁻¹T = I")
+    )
+
+
+def build(ctx: ReportContext) -> Section:
+    """Compute section 2's examples and return the report section."""
+    alpha, beta, gamma = 30 * DEG, 45 * DEG, 60 * DEG
+    elem = {"x": rotx(alpha), "y": roty(beta), "z": rotz(gamma)}
+    R = rotz(gamma) @ roty(beta) @ rotx(alpha)
+    p1 = np.array([0.3, 0.2, 0.1])
+    T = make_transform(R, np.array([0.5, 0.4, 0.3]))
+    parts = [
+        _elementary_part(ctx, elem, (alpha, beta, gamma)),
+        _change_of_frame_part(ctx, R, rotx(alpha) @ roty(beta) @ rotz(gamma), p1),
+        _homogeneous_part(ctx, T, p1),
+        _orthonormality_part(ctx, elem, R, T),
+        _representations_part(ctx, R),
+        _twist_part(ctx, T),
+        _frames_part(ctx, T, p1),
+    ]
     return Section(title="2. Rigid body motion", equations="eqs 1-9", html="".join(parts))

@@ -22,8 +22,11 @@ import numpy as np
 
 from serialkin import models
 from serialkin.chapter.report import ReportContext, Section
+from serialkin.model.robot import Robot
 from serialkin.spatial import rpy_to_matrix
 from serialkin.workspace import (
+    Workspace,
+    WorkspaceSlice,
     constant_orientation_workspace,
     inclusive_orientation_workspace,
     reachable_workspace,
@@ -32,6 +35,9 @@ from serialkin.workspace import (
 from serialkin.workspace.kinds import total_and_dexterous_workspaces
 
 SEED = 2024
+
+#: (label, workspace, closed-form area [m²] or None) of one workspace kind.
+_Kind = tuple[str, Workspace, float | None]
 
 
 def _annulus(L1: float, L2: float) -> float:
@@ -87,25 +93,9 @@ def _dof_table(ctx: ReportContext) -> str:
                             "task space", "m = rank J", "redundancy n − m"])
 
 
-def build(ctx: ReportContext) -> Section:
-    """Compute section 1's workspace examples and return the report section."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from serialkin.workspace.plot import (
-        plot_manipulability_map,
-        plot_slice,
-        plot_workspace,
-        plot_workspace_kinds,
-    )
-
-    progress = False if ctx.quiet else None
-    parts: list[str] = []
-
-    # --- DOF, joint space, task space -------------------------------------------------
-    parts.append(
+def _dof_part(ctx: ReportContext) -> str:
+    """DOF, joint space and task space of every built-in robot (table and reproduction)."""
+    return (
         "<h3>Degrees of freedom, joint space and task space</h3>"
         "<p>The number of DOF is the dimension of the joint space Q (one coordinate per "
         "joint); the task space of a planar arm has m = 3 coordinates (x, y, φ), that of a "
@@ -120,16 +110,9 @@ def build(ctx: ReportContext) -> Section:
             "print(r.n, max(np.linalg.matrix_rank(Jk, tol=1e-9) for Jk in J))  # n, m")
     )
 
-    # --- 2-link arm: area against the closed form --------------------------------------
-    parts.append(
-        "<h3>Maximal workspace of the 2-link arm</h3>"
-        "<p>Joint space sampled uniformly (seeded), every sample's tool position computed "
-        "by the batched FK kernel and binned on an occupancy grid. The area estimate Â "
-        "counts interior cells fully and boundary cells by half; the error bound ε adds "
-        "half the boundary cells and the Chao1 estimate of cells no sample hit "
-        "(see <code>serialkin.workspace.grid</code>). The closed form is</p>"
-        + ctx.eq(r"A = \pi\left((L_1 + L_2)^2 - (L_1 - L_2)^2\right) = 4\pi L_1 L_2")
-    )
+
+def _two_link_area_part(ctx: ReportContext, progress: bool | None) -> str:
+    """Sampled area of the 2-link workspace against its closed form, for four arms."""
     rows = []
     for L1, L2 in ((1.0, 1.0), (1.0, 0.6), (0.7, 0.4), (0.5, 0.9)):
         ws = reachable_workspace(models.two_link(L1, L2), 100_000, seed=SEED,
@@ -138,34 +121,56 @@ def build(ctx: ReportContext) -> Section:
         e = ws.estimate
         rows.append((L1, L2, exact, e.value, e.error, abs(e.value - exact),
                      "yes" if abs(e.value - exact) <= e.error else "NO", e.cell))
-    parts.append(ctx.table(rows, ["L1 [m]", "L2 [m]", "closed form A [m²]",
-                                  "sampled Â [m²]", "error bound ε [m²]", "|Â − A|",
-                                  "within ε", "cell [m]"]))
+    return (
+        "<h3>Maximal workspace of the 2-link arm</h3>"
+        "<p>Joint space sampled uniformly (seeded), every sample's tool position computed "
+        "by the batched FK kernel and binned on an occupancy grid. The area estimate Â "
+        "counts interior cells fully and boundary cells by half; the error bound ε adds "
+        "half the boundary cells and the Chao1 estimate of cells no sample hit "
+        "(see <code>serialkin.workspace.grid</code>). The closed form is</p>"
+        + ctx.eq(r"A = \pi\left((L_1 + L_2)^2 - (L_1 - L_2)^2\right) = 4\pi L_1 L_2")
+        + ctx.table(rows, ["L1 [m]", "L2 [m]", "closed form A [m²]", "sampled Â [m²]",
+                           "error bound ε [m²]", "|Â − A|", "within ε", "cell [m]"])
+    )
+
+
+def _two_link_map_part(ctx: ReportContext, progress: bool | None) -> str:
+    """The 2-link workspace with its boundary and manipulability map (eq 43), one figure."""
+    import matplotlib.pyplot as plt
+
+    from serialkin.workspace.plot import plot_manipulability_map, plot_workspace
+
     two = models.two_link(1.0, 0.6)
     ws2 = reachable_workspace(two, 200_000, seed=SEED, manipulability=True, progress=progress)
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.2))
     plot_workspace(ws2, axes[0], robot=two, q=[0.6, 1.1])
     plot_manipulability_map(ws2, axes[1])
     fig.tight_layout()
-    parts.append("<p>The manipulability of eq 43 of the 2-link arm is "
-                 + ctx.imath(r"w = \sqrt{\det\left(\mathbf{J}\mathbf{J}^T\right)}"
-                             r" = L_1 L_2 \left|\sin q_2\right|")
-                 + ": zero on both boundary circles, the singular configurations "
-                 + ctx.imath(r"q_2 = 0, \pi") + ".</p>")
-    parts.append(ctx.figure(fig, "workspace_two_link",
-                            "2-link arm (L1 = 1 m, L2 = 0.6 m): maximal workspace with its "
-                            "boundary (left) and the manipulability per cell (right, eq 43)."))
-    parts.append(ctx.reproduce("serialkin workspace two_link --out out/ws -w", shell=True))
+    return (
+        "<p>The manipulability of eq 43 of the 2-link arm is "
+        + ctx.imath(r"w = \sqrt{\det\left(\mathbf{J}\mathbf{J}^T\right)}"
+                    r" = L_1 L_2 \left|\sin q_2\right|")
+        + ": zero on both boundary circles, the singular configurations "
+        + ctx.imath(r"q_2 = 0, \pi") + ".</p>"
+        + ctx.figure(fig, "workspace_two_link",
+                     "2-link arm (L1 = 1 m, L2 = 0.6 m): maximal workspace with its "
+                     "boundary (left) and the manipulability per cell (right, eq 43).")
+        + ctx.reproduce("serialkin workspace two_link --out out/ws -w", shell=True)
+    )
 
-    # --- 3-link arm: every kind ---------------------------------------------------------
-    L = (1.0, 0.8, 0.3)
-    three = models.three_link(*L)
+
+def _three_link_kinds(three: Robot, L: tuple[float, float, float],
+                      progress: bool | None) -> list[_Kind]:
+    """(label, workspace, closed-form area or None) of every workspace kind of section 1.
+
+    The total-orientation and dexterous workspaces come from one sampling on one grid, so
+    the dexterous cells are a subset of the total-orientation cells.
+    """
     phi = 0.0
-    # one sampling, one grid: dexterous ⊆ total-orientation cell by cell
     total, dexterous = total_and_dexterous_workspaces(three, 12, 20_000, seed=SEED,
                                                       singularity_margin=0.05,
                                                       progress=progress)
-    kinds = [
+    return [
         ("maximal (reachable)", reachable_workspace(three, 200_000, seed=SEED,
                                                     progress=progress),
          _three_link_reachable(L)),
@@ -176,7 +181,11 @@ def build(ctx: ReportContext) -> Section:
         ("total orientation (12 headings)", total, _three_link_total(L)),
         ("dexterous (12 headings, w ≥ 5 % of max)", dexterous, None),
     ]
-    parts.append(
+
+
+def _three_link_intro(ctx: ReportContext, L: tuple[float, float, float]) -> str:
+    """How the orientation workspaces of the 3-link arm are computed, with the closed forms."""
+    return (
         f"<h3>Workspace kinds of the 3-link arm (L = {L} m)</h3>"
         "<p>Constant- and inclusive-orientation samples are moved onto the orientation "
         "constraint by damped least-squares steps on the angular rows of the Jacobian; the "
@@ -198,23 +207,37 @@ def build(ctx: ReportContext) -> Section:
         + " plus the disc " + ctx.imath(r"|\mathbf{p}| \le L_3 - d") + " when "
         + ctx.imath(r"L_3 > d") + ".</p>"
     )
+
+
+def _three_link_areas(ctx: ReportContext, kinds: list[_Kind]) -> str:
+    """Table of the kinds' areas against their closed forms, and the inclusion check."""
     rows = []
     for label, ws, exact in kinds:
         e = ws.estimate
         ok = "" if exact is None else ("yes" if abs(e.value - exact) <= e.error else "NO")
         rows.append((label, e.value, e.error, "—" if exact is None else exact, ok,
                      ws.points.shape[0]))
-    parts.append(ctx.table(rows, ["kind", "area Â [m²]", "error ε [m²]", "closed form [m²]",
-                                  "within ε", "samples kept"]))
+    total, dexterous = kinds[3][1], kinds[4][1]
     extra = int((dexterous.grid.occupied & ~total.grid.occupied).sum())
     te, de = total.estimate, dexterous.estimate
-    parts.append(
-        "<p>Inclusion check on the common grid (cell "
+    return (
+        ctx.table(rows, ["kind", "area Â [m²]", "error ε [m²]", "closed form [m²]",
+                         "within ε", "samples kept"])
+        + "<p>Inclusion check on the common grid (cell "
         f"{te.cell * 1e3:.3g} mm): {int(dexterous.grid.occupied.sum())} dexterous cells, "
         f"{int(total.grid.occupied.sum())} total-orientation cells, {extra} dexterous cells "
         f"outside the total-orientation set; areas {de.value:.4f} ± {de.error:.2g} m² ≤ "
         f"{te.value:.4f} ± {te.error:.2g} m². Each ± is the sampling error bound: half the "
-        "boundary cells plus the Chao1 estimate of cells no sample hit.</p>")
+        "boundary cells plus the Chao1 estimate of cells no sample hit.</p>"
+    )
+
+
+def _three_link_figure(ctx: ReportContext, kinds: list[_Kind]) -> str:
+    """One panel per workspace kind of the 3-link arm plus an overlay, and its reproduction."""
+    import matplotlib.pyplot as plt
+
+    from serialkin.workspace.plot import plot_workspace, plot_workspace_kinds
+
     fig, axes = plt.subplots(2, 3, figsize=(13, 8.4))
     for ax, (label, ws, _) in zip(axes.ravel(), kinds):
         plot_workspace(ws, ax, color_by_manipulability=False, max_points=5_000,
@@ -223,27 +246,33 @@ def build(ctx: ReportContext) -> Section:
                          labels=["maximal", "constant φ = 0", "dexterous"],
                          title="overlay")
     fig.tight_layout()
-    parts.append(ctx.figure(fig, "workspace_three_link_kinds",
-                            "3-link arm: the workspace kinds of section 1 with their "
-                            "boundaries and areas; bottom right, three of them overlaid. "
-                            "Enclosed gaps of a few cells that no sample hit are not outlined "
-                            "(only true holes are)."))
-    parts.append(ctx.reproduce(
-        "from serialkin import models\n"
-        "from serialkin.workspace.kinds import total_and_dexterous_workspaces\n"
-        "arm = models.three_link(1.0, 0.8, 0.3)\n"
-        "tot, dex = total_and_dexterous_workspaces(arm, 12, 20_000, seed=2024,"
-        " singularity_margin=0.05)"))
+    return (
+        ctx.figure(fig, "workspace_three_link_kinds",
+                   "3-link arm: the workspace kinds of section 1 with their "
+                   "boundaries and areas; bottom right, three of them overlaid. "
+                   "Enclosed gaps of a few cells that no sample hit are not outlined "
+                   "(only true holes are).")
+        + ctx.reproduce(
+            "from serialkin import models\n"
+            "from serialkin.workspace.kinds import total_and_dexterous_workspaces\n"
+            "arm = models.three_link(1.0, 0.8, 0.3)\n"
+            "tot, dex = total_and_dexterous_workspaces(arm, 12, 20_000, seed=2024,"
+            " singularity_margin=0.05)")
+    )
 
-    # --- spatial robot ------------------------------------------------------------------
-    puma = models.puma560()
-    ws3 = reachable_workspace(puma, 300_000, seed=SEED, progress=progress)
-    down = rpy_to_matrix([math.pi, 0.0, 0.0])  # tool z axis pointing down
-    wsc = constant_orientation_workspace(puma, down, 25_000, seed=SEED, progress=progress)
-    wsi = inclusive_orientation_workspace(puma, down, math.radians(30), 25_000, seed=SEED,
-                                          progress=progress)
-    slices = [workspace_slice(ws3, "z", z) for z in (0.2, 0.67, 1.1)]
-    parts.append(
+
+def _three_link_part(ctx: ReportContext, progress: bool | None) -> str:
+    """Every workspace kind of section 1 on the 3-link arm: prose, table, figure."""
+    L = (1.0, 0.8, 0.3)
+    kinds = _three_link_kinds(models.three_link(*L), L, progress)
+    return _three_link_intro(ctx, L) + _three_link_areas(ctx, kinds) + _three_link_figure(
+        ctx, kinds)
+
+
+def _puma_table(ctx: ReportContext, ws3: Workspace, wsc: Workspace, wsi: Workspace,
+                slices: list[WorkspaceSlice]) -> str:
+    """The PUMA 560's workspace volumes and slice areas with their error bounds."""
+    return (
         "<h3>A spatial robot: PUMA 560</h3>"
         "<p>Spatial workspaces are 3D point clouds measured on a voxel grid; planar slices "
         "(samples within half a voxel of the plane) show the cross-sections. The voxel "
@@ -261,6 +290,15 @@ def build(ctx: ReportContext) -> Section:
                 s.points.shape[0]) for s in slices],
             ["set", "volume [m³] / area [m²]", "error bound", "samples"])
     )
+
+
+def _puma_figures(ctx: ReportContext, ws3: Workspace, wsc: Workspace,
+                  slices: list[WorkspaceSlice]) -> str:
+    """The PUMA 560's workspaces in 3D and its horizontal slices: two figures."""
+    import matplotlib.pyplot as plt
+
+    from serialkin.workspace.plot import plot_slice, plot_workspace
+
     fig = plt.figure(figsize=(13, 4.6))
     ax = fig.add_subplot(1, 3, 1, projection="3d")
     plot_workspace(ws3, ax, max_points=5_000)
@@ -270,19 +308,48 @@ def build(ctx: ReportContext) -> Section:
         f"slice z = {slices[1].value:.2f} m: "
         f"{slices[1].estimate.value:.3f} ± {slices[1].estimate.error:.2g} m²"))
     fig.tight_layout()
-    parts.append(ctx.figure(fig, "workspace_puma560",
-                            "PUMA 560: maximal workspace (left), constant-orientation "
-                            "workspace with the tool pointing down (middle) and the maximal "
-                            "workspace's slice at shoulder height (right)."))
+    html = ctx.figure(fig, "workspace_puma560",
+                      "PUMA 560: maximal workspace (left), constant-orientation "
+                      "workspace with the tool pointing down (middle) and the maximal "
+                      "workspace's slice at shoulder height (right).")
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
     for ax, s in zip(axes, slices):
         plot_slice(s, ax=ax)
     fig.tight_layout()
-    parts.append(ctx.figure(fig, "workspace_puma560_slices",
-                            "PUMA 560 maximal workspace: horizontal slices with their "
-                            "boundaries and cross-section areas."))
-    parts.append(ctx.reproduce("serialkin workspace puma560 --samples 400000 --slice z=0.67 "
-                               "--out out/ws", shell=True))
+    return html + ctx.figure(fig, "workspace_puma560_slices",
+                             "PUMA 560 maximal workspace: horizontal slices with their "
+                             "boundaries and cross-section areas.")
+
+
+def _puma_part(ctx: ReportContext, progress: bool | None) -> str:
+    """A spatial robot (PUMA 560): maximal, constant- and inclusive-orientation, slices."""
+    puma = models.puma560()
+    ws3 = reachable_workspace(puma, 300_000, seed=SEED, progress=progress)
+    down = rpy_to_matrix([math.pi, 0.0, 0.0])  # tool z axis pointing down
+    wsc = constant_orientation_workspace(puma, down, 25_000, seed=SEED, progress=progress)
+    wsi = inclusive_orientation_workspace(puma, down, math.radians(30), 25_000, seed=SEED,
+                                          progress=progress)
+    slices = [workspace_slice(ws3, "z", z) for z in (0.2, 0.67, 1.1)]
+    return (_puma_table(ctx, ws3, wsc, wsi, slices) + _puma_figures(ctx, ws3, wsc, slices)
+            + ctx.reproduce("serialkin workspace puma560 --samples 400000 --slice z=0.67 "
+                            "--out out/ws", shell=True))
+
+
+def build(ctx: ReportContext) -> Section:
+    """Compute section 1's workspace examples and return the report section."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    progress = False if ctx.quiet else None
+    parts = [
+        _dof_part(ctx),
+        _two_link_area_part(ctx, progress),
+        _two_link_map_part(ctx, progress),
+        _three_link_part(ctx, progress),
+        _puma_part(ctx, progress),
+    ]
     plt.close("all")
     return Section(
         title="1. Degrees of freedom, joint space and workspace",

@@ -120,11 +120,12 @@ def _shade(ax: Any, phases: list[tuple[int, int, str]], label: bool = False) -> 
 
 def _gif(ctx: ReportContext, robot: Any, tr: Any, name: str, caption: str,
          obstacles: Any = None, frames: int = 40) -> str:
-    from serialkin.viz import animate_trajectory
+    from serialkin.viz import AnimationOptions, animate_trajectory
 
-    data = animate_trajectory(robot, tr.q, path_points=tr.targets[:, :2, 3],
-                              obstacles=obstacles, max_frames=frames, fps=8, dpi=60,
-                              figsize=(5.0, 4.5), title=caption)
+    options = AnimationOptions(max_frames=frames, fps=8, dpi=60, figsize=(5.0, 4.5),
+                               title=caption)
+    data = animate_trajectory(robot, tr.q, options, path_points=tr.targets[:, :2, 3],
+                              obstacles=obstacles)
     return ctx.file_figure(data, f"{name}.gif", caption)
 
 

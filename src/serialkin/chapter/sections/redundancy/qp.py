@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -21,6 +21,9 @@ from serialkin.tracking.analysis import (
 )
 from serialkin.tracking.scenario import Scenario
 
+if TYPE_CHECKING:
+    from serialkin.diffik.resolver import QPResolver
+
 
 def side_by_side(ctx: ReportContext, scenario: Scenario, weighted: Any, weighted_time: Timing,
                  repeat: int = 2) -> list[tuple[ResolverRun, Timing]]:
@@ -37,16 +40,9 @@ def side_by_side(ctx: ReportContext, scenario: Scenario, weighted: Any, weighted
             (compare_row("QP with hard constraints", tq, tqt.median), tqt)]
 
 
-def _qp_part(ctx: ReportContext, sc: Scenario,
-             timed: list[tuple[ResolverRun, Timing]]) -> Section:
-    import matplotlib.pyplot as plt
-
-    from serialkin.viz import plot_motion
-
-    res = qp_resolver(sc)
-    rows = [r for r, _ in timed]
-    w, q = rows
-    parts = [
+def _qp_intro(ctx: ReportContext, res: QPResolver) -> str:
+    """Soft weights against hard constraints: the QP solved in each iteration, in prose."""
+    return (
         "<p>The weighted tasks of eq 48 make obstacles and joint limits <em>soft</em>: a "
         "large weight near contact, but nothing forbids a violation when the primary task "
         "pulls hard enough (the ablation above shows what happens when a weight is zero). "
@@ -65,24 +61,32 @@ def _qp_part(ctx: ReportContext, sc: Scenario,
         + f", safety distance d_s = {res.safety * 1e3:g} mm, "
         + ctx.imath(r"\xi = " + f"{res.collision_gain:g}" + r"\,(d_i - d_s)")
         + "), solved by a dual active-set method (Goldfarb–Idnani) compiled into the "
-        "tracking loop.</p>",
-    ]
+        "tracking loop.</p>"
+    )
+
+
+def _qp_table(ctx: ReportContext, sc: Scenario,
+              timed: list[tuple[ResolverRun, Timing]]) -> str:
+    """Reach, errors, clearance, limit margin, iterations and time of both runs."""
     table = [(r.label, f"{len(r.trajectory) - r.unreached}/{len(sc.path)}", _mm(r.max_error),
               _mm(r.min_clearance), f"{r.worst_margin * DEG:.2f}",
               f"{int(r.trajectory.iterations.sum())}", f"{r.per_point * 1e3:.3g} ms",
               t.text) for r, t in timed]
-    parts.append(ctx.table(table, ["run", "reached (±5 mm)", "max tracking error [mm]",
-                                   "min clearance [mm] (negative: collision)",
-                                   "worst joint-limit margin [°] (negative: outside)",
-                                   "iterations", "time per path point",
-                                   "whole path"]))
+    return ctx.table(table, ["run", "reached (±5 mm)", "max tracking error [mm]",
+                             "min clearance [mm] (negative: collision)",
+                             "worst joint-limit margin [°] (negative: outside)",
+                             "iterations", "time per path point", "whole path"])
+
+
+def _qp_discussion(w: ResolverRun, q: ResolverRun) -> str:
+    """What the two runs show: berth, limit margin, guarantees and cost, in prose."""
     ratio = q.per_point / max(w.per_point, 1e-12)
     reach = ("both runs reach every point" if w.unreached == 0 and q.unreached == 0 else
              f"eq 48 misses {w.unreached} and the QP {q.unreached} points")
     hit = ("neither collides" if min(w.min_clearance, q.min_clearance) > 0 else
            "a link enters an obstacle in " + " and ".join(
-               r.label for r in rows if r.min_clearance <= 0))
-    parts.append(
+               r.label for r in (w, q) if r.min_clearance <= 0))
+    return (
         f"<p>Honestly: here {reach} and {hit}. Eq 48 keeps "
         f"a wider berth ({_mm(w.min_clearance)} mm against the QP's {_mm(q.min_clearance)} mm: "
         "its obstacle weight starts acting at the distance of influence and pushes away, "
@@ -97,9 +101,17 @@ def _qp_part(ctx: ReportContext, sc: Scenario,
         "measured 5× faster here than calling DAQP from Python each iteration; the QP "
         f"needs {int(q.trajectory.iterations.sum())} iterations against eq 48's "
         f"{int(w.trajectory.iterations.sum())}); timings are wall-clock medians on a shared "
-        "machine.</p>")
+        "machine.</p>"
+    )
+
+
+def _qp_margins_figure(ctx: ReportContext, sc: Scenario, res: QPResolver,
+                       rows: list[ResolverRun]) -> str:
+    """Clearance, joint-limit margin and tracking error per path point of both runs."""
+    import matplotlib.pyplot as plt
+
     phases = _phases(sc)
-    steps = np.arange(len(w.trajectory))
+    steps = np.arange(len(rows[0].trajectory))
     fig, axes = plt.subplots(1, 3, figsize=(12.5, 3.8))
     for r, color in zip(rows, ("tab:blue", "tab:red")):
         tr = r.trajectory
@@ -118,24 +130,47 @@ def _qp_part(ctx: ReportContext, sc: Scenario,
         a.grid(True, alpha=0.3)
     axes[0].legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize="small")
     fig.subplots_adjust(wspace=0.35)
-    parts.append(ctx.figure(fig, "twenty_link_qp_vs_eq48",
-                            "Eq 48 (soft, weighted) and the QP (hard constraints) on scenario "
-                            "(c): clearance, limit margin and tracking error per path point."))
+    return ctx.figure(fig, "twenty_link_qp_vs_eq48",
+                      "Eq 48 (soft, weighted) and the QP (hard constraints) on scenario "
+                      "(c): clearance, limit margin and tracking error per path point.")
+
+
+def _qp_motion_figure(ctx: ReportContext, sc: Scenario, q: ResolverRun) -> str:
+    """The QP's motion of the 20-link arm between the obstacles."""
+    import matplotlib.pyplot as plt
+
+    from serialkin.viz import plot_motion
+
     fig, ax = plt.subplots(figsize=(7.2, 5.6))
     plot_motion(sc.robot, q.trajectory.q, ax, path_points=sc.path.points, every=8, q0=sc.q0,
                 obstacles=sc.obstacles, influence=True, labels=True,
                 title="20-link arm tracked by the QP (hard limits and obstacles)")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    parts.append(ctx.figure(fig, "twenty_link_qp_motion",
-                            "The QP's motion between the obstacles A-D (compare Figure 12)."))
-    parts.append(ctx.reproduce(
-        "from serialkin.diffik.resolver import QPResolver\n"
-        "from serialkin.tracking import load_scenario, track\n"
-        "sc = load_scenario('twenty_link_obstacles')\n"
-        "tr = track(sc.robot, sc.path, QPResolver(task=sc.path.task, obstacles=sc.obstacles,\n"
-        "           max_joint_step=0.2), q0=sc.q0)\n"
-        "print(tr.summary())"))
+    return ctx.figure(fig, "twenty_link_qp_motion",
+                      "The QP's motion between the obstacles A-D (compare Figure 12).")
+
+
+def _qp_part(ctx: ReportContext, sc: Scenario,
+             timed: list[tuple[ResolverRun, Timing]]) -> Section:
+    """Eq 48 (soft weights) against the differential-IK QP (hard constraints) on (c)."""
+    res = qp_resolver(sc)
+    rows = [r for r, _ in timed]
+    w, q = rows
+    parts = [
+        _qp_intro(ctx, res),
+        _qp_table(ctx, sc, timed),
+        _qp_discussion(w, q),
+        _qp_margins_figure(ctx, sc, res, rows),
+        _qp_motion_figure(ctx, sc, q),
+        ctx.reproduce(
+            "from serialkin.diffik.resolver import QPResolver\n"
+            "from serialkin.tracking import load_scenario, track\n"
+            "sc = load_scenario('twenty_link_obstacles')\n"
+            "tr = track(sc.robot, sc.path, QPResolver(task=sc.path.task, obstacles=sc.obstacles,\n"
+            "           max_joint_step=0.2), q0=sc.q0)\n"
+            "print(tr.summary())"),
+    ]
     return Section(title="5.3 Kinematically redundant manipulators",
                    part="Weighted tasks (eq 48) against a QP with hard constraints",
                    equations="eq 48 against the differential-IK QP",

@@ -21,15 +21,10 @@ from serialkin.tracking.analysis import (
 from serialkin.tracking.scenario import Scenario
 
 
-def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any,
-                      time_b: Timing, time_c: Timing, runs: list[AblationRun]) -> Section:
-    import matplotlib.pyplot as plt
-
-    from serialkin.viz import plot_joint_trajectories, plot_motion
-
+def _design_text(ctx: ReportContext, sb: Scenario, sc: Scenario) -> str:
+    """The designed path, obstacles and weights of cases (b) and (c), in prose."""
     res = sc.solver
-    names = [o.name for o in sc.obstacles]
-    parts = [
+    return (
         "<p>20 links of L = 16.75 mm (reach " + ctx.imath(r"R = 20L = 0.335\ \mathrm{m}")
         + "). The chapter gives neither the path, nor q0, nor the obstacles (ERRATA); our "
         "design has one phase per secondary task of eq 48, so that each of them acts "
@@ -55,24 +50,36 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
         + " when " + ctx.imath(r"w < w_0 = " + f"{res.manipulability_threshold:g}")
         + " (w of eq 43), in the chapter's faithful mode "
         + ctx.imath(r"\mathbf{x}_c = \mathbf{x}_L = \mathbf{0}")
-        + f"; at most {res.max_iter} iterations per point.</p>",
-    ]
+        + f"; at most {res.max_iter} iterations per point.</p>"
+    )
+
+
+def _results_table(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any) -> str:
+    """Points reached, errors, clearance per obstacle, joint range and iterations of (b), (c)."""
+    from serialkin.redundancy import clearances
+
+    names = [o.name for o in sc.obstacles]
     rows = []
     for label, s, tr in (("(b) free, Figure 11", sb, tb),
                          ("(c) obstacles, limits, singularities, Figure 12", sc, tc)):
-        from serialkin.redundancy import clearances
-
         clear = (tr.clearance.min(axis=0) if tr.clearance.size else np.array(
             [clearances(sc.robot, q, sc.obstacles).min(axis=0) for q in tr.q]).min(axis=0))
         rows.append((label, f"{int(tr.reached.sum())}/{len(s.path)}", _mm(tr.max_error),
                      ", ".join(f"{n}: {c * 1e3:.1f}" for n, c in zip(names, clear)),
                      f"{np.abs(tr.q).max() * DEG:.1f}", f"{int(tr.iterations.sum())}"))
-    parts.append(ctx.table(rows, ["case", "reached (±5 mm)", "max error [mm]",
-                                  "min clearance per obstacle [mm] (negative: collision)",
-                                  "max |q| [°]", "iterations"]))
+    return ctx.table(rows, ["case", "reached (±5 mm)", "max error [mm]",
+                            "min clearance per obstacle [mm] (negative: collision)",
+                            "max |q| [°]", "iterations"])
+
+
+def _timings_text(ctx: ReportContext, sc: Scenario, tb: Any, tc: Any, time_b: Timing,
+                  time_c: Timing) -> str:
+    """Warm timings of (b) and (c), per path and per iteration, and the self-motion."""
     per_it_b = time_b.median / max(int(tb.iterations.sum()), 1)
     per_it_c = time_c.median / max(int(tc.iterations.sum()), 1)
-    parts.append(
+    dq = np.abs(tb.q - tc.q).max() * DEG
+    dx = np.linalg.norm(tb.positions - tc.positions, axis=1).max()
+    return (
         "<p>Timings (whole path, compiled eq 48 loop; an untimed warm-up run first, then the "
         "median and range of repeated runs):</p>"
         + ctx.table([
@@ -85,11 +92,19 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
         "link-obstacle distances and obstacle rows, the eq 49 weights and the manipulability "
         "to the normal equations, and the tasks' compromises need more iterations (points "
         "that cannot be reached exactly — beyond the reach in phase 1, held by a limit in "
-        f"phase 2 — use the whole budget of {res.max_iter} iterations).</p>")
-    dq = np.abs(tb.q - tc.q).max() * DEG
-    dx = np.linalg.norm(tb.positions - tc.positions, axis=1).max()
-    parts.append(f"<p>Self-motion: the joint trajectories of (b) and (c) differ by up to "
-                 f"{dq:.1f}°, while their end-effector paths agree within {dx * 1e3:.3g} mm.</p>")
+        f"phase 2 — use the whole budget of {sc.solver.max_iter} iterations).</p>"
+        f"<p>Self-motion: the joint trajectories of (b) and (c) differ by up to "
+        f"{dq:.1f}°, while their end-effector paths agree within {dx * 1e3:.3g} mm.</p>"
+    )
+
+
+def _motion_figures(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any) -> str:
+    """Figures 11 and 12 (the motions of (b) and (c)) and the animation of (c)."""
+    import matplotlib.pyplot as plt
+
+    from serialkin.viz import plot_motion, plot_obstacles
+
+    parts = []
     for s, tr, fig_no, name in ((sb, tb, 11, "fig11_twenty_link_free"),
                                 (sc, tc, 12, "fig12_twenty_link_obstacles")):
         free = s is sb
@@ -100,8 +115,6 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
                     obstacles=None if free else s.obstacles, influence=not free,
                     labels=not free, title=title)
         if free:  # where the obstacles of (c) are: the free arm never needs to avoid them
-            from serialkin.viz import plot_obstacles
-
             plot_obstacles(ax, sc.obstacles, alpha=0.12, labels=True)
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
@@ -112,9 +125,15 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
         parts.append(ctx.figure(fig, name, caption))
         if not free:  # one animation (GIFs are the costly part of the report)
             parts.append(_gif(ctx, s.robot, tr, name, title, obstacles=s.obstacles))
-    # activity of each task per path point
+    return "".join(parts)
+
+
+def _activity_figure(ctx: ReportContext, sc: Scenario, tc: Any) -> str:
+    """The activity of each secondary task of eq 48 per path point of (c)."""
+    import matplotlib.pyplot as plt
+
+    res = sc.solver
     act = task_activity(sc, tc)
-    phases = _phases(sc)
     steps = np.arange(len(tc))
     fig, axes = plt.subplots(3, 1, figsize=(9.0, 6.6), sharex=True)
     axes[0].plot(steps, act["obstacle"], color="tab:green")
@@ -130,36 +149,48 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
     axes[2].set_title(f"singularity task: added damping (w < w₀ = {res.manipulability_threshold:g}"
                       ")", fontsize=10)
     axes[2].set_xlabel("path point")
+    phases = _phases(sc)
     for i, a in enumerate(axes):
         _shade(a, phases, label=i == 0)
         a.grid(True, alpha=0.3)
     fig.subplots_adjust(hspace=0.45)
     n_act = {k: int((act[k] > 0).sum()) for k in ("obstacle", "limit", "singularity")}
-    parts.append(ctx.figure(fig, "twenty_link_task_activity",
-                            "Each secondary task of eq 48 along the path of (c): "
-                            f"obstacle task active at {n_act['obstacle']}, joint-limit task at "
-                            f"{n_act['limit']}, singularity task at {n_act['singularity']} of "
-                            f"{len(tc)} path points (shaded: the three phases)."))
-    # ablation
-    full = runs[0]
+    return ctx.figure(fig, "twenty_link_task_activity",
+                      "Each secondary task of eq 48 along the path of (c): "
+                      f"obstacle task active at {n_act['obstacle']}, joint-limit task at "
+                      f"{n_act['limit']}, singularity task at {n_act['singularity']} of "
+                      f"{len(tc)} path points (shaded: the three phases).")
+
+
+def _ablation_table(ctx: ReportContext, sc: Scenario, runs: list[AblationRun]) -> str:
+    """What each secondary task of eq 48 contributes: one run with each switched off."""
     arows = []
     for r in runs:
         arows.append((r.label, f"{r.max_joint_difference * DEG:.1f}", _mm(r.min_clearance),
                       f"{r.limit_violation * DEG:.1f}", _mm(r.max_error),
                       f"{r.unreached}"))
-    parts.append(
+    return (
         "<h4>Ablation: each secondary task switched off in turn</h4>"
         "<p>The scenario of (c) run again with one weight of eq 48 set to zero (the obstacle "
         "weight, the eq 49 maximum, or the singularity damping, leaving λ_min = "
-        f"{res.damping:g} m). Each task matters: without the obstacle task the arm passes "
+        f"{sc.solver.damping:g} m). Each task matters: without the obstacle task the arm passes "
         "through obstacles; without the joint-limit task joint 1 leaves its range in phase 2; "
         "without the singularity task the (nearly) stretched arm of phases 1 and 2 chatters "
         "and misses path points by more than the ±5 mm tolerance (at the point 3.4 mm beyond "
         "the reach that is the least error possible; the damped arm stays within it).</p>"
         + ctx.table(arows, ["run", "max |q − q_all| [°]", "min clearance [mm]",
                             "worst limit violation [°]", "max tracking error [mm]",
-                            "points outside ±5 mm"]))
+                            "points outside ±5 mm"])
+    )
+
+
+def _ablation_figure(ctx: ReportContext, sc: Scenario, tc: Any, runs: list[AblationRun]) -> str:
+    """Clearance, joint 1 and tracking error with all tasks and with one switched off."""
+    import matplotlib.pyplot as plt
+
+    full = runs[0]
     by = {r.label: r for r in runs}
+    steps = np.arange(len(tc))
     fig, axes = plt.subplots(1, 3, figsize=(12.5, 3.8))
     no_obs = by["without the obstacle task"].trajectory
     axes[0].plot(steps, full.trajectory.clearance.min(axis=1) * 1e3, label="all tasks")
@@ -180,29 +211,52 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
     axes[2].axhline(sc.tolerance * 1e3, color="k", lw=1)
     axes[2].set_ylabel("tracking error [mm] (tolerance 5 mm)")
     axes[2].set_title("lost points near the singularity", fontsize=10)
+    phases = _phases(sc)
     for a in axes:
         _shade(a, phases)
         a.set_xlabel("path point")
         a.grid(True, alpha=0.3)
         a.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize="small", ncol=1)
     fig.subplots_adjust(wspace=0.35)
-    parts.append(ctx.figure(fig, "twenty_link_ablation",
-                            "What goes wrong when one task is switched off (shaded: the three "
-                            "phases)."))
+    return ctx.figure(fig, "twenty_link_ablation",
+                      "What goes wrong when one task is switched off (shaded: the three "
+                      "phases).")
+
+
+def _joints_figure(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any) -> str:
+    """The joint angles of (b) and (c) side by side."""
+    import matplotlib.pyplot as plt
+
+    from serialkin.viz import plot_joint_trajectories
+
     fig, axes = plt.subplots(1, 2, figsize=(11.0, 3.8), sharey=True)
     plot_joint_trajectories(tb.q, ax=axes[0], robot=sb.robot, title="(b) joint angles")
     plot_joint_trajectories(tc.q, ax=axes[1], robot=sc.robot, title="(c) joint angles")
-    parts.append(ctx.figure(fig, "twenty_link_joints",
-                            "Joint angles of the 20-link arm, free (b) and constrained (c); "
-                            "dashed: the limits ±100° of (c)."))
-    parts.append(ctx.reproduce("serialkin track twenty_link_free --out out/track\n"
-                               "serialkin track twenty_link_obstacles --out out/track",
-                               shell=True))
-    parts.append(ctx.reproduce(
-        "from serialkin.tracking.analysis import ablation\n"
-        "from serialkin.tracking import load_scenario\n"
-        "for r in ablation(load_scenario('twenty_link_obstacles')): print(r.label, "
-        "r.min_clearance, r.limit_violation, r.max_error)"))
+    return ctx.figure(fig, "twenty_link_joints",
+                      "Joint angles of the 20-link arm, free (b) and constrained (c); "
+                      "dashed: the limits ±100° of (c).")
+
+
+def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any,
+                      time_b: Timing, time_c: Timing, runs: list[AblationRun]) -> Section:
+    """The 20-link example: free (b, Figure 11) and constrained (c, Figure 12), ablation."""
+    parts = [
+        _design_text(ctx, sb, sc),
+        _results_table(ctx, sb, sc, tb, tc),
+        _timings_text(ctx, sc, tb, tc, time_b, time_c),
+        _motion_figures(ctx, sb, sc, tb, tc),
+        _activity_figure(ctx, sc, tc),
+        _ablation_table(ctx, sc, runs),
+        _ablation_figure(ctx, sc, tc, runs),
+        _joints_figure(ctx, sb, sc, tb, tc),
+        ctx.reproduce("serialkin track twenty_link_free --out out/track\n"
+                      "serialkin track twenty_link_obstacles --out out/track", shell=True),
+        ctx.reproduce(
+            "from serialkin.tracking.analysis import ablation\n"
+            "from serialkin.tracking import load_scenario\n"
+            "for r in ablation(load_scenario('twenty_link_obstacles')): print(r.label, "
+            "r.min_clearance, r.limit_violation, r.max_error)"),
+    ]
     return Section(title="5.3 Kinematically redundant manipulators",
                    part="Example: the 20-link arm (Figures 11 and 12)",
                    equations="eqs 47-56 at work, Figures 11-12, ablation of eq 48's tasks",
