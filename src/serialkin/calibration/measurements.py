@@ -156,36 +156,50 @@ def make_measurements(robot: Robot, q: object, *, positions: object = None,
         pos, rot = T[:, :3, 3].copy(), T[:, :3, :3].copy()
     k = KINDS[kind]
     if covariance is not None:
-        C = as_float_array(covariance, "covariance")
-        if C.shape == (k, k):
-            C = np.broadcast_to(C, (m, k, k))
-        if C.shape != (m, k, k):
-            raise InputError(f"covariance must have shape ({k}, {k}) or ({m}, {k}, {k}), "
-                             f"got {C.shape}")
-        if not np.allclose(C, np.swapaxes(C, -1, -2), rtol=1e-9, atol=0.0):
-            raise InputError("covariance must be symmetric")
-        try:
-            L = np.linalg.cholesky(C)
-        except np.linalg.LinAlgError:
-            raise InputError("covariance must be positive definite") from None
+        L = _covariance_factor(covariance, m, k)
     else:
         sp = check_positive(sigma_position, "sigma_position")
         sr = check_positive(sigma_rotation, "sigma_rotation")
         L = np.broadcast_to(np.diag([sp] * 3 + [sr] * 3)[:k, :k], (m, k, k))
     if weights is not None:
-        w = as_float_array(weights, "weights", ndim=1)
-        if w.shape != (m,):
-            raise InputError(f"weights must have shape ({m},) like q, got {w.shape}")
-        if not (np.isfinite(w).all() and (w > 0).all()):
-            i = int(np.argmax(~(np.isfinite(w) & (w > 0))))
-            raise InputError(f"weights must be finite and > 0, got {w[i]!r} for measurement {i}")
-        L = L / np.sqrt(w)[:, None, None]
+        L = L / np.sqrt(_checked_weights(weights, m))[:, None, None]
     W = np.linalg.inv(L)
     out = Measurements(kind, qa.copy(), np.ascontiguousarray(pos), rot, np.ascontiguousarray(W),
                        ln, source)
     for a in (out.q, out.positions, out.whitening, out.lines):
         a.setflags(write=False)
     return out
+
+
+def _covariance_factor(covariance: object, m: int, k: int) -> np.ndarray:
+    """The Cholesky factors L (m, k, k) of ``covariance`` (k, k) or (m, k, k), ``C = L·Lᵀ``.
+
+    Raises InputError for another shape or a covariance that is not symmetric positive
+    definite.
+    """
+    C = as_float_array(covariance, "covariance")
+    if C.shape == (k, k):
+        C = np.broadcast_to(C, (m, k, k))
+    if C.shape != (m, k, k):
+        raise InputError(f"covariance must have shape ({k}, {k}) or ({m}, {k}, {k}), "
+                         f"got {C.shape}")
+    if not np.allclose(C, np.swapaxes(C, -1, -2), rtol=1e-9, atol=0.0):
+        raise InputError("covariance must be symmetric")
+    try:
+        return np.linalg.cholesky(C)
+    except np.linalg.LinAlgError:
+        raise InputError("covariance must be positive definite") from None
+
+
+def _checked_weights(weights: object, m: int) -> np.ndarray:
+    """``weights`` as (m,) finite positive floats; InputError naming the first bad one."""
+    w = as_float_array(weights, "weights", ndim=1)
+    if w.shape != (m,):
+        raise InputError(f"weights must have shape ({m},) like q, got {w.shape}")
+    if not (np.isfinite(w).all() and (w > 0).all()):
+        i = int(np.argmax(~(np.isfinite(w) & (w > 0))))
+        raise InputError(f"weights must be finite and > 0, got {w[i]!r} for measurement {i}")
+    return w
 
 
 def read_measurements(path: str | os.PathLike[str], robot: Robot, *,
@@ -205,11 +219,36 @@ def read_measurements(path: str | os.PathLike[str], robot: Robot, *,
             not a number or not finite (named by its line), a quaternion that is not unit.
     """
     from serialkin._files import read_text
-    from serialkin.spatial.rotations import quaternion_to_matrix
 
     label = str(path)
     text = read_text(path, what="measurement file", error=InputError,
                      max_bytes=MAX_MEASUREMENT_BYTES)
+    header, rows, lines = _read_table(text, robot, label)
+    a = np.array(rows)
+    col = {h: i for i, h in enumerate(header)}
+    q = a[:, [col[f"q{i + 1}"] for i in range(robot.n)]]
+    _check_radians(q, robot, label, lines)
+    pos = a[:, [col["x"], col["y"], col["z"]]]
+    w = a[:, col["weight"]] if "weight" in col else None
+    if w is not None and not (w > 0).all():
+        i = int(np.argmax(w <= 0))
+        raise InputError(f"{label}, line {lines[i]}: weight must be > 0, got {w[i]!r}")
+    common = dict(weights=w, sigma_position=sigma_position, sigma_rotation=sigma_rotation,
+                  lines=lines, source=label)
+    if "quat_w" not in col:
+        return make_measurements(robot, q, positions=pos, **common)
+    T = _poses(a[:, [col[c] for c in _QUAT]], pos, label, lines)
+    return make_measurements(robot, q, poses=T, **common)
+
+
+def _read_table(text: str, robot: Robot,
+                label: str) -> tuple[list[str], list[list[float]], list[int]]:
+    """The header (lower case), the rows of numbers and their line numbers of a CSV text.
+
+    ``#`` comments and blank lines are skipped; the header is checked against ``robot``
+    (:func:`_check_header`), every row has one finite number per column. ``label`` names
+    the file in messages; raises InputError naming the line (and column) at fault.
+    """
     header: list[str] | None = None
     rows: list[list[float]] = []
     lines: list[int] = []
@@ -225,24 +264,28 @@ def read_measurements(path: str | os.PathLike[str], robot: Robot, *,
         if len(cells) != len(header):
             raise InputError(f"{label}, line {lineno}: {len(cells)} values but the header "
                              f"names {len(header)} columns")
-        vals = []
-        for name, c in zip(header, cells):
-            try:
-                v = float(c)
-            except ValueError:
-                raise InputError(f"{label}, line {lineno}, column {name!r}: "
-                                 f"{short_repr(c, 40)} is not a number") from None
-            if not math.isfinite(v):
-                raise InputError(f"{label}, line {lineno}, column {name!r}: values must be "
-                                 f"finite, got {short_repr(c, 40)}")
-            vals.append(v)
-        rows.append(vals)
+        rows.append([_number(c, name, label, lineno) for name, c in zip(header, cells)])
         lines.append(lineno)
     if header is None or not rows:
         raise InputError(f"{label}: no measurements found (expected a header line and rows)")
-    a = np.array(rows)
-    col = {h: i for i, h in enumerate(header)}
-    q = a[:, [col[f"q{i + 1}"] for i in range(robot.n)]]
+    return header, rows, lines
+
+
+def _number(cell: str, name: str, label: str, lineno: int) -> float:
+    """The finite float in ``cell`` (column ``name`` of line ``lineno``); else InputError."""
+    try:
+        v = float(cell)
+    except ValueError:
+        raise InputError(f"{label}, line {lineno}, column {name!r}: "
+                         f"{short_repr(cell, 40)} is not a number") from None
+    if not math.isfinite(v):
+        raise InputError(f"{label}, line {lineno}, column {name!r}: values must be "
+                         f"finite, got {short_repr(cell, 40)}")
+    return v
+
+
+def _check_radians(q: np.ndarray, robot: Robot, label: str, lines: list[int]) -> None:
+    """Refuse a revolute joint value (q (m, n) [rad]) beyond a full turn: degrees read as rad."""
     revolute = robot.revolute
     wild = beyond_a_turn(q[:, revolute])
     if wild.any():  # radians are read: 90 means 90 rad, fourteen turns
@@ -251,25 +294,24 @@ def read_measurements(path: str | os.PathLike[str], robot: Robot, *,
         raise InputError(f"{label}, line {lines[i]}, column 'q{joint + 1}': "
                          f"{q[i, np.flatnonzero(revolute)[j]]:.6g} rad is more than a full turn; "
                          "joint values are read in radians (are these degrees?)")
-    pos = a[:, [col["x"], col["y"], col["z"]]]
-    w = a[:, col["weight"]] if "weight" in col else None
-    if w is not None and not (w > 0).all():
-        i = int(np.argmax(w <= 0))
-        raise InputError(f"{label}, line {lines[i]}: weight must be > 0, got {w[i]!r}")
-    common = dict(weights=w, sigma_position=sigma_position, sigma_rotation=sigma_rotation,
-                  lines=lines, source=label)
-    if "quat_w" not in col:
-        return make_measurements(robot, q, positions=pos, **common)
-    quat = a[:, [col[c] for c in _QUAT]]
+
+
+def _poses(quat: np.ndarray, pos: np.ndarray, label: str, lines: list[int]) -> np.ndarray:
+    """(m, 4, 4) poses from unit quaternions (m, 4), scalar first, and positions (m, 3) [m].
+
+    Raises InputError naming the line of the first quaternion whose norm is not 1 (1e-6).
+    """
+    from serialkin.spatial.rotations import quaternion_to_matrix
+
     norm = np.linalg.norm(quat, axis=1)
     if (np.abs(norm - 1.0) > 1e-6).any():
         i = int(np.argmax(np.abs(norm - 1.0)))
         raise InputError(f"{label}, line {lines[i]}: the quaternion must have unit norm, got "
                          f"norm {norm[i]:.9g}")
-    T = np.tile(np.eye(4), (len(rows), 1, 1))
+    T = np.tile(np.eye(4), (quat.shape[0], 1, 1))
     T[:, :3, :3] = quaternion_to_matrix(quat, normalize=True)
     T[:, :3, 3] = pos
-    return make_measurements(robot, q, poses=T, **common)
+    return T
 
 
 def _check_header(header: list[str], robot: Robot, label: str, lineno: int) -> None:

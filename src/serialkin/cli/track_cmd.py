@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -83,12 +84,7 @@ def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_ani
     from serialkin.tracking import list_scenarios, load_scenario
 
     if list_only:
-        names = list_scenarios()
-        if as_json:
-            click.echo(dumps_json({"scenarios": names}), nl=False)
-        else:
-            for n in names:
-                click.echo(n)
+        _echo_scenarios(list_scenarios(), as_json)
         return
     if scenario is None:
         raise CLIError("missing SCENARIO: a scenario file or a shipped name (see --list)")
@@ -105,73 +101,22 @@ def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_ani
         click.echo(f"tracking {sc.name}: {len(sc.path)} path points, robot {sc.robot.name} "
                    f"({sc.robot.n} joints) ...", err=True)
     traj = sc.run()
-    folder = ensure_dir(out)
-    files: dict[str, str] = {}
-    for ext in (("csv", "npz") if fmt == "both" else (fmt,)):
-        p = folder / f"{stem}.{ext}"
-        try:
-            traj.save(p)
-        except OSError as exc:
-            raise CLIError(f"cannot write {p} ({exc.strerror or exc})") from exc
-        files[ext] = str(p)
+    run = _Outputs(sc, traj, ensure_dir(out), stem)
+    _write_trajectory(run, ("csv", "npz") if fmt == "both" else (fmt,))
     if not no_figures or not no_animation:
         import matplotlib
 
         matplotlib.use("Agg")
     if not no_figures:
-        import io
-
-        import matplotlib.pyplot as plt
-
-        from serialkin.viz.trajectory import (
-            plot_clearance,
-            plot_joint_trajectories,
-            plot_motion,
-            plot_tracking_error,
-            tracking_figure,
-        )
-
-        def save(fig: Any, key: str, name: str) -> None:
-            buf = io.BytesIO()
-            fig.savefig(buf, format="png", dpi=100, bbox_inches="tight")
-            plt.close(fig)
-            files[key] = str(write_bytes_atomic(folder / name, buf.getvalue()))
-
-        save(tracking_figure(traj, sc.robot, obstacles=sc.obstacles, title=sc.name),
-             "figure", f"{stem}.png")
-        save(plot_motion(sc.robot, traj, obstacles=sc.obstacles,
-                         title=f"{sc.name}: motion").figure, "motion", f"{stem}_motion.png")
-        save(plot_joint_trajectories(traj, robot=sc.robot).figure, "joints",
-             f"{stem}_joints.png")
-        save(plot_tracking_error(traj).figure, "error", f"{stem}_error.png")
-        if traj.clearance.size:
-            save(plot_clearance(traj).figure, "clearance", f"{stem}_clearance.png")
+        _write_figures(run)
     if not no_animation:
-        from serialkin.viz.animate import animate_trajectory, ffmpeg_available
-
-        formats = ["gif"] + (["mp4"] if mp4 else [])
-        if mp4 and not ffmpeg_available():
-            click.echo("note: --mp4 skipped, ffmpeg is not installed", err=True)
-            formats = ["gif"]
-        for f in formats:
-            data = animate_trajectory(sc.robot, traj, fmt=f, fps=fps, obstacles=sc.obstacles,
-                                      max_frames=max_frames, title=sc.name,
-                                      progress=(not quiet and not as_json
-                                                and sys.stderr.isatty()))
-            files[f] = str(write_bytes_atomic(folder / f"{stem}.{f}", data))
+        _write_animation(run, fps=fps, max_frames=max_frames, mp4=mp4, progress=show)
     if viewer:
-        from serialkin.viz.viewer import write_viewer
-
-        p = folder / f"{stem}.html"
-        try:
-            write_viewer(sc.robot, p, trajectory=traj.q, path_points=traj.targets[:, :3, 3],
-                         obstacles=sc.obstacles, title=sc.name)
-        except OSError as exc:
-            raise CLIError(f"cannot write {p} ({exc.strerror or exc})") from exc
-        files["viewer"] = str(p)
+        _write_viewer(run)
+    files = run.files
     summary = _summary(sc, traj, files)
-    write_text_atomic(folder / f"{stem}.json", dumps_json(summary))
-    files["summary"] = str(folder / f"{stem}.json")
+    write_text_atomic(run.folder / f"{stem}.json", dumps_json(summary))
+    files["summary"] = str(run.folder / f"{stem}.json")
     if as_json:
         click.echo(dumps_json(summary), nl=False)
     elif not quiet:
@@ -184,6 +129,112 @@ def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_ani
         click.echo(str(j), err=True)
     if not traj.complete:
         raise SystemExit(EXIT_NOT_REACHED)
+
+
+def _echo_scenarios(names: list[str], as_json: bool) -> None:
+    """Print the shipped scenarios' names (--list), one a line or as JSON."""
+    if as_json:
+        click.echo(dumps_json({"scenarios": names}), nl=False)
+    else:
+        for n in names:
+            click.echo(n)
+
+
+@dataclass(frozen=True, eq=False)
+class _Outputs:
+    """A tracked scenario and where its outputs go.
+
+    Attributes:
+        sc: the scenario.
+        traj: its trajectory.
+        folder: the output folder (exists).
+        stem: the file name stem of every output.
+        files: what was written so far, key -> path (filled in by the writers).
+    """
+
+    sc: Any
+    traj: Any
+    folder: Path
+    stem: str
+    files: dict[str, str] = field(default_factory=dict)
+
+    def write(self, key: str, suffix: str, data: bytes) -> None:
+        """Write ``data`` atomically to ``<stem><suffix>`` and record it as ``key``."""
+        self.files[key] = str(write_bytes_atomic(self.folder / f"{self.stem}{suffix}", data))
+
+
+def _write_trajectory(run: _Outputs, extensions: tuple[str, ...]) -> None:
+    """Save the trajectory once per extension ('csv', 'npz'); CLIError when it cannot."""
+    for ext in extensions:
+        p = run.folder / f"{run.stem}.{ext}"
+        try:
+            run.traj.save(p)
+        except OSError as exc:
+            raise CLIError(f"cannot write {p} ({exc.strerror or exc})") from exc
+        run.files[ext] = str(p)
+
+
+def _write_figures(run: _Outputs) -> None:
+    """The summary figure and each of its panels alone, as PNG files."""
+    import io
+
+    import matplotlib.pyplot as plt
+
+    from serialkin.viz.trajectory import (
+        plot_clearance,
+        plot_joint_trajectories,
+        plot_motion,
+        plot_tracking_error,
+        tracking_figure,
+    )
+
+    sc, traj = run.sc, run.traj
+
+    def save(fig: Any, key: str, suffix: str) -> None:
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=100, bbox_inches="tight")
+        plt.close(fig)
+        run.write(key, suffix, buf.getvalue())
+
+    save(tracking_figure(traj, sc.robot, obstacles=sc.obstacles, title=sc.name),
+         "figure", ".png")
+    save(plot_motion(sc.robot, traj, obstacles=sc.obstacles,
+                     title=f"{sc.name}: motion").figure, "motion", "_motion.png")
+    save(plot_joint_trajectories(traj, robot=sc.robot).figure, "joints", "_joints.png")
+    save(plot_tracking_error(traj).figure, "error", "_error.png")
+    if traj.clearance.size:
+        save(plot_clearance(traj).figure, "clearance", "_clearance.png")
+
+
+def _write_animation(run: _Outputs, *, fps: float, max_frames: int, mp4: bool,
+                     progress: bool) -> None:
+    """The GIF animation, and the MP4 with ``mp4`` when ffmpeg is present (else a note)."""
+    from serialkin.viz.animate import AnimationOptions, animate_trajectory, ffmpeg_available
+
+    sc = run.sc
+    formats = ["gif"] + (["mp4"] if mp4 else [])
+    if mp4 and not ffmpeg_available():
+        click.echo("note: --mp4 skipped, ffmpeg is not installed", err=True)
+        formats = ["gif"]
+    for f in formats:
+        options = AnimationOptions(fps=fps, max_frames=max_frames, title=sc.name,
+                                   progress=progress)
+        data = animate_trajectory(sc.robot, run.traj, options, fmt=f, obstacles=sc.obstacles)
+        run.write(f, f".{f}", data)
+
+
+def _write_viewer(run: _Outputs) -> None:
+    """The interactive viewer page of the trajectory; CLIError when it cannot be written."""
+    from serialkin.viz.viewer import Scene, write_viewer
+
+    sc, traj = run.sc, run.traj
+    p = run.folder / f"{run.stem}.html"
+    try:
+        write_viewer(Scene(sc.robot, trajectory=traj.q, path_points=traj.targets[:, :3, 3],
+                           obstacles=sc.obstacles, title=sc.name), p)
+    except OSError as exc:
+        raise CLIError(f"cannot write {p} ({exc.strerror or exc})") from exc
+    run.files["viewer"] = str(p)
 
 
 def _with_solver(sc: Any, solver: str, max_joint_step: float | None) -> Any:

@@ -141,6 +141,39 @@ def workspace_cmd(robot: str, kind: str, samples: int | None, seed: int, cell: f
     opts: dict[str, Any] = {"seed": seed, "cell": cell, "resolution": resolution,
                             "progress": progress}
     ori = _orientation(orientation, planar, degrees)
+    opts.update(_kind_options(kind, ori, max_angle=max_angle, orientations=orientations,
+                              margin=margin, manipulability=manipulability, degrees=degrees))
+    if samples is not None:
+        opts["samples"] = samples
+    check_out_folder(out)
+    ws = compute_workspace(r, kind, **opts)
+    folder = ensure_dir(out)
+    files: dict[str, str] = {}
+
+    if points or save_q:
+        files["points"] = str(_save_points(ws, folder / f"workspace_{kind}.npz", save_q))
+    if not no_plot:
+        _save_plots(ws, kind, folder, manipulability, files)
+    slice_summaries = _save_slices(ws, parsed_slices, folder, files, plot=not no_plot)
+    summary = ws.summary()
+    summary["slices"] = slice_summaries
+    summary["files"] = files
+    from serialkin.cli.io import write_text_atomic
+
+    files["summary"] = str(folder / f"workspace_{kind}.json")
+    write_text_atomic(folder / f"workspace_{kind}.json", dumps_json(summary))
+    if as_json:
+        click.echo(dumps_json(summary), nl=False)
+        return
+    if quiet:
+        return
+    _echo_report(r.name, kind, ws, seed, slice_summaries, files)
+
+
+def _kind_options(kind: str, ori: Any, *, max_angle: float | None, orientations: int | None,
+                  margin: float, manipulability: bool, degrees: bool) -> dict[str, Any]:
+    """The keywords of ``compute_workspace`` that depend on ``--kind`` (checked options)."""
+    opts: dict[str, Any] = {}
     if kind in ("constant", "inclusive"):
         if ori is None:
             raise CLIError(f"--kind {kind} needs --orientation (planar: an angle φ; spatial: "
@@ -158,64 +191,63 @@ def workspace_cmd(robot: str, kind: str, samples: int | None, seed: int, cell: f
             opts["singularity_margin"] = margin
     else:
         opts["manipulability"] = manipulability
-    if samples is not None:
-        opts["samples"] = samples
-    check_out_folder(out)
-    ws = compute_workspace(r, kind, **opts)
-    folder = ensure_dir(out)
-    files: dict[str, str] = {}
+    return opts
 
-    if points or save_q:
-        arrays = {"points": ws.points, "grid_counts": ws.grid.counts,
-                  "grid_lower": ws.grid.lower, "grid_cell": np.array(ws.grid.cell)}
-        if ws.manipulability is not None:
-            arrays["manipulability"] = ws.manipulability
-        if save_q:
-            arrays["q"] = ws.q
-        buf = io.BytesIO()
-        np.savez_compressed(buf, **arrays)
-        files["points"] = str(write_bytes_atomic(folder / f"workspace_{kind}.npz",
-                                                 buf.getvalue()))
-    slice_summaries = []
-    if not no_plot:
-        import matplotlib
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+def _save_points(ws: Any, path: Path, save_q: bool) -> Path:
+    """Write the samples, the grid (and q with ``save_q``) of ``ws`` as a compressed .npz."""
+    arrays = {"points": ws.points, "grid_counts": ws.grid.counts,
+              "grid_lower": ws.grid.lower, "grid_cell": np.array(ws.grid.cell)}
+    if ws.manipulability is not None:
+        arrays["manipulability"] = ws.manipulability
+    if save_q:
+        arrays["q"] = ws.q
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **arrays)
+    return write_bytes_atomic(path, buf.getvalue())
 
-        from serialkin.workspace.plot import plot_manipulability_map, plot_slice, plot_workspace
 
-        ax = plot_workspace(ws)
-        files["figure"] = str(save_figure(ax.figure, folder / f"workspace_{kind}.png"))
-        if ws.manipulability is not None and (manipulability or kind == "dexterous"):
-            ax = plot_manipulability_map(ws)
-            files["manipulability"] = str(save_figure(ax.figure,
-                                                      folder / f"manipulability_{kind}.png"))
-        plt.close("all")
-    for axis, value in parsed_slices:
+def _save_plots(ws: Any, kind: str, folder: Path, manipulability: bool,
+                files: dict[str, str]) -> None:
+    """Plot the workspace (and its manipulability map) into ``folder``, adding to ``files``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from serialkin.workspace.plot import plot_manipulability_map, plot_workspace
+
+    ax = plot_workspace(ws)
+    files["figure"] = str(save_figure(ax.figure, folder / f"workspace_{kind}.png"))
+    if ws.manipulability is not None and (manipulability or kind == "dexterous"):
+        ax = plot_manipulability_map(ws)
+        files["manipulability"] = str(save_figure(ax.figure,
+                                                  folder / f"manipulability_{kind}.png"))
+    plt.close("all")
+
+
+def _save_slices(ws: Any, slices: list[tuple[str, float]], folder: Path,
+                 files: dict[str, str], *, plot: bool) -> list[dict[str, Any]]:
+    """Each --slice's area (and, with ``plot``, its figure, added to ``files``): summaries."""
+    summaries = []
+    for axis, value in slices:
         from serialkin.workspace import workspace_slice
 
         sl = workspace_slice(ws, axis, value)
-        slice_summaries.append({"axis": axis, "value": value, "area": sl.estimate.as_dict()})
-        if not no_plot:
+        summaries.append({"axis": axis, "value": value, "area": sl.estimate.as_dict()})
+        if plot:
             from serialkin.workspace.plot import plot_slice
 
             ax = plot_slice(sl)
             key = f"slice_{axis}_{value:g}"
             files[key] = str(save_figure(ax.figure, folder / f"{key}.png"))
-    summary = ws.summary()
-    summary["slices"] = slice_summaries
-    summary["files"] = files
-    from serialkin.cli.io import write_text_atomic
+    return summaries
 
-    files["summary"] = str(folder / f"workspace_{kind}.json")
-    write_text_atomic(folder / f"workspace_{kind}.json", dumps_json(summary))
-    if as_json:
-        click.echo(dumps_json(summary), nl=False)
-        return
-    if quiet:
-        return
-    click.echo(f"{r.name}: {kind} workspace from {ws.samples} samples "
+
+def _echo_report(name: str, kind: str, ws: Any, seed: int,
+                 slice_summaries: list[dict[str, Any]], files: dict[str, str]) -> None:
+    """Print the estimate, the slices' areas and the files written."""
+    click.echo(f"{name}: {kind} workspace from {ws.samples} samples "
                f"({ws.points.shape[0]} accepted, seed {seed})")
     click.echo(f"  {ws.estimate}")
     click.echo(f"  bounds [{ws.estimate.lower:.6g}, {ws.estimate.upper:.6g}] "
@@ -226,5 +258,3 @@ def workspace_cmd(robot: str, kind: str, samples: int | None, seed: int, cell: f
                    f"{a['error']:.2g} m^2")
     for k, v in files.items():
         click.echo(f"  wrote {v}" if k != "summary" else f"  wrote {v}")
-
-

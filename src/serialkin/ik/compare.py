@@ -227,13 +227,7 @@ def compare(
     """
     if not isinstance(robot, Robot):
         raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
-    allowed = {"mask", "max_iter", "restarts", "respect_limits"}
-    unknown = sorted(set(options) - allowed)
-    if unknown:
-        raise InputError(
-            f"unknown option(s) {unknown} for compare; common options are "
-            f"{sorted(allowed)}, method-specific ones go in method_options={{name: {{...}}}}"
-        )
+    _check_common_options(options)
     tol_v = check_tol(tol)
     tgt = parse_target(robot, targets, options.get("mask"))
     Ts = tgt.T if tgt.batch else tgt.T[None]
@@ -241,10 +235,10 @@ def compare(
     if N == 0:
         raise InputError("targets is empty; give at least one target")
     raw = np.asarray(targets, dtype=float)
-    per_target = raw if tgt.batch else raw[None]
     respect = bool(options.get("respect_limits", True))
-    Q0 = None if q0 is None else check_q0(robot, q0, N, respect)
-    seeds = as_generator(seed).integers(0, 2**62, size=N)
+    runs = _Runs(robot=robot, targets=raw if tgt.batch else raw[None],
+                 q0=None if q0 is None else check_q0(robot, q0, N, respect),
+                 seeds=as_generator(seed).integers(0, 2**62, size=N), tol=tol_v)
     names = _method_names(methods)
     mopts = dict(method_options or {})
     for m in mopts:
@@ -258,38 +252,80 @@ def compare(
                                         f"{', '.join(spec.targets)})"))
             continue
         kw = {**options, **mopts.get(name, {})}
-
-        def run(k: int, name: str = name, kw: dict[str, Any] = kw) -> Any:
-            return solve(robot, per_target[k], name, q0=None if Q0 is None else Q0[k],
-                         tol=tol_v, seed=int(seeds[k]), **kw)
-
         try:
-            run(0)  # warm-up (compilation), untimed
+            runs.solve(0, name, kw)  # warm-up (compilation), untimed
         except (NotSupportedError, NoClosedFormError) as exc:
             table.skipped.append((name, str(exc)))
             continue
-        times = np.empty(N)
-        ok = np.empty(N, dtype=bool)
-        its = np.empty(N)
-        pe = np.empty(N)
-        oe = np.empty(N)
-        inside = np.empty(N, dtype=bool)
-        for k in range(N):
-            t0 = time.perf_counter()
-            res = run(k)
-            times[k] = time.perf_counter() - t0
-            ok[k] = bool(res.success)
-            its[k] = res.iterations
-            pe[k] = res.position_error
-            oe[k] = res.orientation_error
-            inside[k] = bool(robot.within_limits(res.q, 1e-12))
-        table.rows.append(CompareRow(
-            method=name, family=spec.family, solves=N, success_rate=float(ok.mean()),
-            median_time=float(np.median(times)), mean_time=float(times.mean()),
-            median_iterations=float(np.median(its)),
-            median_position_error=float(np.median(pe)), max_position_error=float(pe.max()),
-            median_orientation_error=float(np.median(oe)),
-            max_orientation_error=float(oe.max()),
-            within_limits_rate=float(inside.mean()),
-        ))
+        table.rows.append(_method_row(runs, name, spec.family, kw))
     return table
+
+
+def _check_common_options(options: Mapping[str, Any]) -> None:
+    """Raise InputError for a ``**options`` name of :func:`compare` not common to all methods."""
+    allowed = {"mask", "max_iter", "restarts", "respect_limits"}
+    unknown = sorted(set(options) - allowed)
+    if unknown:
+        raise InputError(
+            f"unknown option(s) {unknown} for compare; common options are "
+            f"{sorted(allowed)}, method-specific ones go in method_options={{name: {{...}}}}"
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class _Runs:
+    """What every method of :func:`compare` solves: the same targets, guesses and seeds.
+
+    Attributes:
+        robot: the robot.
+        targets: (N, ...) the targets as given, one per row.
+        q0: (N, n) checked initial guesses, or None (each solve draws its start).
+        seeds: (N,) the derived seed of each target.
+        tol: tolerance on position [m] and orientation [rad] errors.
+    """
+
+    robot: Robot
+    targets: np.ndarray
+    q0: np.ndarray | None
+    seeds: np.ndarray
+    tol: float
+
+    @property
+    def count(self) -> int:
+        """Number of targets N."""
+        return self.seeds.shape[0]
+
+    def solve(self, k: int, method: str, kw: Mapping[str, Any]) -> Any:
+        """Solve target ``k`` with ``method`` and the keywords ``kw``; the IKResult."""
+        return solve(self.robot, self.targets[k], method,
+                     q0=None if self.q0 is None else self.q0[k], tol=self.tol,
+                     seed=int(self.seeds[k]), **kw)
+
+
+def _method_row(runs: _Runs, method: str, family: str, kw: Mapping[str, Any]) -> CompareRow:
+    """Solve every target of ``runs`` with ``method``, timing each solve; its statistics."""
+    N = runs.count
+    times = np.empty(N)
+    ok = np.empty(N, dtype=bool)
+    its = np.empty(N)
+    pe = np.empty(N)
+    oe = np.empty(N)
+    inside = np.empty(N, dtype=bool)
+    for k in range(N):
+        t0 = time.perf_counter()
+        res = runs.solve(k, method, kw)
+        times[k] = time.perf_counter() - t0
+        ok[k] = bool(res.success)
+        its[k] = res.iterations
+        pe[k] = res.position_error
+        oe[k] = res.orientation_error
+        inside[k] = bool(runs.robot.within_limits(res.q, 1e-12))
+    return CompareRow(
+        method=method, family=family, solves=N, success_rate=float(ok.mean()),
+        median_time=float(np.median(times)), mean_time=float(times.mean()),
+        median_iterations=float(np.median(its)),
+        median_position_error=float(np.median(pe)), max_position_error=float(pe.max()),
+        median_orientation_error=float(np.median(oe)),
+        max_orientation_error=float(oe.max()),
+        within_limits_rate=float(inside.mean()),
+    )

@@ -667,12 +667,42 @@ def robot_from_mjcf(path_or_string: str | os.PathLike[str], base_body: str | Non
     """
     from serialkin.model.robot import Robot
 
-    for name, value in (("base_body", base_body), ("end_body", end_body),
-                        ("tool_site", tool_site)):
+    _check_names(base_body=base_body, end_body=end_body, tool_site=tool_site)
+    root, source, reader = _read_model(path_or_string, resolve_meshes)
+    bodies = reader.bodies
+    base = 0 if base_body is None else _find_body(bodies, base_body, "base_body", source)
+    end = _end_body(reader, base, end_body, tool_site, source)
+    path_ids, base_T = _chain_path(bodies, base, end, source)
+    joints, link_names, places = _chain_joints(bodies, path_ids, source)
+    if not joints:
+        raise RobotDefinitionError(
+            f"{source}: no hinge or slide joint between {short_repr(bodies[path_ids[0]].name)} "
+            f"and {short_repr(bodies[end].name)}")
+    _weld(bodies, places)
+    tool = _tool_pose(reader, places, end, len(joints), tool_site, source)
+    name = root.get("model") or "mjcf_robot"
+    geometry = tuple(
+        LinkGeometry(bodies[b].name, frame,
+                     tuple(_posed(s, T) for s in bodies[b].visual),
+                     tuple(_posed(s, T) for s in bodies[b].collision))
+        for b, (frame, T) in sorted(places.items()))
+    return Robot(joints, base=base_T, tool=tool, name=name,
+                 source=f"MJCF {source} ({bodies[path_ids[0]].name} -> {bodies[end].name}"
+                        + (f", site {tool_site}" if tool_site else "") + ")",
+                 link_names=tuple(link_names), geometry=geometry)
+
+
+def _check_names(**names: object) -> None:
+    """Raise InputTypeError for a body or site name (keyword: its argument) not a str or None."""
+    for name, value in names.items():
         if value is not None and not isinstance(value, str):
             raise InputTypeError(f"{name} must be a body or site name (str) or None, got "
                                  f"{type(value).__name__} {short_repr(value)}")
 
+
+def _read_model(path_or_string: str | os.PathLike[str],
+                resolve_meshes: bool) -> tuple[ET.Element, str, _Reader]:
+    """The ``<mujoco>`` root (includes expanded), the source label and its bodies' reader."""
     text = os.fspath(path_or_string)
     if isinstance(text, bytes):
         text = text.decode()
@@ -690,29 +720,32 @@ def robot_from_mjcf(path_or_string: str | os.PathLike[str], base_body: str | Non
     # bodies, so the depth is checked once, on the whole expanded model
     _expand_includes(root, _Includes(folder or Path.cwd()), source, (source,))
     _depth_checked(root, source)
-    reader = _Reader(root, source, folder, resolve_meshes)
-    bodies = reader.bodies
+    return root, source, _Reader(root, source, folder, resolve_meshes)
 
-    base = 0 if base_body is None else _find_body(bodies, base_body, "base_body", source)
+
+def _end_body(reader: _Reader, base: int, end_body: str | None, tool_site: str | None,
+              source: str) -> int:
+    """The chain's last body: ``end_body``, else the body of ``tool_site``, else the tip."""
     if tool_site is not None and tool_site not in reader.sites:
         near = difflib.get_close_matches(tool_site, list(reader.sites), n=3)
         raise RobotDefinitionError(
             f"{source}: tool_site {short_repr(tool_site)} is not a named site of the model"
             + (f"; did you mean {', '.join(map(repr, near))}?" if near else ""))
     if end_body is not None:
-        end = _find_body(bodies, end_body, "end_body", source)
-    elif tool_site is not None:
-        end = reader.sites[tool_site]
-    else:
-        end = _pick_end(bodies, base, source)
-    path_ids, base_T = _chain_path(bodies, base, end, source)
-    joints, link_names, places = _chain_joints(bodies, path_ids, source)
-    if not joints:
-        raise RobotDefinitionError(
-            f"{source}: no hinge or slide joint between {short_repr(bodies[path_ids[0]].name)} "
-            f"and {short_repr(bodies[end].name)}")
-    n = len(joints)
-    _weld(bodies, places)
+        return _find_body(reader.bodies, end_body, "end_body", source)
+    if tool_site is not None:
+        return reader.sites[tool_site]
+    return _pick_end(reader.bodies, base, source)
+
+
+def _tool_pose(reader: _Reader, places: dict[int, tuple[int, np.ndarray]], end: int, n: int,
+               tool_site: str | None, source: str) -> np.ndarray:
+    """The tool (4, 4) in the last joint's frame: the end body's pose, or ``tool_site``'s.
+
+    ``places`` holds every chain or welded body's (frame, pose in it); ``n`` is the number
+    of joints (the last frame).
+    """
+    bodies = reader.bodies
     tool = places[end][1]
     if tool_site is not None:
         sb = reader.sites[tool_site]
@@ -722,16 +755,7 @@ def robot_from_mjcf(path_or_string: str | os.PathLike[str], base_body: str | Non
                 f"{short_repr(bodies[sb].name)}, which is not fixed to the end body "
                 f"{short_repr(bodies[end].name)}")
         tool = places[sb][1] @ bodies[sb].sites[tool_site]
-    name = root.get("model") or "mjcf_robot"
-    geometry = tuple(
-        LinkGeometry(bodies[b].name, frame,
-                     tuple(_posed(s, T) for s in bodies[b].visual),
-                     tuple(_posed(s, T) for s in bodies[b].collision))
-        for b, (frame, T) in sorted(places.items()))
-    return Robot(joints, base=base_T, tool=tool, name=name,
-                 source=f"MJCF {source} ({bodies[path_ids[0]].name} -> {bodies[end].name}"
-                        + (f", site {tool_site}" if tool_site else "") + ")",
-                 link_names=tuple(link_names), geometry=geometry)
+    return tool
 
 
 def _chain_path(bodies: list[_Body], base: int, end: int, source: str

@@ -182,6 +182,43 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
     from serialkin.model.robot import Robot
 
     root, source = _read_xml(path_or_string)
+    tree = _read_tree(root, source)
+    base, tip = _chain_ends(tree, base_link, tip_link, source)
+    chain = _chain_between(tree, base, tip, source)
+    out, link_names, fixed = _moving_joints(chain, base, tip, source)
+    folder = None if source == "<string>" else Path(source).resolve().parent
+    places = _link_frames(base, chain, tree.children, tree.by_child)
+    resolver = MeshResolver(folder, package_map or {}, search_path, resolve_meshes)
+    geometry = tuple(
+        _link_geometry(el, places[el.get("name")], source, resolver)
+        for el in root.findall("link") if el.get("name") in places)
+    return Robot(out, tool=fixed, name=root.get("name") or "urdf_robot",
+                 source=f"URDF {source} ({base} -> {tip})",
+                 link_names=tuple(link_names) + ((tip,) if link_names[-1] != tip else ()),
+                 geometry=geometry)
+
+
+@dataclass(frozen=True, eq=False)
+class _Tree:
+    """The links and joints of a URDF, checked to form one tree.
+
+    Attributes:
+        links: link names, in file order.
+        link_set: the same names, as a set.
+        by_child: the joint whose child each link is (every link but the root).
+        children: the child links of each link.
+        root: the root link.
+    """
+
+    links: list[str]
+    link_set: set[str]
+    by_child: dict[str, _UJoint]
+    children: dict[str, list[str]]
+    root: str
+
+
+def _read_tree(root: ET.Element, source: str) -> _Tree:
+    """The link tree of the ``<robot>`` element ``root``; RobotDefinitionError if not a tree."""
     links = [el.get("name") for el in root.findall("link")]
     if any(n is None for n in links):
         raise RobotDefinitionError(f"{source}: a <link> has no name attribute")
@@ -214,33 +251,42 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
             + (f" ({_names(roots)})" if roots else "; the joints form a loop")
         )
     _check_tree(roots[0], children, source)
-    base = base_link or roots[0]
-    if base not in link_set:
+    return _Tree(links, link_set, by_child, children, roots[0])
+
+
+def _chain_ends(tree: _Tree, base_link: str | None, tip_link: str | None,
+                source: str) -> tuple[str, str]:
+    """The base and tip links of the chain (defaults: the root, the single leaf below base)."""
+    base = base_link or tree.root
+    if base not in tree.link_set:
         raise RobotDefinitionError(
             f"{source}: base_link {short_repr(base)} is not a link of the robot")
     if tip_link is None:
-        leaves = [n for n in links if not children[n] and n != base]
-        below = [n for n in leaves if _is_below(n, base, by_child)]
+        leaves = [n for n in tree.links if not tree.children[n] and n != base]
+        below = [n for n in leaves if _is_below(n, base, tree.by_child)]
         if len(below) != 1:
             raise RobotDefinitionError(
                 f"{source}: the tree below {short_repr(base)} branches into {len(below)} leaves "
                 f"({_names(below)}); pass tip_link= one of them"
             )
-        tip = below[0]
-    else:
-        tip = tip_link
-        if tip not in link_set:
-            raise RobotDefinitionError(
-                f"{source}: tip_link {short_repr(tip)} is not a link of the robot")
+        return base, below[0]
+    if tip_link not in tree.link_set:
+        raise RobotDefinitionError(
+            f"{source}: tip_link {short_repr(tip_link)} is not a link of the robot")
+    return base, tip_link
+
+
+def _chain_between(tree: _Tree, base: str, tip: str, source: str) -> list[_UJoint]:
+    """The joints from ``base`` to ``tip``, in order; NotSupportedError for one on it."""
     chain: list[_UJoint] = []
     link = tip
     seen = {tip}
     while link != base:
-        if link not in by_child:
+        if link not in tree.by_child:
             raise RobotDefinitionError(
                 f"{source}: tip_link {short_repr(tip)} is not below base_link {short_repr(base)}"
             )
-        j = by_child[link]
+        j = tree.by_child[link]
         chain.append(j)
         link = j.parent
         if link in seen:
@@ -251,6 +297,16 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
     for j in chain:
         if j.unsupported:
             raise NotSupportedError(j.unsupported)
+    return chain
+
+
+def _moving_joints(chain: list[_UJoint], base: str, tip: str,
+                   source: str) -> tuple[list[Joint], list[str], np.ndarray]:
+    """The chain's moving joints (fixed ones merged), their link names from ``base``, the tool.
+
+    Fixed joints before a moving joint go into its origin, those after the last into the
+    tool (4, 4); RobotDefinitionError when no joint moves.
+    """
     out: list[Joint] = []
     link_names = [base]
     fixed = np.eye(4)
@@ -266,16 +322,7 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
         raise RobotDefinitionError(
             f"{source}: no moving joint between {short_repr(base)} and {short_repr(tip)}"
         )
-    folder = None if source == "<string>" else Path(source).resolve().parent
-    places = _link_frames(base, chain, children, by_child)
-    resolver = MeshResolver(folder, package_map or {}, search_path, resolve_meshes)
-    geometry = tuple(
-        _link_geometry(el, places[el.get("name")], source, resolver)
-        for el in root.findall("link") if el.get("name") in places)
-    return Robot(out, tool=fixed, name=root.get("name") or "urdf_robot",
-                 source=f"URDF {source} ({base} -> {tip})",
-                 link_names=tuple(link_names) + ((tip,) if link_names[-1] != tip else ()),
-                 geometry=geometry)
+    return out, link_names, fixed
 
 
 def _link_frames(base: str, chain: list[_UJoint], children: dict[str, list[str]],

@@ -143,16 +143,7 @@ def base_placement(robot: Robot, tasks: object, *, resolution: float = 0.1, yaws
     yaws = check_int(yaws, "yaws", minimum=1)
     seed = check_int(seed, "seed", minimum=0, maximum=2**63 - 1)
     task = "pose" if robot.n >= 6 else "position"
-    if region is None:
-        lo, hi = robot_reach_box(robot)
-        reach = float(np.max(np.abs(np.concatenate([lo, hi]))))
-        box = np.array([[T[:, 0, 3].min() - reach, T[:, 0, 3].max() + reach],
-                        [T[:, 1, 3].min() - reach, T[:, 1, 3].max() + reach]])
-    else:
-        box = as_float_array(region, "region")
-        if box.shape != (2, 2) or not np.all(box[:, 0] <= box[:, 1]):
-            raise InputError("region must be ((xmin, xmax), (ymin, ymax)) with min <= max "
-                             f"[m], got {box.tolist() if box.size <= 8 else box.shape}")
+    box = _floor_box(robot, T, region)
     ix = (math.floor(box[0, 0] / res), math.ceil(box[0, 1] / res) + 1)
     iy = (math.floor(box[1, 0] / res), math.ceil(box[1, 1] / res) + 1)
     M = T.shape[0]
@@ -162,15 +153,7 @@ def base_placement(robot: Robot, tasks: object, *, resolution: float = 0.1, yaws
     ys = np.arange(*iy) * res
     psi = 2.0 * math.pi * np.arange(yaws) / yaws
     sol = resolve_solver(robot, task, solver, scene)
-    X, Y, P = np.meshgrid(xs, ys, psi, indexing="ij")
-    c, s = np.cos(P.ravel()), np.sin(P.ravel())
-    # B⁻¹ = [Rzᵀ, −Rzᵀ t]: targets in the robot's frame for every candidate and task
-    Binv = np.zeros((K, 4, 4))
-    Binv[:, 0, 0], Binv[:, 0, 1], Binv[:, 1, 0], Binv[:, 1, 1] = c, s, -s, c
-    Binv[:, 2, 2] = Binv[:, 3, 3] = 1.0
-    t = np.stack([X.ravel(), Y.ravel(), np.full(K, float(floor_z))], axis=-1)
-    Binv[:, :3, 3] = -np.einsum("kij,kj->ki", Binv[:, :3, :3], t)
-    rel = np.einsum("kab,mbc->kmac", Binv, T).reshape(K * M, 4, 4)
+    rel = _relative_targets(T, xs, ys, psi, float(floor_z))
     targets = rel if task == "pose" else np.ascontiguousarray(rel[:, :3, 3])
     q0 = voxel_starts(robot, seed, 0, K, M) if sol == "numerical" else None
     ok, _, w = solve_targets(robot, task, targets, sol, q0=q0, seed=restart_seed(seed),
@@ -186,3 +169,47 @@ def base_placement(robot: Robot, tasks: object, *, resolution: float = 0.1, yaws
     return BasePlacement(xs, ys, psi, float(floor_z), reached.reshape(shape),
                          dex.reshape(shape), M, base_pose(xs[i], ys[j], psi[k], float(floor_z)),
                          (i, j, k))
+
+
+def _floor_box(robot: Robot, T: np.ndarray, region: object) -> np.ndarray:
+    """((xmin, xmax), (ymin, ymax)) [m] searched: ``region``, or the task box widened by the reach.
+
+    ``T`` is (M, 4, 4), the task poses; raises InputError for a malformed ``region``.
+    """
+    if region is None:
+        lo, hi = robot_reach_box(robot)
+        reach = float(np.max(np.abs(np.concatenate([lo, hi]))))
+        return np.array([[T[:, 0, 3].min() - reach, T[:, 0, 3].max() + reach],
+                         [T[:, 1, 3].min() - reach, T[:, 1, 3].max() + reach]])
+    box = as_float_array(region, "region")
+    if box.shape != (2, 2) or not np.all(box[:, 0] <= box[:, 1]):
+        raise InputError("region must be ((xmin, xmax), (ymin, ymax)) with min <= max "
+                         f"[m], got {box.tolist() if box.size <= 8 else box.shape}")
+    return box
+
+
+def _relative_targets(T: np.ndarray, xs: np.ndarray, ys: np.ndarray, psi: np.ndarray,
+                      floor_z: float) -> np.ndarray:
+    """Every task pose in the robot's frame for every candidate base: ``B⁻¹ T_m``.
+
+    Args:
+        T: (M, 4, 4) task poses in the world frame [m].
+        xs: (nx,) candidate x [m].
+        ys: (ny,) candidate y [m].
+        psi: (nyaw,) candidate headings [rad].
+        floor_z: height of the floor plane [m].
+
+    Returns:
+        (K·M, 4, 4), K = nx·ny·nyaw candidates in (x, y, ψ) C order, tasks fastest.
+    """
+    X, Y, P = np.meshgrid(xs, ys, psi, indexing="ij")
+    K = X.size
+    M = T.shape[0]
+    c, s = np.cos(P.ravel()), np.sin(P.ravel())
+    # B⁻¹ = [Rzᵀ, −Rzᵀ t]: targets in the robot's frame for every candidate and task
+    Binv = np.zeros((K, 4, 4))
+    Binv[:, 0, 0], Binv[:, 0, 1], Binv[:, 1, 0], Binv[:, 1, 1] = c, s, -s, c
+    Binv[:, 2, 2] = Binv[:, 3, 3] = 1.0
+    t = np.stack([X.ravel(), Y.ravel(), np.full(K, floor_z)], axis=-1)
+    Binv[:, :3, 3] = -np.einsum("kij,kj->ki", Binv[:, :3, :3], t)
+    return np.einsum("kab,mbc->kmac", Binv, T).reshape(K * M, 4, 4)

@@ -29,7 +29,8 @@ reach within the bound as not reached instead of jumping.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -155,6 +156,61 @@ def _ik_target(path: Path, k: int) -> np.ndarray:
     return np.array(path.targets[k])
 
 
+@dataclass(frozen=True, eq=False)
+class _TrackSettings:
+    """The checked settings of one :func:`track` call, shared by its helpers.
+
+    Attributes:
+        q_start: (n,) start configuration [rad or m].
+        rows: task rows of the path's task.
+        obstacles: the obstacles (a resolver's own when none were given).
+        link_radius: link capsule radius [m].
+        accept: acceptance tolerance [m] (``tolerance``).
+        conv: convergence tolerance of the iterations [m] (``tol``).
+        lam: DLS damping λ [m] (``damping``).
+        budget: iteration budget per point (``max_iter``).
+        cap: cap on the joint step per DLS iteration [rad] (``max_step``).
+        jump: ``max_joint_step`` [rad or m], or None.
+        stop: stop after the first point not reached (``on_unreachable='stop'``).
+    """
+
+    q_start: np.ndarray
+    rows: np.ndarray
+    obstacles: tuple
+    link_radius: float
+    accept: float
+    conv: float
+    lam: float
+    budget: int
+    cap: float
+    jump: float | None
+    stop: bool
+
+
+@dataclass(frozen=True, eq=False)
+class _Record:
+    """What :func:`track` records per path point, filled in place by the solver loops.
+
+    Attributes:
+        Q: (p, n) joint values.
+        ITER: (p,) iterations.
+        ERR: (p,) final task errors [m].
+        TIMES: (p,) wall time [s].
+        reasons: why a solver stopped early at a point (QP), by point index.
+    """
+
+    Q: np.ndarray
+    ITER: np.ndarray
+    ERR: np.ndarray
+    TIMES: np.ndarray
+    reasons: dict[int, str]
+
+    @classmethod
+    def empty(cls, p: int, n: int) -> _Record:
+        """Zeroed buffers for ``p`` points of an ``n``-joint robot."""
+        return cls(np.zeros((p, n)), np.zeros(p, dtype=np.int64), np.zeros(p), np.zeros(p), {})
+
+
 def track(
     robot,
     path: Path,
@@ -207,6 +263,28 @@ def track(
             overlapping the base.
         InputTypeError: path is not a Path.
     """
+    s = _track_settings(robot, path, solver, q0=q0, obstacles=obstacles,
+                        link_radius=link_radius, tolerance=tolerance,
+                        on_unreachable=on_unreachable, damping=damping, tol=tol,
+                        max_iter=max_iter, max_step=max_step, max_joint_step=max_joint_step)
+    rec = _Record.empty(len(path), robot.n)
+    targets = np.ascontiguousarray(path.targets)
+    if isinstance(solver, str) and solver == "dls":
+        label, count = _run_dls(robot, targets, s, rec)
+    else:
+        label, step = _solver_step(robot, path, solver, targets, s, ik_options)
+        count = _run_steps(step, len(path), s, rec)
+    stopped = s.stop and count > 0 and rec.ERR[count - 1] > s.accept
+    return _assemble(robot, path, rec.Q[:count], rec.ITER[:count], rec.ERR[:count],
+                     rec.TIMES[:count], s.obstacles, s.link_radius, s.accept, label, stopped,
+                     s.q_start, s.jump, rec.reasons)
+
+
+def _track_settings(robot, path: Path, solver: object, *, q0: object, obstacles: tuple,
+                    link_radius: float, tolerance: float, on_unreachable: str, damping: float,
+                    tol: float, max_iter: int, max_step: float,
+                    max_joint_step: float | None) -> _TrackSettings:
+    """Check the arguments of :func:`track` (same names) and gather them; raises as it does."""
     if not isinstance(path, Path):
         raise InputTypeError(f"path must be a serialkin.tracking.Path, got {type(path).__name__}")
     check_choice(on_unreachable, "on_unreachable", ON_UNREACHABLE)
@@ -227,83 +305,90 @@ def track(
     obstacles = tuple(obstacles)
     encode_obstacles(obstacles)
     check_obstacles(robot, obstacles, link_radius=link_radius)
-    stop = on_unreachable == "stop"
-    p = len(path)
-    n = robot.n
-    Q = np.zeros((p, n))
-    ITER = np.zeros(p, dtype=np.int64)
-    ERR = np.zeros(p)
-    TIMES = np.zeros(p)
-    reasons: dict[int, str] = {}  # why a solver stopped early at a point (QP)
-    targets = np.ascontiguousarray(path.targets)
+    return _TrackSettings(q_start, rows, obstacles, link_radius, accept, conv, lam, budget, cap,
+                          jump, on_unreachable == "stop")
 
-    if isinstance(solver, str) and solver == "dls":
-        label = f"DLS (eq 46), λ = {lam:g} m"
+
+def _run_dls(robot, targets: np.ndarray, s: _TrackSettings, rec: _Record) -> tuple[str, int]:
+    """Track ``targets`` (p, 4, 4) with the compiled DLS loop; (solver label, points computed)."""
+    label = f"DLS (eq 46), λ = {s.lam:g} m"
+    t0 = time.perf_counter()
+    revolute = robot.revolute.astype(float)
+    count = dls_track(s.q_start, targets, s.rows, robot.chain.F, robot.chain.meta, s.lam, s.conv,
+                      s.budget, s.cap, s.accept, s.stop, 1e-3,
+                      np.ascontiguousarray(robot.qlim[:, 0]),
+                      np.ascontiguousarray(robot.qlim[:, 1]), revolute, rec.Q, rec.ITER, rec.ERR)
+    elapsed = time.perf_counter() - t0
+    # per-point time: shared in proportion to the iterations used
+    its = rec.ITER[:count].astype(float) + 1.0
+    rec.TIMES[:count] = elapsed * its / its.sum()
+    return label, count
+
+
+def _check_resolver_task(solver: MultiTaskResolver | QPResolver, path: Path,
+                         rows: np.ndarray) -> None:
+    """Raise InputError when the resolver's task rows are not the path's."""
+    if list(task_rows(solver.task)) != list(rows):
+        raise InputError(f"the resolver's task {solver.task!r} does not match the "
+                         f"path's task {path.task!r}")
+
+
+def _solver_step(robot, path: Path, solver: object, targets: np.ndarray, s: _TrackSettings,
+                 ik_options: Mapping[str, Any] | None) -> tuple[str, Callable]:
+    """The label and the per-point step ``step(k, q) -> result`` of a solver other than 'dls'.
+
+    The result has ``q``, ``iterations``, ``error`` and, optionally, ``reason``.
+    """
+    if isinstance(solver, str) and solver == "multitask":
+        solver = MultiTaskResolver(task=path.task, obstacles=s.obstacles,
+                                   link_radius=s.link_radius, max_iter=s.budget, tol=s.conv)
+    if isinstance(solver, str) and solver == "qp":
+        solver = QPResolver(task=path.task, obstacles=s.obstacles, link_radius=s.link_radius,
+                            max_iter=s.budget, tol=s.conv, max_joint_step=s.jump)
+    if isinstance(solver, QPResolver):
+        _check_resolver_task(solver, path, s.rows)
+        if s.jump is not None and solver.max_joint_step is None:
+            solver = solver.with_options(max_joint_step=s.jump)
+        qstate = solver.prepare(robot)
+        return ("differential-IK QP (hard limits and collision constraints)",
+                lambda k, q: qstate.solve(targets[k], q))
+    if isinstance(solver, MultiTaskResolver):
+        _check_resolver_task(solver, path, s.rows)
+        state = solver.prepare(robot)
+        return "multi-task resolution (eq 48)", lambda k, q: state.solve(targets[k], q)
+    if isinstance(solver, str):
+        if ik_options is not None and (not isinstance(ik_options, Mapping) or not all(
+                isinstance(k, str) for k in ik_options)):
+            raise InputTypeError("ik_options must be a mapping of robot.ik option names "
+                                 f"(str) to values, got {short_repr(ik_options, 80)}")
+        opts = dict(ik_options or {})
+        opts.setdefault("max_iter", s.budget)
+        opts.setdefault("tol", s.conv)
+        return f"IK method {solver!r}", _ik_step(robot, path, solver, opts)
+    raise InputTypeError("solver must be 'dls', 'multitask', 'qp', an IK method name, "
+                         f"a MultiTaskResolver or a QPResolver, got "
+                         f"{type(solver).__name__}")
+
+
+def _run_steps(step: Callable, p: int, s: _TrackSettings, rec: _Record) -> int:
+    """Run ``step`` point by point from ``s.q_start``, timing each; the points computed."""
+    q = s.q_start.copy()
+    count = 0
+    for k in range(p):
         t0 = time.perf_counter()
-        revolute = robot.revolute.astype(float)
-        count = dls_track(q_start, targets, rows, robot.chain.F, robot.chain.meta, lam, conv,
-                          budget, cap, accept, stop, 1e-3, np.ascontiguousarray(robot.qlim[:, 0]),
-                          np.ascontiguousarray(robot.qlim[:, 1]), revolute, Q, ITER, ERR)
-        elapsed = time.perf_counter() - t0
-        # per-point time: shared in proportion to the iterations used
-        its = ITER[:count].astype(float) + 1.0
-        TIMES[:count] = elapsed * its / its.sum()
-    else:
-        if isinstance(solver, str) and solver == "multitask":
-            solver = MultiTaskResolver(task=path.task, obstacles=obstacles,
-                                       link_radius=link_radius, max_iter=budget, tol=conv)
-        if isinstance(solver, str) and solver == "qp":
-            solver = QPResolver(task=path.task, obstacles=obstacles, link_radius=link_radius,
-                                max_iter=budget, tol=conv, max_joint_step=jump)
-        if isinstance(solver, QPResolver):
-            if list(task_rows(solver.task)) != list(rows):
-                raise InputError(f"the resolver's task {solver.task!r} does not match the "
-                                 f"path's task {path.task!r}")
-            if jump is not None and solver.max_joint_step is None:
-                solver = solver.with_options(max_joint_step=jump)
-            label = "differential-IK QP (hard limits and collision constraints)"
-            qstate = solver.prepare(robot)
-            step = lambda k, q: qstate.solve(targets[k], q)  # noqa: E731
-        elif isinstance(solver, MultiTaskResolver):
-            if list(task_rows(solver.task)) != list(rows):
-                raise InputError(f"the resolver's task {solver.task!r} does not match the "
-                                 f"path's task {path.task!r}")
-            label = "multi-task resolution (eq 48)"
-            state = solver.prepare(robot)
-            step = lambda k, q: state.solve(targets[k], q)  # noqa: E731
-        elif isinstance(solver, str):
-            label = f"IK method {solver!r}"
-            if ik_options is not None and (not isinstance(ik_options, Mapping) or not all(
-                    isinstance(k, str) for k in ik_options)):
-                raise InputTypeError("ik_options must be a mapping of robot.ik option names "
-                                     f"(str) to values, got {short_repr(ik_options, 80)}")
-            opts = dict(ik_options or {})
-            opts.setdefault("max_iter", budget)
-            opts.setdefault("tol", conv)
-            step = _ik_step(robot, path, solver, opts)
-        else:
-            raise InputTypeError("solver must be 'dls', 'multitask', 'qp', an IK method name, "
-                                 f"a MultiTaskResolver or a QPResolver, got "
-                                 f"{type(solver).__name__}")
-        q = q_start.copy()
-        count = 0
-        for k in range(p):
-            t0 = time.perf_counter()
-            res = step(k, q)
-            TIMES[k] = time.perf_counter() - t0
-            q = np.array(res.q, dtype=float)
-            Q[k] = q
-            ITER[k] = res.iterations
-            ERR[k] = res.error
-            reason = getattr(res, "reason", "")
-            if reason:
-                reasons[k] = reason
-            count = k + 1
-            if stop and res.error > accept:
-                break
-    return _assemble(robot, path, Q[:count], ITER[:count], ERR[:count], TIMES[:count],
-                     obstacles, link_radius, accept, label,
-                     stop and count > 0 and ERR[count - 1] > accept, q_start, jump, reasons)
+        res = step(k, q)
+        rec.TIMES[k] = time.perf_counter() - t0
+        q = np.array(res.q, dtype=float)
+        rec.Q[k] = q
+        rec.ITER[k] = res.iterations
+        rec.ERR[k] = res.error
+        reason = getattr(res, "reason", "")
+        if reason:
+            rec.reasons[k] = reason
+        count = k + 1
+        if s.stop and res.error > s.accept:
+            break
+    return count
 
 
 class _IKStats:

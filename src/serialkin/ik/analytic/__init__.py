@@ -52,7 +52,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Mapping
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -795,52 +795,94 @@ def ik_all(robot: Robot, target: object, *, tol: float = _TOL, all_turns: bool =
             and grid is None and reference is None and report is False and all_turns is False
             and not options and target.shape == _SHAPE44 and target.dtype is _F64
             and target.flags.carray):
-        # The fast path: the defaults (by identity) and one C-contiguous, aligned, writeable
-        # float64 pose. The rigidity check and the solve are one compiled call
-        # (dispatch.solve_packed) on the robot's cached packed data; the rows are the
-        # ordinary path's, bit for bit.
-        entry = _FAST.get(robot)
-        if entry is None:
-            entry = _fast_entry(robot)
-        out = _EMPTY(entry[5])
-        conv = _ZEROS(_CONV, _I64)  # False beyond the branches
-        k = entry[1](target, entry[2], entry[3], entry[4], out, conv)
-        if k >= 0:
-            return _ALL(out[:k], k, conv, entry[6], entry[7])
-        if k < -1:  # a nearly ideal arm whose refined branches are doubtful
-            from serialkin.ik.analytic.general import DEFAULT_GRID
+        res = _ik_all_fast(robot, target)
+        if res is not None:
+            return res
+        # not rigid to 1e-13: the ordinary path checks, projects or raises
+    return _ik_all_checked(robot, target, _AllOptions(
+        tol=tol, all_turns=all_turns, free=free, near_tol=near_tol, grid=grid,
+        reference=reference, weights=weights, norm=norm, report=report, unknown=options))
 
-            rows = _with_general(robot, target, out[:-2 - k], _TOL, DEFAULT_GRID)
-            return _ALL(rows, rows.shape[0], conv, entry[6], entry[7])
-        # k == -1: not rigid to 1e-13; the ordinary path checks, projects or raises
-    if options:
-        raise InputError(f"unknown option(s) for ik_all: {', '.join(sorted(options))}; "
-                         "accepted: tol, all_turns, free, near_tol, grid, reference, "
-                         "weights, norm, report")
-    if free is not None:
-        solve = {"tol": tol, "all_turns": all_turns, "near_tol": near_tol, "grid": grid,
-                 "report": report}
-        return _ik_all_locked(robot, target, free, (reference, weights, norm), solve)
-    near_tol = check_positive(near_tol, "near_tol", allow_zero=True)
-    p = _prepared(robot, near_tol)
-    tol = check_positive(tol, "tol")
+
+def _ik_all_fast(robot: Robot, target: np.ndarray) -> AllSolutions | None:
+    """:func:`ik_all` with its defaults for one C-contiguous, aligned, writeable float64 pose.
+
+    The fast path: the rigidity check and the solve are one compiled call
+    (dispatch.solve_packed) on the robot's cached packed data; the rows are the ordinary
+    path's, bit for bit. None when the target is not rigid to 1e-13 (the ordinary path
+    then checks, projects or raises).
+    """
+    entry = _FAST.get(robot)
+    if entry is None:
+        entry = _fast_entry(robot)
+    out = _EMPTY(entry[5])
+    conv = _ZEROS(_CONV, _I64)  # False beyond the branches
+    k = entry[1](target, entry[2], entry[3], entry[4], out, conv)
+    if k >= 0:
+        return _ALL(out[:k], k, conv, entry[6], entry[7])
+    if k < -1:  # a nearly ideal arm whose refined branches are doubtful
+        from serialkin.ik.analytic.general import DEFAULT_GRID
+
+        rows = _with_general(robot, target, out[:-2 - k], _TOL, DEFAULT_GRID)
+        return _ALL(rows, rows.shape[0], conv, entry[6], entry[7])
+    return None  # k == -1
+
+
+@dataclass(frozen=True, eq=False)
+class _AllOptions:
+    """The keyword arguments of one :func:`ik_all` call, as given (same names, unchecked).
+
+    ``unknown`` holds the ``**options`` (none are accepted).
+    """
+
+    tol: float
+    all_turns: bool
+    free: Mapping[int, float] | None
+    near_tol: float
+    grid: int | None
+    reference: object
+    weights: object
+    norm: str
+    report: bool
+    unknown: Mapping[str, Any]
+
+
+def _check_grid(grid: object) -> int:
+    """``grid`` of :func:`ik_all` as an int in 4..2000 (None: the default); raises InputError."""
     if grid is None:
         from serialkin.ik.analytic.general import DEFAULT_GRID
 
         grid = DEFAULT_GRID
     if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 4 <= grid <= 2000:
         raise InputError(f"grid must be an int in 4..2000, got {short_repr(grid, 40)}")
-    grid = int(grid)
+    return int(grid)
+
+
+def _ik_all_checked(robot: Robot, target: object, o: _AllOptions) -> AllSolutions:
+    """:func:`ik_all` past its fast path: check the options, then solve one target or a batch."""
+    if o.unknown:
+        raise InputError(f"unknown option(s) for ik_all: {', '.join(sorted(o.unknown))}; "
+                         "accepted: tol, all_turns, free, near_tol, grid, reference, "
+                         "weights, norm, report")
+    if o.free is not None:
+        solve = {"tol": o.tol, "all_turns": o.all_turns, "near_tol": o.near_tol,
+                 "grid": o.grid, "report": o.report}
+        return _ik_all_locked(robot, target, o.free, (o.reference, o.weights, o.norm), solve)
+    near_tol = check_positive(o.near_tol, "near_tol", allow_zero=True)
+    p = _prepared(robot, near_tol)
+    tol = check_positive(o.tol, "tol")
+    grid = _check_grid(o.grid)
     a = target if type(target) is np.ndarray else as_float_array(target, "target")
     if a.ndim >= 3 and a.shape[-2:] == (4, 4):
-        if all_turns:
+        if o.all_turns:
             raise InputError("all_turns applies to one target; for a batch, call ik_all per "
                              "target with all_turns=True")
-        res = _ik_all_batch(p, robot, a, tol, grid, report)
-        if reference is not None:
-            res = _sort_batch(robot, res, reference, weights, norm)
+        res = _ik_all_batch(p, robot, a, tol, grid, o.report)
+        if o.reference is not None:
+            res = _sort_batch(robot, res, o.reference, o.weights, o.norm)
         return res
-    return _ik_all_one(p, robot, a, tol, grid, all_turns, reference, weights, norm, report)
+    return _ik_all_one(p, robot, a, tol, grid, o.all_turns, o.reference, o.weights, o.norm,
+                       o.report)
 
 
 def _ik_all_locked(robot: Robot, target: object, free: object, order: tuple,
