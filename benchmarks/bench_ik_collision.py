@@ -34,12 +34,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 from _common import Stat, header, record, wall_s  # noqa: E402
 
 from serialkin import models  # noqa: E402
-from serialkin.collision import Box, HalfSpace, scene_clearance, self_clearance  # noqa: E402
-from serialkin.redundancy.obstacles import Sphere  # noqa: E402
+from serialkin.collision import scene_clearance, self_clearance  # noqa: E402
+from serialkin.model.geometry import Box, HalfSpace, Sphere  # noqa: E402
 
 SCENE = [HalfSpace([0.0, 0.0, 1.0], -0.10, name="table"),
-         Sphere(np.array([0.45, 0.25, 0.45]), 0.10, name="ball"),
-         Box([0.40, -0.35, 0.25], [0.06, 0.06, 0.06], name="crate")]
+         Sphere(0.10, center=[0.45, 0.25, 0.45], name="ball"),
+         Box((0.12, 0.12, 0.12), center=[0.40, -0.35, 0.25], name="crate")]
 
 
 def free_targets(robot, count: int, margin: float, seed: int) -> np.ndarray:

@@ -31,14 +31,8 @@ import numpy as np  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 import serialkin as sk  # noqa: E402
-from serialkin.collision import (  # noqa: E402
-    Box,
-    HalfSpace,
-    in_collision,
-    scene_clearance,
-    self_clearance,
-)
-from serialkin.redundancy import Capsule, Sphere  # noqa: E402
+from serialkin.collision import in_collision, scene_clearance, self_clearance  # noqa: E402
+from serialkin.model.geometry import Box, Capsule, HalfSpace, Sphere  # noqa: E402
 from serialkin.viz import plot_obstacles, plot_robot  # noqa: E402
 
 out = Path(os.environ.get("SERIALKIN_EXAMPLE_OUT") or tempfile.mkdtemp(prefix="serialkin_"))
@@ -47,8 +41,8 @@ out.mkdir(parents=True, exist_ok=True)
 panda = sk.models.panda()
 model = panda.collision                               # capsules per body
 scene = [HalfSpace([0, 0, 1], -0.10, name="table"),  # table top 10 cm below the base frame
-         Sphere(np.array([0.45, 0.25, 0.45]), 0.10, name="ball"),
-         Box([0.40, -0.35, 0.25], [0.06, 0.06, 0.06], name="crate")]
+         Sphere(0.10, center=[0.45, 0.25, 0.45], name="ball"),
+         Box((0.12, 0.12, 0.12), center=[0.40, -0.35, 0.25], name="crate")]
 print(f"{panda.name}: {len(model.body_names)} collision bodies; scene: "
       + ", ".join(s.name for s in scene))
 
@@ -108,7 +102,7 @@ def capsules(q):
     for s, f in enumerate(model.shape_frame):
         a = frames[f] @ np.append(model.a[s], 1.0)
         b = frames[f] @ np.append(model.b[s], 1.0)
-        caps.append(Capsule(a[:3], b[:3], float(model.radius[s])))
+        caps.append(Capsule(float(model.radius[s]), a=a[:3], b=b[:3]))
     return caps
 
 

@@ -42,7 +42,8 @@ from serialkin.diffik import (  # noqa: E402
     QPResolver,
     VelocityLimit,
 )
-from serialkin.redundancy import Sphere, clearances  # noqa: E402
+from serialkin.model.geometry import Sphere  # noqa: E402
+from serialkin.redundancy import clearances  # noqa: E402
 from serialkin.tracking import load_scenario, track  # noqa: E402
 
 out = Path(os.environ.get("SERIALKIN_EXAMPLE_OUT") or tempfile.mkdtemp(prefix="serialkin_"))
@@ -56,7 +57,7 @@ panda = sk.models.panda()
 q_start = np.array([0.0, -0.4, 0.0, -2.0, 0.0, 1.6, 0.8])
 target = panda.fk(q_start)
 target[:3, 3] += [0.15, 0.10, -0.10]
-ball = Sphere(np.array([0.50, 0.05, 0.45]), 0.05, name="ball")
+ball = Sphere(0.05, center=[0.50, 0.05, 0.45], name="ball")
 safety = 0.01                                         # d_s [m], links as capsules of 5 cm
 print(f"{'joint 4 range [rad]':<22}{'QP steps':>9}{'final error':>14}{'max q4':>9}"
       f"{'min clearance':>15}")

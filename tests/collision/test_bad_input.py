@@ -8,9 +8,7 @@ import pytest
 from serialkin import models
 from serialkin.collision import (
     AllowedCollisionMatrix,
-    Box,
     CollisionModel,
-    HalfSpace,
     acm_from_srdf,
     panda_collision_model,
     read_srdf,
@@ -19,6 +17,7 @@ from serialkin.collision import (
     self_clearance,
 )
 from serialkin.errors import InputError, InputTypeError, RobotDefinitionError
+from serialkin.model.geometry import Box, HalfSpace
 
 
 @pytest.fixture(scope="module")
@@ -57,9 +56,10 @@ def test_scene_item_type(panda):
 
 
 @pytest.mark.parametrize(("build", "match"), [
-    (lambda: Box([0, 0, 0], [0.1, -0.1, 0.1]), "half_extents must be >= 0"),
-    (lambda: Box([0, 0, 0], [0.1, 0.1]), "half_extents must be a vector of 3"),
-    (lambda: Box([0, 0, 0], [0.1, 0.1, 0.1], np.ones((3, 3))), "rotation"),
+    (lambda: Box((0.2, -0.2, 0.2)), r"box size: expected finite numbers >= 0"),
+    (lambda: Box((0.2, 0.2)), "box size: expected 3 numbers"),
+    (lambda: Box((0.2, 0.2, 0.2), center=[0, 0]), "center must be a vector of 3"),
+    (lambda: Box((0.2, 0.2, 0.2), rotation=np.ones((3, 3))), "rotation"),
     (lambda: HalfSpace([0, 0, 0]), "normal must be a non-zero vector"),
     (lambda: HalfSpace([0, 0, 1], float("nan")), "offset"),
 ])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -11,9 +12,7 @@ import pytest
 from serialkin import models
 from serialkin.collision import (
     AllowedCollisionMatrix,
-    Box,
     CollisionModel,
-    HalfSpace,
     acm_from_srdf,
     default_acm,
     in_collision,
@@ -26,7 +25,7 @@ from serialkin.collision import (
 )
 from serialkin.collision import kernels as K
 from serialkin.errors import InputError, RobotDefinitionError
-from serialkin.redundancy.obstacles import Capsule, Circle, Sphere
+from serialkin.model.geometry import Box, Capsule, Cylinder, HalfSpace, Sphere
 
 _SHARE = (Path(sys.prefix) / "lib" / f"python{sys.version_info.major}.{sys.version_info.minor}"
           / "site-packages" / "cmeel.prefix" / "share" / "example-robot-data" / "robots")
@@ -172,9 +171,10 @@ def test_scene_clearance_table_and_box(panda):
     robot, model = panda
     rng = np.random.default_rng(5)
     Q = rng.uniform(robot.qlim[:, 0], robot.qlim[:, 1], (6, 7))
-    box = Box([0.5, 0.0, 0.3], [0.1, 0.2, 0.05])
+    box = Box((0.2, 0.4, 0.1), center=[0.5, 0.0, 0.3])
     table = HalfSpace([0, 0, 1], -0.2)
-    scene = [box, table, Sphere([0.3, 0.3, 0.6], 0.05), Capsule([0, 0.5, 0], [0, 0.5, 1], 0.03)]
+    scene = [box, table, Sphere(0.05, center=[0.3, 0.3, 0.6]),
+             Capsule(0.03, a=[0, 0.5, 0], b=[0, 0.5, 1])]
     c = scene_clearance(robot, model, Q, scene)
     for k, q in enumerate(Q):
         F = robot.fk_all(q)
@@ -195,10 +195,10 @@ def test_scene_clearance_table_and_box(panda):
 
 
 def test_scene_z_cylinder_is_planar_distance(panda):
-    """A Circle (infinite z-cylinder) obstacle is measured in the xy plane."""
+    """An infinite z-cylinder obstacle is measured in the xy plane."""
     robot, model = panda
     q = robot.random_q(3, seed=2)
-    post = Circle([0.4, -0.2], 0.05)
+    post = Cylinder(0.05, math.inf, center=[0.4, -0.2, 0.0])
     c = scene_clearance(robot, model, q, [post])
     for k in range(3):
         F = robot.fk_all(q[k])

@@ -2,16 +2,18 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 import serialkin as sk
-from serialkin.collision import Box, HalfSpace, scene_clearance, self_clearance
+from serialkin.collision import scene_clearance, self_clearance
 from serialkin.diffik import DiffIK, FrameTask, PositionLimit, PostureTask, VelocityLimit
 from serialkin.diffik.model_collision import ModelCollisionAvoidance
 from serialkin.diffik.tasks import Workspace
 from serialkin.errors import InputError
-from serialkin.redundancy import Capsule, Circle, Sphere
+from serialkin.model.geometry import Box, Capsule, Cylinder, HalfSpace, Sphere
 
 
 @pytest.fixture(scope="module")
@@ -20,9 +22,10 @@ def panda():
 
 
 def _scene():
-    return [HalfSpace([0, 0, 1], -0.12), Box([0.5, 0.0, 0.3], [0.1, 0.2, 0.05]),
-            Sphere([0.3, 0.3, 0.5], 0.05), Circle([0.4, -0.4], 0.05),
-            Capsule([0.6, -0.2, 0.2], [0.6, 0.2, 0.6], 0.03)]
+    return [HalfSpace([0, 0, 1], -0.12), Box((0.2, 0.4, 0.1), center=[0.5, 0.0, 0.3]),
+            Sphere(0.05, center=[0.3, 0.3, 0.5]),
+            Cylinder(0.05, math.inf, center=[0.4, -0.4, 0.0]),
+            Capsule(0.03, a=[0.6, -0.2, 0.2], b=[0.6, 0.2, 0.6])]
 
 
 @pytest.mark.parametrize("seed", [3, 4])
@@ -65,7 +68,7 @@ def test_distances_agree_with_the_collision_queries(panda):
 
 def test_pulled_into_a_box_the_arm_stops_at_the_safety_distance(panda):
     """A target inside a box: small steps never bring any capsule into the box or the table."""
-    box = Box([0.55, 0.0, 0.25], [0.08, 0.08, 0.08])
+    box = Box((0.16, 0.16, 0.16), center=[0.55, 0.0, 0.25])
     scene = [box, HalfSpace([0, 0, 1], -0.12)]
     q = np.array([0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8])
     target = panda.fk(q)

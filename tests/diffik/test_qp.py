@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -22,7 +24,7 @@ from serialkin.diffik import (
 )
 from serialkin.diffik.tasks import Workspace
 from serialkin.errors import InputError, InputTypeError
-from serialkin.redundancy import Capsule, Circle, Sphere
+from serialkin.model.geometry import Capsule, Cylinder, Sphere
 from serialkin.tracking import planar_arm
 
 
@@ -107,8 +109,8 @@ def _fd_gradient(f, q, h=1e-6):
 
 
 @pytest.mark.parametrize("obstacle", [
-    Sphere([0.3, 0.2, 0.5], 0.05, influence=5.0),
-    Capsule([0.4, -0.3, 0.0], [0.4, 0.3, 0.8], 0.03, influence=5.0),
+    Sphere(0.05, center=[0.3, 0.2, 0.5], influence=5.0),
+    Capsule(0.03, a=[0.4, -0.3, 0.0], b=[0.4, 0.3, 0.8], influence=5.0),
 ])
 def test_obstacle_rows_match_finite_differences(panda, obstacle):
     """Each collision row is −∇d: it matches central differences of the clearance."""
@@ -143,11 +145,11 @@ def test_self_collision_rows_match_finite_differences(panda):
 def test_collision_damper_limits_the_approach(arm):
     """A step pulled into an obstacle loses at most gain·(d − d_s) of clearance (first order)."""
     q = np.full(arm.n, 0.2)
-    obs = Circle([0.55, 0.45], 0.05, influence=0.1)
+    obs = Cylinder(0.05, math.inf, center=[0.55, 0.45, 0.0], influence=0.1)
     con = CollisionAvoidance([obs], safety=0.01, gain=0.5)
     T = arm.fk(q)
     target = T.copy()
-    target[:2, 3] = obs.center  # the tool is pulled into the obstacle's centre
+    target[:2, 3] = obs.center[:2]  # the tool is pulled into the obstacle's centre
     ik = DiffIK(arm, [FrameTask(target, task="planar")], [con, VelocityLimit(0.05)])
     for _ in range(60):
         C0, _ = con.distances(arm, q)
@@ -174,7 +176,8 @@ def test_conflicting_bounds_are_a_result_naming_the_joint(panda):
 def test_infeasible_collision_rows_are_a_result(arm):
     """A link inside the safety distance that cannot move out (tiny velocity box): a reason."""
     q = np.zeros(arm.n)
-    obs = Circle([0.45, 0.04], 0.03, influence=0.05)  # 1 cm from the stretched arm
+    # 1 cm from the stretched arm
+    obs = Cylinder(0.03, math.inf, center=[0.45, 0.04, 0.0], influence=0.05)
     con = CollisionAvoidance([obs], safety=0.05, influence=0.1, gain=1.0)  # wants 4 cm out
     res = solve_step(arm, q, [PostureTask(q)], [con, VelocityLimit(1e-4)])
     assert not res.success and "infeasible" in res.reason
@@ -214,7 +217,7 @@ def test_bad_input_raises_library_errors(panda):
     with pytest.raises(InputError, match="solver"):
         DiffIK(panda, [PostureTask(np.zeros(7))], solver="quadprog!")
     with pytest.raises(InputError, match="influence"):
-        CollisionAvoidance([Sphere([1, 1, 1], 0.1)], safety=0.1, influence=0.05)
+        CollisionAvoidance([Sphere(0.1, center=[1, 1, 1])], safety=0.1, influence=0.05)
     with pytest.raises(InputError, match="weight"):
         PostureTask(np.zeros(7), weight=-1.0)
     bad = CustomTask(lambda x: (np.eye(3), np.zeros(3)), name="mine")
@@ -227,7 +230,8 @@ def test_compiled_solver_agrees_with_daqp_with_collision_rows(arm, seed):
     """solver='compiled' gives DAQP's step on a QP with limits, a velocity box and distance rows."""
     rng = np.random.default_rng(seed)
     q = rng.uniform(-0.5, 0.5, arm.n)
-    obs = [Circle([0.4, 0.3], 0.05, influence=0.3), Circle([0.2, -0.2], 0.04, influence=0.3)]
+    obs = [Cylinder(0.05, math.inf, center=[0.4, 0.3, 0.0], influence=0.3),
+           Cylinder(0.04, math.inf, center=[0.2, -0.2, 0.0], influence=0.3)]
     target = arm.fk(q)
     target[:2, 3] = [0.3, 0.45]
     tasks = [FrameTask(target, task="planar"), PostureTask(q, weight=1e-3)]
@@ -242,7 +246,7 @@ def test_compiled_solver_agrees_with_daqp_with_collision_rows(arm, seed):
 def test_compiled_solver_reports_infeasibility(arm):
     """The compiled solver finds the infeasible collision QP infeasible too (a result)."""
     q = np.zeros(arm.n)
-    obs = Circle([0.45, 0.04], 0.03, influence=0.05)
+    obs = Cylinder(0.03, math.inf, center=[0.45, 0.04, 0.0], influence=0.05)
     con = CollisionAvoidance([obs], safety=0.05, influence=0.1, gain=1.0)
     res = solve_step(arm, q, [PostureTask(q)], [con, VelocityLimit(1e-4)], solver="compiled")
     assert not res.success and "infeasible" in res.reason

@@ -8,19 +8,19 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from serialkin import models
-from serialkin.collision import Box, HalfSpace, default_acm, scene_clearance, self_clearance
+from serialkin.collision import default_acm, scene_clearance, self_clearance
 from serialkin.collision.queries import checked_shape_pairs
 from serialkin.errors import InputError, InputTypeError
 from serialkin.ik import _kernels as K
 from serialkin.ik import solver
-from serialkin.redundancy.obstacles import Sphere
+from serialkin.model.geometry import Box, HalfSpace, Sphere
 
 from .conftest import ACCURACY
 
 #: Table top 10 cm below the Panda's base frame: the fitted base capsule reaches 8 cm down.
 TABLE = HalfSpace([0.0, 0.0, 1.0], -0.10, name="table")
-BALL = Sphere(np.array([0.45, 0.25, 0.45]), 0.10, name="ball")
-CRATE = Box([0.40, -0.35, 0.25], [0.06, 0.06, 0.06], name="crate")
+BALL = Sphere(0.10, center=[0.45, 0.25, 0.45], name="ball")
+CRATE = Box((0.12, 0.12, 0.12), center=[0.40, -0.35, 0.25], name="crate")
 SCENE = [TABLE, BALL, CRATE]
 
 
@@ -170,7 +170,7 @@ def test_target_inside_obstacle_fails_with_reason(panda):
     """A target inside an obstacle: failure, naming the obstacle, with a finite best attempt."""
     q = free_configurations(panda, 1, seed=8)[0]
     T = panda.fk(q)
-    ball = Sphere(T[:3, 3].copy(), 0.05, name="blob")
+    ball = Sphere(0.05, center=T[:3, 3], name="blob")
     res = panda.ik(T, scene=[ball], restarts=3, seed=0)
     assert not res.success
     assert "inside obstacle 'blob'" in res.reason

@@ -187,13 +187,13 @@ def test_bad_settings_name_the_argument(kwargs, match, tmp_path):
 
 def test_scene_only_removes_reached_targets():
     """With obstacles (collision-aware numerical IK) no voxel reaches more orientations."""
-    from serialkin.redundancy.obstacles import Sphere
+    from serialkin.model.geometry import Sphere
 
     r = models.get("ur5")
     opts = {"bounds": [[0.3, 0.5], [-0.1, 0.1], [0.2, 0.4]], "solver": "numerical",
             "restarts": 8, "progress": False}
     try:
-        blocked = reachability_map(r, 0.1, 4, scene=[Sphere([0.4, 0.0, 0.3], 0.08)], **opts)
+        blocked = reachability_map(r, 0.1, 4, scene=[Sphere(0.08, center=[0.4, 0.0, 0.3])], **opts)
     except InputError as exc:
         if "unknown option" in str(exc) and "scene" in str(exc):
             pytest.skip("this version's IK takes no collision scene yet")

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from serialkin.errors import InputError
+from serialkin.model.geometry import Cylinder
 from serialkin.redundancy import (
-    Circle,
     MultiTaskResolver,
     joint_limit_repulsion,
     joint_limit_weights,
@@ -59,7 +61,7 @@ def test_obstacle_task_damps_the_approach():
     """Eq 48 with the obstacle task: the approach rate J_c q̇ is smaller than without it."""
     robot = twenty_link()
     q = np.full(20, np.radians(6.0))
-    obs = Circle([0.1, 0.07], 0.02, influence=0.05)
+    obs = Cylinder(0.02, math.inf, center=[0.1, 0.07, 0.0], influence=0.05)
     Jc, c, _ = obstacle_jacobian(robot, q, [obs])
     assert Jc.shape[0] > 0
     xdot = np.array([-0.005, 0.005])
@@ -75,7 +77,7 @@ def test_repulsive_mode_retreats():
     """With a repulsive gain the closest link moves away (negative approach rate) at ẋ = 0."""
     robot = twenty_link()
     q = np.full(20, np.radians(6.0))
-    obs = Circle([0.1, 0.07], 0.02, influence=0.05)
+    obs = Cylinder(0.02, math.inf, center=[0.1, 0.07, 0.0], influence=0.05)
     Jc, c, _ = obstacle_jacobian(robot, q, [obs])
     res = MultiTaskResolver(task="planar", obstacles=(obs,), repulsive_gain=1.0,
                             damping=0.01)
@@ -112,4 +114,5 @@ def test_resolver_rejects_bad_settings():
     with pytest.raises(InputError, match="xdot"):
         MultiTaskResolver().velocity(six_link(), np.zeros(6), [0.0, 0.0, 0.0])
     with pytest.raises(InputError, match="overlaps"):
-        MultiTaskResolver(obstacles=(Circle([0, 0], 0.05),)).prepare(six_link())
+        post = Cylinder(0.05, math.inf, center=[0, 0, 0.0])
+        MultiTaskResolver(obstacles=(post,)).prepare(six_link())

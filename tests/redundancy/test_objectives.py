@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from serialkin.errors import InputError, InputTypeError
+from serialkin.model.geometry import Cylinder
 from serialkin.redundancy import (
-    Circle,
     custom_objective,
     jacobian_derivative,
     joint_limit_distance,
@@ -110,7 +112,8 @@ def test_joint_limit_objective_rejects_bad_limits():
 def test_obstacle_distance_gradient_matches_finite_differences(seed, squared):
     """Eq 45's gradient (closest pair, eqs 51-56) matches finite differences away from ties."""
     robot = six_link()
-    obs = [Circle([0.25, 0.2], 0.05), Circle([-0.2, -0.25], 0.04)]
+    obs = [Cylinder(0.05, math.inf, center=[0.25, 0.2, 0.0]),
+           Cylinder(0.04, math.inf, center=[-0.2, -0.25, 0.0])]
     rng = np.random.default_rng(seed)
     q = rng.uniform(-1.2, 1.2, 6)
     obj = obstacle_distance(robot, obs, squared=squared)

@@ -2,22 +2,22 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from serialkin.errors import InputError, InputTypeError
+from serialkin.model.geometry import Capsule, Cylinder, Sphere
 from serialkin.redundancy import (
-    Capsule,
-    Circle,
-    Sphere,
     check_obstacles,
     clearances,
     closest_pairs,
     obstacle_jacobian,
 )
-from serialkin.redundancy.obstacles import obstacle_from_dict, robot_segments
+from serialkin.redundancy.obstacles import obstacle_from_dict, obstacle_to_dict, robot_segments
 
 from ._robots import six_link, spatial_rp
 
@@ -28,8 +28,8 @@ def _brute_clearance(P0, P1, obstacle, samples=4001):
     """Clearance by dense sampling of the segment (independent reference)."""
     t = np.linspace(0, 1, samples)[:, None]
     pts = P0 + t * (P1 - P0)
-    if isinstance(obstacle, Circle):
-        d = np.linalg.norm(pts[:, :2] - obstacle.center, axis=1)
+    if isinstance(obstacle, Cylinder):
+        d = np.linalg.norm(pts[:, :2] - obstacle.center[:2], axis=1)
     elif isinstance(obstacle, Sphere):
         d = np.linalg.norm(pts - obstacle.center, axis=1)
     else:
@@ -44,9 +44,9 @@ def _random_scene(seed):
     rng = np.random.default_rng(seed)
     robot = spatial_rp()
     q = robot.random_q(seed=rng)
-    obs = [Circle(rng.uniform(-0.4, 0.4, 2), 0.03),
-           Sphere(rng.uniform(-0.4, 0.4, 3), 0.04),
-           Capsule(rng.uniform(-0.4, 0.4, 3), rng.uniform(-0.4, 0.4, 3), 0.02)]
+    obs = [Cylinder(0.03, math.inf, center=[*rng.uniform(-0.4, 0.4, 2), 0.0]),
+           Sphere(0.04, center=rng.uniform(-0.4, 0.4, 3)),
+           Capsule(0.02, a=rng.uniform(-0.4, 0.4, 3), b=rng.uniform(-0.4, 0.4, 3))]
     return robot, q, obs
 
 
@@ -54,7 +54,7 @@ def test_closest_point_is_clamped_to_the_segment():
     """ERRATA (51)-(52): an obstacle beyond a link's end is closest to the end, not the line."""
     robot = six_link()
     q = np.zeros(6)  # links along +x: link 1 from (0,0) to (0.1,0)
-    obs = [Circle([-0.3, 0.05], 0.02)]  # behind the base, off the line
+    obs = [Cylinder(0.02, math.inf, center=[-0.3, 0.05, 0.0])]  # behind the base, off the line
     pairs = closest_pairs(robot, q, obs)
     p = pairs[0]
     assert p.t == 0.0
@@ -104,8 +104,9 @@ def test_obstacle_jacobian_keeps_only_pairs_within_influence():
     """Only link/obstacle pairs closer than the influence distance give rows."""
     robot = six_link()
     q = np.zeros(6)
-    near = Circle([0.15, 0.05], 0.03, influence=0.05)   # 20 mm from links 1-2
-    far = Circle([0.15, 0.5], 0.03, influence=0.05)
+    # 20 mm from links 1-2
+    near = Cylinder(0.03, math.inf, center=[0.15, 0.05, 0.0], influence=0.05)
+    far = Cylinder(0.03, math.inf, center=[0.15, 0.5, 0.0], influence=0.05)
     Jc, c, pairs = obstacle_jacobian(robot, q, [near, far])
     assert Jc.shape[1] == 6 and Jc.shape[0] == len(pairs) == len(c) > 0
     assert all(j == 0 for _, j in pairs)
@@ -118,20 +119,20 @@ def test_obstacle_overlapping_base_is_rejected():
     """An obstacle that covers the robot's base raises InputError naming it."""
     robot = six_link()
     with pytest.raises(InputError, match="overlaps the robot base"):
-        check_obstacles(robot, [Circle([0.01, 0.0], 0.05, name="pillar")])
-    check_obstacles(robot, [Circle([0.2, 0.0], 0.05)])
+        check_obstacles(robot, [Cylinder(0.05, math.inf, center=[0.01, 0.0, 0.0], name="pillar")])
+    check_obstacles(robot, [Cylinder(0.05, math.inf, center=[0.2, 0.0, 0.0])])
 
 
 def test_obstacle_construction_errors():
     """Bad radii, centres and dictionaries raise clear errors."""
     with pytest.raises(InputError, match="radius"):
-        Circle([0, 0], -1.0)
+        Cylinder(-1.0, math.inf, center=[0, 0, 0])
     with pytest.raises(InputError, match="center"):
-        Sphere([0, 0], 1.0)
+        Sphere(1.0, center=[0, 0])
     with pytest.raises(InputError, match="finite"):
-        Circle([np.nan, 0], 1.0)
+        Cylinder(1.0, math.inf, center=[np.nan, 0, 0])
     with pytest.raises(InputError, match="influence"):
-        Circle([0, 0], 1.0, influence=-0.1)
+        Cylinder(1.0, math.inf, center=[0, 0, 0], influence=-0.1)
     with pytest.raises(InputError, match="obstacle.type"):
         obstacle_from_dict({"type": "cube"})
     with pytest.raises(InputError, match="'obstacle.radius' is missing"):
@@ -141,5 +142,5 @@ def test_obstacle_construction_errors():
     with pytest.raises(InputTypeError):
         clearances(six_link(), np.zeros(6), ["not an obstacle"])
     o = obstacle_from_dict({"type": "capsule", "a": [0, 0, 0], "b": [1, 0, 0], "radius": 0.1})
-    back = obstacle_from_dict(o.to_dict())
+    back = obstacle_from_dict(obstacle_to_dict(o))
     assert isinstance(back, Capsule) and np.allclose(back.b, o.b) and back.radius == o.radius

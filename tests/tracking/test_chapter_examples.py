@@ -77,7 +77,7 @@ def test_constrained_twenty_link_avoids_obstacles_and_limits(constrained):
         t = np.linspace(0, 1, 50)[:, None, None]
         pts = (F[:-1] + t * (F[1:] - F[:-1])).reshape(-1, 2)
         for o in s.obstacles:
-            assert np.min(np.linalg.norm(pts - o.center, axis=1)) > o.radius
+            assert np.min(np.linalg.norm(pts - o.center[:2], axis=1)) > o.radius
 
 
 def test_self_motion_differs_while_task_path_agrees(free, constrained):

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import copy
+import math
 
 import numpy as np
 import pytest
 
 from serialkin.diffik.resolver import QPResolver
 from serialkin.errors import InputError
-from serialkin.redundancy import Circle
+from serialkin.model.geometry import Cylinder
 from serialkin.tracking import Path, load_scenario, planar_arm, scenario_from_dict, track
 
 
@@ -21,10 +22,11 @@ def _circle_clearance(robot, Q, obstacles):
         a, b = P[:-1], P[1:]
         for j, o in enumerate(obstacles):
             d = b - a
-            t = np.clip(np.einsum("ij,ij->i", o.center - a, d) / np.einsum("ij,ij->i", d, d),
+            c = o.center[:2]  # a vertical cylinder: its circle in the plane
+            t = np.clip(np.einsum("ij,ij->i", c - a, d) / np.einsum("ij,ij->i", d, d),
                         0.0, 1.0)
             closest = a + t[:, None] * d
-            out[k, j] = np.linalg.norm(closest - o.center, axis=1).min() - o.radius
+            out[k, j] = np.linalg.norm(closest - c, axis=1).min() - o.radius
     return out
 
 
@@ -93,7 +95,7 @@ def test_joint_jumps_are_reported_never_silent():
 def test_target_inside_an_obstacle_is_not_reached_and_not_entered():
     """A path point inside an obstacle is reported unreached; the arm stops outside it."""
     arm = planar_arm(6, 0.1)
-    obs = Circle([0.3, 0.25], 0.05, influence=0.03)
+    obs = Cylinder(0.05, math.inf, center=[0.3, 0.25, 0.0], influence=0.03)
     path = Path.from_points([[0.35, 0.1], [0.3, 0.25]])
     tr = track(arm, path, "qp", q0=np.full(6, 0.2), obstacles=(obs,))
     assert tr.reached.tolist() == [True, False]
@@ -204,7 +206,7 @@ def test_self_collision_tracking_keeps_links_apart_in_both_loops():
 def test_margin_larger_than_the_free_space_is_reported(tmp_path):
     """A safety distance no configuration can keep: infeasible QPs are named, never silent."""
     arm = planar_arm(6, 0.1)
-    obs = Circle([0.3, 0.2], 0.05, influence=0.05)
+    obs = Cylinder(0.05, math.inf, center=[0.3, 0.2, 0.0], influence=0.05)
     path = Path.from_points([arm.fk(np.full(6, 0.2))[:2, 3], [0.45, 0.1]])
     res = QPResolver(task="planar", obstacles=(obs,), safety=0.5, max_step=0.01)
     tr = track(arm, path, res, q0=np.full(6, 0.2))
@@ -218,10 +220,11 @@ def test_margin_larger_than_the_free_space_is_reported(tmp_path):
 def test_panda_tracking_with_its_capsule_model_and_a_scene():
     """A Panda path over a box on a table: no capsule enters the scene or another body."""
     import serialkin as sk
-    from serialkin.collision import Box, HalfSpace, scene_clearance, self_clearance
+    from serialkin.collision import scene_clearance, self_clearance
+    from serialkin.model.geometry import Box, HalfSpace
 
     panda = sk.models.get("panda")
-    box = Box([0.5, 0.0, 0.1], [0.1, 0.15, 0.1])
+    box = Box((0.2, 0.3, 0.2), center=[0.5, 0.0, 0.1])
     scene = (box, HalfSpace([0, 0, 1], -0.12))
     q0 = np.array([0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8])
     start = panda.fk(q0)[:3, 3]

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 from serialkin.errors import InputError, InputTypeError
-from serialkin.redundancy import Circle, MultiTaskResolver
+from serialkin.model.geometry import Cylinder
+from serialkin.redundancy import MultiTaskResolver
 from serialkin.tracking import Path, Trajectory, planar_arm, track
 
 
@@ -72,7 +75,7 @@ def test_bad_tracking_arguments(arm):
     with pytest.raises(InputTypeError, match="solver"):
         track(arm, path, solver=3)
     with pytest.raises(InputError, match="overlaps"):
-        track(arm, path, obstacles=[Circle([0.0, 0.0], 0.02)])
+        track(arm, path, obstacles=[Cylinder(0.02, math.inf, center=[0.0, 0.0, 0.0])])
     with pytest.raises(InputError, match="task"):
         track(arm, path, MultiTaskResolver(task="position"))
 
@@ -91,7 +94,7 @@ def test_path_constructors():
 
 def test_trajectory_roundtrip_csv_and_npz(arm, tmp_path):
     """Saving to CSV and NPZ and loading back gives the same trajectory."""
-    obs = [Circle([0.0, 0.3], 0.05, name="post")]
+    obs = [Cylinder(0.05, math.inf, center=[0.0, 0.3, 0.0], name="post")]
     tr = track(arm.with_limits(np.tile([-2.5, 2.5], (6, 1))), _path_with_unreachable(),
                q0=np.full(6, 0.3), obstacles=obs)
     assert tr.clearance.shape == (5, 1)

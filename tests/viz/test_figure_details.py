@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import io
+import math
 
 import matplotlib.pyplot as plt
 import numpy as np
 from PIL import Image
 
-from serialkin.redundancy import Circle
+from serialkin.model.geometry import Cylinder
 from serialkin.tracking.scenario import planar_arm
 from serialkin.viz import (
     AnimationOptions,
@@ -39,7 +40,7 @@ def test_motion_shows_start_pose_labels_and_legend_outside():
     """plot_motion(q0=..., labels=True): start pose drawn, names written, legend off the axes."""
     robot = planar_arm(4, 0.1)
     Q = np.linspace([0.2, 0.3, 0.2, 0.1], [0.8, 0.5, 0.4, 0.3], 10)
-    obs = [Circle([0.1, 0.25], 0.03, influence=0.02, name="A")]
+    obs = [Cylinder(0.03, math.inf, center=[0.1, 0.25, 0.0], influence=0.02, name="A")]
     ax = plot_motion(robot, Q, path_points=np.zeros((3, 2)) + 0.1, q0=np.zeros(4),
                      obstacles=obs, influence=True, labels=True)
     start = [ln for ln in ax.get_lines() if ln.get_gid() == "serialkin-start"]

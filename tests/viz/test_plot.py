@@ -1,11 +1,14 @@
 """Tests for serialkin.viz.plot: the drawn artists carry the kinematics' numbers."""
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from serialkin.errors import InputError, InputTypeError
+from serialkin.model.geometry import Capsule, Cylinder, Sphere
 from serialkin.viz.plot import (
     as_obstacle,
     is_3d_axes,
@@ -176,18 +179,19 @@ def test_plot_path_2d_and_3d(planar3, spatial4):
 
 
 def test_redundancy_obstacle_classes():
-    """The redundancy helper's Circle/Sphere/Capsule and their to_dict() forms are drawn."""
+    """The obstacle shapes (Cylinder/Sphere/Capsule) and their plain-data forms are drawn."""
     obstacles = pytest.importorskip("serialkin.redundancy.obstacles")
-    circle = obstacles.Circle(center=[0.4, 0.1], radius=0.05, influence=0.03)
-    sphere = obstacles.Sphere(center=[0.1, 0.2, 0.3], radius=0.07)
-    capsule = obstacles.Capsule(a=[0, 0, 0], b=[0.2, 0, 0.1], radius=0.02)
-    for src in (circle, circle.to_dict()):
+    circle = Cylinder(0.05, math.inf, center=[0.4, 0.1, 0.0], influence=0.03)
+    sphere = Sphere(0.07, center=[0.1, 0.2, 0.3])
+    capsule = Capsule(0.02, a=[0, 0, 0], b=[0.2, 0, 0.1])
+    to_dict = obstacles.obstacle_to_dict
+    for src in (circle, to_dict(circle)):
         ob = as_obstacle(src)
         assert ob.kind == "cylinder" and ob.height is None and ob.influence == 0.03
         np.testing.assert_allclose(ob.center, [0.4, 0.1, 0.0])
-    for src in (sphere, sphere.to_dict()):
+    for src in (sphere, to_dict(sphere)):
         assert as_obstacle(src).kind == "sphere"
-    for src in (capsule, capsule.to_dict()):
+    for src in (capsule, to_dict(capsule)):
         ob = as_obstacle(src)
         assert ob.kind == "capsule"
         np.testing.assert_allclose(ob.b, [0.2, 0, 0.1])

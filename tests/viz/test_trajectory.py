@@ -1,11 +1,13 @@
 """Tests for serialkin.viz.trajectory: plotted lines hold the trajectory's numbers."""
 
+import math
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from serialkin.errors import InputError
+from serialkin.model.geometry import Cylinder
 from serialkin.viz.trajectory import (
     clearance_along,
     plot_clearance,
@@ -78,8 +80,8 @@ def test_clearance_lines_and_contact():
 def test_clearance_along_matches_redundancy(planar3):
     """clearance_along equals the redundancy module's per-configuration minimum."""
     ob = pytest.importorskip("serialkin.redundancy.obstacles")
-    obstacles = [ob.Circle([0.6, 0.6], 0.1), dict(type="sphere", center=[0.0, 0.8, 0.0],
-                                                  radius=0.05)]
+    obstacles = [Cylinder(0.1, math.inf, center=[0.6, 0.6, 0.0]),
+                 dict(type="sphere", center=[0.0, 0.8, 0.0], radius=0.05)]
     Q = planar3.random_q(4, seed=5)
     C = clearance_along(planar3, Q, obstacles)
     assert C.shape == (4, 2)
@@ -105,11 +107,10 @@ def test_motion_draws_selected_poses(planar3):
 def test_tracking_figure_from_real_track():
     """tracking_figure accepts a Trajectory from serialkin.tracking.track (4 panels)."""
     tracking = pytest.importorskip("serialkin.tracking")
-    ob = pytest.importorskip("serialkin.redundancy.obstacles")
     from serialkin import models
 
     robot = models.planar(6, 0.1)
-    obstacles = [ob.Circle([-0.1, 0.25], 0.05, name="post")]
+    obstacles = [Cylinder(0.05, math.inf, center=[-0.1, 0.25, 0.0], name="post")]
     traj = tracking.track(robot, tracking.Path.circle([-0.25, 0.0], 0.1), obstacles=obstacles)
     fig = tracking_figure(traj, robot, obstacles=obstacles, title="six-link")
     assert len(fig.axes) == 4

@@ -2,8 +2,9 @@
 
 * :mod:`~serialkin.collision.kernels` — compiled signed distances with witness points
   (sphere, capsule, box, half-space);
-* :mod:`~serialkin.collision.shapes` — scene shapes (boxes, half-spaces, and the obstacles
-  of :mod:`serialkin.redundancy.obstacles`);
+* :mod:`~serialkin.collision.shapes` — the flat encoding of a scene, whose shapes are
+  those of :mod:`serialkin.model.geometry` (``Sphere``, ``Capsule``, ``Box``,
+  ``HalfSpace``, the infinite ``Cylinder`` along z) in the world frame;
 * :class:`CollisionModel` — capsules per body per frame (defined in
   :mod:`serialkin.model.collision_model`: a robot carries it);
 * :mod:`~serialkin.collision.fit` — capsules fitted to link geometry (meshes, primitives),
@@ -36,7 +37,6 @@ from serialkin.collision.robots import (
     stanford_collision_model,
     ur5_collision_model,
 )
-from serialkin.collision.shapes import Box, HalfSpace
 from serialkin.collision.srdf import Srdf, read_srdf
 from serialkin.model.collision_model import CollisionModel
 from serialkin.model.robot import provide
@@ -45,11 +45,9 @@ provide("fit_collision", collision_model_from_geometry)  # Robot.fit_collision c
 
 __all__ = [
     "AllowedCollisionMatrix",
-    "Box",
     "Clearance",
     "CollisionModel",
     "FitReport",
-    "HalfSpace",
     "ShapeFit",
     "Srdf",
     "acm_from_srdf",
@@ -68,3 +66,10 @@ __all__ = [
     "stanford_collision_model",
     "ur5_collision_model",
 ]
+
+
+def __getattr__(name: str) -> object:
+    """``Box``, ``HalfSpace``: old names of :mod:`serialkin.model.geometry` classes (warn)."""
+    from serialkin.collision.shapes import _deprecated
+
+    return _deprecated(__name__, name)

@@ -443,9 +443,9 @@ def scene_clearance(robot, model: CollisionModel, q: object, scene) -> Clearance
         robot: the robot.
         model: its collision model.
         q: joint values, shape (..., n).
-        scene: a shape or a sequence of :class:`~serialkin.redundancy.obstacles.Sphere`,
-            ``Capsule``, ``Circle`` (z-cylinder), :class:`~serialkin.collision.shapes.Box`,
-            :class:`~serialkin.collision.shapes.HalfSpace`, in the world frame.
+        scene: a shape or a sequence of shapes of :mod:`serialkin.model.geometry` in
+            the world frame: ``Sphere``, ``Capsule``, ``Box``, ``HalfSpace`` and the
+            infinite ``Cylinder`` along z (see :func:`~serialkin.collision.shapes.encode_scene`).
 
     Returns:
         :class:`Clearance`: ``distance`` (...,) [m], ``pair`` (..., 2) = (body, scene index).

@@ -1,31 +1,32 @@
-"""Scene shapes and their flat encoding for the compiled clearance kernels.
+"""The flat encoding of a collision scene for the compiled clearance kernels.
 
-A *scene* is a sequence of shapes fixed in the world frame (metres):
-
-* :class:`serialkin.redundancy.obstacles.Sphere` and
-  :class:`~serialkin.redundancy.obstacles.Capsule` — the obstacles the redundancy tasks
-  already use (one definition of each; their ``influence`` is ignored here);
-* :class:`~serialkin.redundancy.obstacles.Circle` (``Cylinder``) — an infinite cylinder
-  along the world z axis: its distance is measured in the xy plane;
-* :class:`Box` — an oriented box;
-* :class:`HalfSpace` — the solid ``{x : nᵀx ≤ offset}`` (a table, a wall, the floor).
+A *scene* is a sequence of shapes of :mod:`serialkin.model.geometry` fixed in the world
+frame (metres): :class:`~serialkin.model.geometry.Sphere`,
+:class:`~serialkin.model.geometry.Capsule`, :class:`~serialkin.model.geometry.Box`,
+:class:`~serialkin.model.geometry.HalfSpace` and the infinite
+:class:`~serialkin.model.geometry.Cylinder` along z (its distance is measured in the xy
+plane). Their ``influence`` is not used here.
 
 :func:`encode_scene` packs a scene into a (k, 16) float array, one row per shape:
 ``kind`` in column 0, then the parameters (see :data:`KIND_NAMES`).
+
+``Box`` and ``HalfSpace`` were defined here before the shapes had one vocabulary; the
+old names still build the shared classes for one release, with a ``DeprecationWarning``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+import warnings
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
-from serialkin._checks import as_float_array, as_vector, check_real, check_rotation
-from serialkin.errors import InputError, InputTypeError
-from serialkin.redundancy.obstacles import Capsule, Circle, Sphere
+from serialkin._checks import as_float_array, as_vector
+from serialkin.errors import InputError, InputTypeError, NotSupportedError
+from serialkin.model import geometry  # not its names: Box and HalfSpace here are the old ones
 
-__all__ = ["KIND_NAMES", "Box", "HalfSpace", "encode_scene"]
+__all__ = ["KIND_NAMES", "encode_scene"]
 
 KIND_SPHERE, KIND_CAPSULE, KIND_BOX, KIND_HALFSPACE, KIND_CIRCLE = 0, 1, 2, 3, 4
 #: Row layout of :func:`encode_scene` by kind (column 0 holds the kind).
@@ -38,83 +39,89 @@ KIND_NAMES = {
 }
 ROW = 16
 
-
-@dataclass(frozen=True)
-class Box:
-    """An oriented box: the points ``center + rotation @ u`` with ``|u_k| ≤ half_extents[k]``.
-
-    Attributes:
-        center: (3,) centre in the world frame [m].
-        half_extents: (3,) half side lengths along the box axes [m], each ≥ 0.
-        rotation: (3, 3) rotation whose columns are the box axes in the world frame
-            (identity by default).
-        name: label.
-    """
-
-    center: np.ndarray
-    half_extents: np.ndarray
-    rotation: np.ndarray = None  # type: ignore[assignment]
-    name: str = ""
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "center", as_vector(self.center, "center", 3).copy())
-        h = as_vector(self.half_extents, "half_extents", 3).copy()
-        if (h < 0).any():
-            raise InputError(f"half_extents must be >= 0, got {h.tolist()}")
-        object.__setattr__(self, "half_extents", h)
-        R = np.eye(3) if self.rotation is None else check_rotation(self.rotation, "rotation")
-        if R.shape != (3, 3):
-            raise InputError(f"rotation must have shape (3, 3), got {R.shape}")
-        object.__setattr__(self, "rotation", np.array(R, dtype=float))
-
-
-@dataclass(frozen=True)
-class HalfSpace:
-    """The solid ``{x : normalᵀ x ≤ offset}`` below a plane (a table top: normal +z).
-
-    Attributes:
-        normal: (3,) outward normal of the solid, normalised on construction.
-        offset: signed height of the plane along ``normal`` [m].
-        name: label.
-    """
-
-    normal: np.ndarray
-    offset: float = 0.0
-    name: str = ""
-
-    def __post_init__(self) -> None:
-        n = as_vector(self.normal, "normal", 3)
-        norm = float(np.linalg.norm(n))
-        if norm < 1e-12:
-            raise InputError(f"normal must be a non-zero vector, got {n.tolist()}")
-        object.__setattr__(self, "normal", n / norm)
-        object.__setattr__(self, "offset", check_real(self.offset, "offset"))
+_SCENE_TYPES = (geometry.Sphere, geometry.Capsule, geometry.Cylinder, geometry.Box,
+                geometry.HalfSpace)
 
 
 def encode_scene(scene: Sequence[object]) -> np.ndarray:
     """Pack scene shapes into a (k, 16) float array (layout in :data:`KIND_NAMES`).
 
+    Args:
+        scene: one shape or a sequence of shapes, in the world frame.
+
     Raises:
-        InputTypeError: an item is not a Sphere, Capsule, Circle, Box or HalfSpace.
+        InputTypeError: an item is not a Sphere, Capsule, Cylinder, Box or HalfSpace.
+        NotSupportedError: a cylinder that is finite or whose axis is not along z.
     """
-    if isinstance(scene, (Sphere, Capsule, Circle, Box, HalfSpace)):
+    if isinstance(scene, _SCENE_TYPES):
         scene = [scene]
     rows = np.zeros((len(scene), ROW))
     for i, s in enumerate(scene):
         r = rows[i]
-        if isinstance(s, Sphere):
+        if isinstance(s, geometry.Sphere):
             r[0], r[1:4], r[4] = KIND_SPHERE, s.center, s.radius
-        elif isinstance(s, Capsule):
+        elif isinstance(s, geometry.Capsule):
             r[0], r[1:4], r[4:7], r[7] = KIND_CAPSULE, s.a, s.b, s.radius
-        elif isinstance(s, Circle):
-            r[0], r[1:3], r[3] = KIND_CIRCLE, s.center, s.radius
-        elif isinstance(s, Box):
+        elif isinstance(s, geometry.Cylinder):
+            if not s.infinite_along_z:
+                raise NotSupportedError(
+                    f"scene[{i}]: a Cylinder in a scene must be infinite along z "
+                    f"(length=math.inf, axis along the world z), got length {s.length:g} m "
+                    f"and axis {s.axis.round(6).tolist()}")
+            r[0], r[1:3], r[3] = KIND_CIRCLE, s.center[:2], s.radius
+        elif isinstance(s, geometry.Box):
             r[0], r[1:4], r[4:13], r[13:16] = (KIND_BOX, s.center, s.rotation.ravel(),
                                                s.half_extents)
-        elif isinstance(s, HalfSpace):
+        elif isinstance(s, geometry.HalfSpace):
             r[0], r[1:4], r[4] = KIND_HALFSPACE, s.normal, s.offset
         else:
             raise InputTypeError(
-                f"scene[{i}] must be a Sphere, Capsule, Circle, Box or HalfSpace, "
+                f"scene[{i}] must be a Sphere, Capsule, Cylinder, Box or HalfSpace, "
                 f"got {type(s).__name__}")
     return np.ascontiguousarray(as_float_array(rows, "scene"))
+
+
+# ------------------------------------------------------------------ deprecated names
+def _old_box(center: object, half_extents: object, rotation: object = None,
+             name: str = "") -> geometry.Box:
+    """The old ``Box(center, half_extents, rotation=None, name='')``: a Box of size 2·h."""
+    h = as_vector(half_extents, "half_extents", 3)
+    if (h < 0).any():
+        raise InputError(f"half_extents must be >= 0, got {h.tolist()}")
+    placement: dict[str, Any] = {} if rotation is None else {"rotation": rotation}
+    return geometry.Box(tuple(2.0 * h), center=center, name=name, **placement)
+
+
+def _old_halfspace(normal: object, offset: float = 0.0, name: str = "") -> geometry.HalfSpace:
+    """The old ``HalfSpace(normal, offset=0.0, name='')``."""
+    return geometry.HalfSpace(normal, offset, name=name)
+
+
+_old_box.__name__ = _old_box.__qualname__ = "Box"
+_old_halfspace.__name__ = _old_halfspace.__qualname__ = "HalfSpace"
+
+#: Old name -> (thin constructor, the call in the shared vocabulary).
+_DEPRECATED: dict[str, tuple[Callable[..., Any], str]] = {
+    "Box": (_old_box, "Box(size=2 * half_extents, center=..., rotation=..., name=...)"),
+    "HalfSpace": (_old_halfspace, "HalfSpace(normal, offset, name=...)"),
+}
+
+
+def _deprecated(module: str, name: str) -> Callable[..., Any]:
+    """The thin constructor of an old scene-shape name, with a ``DeprecationWarning``.
+
+    Raises:
+        AttributeError: ``name`` is not an old name (``module`` has no such attribute).
+    """
+    if name not in _DEPRECATED:
+        raise AttributeError(f"module {module!r} has no attribute {name!r}")
+    build, call = _DEPRECATED[name]
+    warnings.warn(f"{module}.{name} is deprecated: import {name} from serialkin.model.geometry "
+                  f"(one class per shape), sizes first and placement by keyword: {call}",
+                  DeprecationWarning, stacklevel=3)
+    return build
+
+
+def __getattr__(name: str) -> Callable[..., Any]:
+    """``Box``, ``HalfSpace``: the old names, building the shared classes (warns)."""
+    return _deprecated(__name__, name)

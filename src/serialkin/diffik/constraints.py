@@ -237,7 +237,8 @@ class CollisionAvoidance(Constraint):
     offset adds one segment, which is not checked against itself here).
 
     Attributes:
-        obstacles: :class:`~serialkin.redundancy.obstacles.Circle`, ``Sphere``, ``Capsule``.
+        obstacles: :class:`~serialkin.model.geometry.Cylinder` (infinite along z),
+            ``Sphere``, ``Capsule``.
         link_radius: capsule radius of the links [m].
         safety: d_s, the clearance kept [m] (≥ 0).
         influence: d_i, the clearance below which a pair is constrained [m]; None uses

@@ -5,8 +5,8 @@
 :class:`~serialkin.model.collision_model.CollisionModel` (the fitted capsules and spheres per
 link frame that ``robot.collision`` carries, e.g. the zoo's Panda and UR5) against scene
 shapes (spheres, capsules, z-cylinders, boxes, half-spaces of
-:mod:`serialkin.collision.shapes`) and between the robot's own bodies (pairs checked by
-the allowed-collision matrix).
+:mod:`serialkin.model.geometry`, encoded by :mod:`serialkin.collision.shapes`) and
+between the robot's own bodies (pairs checked by the allowed-collision matrix).
 
 For every pair the compiled kernels of :mod:`serialkin.collision.kernels` give the signed
 distance ``d`` and the witness points ``w₁`` (on the robot shape) and ``w₂``; ``(w₁ − w₂)/d``
@@ -183,8 +183,8 @@ class ModelCollisionAvoidance(Constraint):
     """Velocity-damper rows from a capsule collision model, a scene and self pairs.
 
     Attributes:
-        scene: scene shapes in the world frame (``Sphere``, ``Capsule``, ``Circle``,
-            ``Box``, ``HalfSpace``), or ().
+        scene: scene shapes in the world frame (``Sphere``, ``Capsule``, ``Box``,
+            ``HalfSpace``, the infinite ``Cylinder`` along z), or ().
         model: the :class:`~serialkin.model.collision_model.CollisionModel`; None uses the
             robot's ``robot.collision``.
         acm: allowed-collision matrix for the self pairs (default: the model's default).

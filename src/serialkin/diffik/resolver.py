@@ -43,7 +43,8 @@ from serialkin.diffik.constraints import (
 from serialkin.diffik.qp import DiffIK, check_solver
 from serialkin.diffik.tasks import FrameTask, PostureTask
 from serialkin.errors import InputError
-from serialkin.redundancy.obstacles import Capsule, Circle, Sphere, check_obstacles
+from serialkin.model.geometry import Capsule, Cylinder, Sphere
+from serialkin.redundancy.obstacles import check_obstacles, encode_obstacles
 
 __all__ = ["QPResolver", "QPSolveStats"]
 
@@ -65,7 +66,9 @@ class QPResolver:
 
     Attributes:
         task: the path's task rows ('planar', 'position', 'pose', ...).
-        obstacles: obstacles of :mod:`serialkin.redundancy.obstacles`.
+        obstacles: obstacles of the obstacle task (:mod:`serialkin.redundancy.obstacles`:
+            ``Sphere``, ``Capsule`` and the infinite ``Cylinder`` along z of
+            :mod:`serialkin.model.geometry`).
         link_radius: link capsule radius [m].
         safety: d_s, clearance kept from obstacles [m].
         collision_gain: fraction of ``d − d_s`` the clearance may lose per step, (0, 1].
@@ -110,13 +113,14 @@ class QPResolver:
         task_rows(self.task)
         if isinstance(self.obstacles, (str, bytes, Mapping)) or not isinstance(
                 self.obstacles, Iterable):
-            raise InputError("obstacles must be a list of Circle, Sphere or Capsule, got "
+            raise InputError("obstacles must be a list of Cylinder, Sphere or Capsule, got "
                              f"{type(self.obstacles).__name__} {short_repr(self.obstacles)}")
         obs = tuple(self.obstacles)
         for i, o in enumerate(obs):
-            if not isinstance(o, (Circle, Sphere, Capsule)):
-                raise InputError(f"obstacles[{i}] must be a Circle, Sphere or Capsule, got "
+            if not isinstance(o, Cylinder | Sphere | Capsule):
+                raise InputError(f"obstacles[{i}] must be a Cylinder, Sphere or Capsule, got "
                                  f"{type(o).__name__}")
+        encode_obstacles(obs)  # a finite or tilted cylinder: NotSupportedError
         object.__setattr__(self, "obstacles", obs)
         from serialkin.collision.shapes import encode_scene
 

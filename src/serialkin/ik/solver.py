@@ -392,11 +392,10 @@ def solve(
             :data:`MAX_RESTARTS` (10⁵).
         seed: None, int or numpy Generator for the random starts.
         respect_limits: keep q inside the joint limits (each method documents how).
-        scene: obstacles in the world frame — one or a sequence of
-            :class:`~serialkin.collision.shapes.Box`, :class:`~serialkin.collision.shapes.HalfSpace`
-            and the :mod:`serialkin.redundancy.obstacles` shapes (``Sphere``, ``Capsule``,
-            ``Circle``) — that a solution must clear by ``margin`` (needs
-            ``robot.collision``; Jacobian-family methods).
+        scene: obstacles in the world frame — one or a sequence of shapes of
+            :mod:`serialkin.model.geometry` (``Sphere``, ``Capsule``, ``Box``,
+            ``HalfSpace``, the infinite ``Cylinder`` along z) — that a solution must clear
+            by ``margin`` (needs ``robot.collision``; Jacobian-family methods).
         self_collision: also ask for a self-collision-free solution (the robot's shape
             pairs not allowed by ``acm``).
         margin: clearance a solution must keep [m], ≥ 0 (0: touching is allowed).
@@ -425,12 +424,41 @@ def solve(
             res = _fast(robot, target, method, q0, seed)
             if res is not None:
                 return res
+    return _solve_checked(robot, target, method, _Request(
+        q0=q0, mask=mask, tol=tol, max_iter=max_iter, restarts=restarts, seed=seed,
+        respect_limits=respect_limits, scene=scene, self_collision=self_collision,
+        margin=margin, acm=acm, options=options))
+
+
+@dataclass(frozen=True, eq=False)
+class _Request:
+    """The keyword arguments of one :func:`solve` call, as given (same names, unchecked)."""
+
+    q0: object
+    mask: object
+    tol: float | None
+    max_iter: int | None
+    restarts: int | None
+    seed: None | int | np.random.Generator
+    respect_limits: object
+    scene: object
+    self_collision: object
+    margin: object
+    acm: object
+    options: Mapping[str, Any]
+
+
+def _check_robot(robot: object) -> None:
+    """Raise InputTypeError unless ``robot`` is a Robot (a model name says how to build one)."""
     if not isinstance(robot, Robot):
         hint = (f" (a model name: serialkin.models.get({short_repr(robot, 40)}) builds it)"
                 if isinstance(robot, str) else "")
         raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__} "
                              f"{short_repr(robot, 40)}{hint}")
-    spec = get_method(method)
+
+
+def _check_joint_count(robot: Robot, spec: MethodSpec) -> None:
+    """Raise InputError when ``robot`` has more joints than ``spec`` takes (naming others)."""
     if spec.max_joints is not None and robot.n > spec.max_joints:
         scalable = [m for m in available_methods() if get_method(m).max_joints is None
                     and get_method(m).family != "analytic"]
@@ -439,41 +467,53 @@ def solve(
             f"cost per iteration grows faster than the number of joints); robot "
             f"{short_repr(robot.name)} has {robot.n}: use one of {', '.join(scalable)}"
         )
+
+
+def _check_batch_size(robot: Robot, target: object) -> None:
+    """Refuse a batch target whose copies and results exceed the memory budget."""
     shape = getattr(target, "shape", None)
     if shape is not None and len(shape) >= 2:  # before parse_target copies a batch
         # per target: its copy (16), q (n) and the kernel's info: refused before allocation
         count = math.prod(shape[:-1]) // (4 if shape[-2:] == (4, 4) else 1)
         check_allocation("the IK batch (targets and results)",
                          (count, robot.n + K.N_INFO + 16), 8, setting="target")
-    tgt = parse_target(robot, target, mask)
+
+
+def _solve_checked(robot: object, target: object, method: str, req: _Request) -> IKResult:
+    """:func:`solve` past its fast path: check every argument, then run the method."""
+    _check_robot(robot)
+    spec = get_method(method)
+    _check_joint_count(robot, spec)
+    _check_batch_size(robot, target)
+    tgt = parse_target(robot, target, req.mask)
     if tgt.kind not in spec.targets:
         raise InputError(
             f"method {spec.name!r} does not accept {tgt.kind} targets; it accepts "
             f"{', '.join(spec.targets)}"
         )
-    tol_v = DEFAULT_TOL if tol is None else check_tol(tol)
-    iters = spec.max_iter if max_iter is None else check_int(
-        max_iter, "max_iter", minimum=1, maximum=MAX_ITERATIONS)
-    nrest = spec.restarts if restarts is None else check_int(
-        restarts, "restarts", minimum=0, maximum=MAX_RESTARTS)
-    if not isinstance(respect_limits, (bool, np.bool_)):
-        raise InputTypeError(f"respect_limits must be True or False, got {respect_limits!r}")
-    opts = _options(spec, options)
+    tol_v = DEFAULT_TOL if req.tol is None else check_tol(req.tol)
+    iters = spec.max_iter if req.max_iter is None else check_int(
+        req.max_iter, "max_iter", minimum=1, maximum=MAX_ITERATIONS)
+    nrest = spec.restarts if req.restarts is None else check_int(
+        req.restarts, "restarts", minimum=0, maximum=MAX_RESTARTS)
+    if not isinstance(req.respect_limits, (bool, np.bool_)):
+        raise InputTypeError(f"respect_limits must be True or False, got {req.respect_limits!r}")
+    respect = bool(req.respect_limits)
+    opts = _options(spec, req.options)
     coll = None
-    if (scene is not None or self_collision is not False or acm is not None
-            or not (type(margin) is float and margin == 0.0)):
-        coll = _collision_setup(robot, spec, scene, self_collision, margin, acm)
+    if (req.scene is not None or req.self_collision is not False or req.acm is not None
+            or not (type(req.margin) is float and req.margin == 0.0)):
+        coll = _collision_setup(robot, spec, req.scene, req.self_collision, req.margin, req.acm)
     n_targets = tgt.T.shape[0] if tgt.batch else None
-    q0a = None if q0 is None else check_q0(robot, q0, n_targets, bool(respect_limits))
-    stream = _stream_seed(seed)
+    q0a = None if req.q0 is None else check_q0(robot, req.q0, n_targets, respect)
+    stream = _stream_seed(req.seed)
     if coll is not None and coll.active:
-        return _solve_collision(robot, tgt, spec, q0a, tol_v, iters, nrest, stream,
-                                bool(respect_limits), opts, coll)
+        return _solve_collision(robot, tgt, spec, q0a, tol_v, iters, nrest, stream, respect,
+                                opts, coll)
     if spec.kernel is not None:
-        return _solve_compiled(robot, tgt, spec, q0a, tol_v, iters, nrest, stream,
-                               bool(respect_limits), opts)
-    return _solve_python(robot, tgt, spec, q0a, tol_v, iters, nrest, stream,
-                         bool(respect_limits), opts)
+        return _solve_compiled(robot, tgt, spec, q0a, tol_v, iters, nrest, stream, respect,
+                               opts)
+    return _solve_python(robot, tgt, spec, q0a, tol_v, iters, nrest, stream, respect, opts)
 
 
 def _fast_entry(robot: object, method: str) -> tuple | None:

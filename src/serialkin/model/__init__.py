@@ -3,7 +3,8 @@
 * :class:`Robot` (``robot.py``), built from :class:`DHLink` tables (``dh.py``), general
   :class:`Joint` s (``joint.py``), URDF (``urdf.py``), MJCF (``mjcf.py``), xacro
   (``xacro.py``) or robot files (``robotfile.py``);
-* link visual/collision shapes (``geometry.py``) and triangle meshes (``mesh.py``; loading
+* shapes (``geometry.py``: link visual/collision geometry, collision scenes and
+  obstacles share them) and triangle meshes (``mesh.py``; loading
   needs the ``mesh`` extra);
 * the built-in zoo is :mod:`serialkin.models`.
 """
@@ -13,6 +14,7 @@ from serialkin.model.geometry import (
     Box,
     Capsule,
     Cylinder,
+    HalfSpace,
     LinkGeometry,
     Mesh,
     Shape,
@@ -33,6 +35,7 @@ __all__ = [
     "Capsule",
     "Cylinder",
     "DHLink",
+    "HalfSpace",
     "Joint",
     "LinkGeometry",
     "Mesh",

@@ -1,4 +1,41 @@
-"""Link geometry: the visual and collision shapes of a robot, posed in its link frames.
+"""Shapes: the one vocabulary of link geometry, collision scenes and obstacles (metres).
+
+Every shape is described in one frame, *its frame*: a chain frame for link geometry (then
+placed in that frame by :attr:`Shape.origin`), the world frame for a collision scene
+(:mod:`serialkin.collision`) and for the obstacles of the obstacle-avoidance tasks
+(:mod:`serialkin.redundancy`, :mod:`serialkin.diffik`). Sizes come first, positionally and
+in URDF's order; the placement in the frame and the obstacle attributes are keywords:
+
+* :class:`Sphere` ``(radius, *, center)`` — the points within ``radius`` of ``center``;
+* :class:`Box` ``(size, *, center, rotation)`` — edge lengths ``size`` along the box axes;
+* :class:`Cylinder` ``(radius, length, *, center, rotation)`` — axis along the third box
+  axis, ``length`` its height (``math.inf``: an infinite cylinder);
+* :class:`Capsule` ``(radius, length)`` or ``(radius, *, a, b)`` — the points within
+  ``radius`` of the segment from ``a`` to ``b``; ``length`` puts the ends at
+  ``z = ±length/2`` (the total extent is ``length + 2 radius``);
+* :class:`HalfSpace` ``(normal, offset)`` — the solid ``{x : normalᵀ x ≤ offset}``;
+* :class:`Mesh` ``(filename, scale)`` — a mesh file, named here and never loaded; link
+  geometry only, placed by :attr:`Shape.origin`.
+
+Placement: ``center`` (3,) [m] is a point of the frame; ``rotation`` (3, 3) holds the
+shape's own axes as columns (a box's edges are along them, a cylinder's axis is the third
+column); a capsule is placed by the ends ``a``, ``b`` (3,) [m] of its segment. The
+defaults put a shape at the frame's origin along its axes (URDF's convention: centred, a
+cylinder's and a capsule's axis along z). ``pose`` (4, 4) is the placement of a bounded
+shape as one transform. The vertical cylinder through the point (x, y) of the xy plane (a
+circle of a planar scene) is ``Cylinder(r, math.inf, center=[x, y, 0.0])``.
+
+Every solid also carries ``name`` (a label) and ``influence`` [m]: the distance from its
+surface within which an obstacle-avoidance task acts on it (read by the obstacle tasks of
+:mod:`serialkin.redundancy` and :mod:`serialkin.diffik`, ignored by collision queries and
+by link geometry).
+
+Who accepts what: link geometry (:class:`Shape`) the bounded shapes at their frame's origin
+and meshes; collision scenes spheres, capsules, boxes, half-spaces and infinite cylinders
+along z; the obstacle tasks spheres, capsules and infinite cylinders along z. Collision and
+redundancy pack them into their own kernel arrays
+(:func:`serialkin.collision.shapes.encode_scene`,
+:func:`serialkin.redundancy.obstacles.encode_obstacles`).
 
 A :class:`LinkGeometry` holds the shapes of one named part (a URDF ``<link>``) fixed to
 one *frame* of the compiled chain: index ``0..n`` of :meth:`Robot.fk_all` (0 = base,
@@ -7,26 +44,29 @@ the flange) keeps its own name and its frame index; its shapes' origins are then
 expressed in that chain frame (the fixed transforms composed in). The world pose of a
 shape at joint values ``q`` is therefore ``fk_all(q)[frame] @ shape.origin``.
 
-Primitives follow URDF/ROS: a :class:`Box` is centred on its origin with edge lengths
-``size`` (x, y, z); a :class:`Cylinder` and a :class:`Capsule` are centred with their
-axis along z (``length`` is the cylinder's height, the capsule's segment between the
-centres of its end spheres); a :class:`Mesh` file is scaled per axis by ``scale``.
-Meshes are only named here, never loaded. Lengths in metres.
+Errors of every constructor: :class:`~serialkin.errors.RobotDefinitionError` (an
+``InputError``) for a negative or non-finite size; ``InputError`` or ``InputTypeError``
+for a point of the wrong shape or not finite, a matrix that is not a rotation, a negative
+``influence`` or a name that is not a string. Each message names the field.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import KW_ONLY, dataclass, field, fields
+from typing import ClassVar
 
 import numpy as np
 
-from serialkin._checks import short_repr
-from serialkin.errors import RobotDefinitionError
+from serialkin._checks import as_vector, check_positive, check_real, check_rotation, short_repr
+from serialkin.errors import InputError, InputTypeError, RobotDefinitionError
 from serialkin.model.joint import check_fixed_transform
 
-__all__ = ["Box", "Capsule", "Cylinder", "Geometry", "LinkGeometry", "Mesh", "Shape",
-           "Sphere"]
+__all__ = ["DEFAULT_INFLUENCE", "Box", "Capsule", "Cylinder", "Geometry", "HalfSpace",
+           "LinkGeometry", "Mesh", "Shape", "Solid", "Sphere"]
+
+#: Default ``influence`` of a solid [m]: the obstacle tasks act within 2 cm of its surface.
+DEFAULT_INFLUENCE = 0.02
 
 
 def _check_sizes(kind: str, **fields: float | tuple[float, ...]) -> None:
@@ -55,59 +95,323 @@ def _float(value: object, kind: str, name: str) -> float:
     return _floats(value, 1, kind, name)[0]
 
 
-@dataclass(frozen=True)
-class Box:
-    """A box centred on its origin; ``size`` = edge lengths (x, y, z) [m]."""
-
-    size: tuple[float, float, float]
-
-    def __post_init__(self) -> None:
-        """Validate: three finite sizes >= 0."""
-        object.__setattr__(self, "size", _floats(self.size, 3, "box", "size"))
-        _check_sizes("box", size=self.size)
+def _size(value: object, kind: str, name: str) -> float:
+    """One finite size >= 0 [m]."""
+    v = _float(value, kind, name)
+    _check_sizes(kind, **{name: v})
+    return v
 
 
-@dataclass(frozen=True)
-class Cylinder:
-    """A cylinder centred on its origin, axis z; ``radius``, ``length`` (height) [m]."""
-
-    radius: float
-    length: float
-
-    def __post_init__(self) -> None:
-        """Validate: finite radius and length >= 0."""
-        object.__setattr__(self, "radius", _float(self.radius, "cylinder", "radius"))
-        object.__setattr__(self, "length", _float(self.length, "cylinder", "length"))
-        _check_sizes("cylinder", radius=self.radius, length=self.length)
+def _point(value: object, name: str) -> np.ndarray:
+    """A finite point (3,) [m], copied (float64, C order)."""
+    return as_vector(value, name, 3).copy()
 
 
-@dataclass(frozen=True)
-class Sphere:
-    """A sphere centred on its origin; ``radius`` [m]."""
-
-    radius: float
-
-    def __post_init__(self) -> None:
-        """Validate: a finite radius >= 0."""
-        object.__setattr__(self, "radius", _float(self.radius, "sphere", "radius"))
-        _check_sizes("sphere", radius=self.radius)
+def _rotation(value: object) -> np.ndarray:
+    """A (3, 3) rotation matrix, copied (float64, C order)."""
+    R = check_rotation(value, "rotation")
+    if R.shape != (3, 3):
+        raise InputError(f"rotation must have shape (3, 3), got {R.shape}")
+    return np.array(R, dtype=float)
 
 
-@dataclass(frozen=True)
-class Capsule:
-    """A capsule centred on its origin, axis z: segment ``length`` [m] swept by ``radius``.
+def _pose(R: np.ndarray | None, p: np.ndarray) -> np.ndarray:
+    T = np.eye(4)
+    if R is not None:
+        T[:3, :3] = R
+    T[:3, 3] = p
+    return T
 
-    The end-sphere centres are at ``z = ±length/2``; the total extent is ``length + 2 radius``.
+
+def _same(x: object, y: object) -> bool:
+    if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
+        return bool(np.array_equal(x, y))
+    return x == y
+
+
+def _key(x: object) -> object:
+    return tuple(np.ravel(x).tolist()) if isinstance(x, np.ndarray) else x
+
+
+class _Solid:
+    """Shared by the solids: equality and hash by value (arrays compared elementwise).
+
+    The arrays of a solid are its own copies; do not modify them in place (the solid is
+    frozen and hashed by value).
     """
 
+    kind: ClassVar[str]
+
+    def __eq__(self, other: object) -> bool:
+        """The same shape class with equal fields (arrays equal element by element)."""
+        if type(other) is not type(self):
+            return NotImplemented
+        return all(_same(getattr(self, f.name), getattr(other, f.name)) for f in fields(self))
+
+    def __hash__(self) -> int:
+        """A hash of the class and the field values."""
+        return hash((type(self).__name__,
+                     *(_key(getattr(self, f.name)) for f in fields(self))))
+
+    def _check_label(self) -> None:
+        """Validate ``influence`` (a number >= 0 [m]) and ``name`` (a string)."""
+        object.__setattr__(self, "influence",
+                           check_positive(self.influence, "influence", allow_zero=True))
+        if not isinstance(self.name, str):
+            raise InputTypeError(f"name must be a string, got {short_repr(self.name)}")
+
+
+def _origin() -> np.ndarray:
+    return np.zeros(3)
+
+
+def _identity() -> np.ndarray:
+    return np.eye(3)
+
+
+@dataclass(frozen=True, eq=False)
+class Sphere(_Solid):
+    """A ball: the points within ``radius`` of ``center``.
+
+    Attributes:
+        radius: radius [m], finite and >= 0.
+        center: (3,) centre in the shape's frame [m] (default: the frame's origin).
+        influence: distance from the surface within which an obstacle task acts [m].
+        name: label.
+    """
+
+    kind: ClassVar[str] = "sphere"
     radius: float
-    length: float
+    _: KW_ONLY
+    center: np.ndarray = field(default_factory=_origin)
+    influence: float = DEFAULT_INFLUENCE
+    name: str = ""
 
     def __post_init__(self) -> None:
-        """Validate: finite radius and length >= 0."""
-        object.__setattr__(self, "radius", _float(self.radius, "capsule", "radius"))
-        object.__setattr__(self, "length", _float(self.length, "capsule", "length"))
-        _check_sizes("capsule", radius=self.radius, length=self.length)
+        """Validate: a finite radius >= 0, a finite centre (3,), the label."""
+        object.__setattr__(self, "radius", _size(self.radius, "sphere", "radius"))
+        object.__setattr__(self, "center", _point(self.center, "center"))
+        self._check_label()
+
+    @property
+    def pose(self) -> np.ndarray:
+        """(4, 4) placement in the shape's frame: the translation to ``center``."""
+        return _pose(None, self.center)
+
+
+@dataclass(frozen=True, eq=False)
+class Box(_Solid):
+    """A box: the points ``center + rotation @ u`` with ``|u_k| <= size[k] / 2``.
+
+    Attributes:
+        size: edge lengths (x, y, z) along the box axes [m], each finite and >= 0.
+        center: (3,) centre in the shape's frame [m] (default: the frame's origin).
+        rotation: (3, 3) rotation whose columns are the box axes in the shape's frame
+            (default: identity).
+        influence: distance from the surface within which an obstacle task acts [m].
+        name: label.
+    """
+
+    kind: ClassVar[str] = "box"
+    size: tuple[float, float, float]
+    _: KW_ONLY
+    center: np.ndarray = field(default_factory=_origin)
+    rotation: np.ndarray = field(default_factory=_identity)
+    influence: float = DEFAULT_INFLUENCE
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        """Validate: three finite sizes >= 0, a finite centre, a rotation, the label."""
+        object.__setattr__(self, "size", _floats(self.size, 3, "box", "size"))
+        _check_sizes("box", size=self.size)
+        object.__setattr__(self, "center", _point(self.center, "center"))
+        object.__setattr__(self, "rotation", _rotation(self.rotation))
+        self._check_label()
+
+    @property
+    def half_extents(self) -> np.ndarray:
+        """(3,) half edge lengths ``size / 2`` [m]."""
+        return np.array(self.size) / 2.0
+
+    @property
+    def pose(self) -> np.ndarray:
+        """(4, 4) placement in the shape's frame: ``rotation`` and ``center``."""
+        return _pose(self.rotation, self.center)
+
+
+@dataclass(frozen=True, eq=False)
+class Cylinder(_Solid):
+    """A cylinder: the points within ``radius`` of its axis, over ``length`` along it.
+
+    Attributes:
+        radius: radius [m], finite and >= 0.
+        length: height along the axis [m], >= 0; ``math.inf`` for an infinite cylinder.
+        center: (3,) centre in the shape's frame [m] (default: the frame's origin); for
+            an infinite cylinder any point of its axis.
+        rotation: (3, 3) rotation whose third column is the axis (default: identity, the
+            axis along the frame's z).
+        influence: distance from the surface within which an obstacle task acts [m].
+        name: label.
+    """
+
+    kind: ClassVar[str] = "cylinder"
+    radius: float
+    length: float
+    _: KW_ONLY
+    center: np.ndarray = field(default_factory=_origin)
+    rotation: np.ndarray = field(default_factory=_identity)
+    influence: float = DEFAULT_INFLUENCE
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        """Validate: a finite radius >= 0, a length >= 0 (inf allowed), the placement."""
+        object.__setattr__(self, "radius", _size(self.radius, "cylinder", "radius"))
+        length = _float(self.length, "cylinder", "length")
+        if not (length >= 0.0):  # NaN fails too
+            raise RobotDefinitionError(
+                f"cylinder length: expected a number >= 0 [m] (math.inf: an infinite "
+                f"cylinder), got {short_repr(self.length)}")
+        object.__setattr__(self, "length", length)
+        object.__setattr__(self, "center", _point(self.center, "center"))
+        object.__setattr__(self, "rotation", _rotation(self.rotation))
+        self._check_label()
+
+    @property
+    def axis(self) -> np.ndarray:
+        """(3,) unit direction of the axis in the shape's frame (``rotation[:, 2]``)."""
+        return self.rotation[:, 2].copy()
+
+    @property
+    def infinite_along_z(self) -> bool:
+        """True for an infinite cylinder whose axis is the frame's z direction.
+
+        Its distances are measured in the xy plane, to the circle of radius ``radius``
+        about ``center[:2]``: the only cylinder that collision scenes and the obstacle
+        tasks accept.
+        """
+        return math.isinf(self.length) and abs(float(self.rotation[2, 2])) >= 1.0 - 1e-12
+
+    @property
+    def pose(self) -> np.ndarray:
+        """(4, 4) placement in the shape's frame: ``rotation`` and ``center``."""
+        return _pose(self.rotation, self.center)
+
+
+def _frame_with_z(z: np.ndarray) -> np.ndarray:
+    """A rotation whose third column is the unit vector ``z`` (identity for z = +e_z).
+
+    The branchless orthonormal basis of Duff et al., "Building an orthonormal basis,
+    revisited" (JCGT 6(1), 2017): with ``s = sign(z_z)`` and ``k = −1/(s + z_z)``,
+    ``x = (1 + s z_x² k, s z_x z_y k, −s z_x)``, ``y = (z_x z_y k, s + z_y² k, −z_y)``;
+    accurate for every direction (``|s + z_z| >= 1``).
+    """
+    s = math.copysign(1.0, float(z[2]))
+    k = -1.0 / (s + z[2])
+    xy = z[0] * z[1] * k
+    x = [1.0 + s * z[0] * z[0] * k, s * xy, -s * z[0]]
+    y = [xy, s + z[1] * z[1] * k, -z[1]]
+    return np.column_stack([x, y, z])
+
+
+@dataclass(frozen=True, eq=False, init=False)
+class Capsule(_Solid):
+    """A capsule: the points within ``radius`` of the segment from ``a`` to ``b``.
+
+    Built from its size, ``Capsule(radius, length)``, it is centred on the frame's origin
+    with its axis along z (URDF: the segment's ends at ``z = ±length/2``); built from its
+    ends, ``Capsule(radius, a=..., b=...)``, it lies where they are.
+
+    Attributes:
+        radius: radius [m], finite and >= 0.
+        a: (3,) first end of the segment in the shape's frame [m].
+        b: (3,) second end [m] (``a = b``: a sphere).
+        influence: distance from the surface within which an obstacle task acts [m].
+        name: label.
+    """
+
+    kind: ClassVar[str] = "capsule"
+    radius: float
+    a: np.ndarray
+    b: np.ndarray
+    influence: float = DEFAULT_INFLUENCE
+    name: str = ""
+
+    def __init__(self, radius: float, length: float | None = None, *,
+                 a: object = None, b: object = None, influence: float = DEFAULT_INFLUENCE,
+                 name: str = "") -> None:
+        """Build from ``radius`` and either ``length`` or both ends ``a`` and ``b``.
+
+        Raises:
+            InputError: both a length and ends, or neither (and the errors of the module).
+        """
+        r = _size(radius, "capsule", "radius")
+        if length is not None:
+            if a is not None or b is not None:
+                raise InputError("capsule: give either its length (the segment centred on "
+                                 "the frame's origin along z) or its ends a and b, not both")
+            half = _size(length, "capsule", "length") / 2.0
+            a, b = np.array([0.0, 0.0, -half]), np.array([0.0, 0.0, half])
+        elif a is None or b is None:
+            raise InputError("capsule: give its length (the segment centred on the frame's "
+                             "origin along z) or both ends a and b")
+        object.__setattr__(self, "radius", r)
+        object.__setattr__(self, "a", _point(a, "a"))
+        object.__setattr__(self, "b", _point(b, "b"))
+        object.__setattr__(self, "influence", influence)
+        object.__setattr__(self, "name", name)
+        self._check_label()
+
+    @property
+    def length(self) -> float:
+        """Length of the segment ``‖b − a‖`` [m] (between the end-sphere centres)."""
+        return float(np.linalg.norm(self.b - self.a))
+
+    @property
+    def center(self) -> np.ndarray:
+        """(3,) midpoint of the segment [m]."""
+        return (self.a + self.b) / 2.0
+
+    @property
+    def pose(self) -> np.ndarray:
+        """(4, 4) placement: at the midpoint, z along ``b − a`` (identity for ``a = b``).
+
+        A capsule is symmetric about its axis: the other two axes are a fixed choice
+        (the identity for an axis along +z, as ``Capsule(radius, length)`` has).
+        """
+        d = self.b - self.a
+        n = float(np.linalg.norm(d))
+        return _pose(np.eye(3) if n == 0.0 else _frame_with_z(d / n), self.center)
+
+
+@dataclass(frozen=True, eq=False)
+class HalfSpace(_Solid):
+    """The solid ``{x : normalᵀ x <= offset}`` below a plane (a table top: normal +z).
+
+    Unbounded: a collision scene accepts it, link geometry does not.
+
+    Attributes:
+        normal: (3,) outward unit normal of the solid (normalised on construction).
+        offset: signed height of the plane along ``normal`` [m].
+        influence: distance from the surface within which an obstacle task acts [m].
+        name: label.
+    """
+
+    kind: ClassVar[str] = "halfspace"
+    normal: np.ndarray
+    offset: float = 0.0
+    _: KW_ONLY
+    influence: float = DEFAULT_INFLUENCE
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        """Validate: a finite non-zero normal (normalised), a finite offset, the label."""
+        n = as_vector(self.normal, "normal", 3)
+        norm = float(np.linalg.norm(n))
+        if norm < 1e-12:
+            raise InputError(f"normal must be a non-zero vector, got {n.tolist()}")
+        object.__setattr__(self, "normal", n / norm)
+        object.__setattr__(self, "offset", check_real(self.offset, "offset"))
+        self._check_label()
 
 
 @dataclass(frozen=True)
@@ -115,9 +419,11 @@ class Mesh:
     """A mesh file (not loaded), scaled per axis by ``scale``.
 
     ``filename`` is the resolved absolute path when the importer found the file, else the
-    path as written (``package://...`` or relative).
+    path as written (``package://...`` or relative). Link geometry only: a mesh has no
+    placement of its own (its :class:`Shape`'s ``origin`` places it).
     """
 
+    kind: ClassVar[str] = "mesh"
     filename: str
     scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
@@ -130,15 +436,41 @@ class Mesh:
         _check_sizes("mesh", scale=self.scale)
 
 
+#: The shapes of link geometry.
 Geometry = Box | Cylinder | Sphere | Capsule | Mesh
+#: The solids: what a collision scene or an obstacle list is made of.
+Solid = Sphere | Capsule | Cylinder | Box | HalfSpace
+
+
+def _check_link_geometry(g: Geometry) -> None:
+    """Refuse an unbounded shape, or one placed off its frame's origin, as link geometry."""
+    if isinstance(g, Mesh):
+        return
+    if isinstance(g, Cylinder) and math.isinf(g.length):
+        raise RobotDefinitionError(
+            "cylinder length: link geometry is bounded, expected a finite length [m], got inf")
+    if not np.array_equal(g.pose, np.eye(4)):
+        raise RobotDefinitionError(
+            f"shape geometry: a {g.kind} of link geometry sits at its frame's origin along "
+            f"its axes and is placed by the Shape's origin; got one placed by the pose "
+            f"{short_repr(np.round(g.pose[:3], 9).tolist())} (build it at the origin and "
+            f"pass that pose as origin=...)")
 
 
 @dataclass(frozen=True, eq=False)
 class Shape:
     """One posed geometry: ``origin`` (4, 4) is its pose in the owning chain frame.
 
+    ``geometry`` is a bounded shape at its own frame's origin along its axes (the
+    defaults of its placement: ``Sphere(r)``, ``Box(size)``, ``Cylinder(r, length)``,
+    ``Capsule(r, length)``) or a :class:`Mesh`; ``origin`` places it, so its world pose at
+    ``q`` is ``fk_all(q)[frame] @ origin``. Its ``name`` and ``influence`` are not used here.
     ``name`` is the URDF ``<visual name>``/``<collision name>`` (may be empty);
     ``material`` and ``rgba`` (4 numbers in [0, 1]) are optional appearance.
+
+    Raises:
+        RobotDefinitionError: another kind of geometry, one placed off its frame's origin
+            or an infinite cylinder, an origin that is not a rigid transform, a bad colour.
     """
 
     geometry: Geometry
@@ -153,6 +485,7 @@ class Shape:
             raise RobotDefinitionError(
                 f"shape geometry: expected a Box, Cylinder, Sphere, Capsule or Mesh, got "
                 f"{type(self.geometry).__name__}")
+        _check_link_geometry(self.geometry)
         T = np.array(check_fixed_transform(self.origin, "shape origin"), dtype=float)
         T.setflags(write=False)
         object.__setattr__(self, "origin", T)

@@ -274,7 +274,11 @@ def decimate(mesh: TriangleMesh, max_faces: int) -> TriangleMesh:
 
 
 def primitive_mesh(geometry: object, sections: int = 24) -> TriangleMesh:
-    """A triangulated box, cylinder, sphere or capsule (centred, axis z, as URDF).
+    """A triangulated box, cylinder, sphere or capsule, placed as it is in its frame.
+
+    The vertices are in the shape's frame: a shape at its frame's origin (link geometry,
+    as URDF: centred, axis z) is meshed there, a placed one (``center``, ``rotation``,
+    capsule ends) where it is.
 
     Args:
         geometry: a :class:`~serialkin.model.geometry.Box`, ``Cylinder``, ``Sphere`` or
@@ -283,13 +287,15 @@ def primitive_mesh(geometry: object, sections: int = 24) -> TriangleMesh:
 
     Raises:
         InputTypeError: ``geometry`` is not one of those primitives.
-        NotSupportedError: trimesh is not installed.
+        NotSupportedError: trimesh is not installed, or an infinite cylinder.
     """
     from serialkin.model.geometry import Box, Capsule, Cylinder, Sphere
 
     sections = check_int(sections, "sections", minimum=3, maximum=1024)
     trimesh = _trimesh()
     g = geometry
+    if isinstance(g, Cylinder) and np.isinf(g.length):
+        raise NotSupportedError("an infinite cylinder has no finite mesh")
     if isinstance(g, Box):
         tm = trimesh.creation.box(extents=g.size)
     elif isinstance(g, Cylinder):
@@ -303,8 +309,11 @@ def primitive_mesh(geometry: object, sections: int = 24) -> TriangleMesh:
     else:
         raise InputTypeError(f"geometry must be a Box, Cylinder, Sphere or Capsule, got "
                              f"{type(g).__name__}")
-    return TriangleMesh(np.asarray(tm.vertices, dtype=float),
-                        np.asarray(tm.faces, dtype=np.int64), type(g).__name__.lower())
+    V = np.asarray(tm.vertices, dtype=float)
+    T = g.pose
+    if not np.array_equal(T, np.eye(4)):
+        V = V @ T[:3, :3].T + T[:3, 3]
+    return TriangleMesh(V, np.asarray(tm.faces, dtype=np.int64), type(g).__name__.lower())
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,9 @@
   (eq 43), joint-limit distance (eq 44), obstacle distance (eq 45), user callables.
 * :mod:`~serialkin.redundancy.nullspace` — eq 42, projected gradient, two-task priority.
 * :mod:`~serialkin.redundancy.multitask` — weighted multi-task resolution (eqs 47-50).
-* :mod:`~serialkin.redundancy.obstacles` — obstacles and obstacle Jacobians (eqs 51-56).
+* :mod:`~serialkin.redundancy.obstacles` — link-obstacle distances and obstacle Jacobians
+  (eqs 51-56); the obstacles are shapes of :mod:`serialkin.model.geometry` (``Sphere``,
+  ``Capsule``, the infinite ``Cylinder`` along z).
 """
 
 from serialkin.redundancy.multitask import (
@@ -30,10 +32,6 @@ from serialkin.redundancy.objectives import (
     obstacle_distance,
 )
 from serialkin.redundancy.obstacles import (
-    Capsule,
-    Circle,
-    Cylinder,
-    Sphere,
     check_obstacles,
     clearances,
     closest_pairs,
@@ -41,12 +39,8 @@ from serialkin.redundancy.obstacles import (
 )
 
 __all__ = [
-    "Capsule",
-    "Circle",
-    "Cylinder",
     "MultiTaskResolver",
     "Objective",
-    "Sphere",
     "check_obstacles",
     "clearances",
     "closest_pairs",
@@ -66,3 +60,10 @@ __all__ = [
     "self_motion",
     "task_priority_velocity",
 ]
+
+
+def __getattr__(name: str) -> object:
+    """``Circle``, ``Cylinder``, ``Sphere``, ``Capsule``: old obstacle names (warn)."""
+    from serialkin.redundancy.obstacles import _deprecated
+
+    return _deprecated(__name__, name)

@@ -48,15 +48,14 @@ from serialkin._checks import (
 from serialkin.errors import InputError
 from serialkin.kinematics import kernels as K
 from serialkin.kinematics.dls import manipulability_of, spd_solve_into
+from serialkin.model.geometry import Capsule, Cylinder, Sphere
 from serialkin.model.limits import check_interval
 from serialkin.redundancy.objectives import task_rows
 from serialkin.redundancy.obstacles import (
-    Capsule,
-    Circle,
-    Sphere,
     _Geometry,
     accumulate_obstacle_task,
     check_obstacles,
+    encode_obstacles,
     update_geometry_into,
 )
 from serialkin.spatial.kernels import pose_error_into
@@ -318,8 +317,8 @@ class MultiTaskResolver:
     Attributes:
         task: primary task rows ('planar', 'position', 'planar_pose', 'pose' or indices).
         weight: W, primary-task weight (scalar, ≥ 0) [1].
-        obstacles: obstacles (:class:`~serialkin.redundancy.obstacles.Circle`, ``Sphere``,
-            ``Capsule``); each carries its influence distance.
+        obstacles: obstacles (:class:`~serialkin.model.geometry.Cylinder` infinite along
+            z, ``Sphere``, ``Capsule``); each carries its influence distance.
         obstacle_weight: maximum W_c (at contact) [1].
         link_radius: links modelled as capsules of this radius [m].
         joint_limit_weight: maximum W_L of eq 49 [1]; 0 disables the joint-limit task.
@@ -368,13 +367,14 @@ class MultiTaskResolver:
         check_int(self.max_iter, "max_iter", minimum=1, maximum=MAX_ITERATIONS)
         if isinstance(self.obstacles, (str, bytes, Mapping)) or not isinstance(
                 self.obstacles, Iterable):
-            raise InputError("obstacles must be a list of Circle, Sphere or Capsule, got "
+            raise InputError("obstacles must be a list of Cylinder, Sphere or Capsule, got "
                              f"{type(self.obstacles).__name__} {short_repr(self.obstacles)}")
         obs = tuple(self.obstacles)
         for i, o in enumerate(obs):
-            if not isinstance(o, (Circle, Sphere, Capsule)):
-                raise InputError(
-                    f"obstacles[{i}] must be a Circle, Sphere or Capsule, got {type(o).__name__}")
+            if not isinstance(o, Cylinder | Sphere | Capsule):
+                raise InputError(f"obstacles[{i}] must be a Cylinder, Sphere or Capsule, got "
+                                 f"{type(o).__name__}")
+        encode_obstacles(obs)  # a finite or tilted cylinder: NotSupportedError
         object.__setattr__(self, "obstacles", obs)
 
     def with_options(self, **changes: object) -> MultiTaskResolver:

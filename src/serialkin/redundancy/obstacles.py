@@ -7,13 +7,22 @@ segment runs from the origin of frame n to the tool point. For a standard-DH arm
 are the physical links (the joint axis z_{i−1} passes through frame i−1's origin, so it is
 a point of link i); a prismatic joint makes its segment stretch.
 
-Obstacles (all with an ``influence`` distance [m], beyond which the obstacle task of
-:mod:`serialkin.redundancy.multitask` ignores them):
+Obstacles are shapes of :mod:`serialkin.model.geometry` in the world frame, each with
+its ``influence`` distance [m] beyond which the obstacle task of
+:mod:`serialkin.redundancy.multitask` ignores it:
 
-* :class:`Circle` — a circle in the world xy plane, i.e. an infinite cylinder along z
-  (``Cylinder`` is the same class); the distance is measured in the xy plane.
-* :class:`Sphere` — a ball in 3-D.
-* :class:`Capsule` — a segment with a radius in 3-D (a cylinder with round ends).
+* :class:`~serialkin.model.geometry.Cylinder` infinite along z
+  (``Cylinder(r, math.inf, center=[x, y, 0.0])``): a circle of the world xy plane; the
+  distance is measured in that plane;
+* :class:`~serialkin.model.geometry.Sphere` — a ball in 3-D;
+* :class:`~serialkin.model.geometry.Capsule` — a segment with a radius in 3-D.
+
+:func:`encode_obstacles` packs them into the (k, 8) rows of the compiled kernel;
+:func:`obstacle_from_field` / :func:`obstacle_from_dict` read the form of scenario files
+(``{type: circle|cylinder|sphere|capsule, ...}``) and :func:`obstacle_to_dict` writes it.
+The old names ``Circle``, ``Cylinder``, ``Sphere`` and ``Capsule`` of this module (and of
+:mod:`serialkin.redundancy`) still build the shared classes for one release, with a
+``DeprecationWarning``.
 
 Closest point (eqs 51-52, corrected by the ERRATA): the projection ``p_i = e_iᵀ(s_0 − s_i)``
 of the obstacle centre on link i is clamped to ``[0, ℓ_i]`` so that the closest point
@@ -30,32 +39,32 @@ approaches the obstacle; ``−J_ci`` is the gradient of its clearance.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from serialkin._checks import as_vector, check_positive
-from serialkin.errors import InputError, InputTypeError
+from serialkin.errors import InputError, InputTypeError, NotSupportedError
 from serialkin.kinematics import kernels as K
+from serialkin.model import geometry  # not its names: Sphere, Capsule here are the old ones
 from serialkin.spatial.segments import closest_segment_segment
 
 from .._jit import njit_exact
 
 __all__ = [
-    "Capsule",
-    "Circle",
     "ClosestPair",
-    "Cylinder",
     "Obstacle",
-    "Sphere",
     "check_obstacles",
     "clearances",
     "closest_pairs",
+    "encode_obstacles",
     "obstacle_from_dict",
     "obstacle_from_field",
     "obstacle_jacobian",
+    "obstacle_to_dict",
     "robot_segments",
 ]
 
@@ -63,128 +72,41 @@ KIND_CIRCLE = 0
 KIND_SPHERE = 1
 KIND_CAPSULE = 2
 
-
-def _normalise(obstacle: Any, **points: int) -> None:
-    """Check and store the fields of a frozen obstacle: copies of its ``points``.
-
-    ``points`` maps a field name to its number of coordinates (2 or 3); ``radius`` must
-    be > 0 and ``influence`` >= 0.
-    """
-    for name, size in points.items():
-        value = as_vector(getattr(obstacle, name), name, size).copy()
-        object.__setattr__(obstacle, name, value)
-    object.__setattr__(obstacle, "radius", check_positive(obstacle.radius, "radius"))
-    object.__setattr__(obstacle, "influence",
-                       check_positive(obstacle.influence, "influence", allow_zero=True))
-
-
-@dataclass(frozen=True)
-class Circle:
-    """A circle in the world xy plane (an infinite cylinder along z).
-
-    Attributes:
-        center: (2,) centre (x, y) [m].
-        radius: radius [m] (> 0).
-        influence: distance from the surface within which the obstacle task acts [m].
-        name: label.
-    """
-
-    center: np.ndarray
-    radius: float
-    influence: float = 0.02
-    name: str = ""
-    kind: int = field(default=KIND_CIRCLE, init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        _normalise(self, center=2)
-
-    def encode(self) -> np.ndarray:
-        """Row (kind, a(3), b(3), radius) for the compiled distance kernel."""
-        c = self.center
-        return np.array([KIND_CIRCLE, c[0], c[1], 0.0, c[0], c[1], 0.0, self.radius])
-
-    def to_dict(self) -> dict:
-        """Plain-data description (scenario files)."""
-        return {"type": "circle", "center": self.center.tolist(), "radius": self.radius,
-                "influence": self.influence, "name": self.name}
-
-
-Cylinder = Circle
-
-
-@dataclass(frozen=True)
-class Sphere:
-    """A ball in 3-D: centre (3,) [m], radius [m], influence [m], name."""
-
-    center: np.ndarray
-    radius: float
-    influence: float = 0.02
-    name: str = ""
-    kind: int = field(default=KIND_SPHERE, init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        _normalise(self, center=3)
-
-    def encode(self) -> np.ndarray:
-        """Row (kind, a(3), b(3), radius) for the compiled distance kernel."""
-        c = self.center
-        return np.array([KIND_SPHERE, *c, *c, self.radius])
-
-    def to_dict(self) -> dict:
-        """Plain-data description (scenario files)."""
-        return {"type": "sphere", "center": self.center.tolist(), "radius": self.radius,
-                "influence": self.influence, "name": self.name}
-
-
-@dataclass(frozen=True)
-class Capsule:
-    """A capsule in 3-D: the points within ``radius`` of the segment [a, b] (3,) [m]."""
-
-    a: np.ndarray
-    b: np.ndarray
-    radius: float
-    influence: float = 0.02
-    name: str = ""
-    kind: int = field(default=KIND_CAPSULE, init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        _normalise(self, a=3, b=3)
-
-    def encode(self) -> np.ndarray:
-        """Row (kind, a(3), b(3), radius) for the compiled distance kernel."""
-        return np.array([KIND_CAPSULE, *self.a, *self.b, self.radius])
-
-    def to_dict(self) -> dict:
-        """Plain-data description (scenario files)."""
-        return {"type": "capsule", "a": self.a.tolist(), "b": self.b.tolist(),
-                "radius": self.radius, "influence": self.influence, "name": self.name}
-
-
-Obstacle = Circle | Sphere | Capsule
+#: The shapes an obstacle task accepts (a Cylinder only when infinite along z).
+Obstacle = geometry.Cylinder | geometry.Sphere | geometry.Capsule
 
 
 def obstacle_from_field(f: Any) -> Obstacle:
     """Build an obstacle from a file field ``{type: circle|cylinder|sphere|capsule, ...}``.
 
     ``f`` is a :class:`serialkin._files.Field` (the reader every file format shares):
-    the type, the fields of that type and their values are checked before use.
+    the type, the fields of that type and their values are checked before use. A
+    ``circle`` (or ``cylinder``) has a ``center`` [x, y] and is the vertical infinite
+    :class:`~serialkin.model.geometry.Cylinder` through it; a ``sphere`` has a ``center``
+    [x, y, z], a ``capsule`` its ends ``a`` and ``b``; all have a ``radius`` > 0 and
+    optionally ``influence`` and ``name`` (lengths in metres).
 
     Raises:
         f.error: unknown type or a missing/invalid field; the message names the field.
     """
-    kinds = {"circle": Circle, "cylinder": Circle, "sphere": Sphere, "capsule": Capsule}
+    kinds = ("circle", "cylinder", "sphere", "capsule")
     f.mapping(what="a mapping {type: circle|cylinder|sphere|capsule, ...}")
     t = f["type"].string(choices=kinds)
     points = {"circle": {"center": 2}, "cylinder": {"center": 2}, "sphere": {"center": 3},
               "capsule": {"a": 3, "b": 3}}[t]
     f.mapping({*points, "radius", "type", "influence", "name"}, (*points, "radius"))
-    kwargs: dict[str, Any] = {k: f[k].vector(size, unit="m") for k, size in points.items()}
-    kwargs["radius"] = f["radius"].number(lo=0.0, lo_open=True, unit="m")
+    p = {k: f[k].vector(size, unit="m") for k, size in points.items()}
+    radius = f["radius"].number(lo=0.0, lo_open=True, unit="m")
+    label: dict[str, Any] = {"name": f["name"].string(default="", nonempty=False,
+                                                       max_len=1000)}
     if f["influence"].present:
-        kwargs["influence"] = f["influence"].number(lo=0.0, unit="m")
-    kwargs["name"] = f["name"].string(default="", nonempty=False, max_len=1000)
+        label["influence"] = f["influence"].number(lo=0.0, unit="m")
     try:
-        return kinds[t](**kwargs)
+        if t == "sphere":
+            return geometry.Sphere(radius, center=p["center"], **label)
+        if t == "capsule":
+            return geometry.Capsule(radius, a=p["a"], b=p["b"], **label)
+        return geometry.Cylinder(radius, math.inf, center=[*p["center"], 0.0], **label)
     except (InputError, InputTypeError) as exc:  # pragma: no cover - fields checked above
         raise f.fail(f"is invalid: {exc}") from exc
 
@@ -200,15 +122,65 @@ def obstacle_from_dict(d: dict, where: str = "obstacle") -> Obstacle:
     return obstacle_from_field(Field(d, where, "", InputError))
 
 
+def obstacle_to_dict(obstacle: Obstacle) -> dict:
+    """The plain-data form of an obstacle that :func:`obstacle_from_dict` reads back.
+
+    A vertical infinite cylinder is written as ``{type: circle, center: [x, y], ...}``
+    (the height of its centre is not kept: it does not change the shape).
+
+    Raises:
+        InputTypeError: not a Cylinder, Sphere or Capsule.
+        NotSupportedError: a cylinder that is finite or whose axis is not along z.
+    """
+    _row(obstacle, "obstacle")
+    o = obstacle
+    label = {"influence": o.influence, "name": o.name}
+    if isinstance(o, geometry.Cylinder):
+        return {"type": "circle", "center": o.center[:2].tolist(), "radius": o.radius,
+                **label}
+    if isinstance(o, geometry.Sphere):
+        return {"type": "sphere", "center": o.center.tolist(), "radius": o.radius, **label}
+    return {"type": "capsule", "a": o.a.tolist(), "b": o.b.tolist(), "radius": o.radius,
+            **label}
+
+
+def _row(o: object, where: str) -> np.ndarray:
+    """The kernel row (kind, a(3), b(3), radius) of one obstacle.
+
+    Raises:
+        InputTypeError: not a Cylinder, Sphere or Capsule.
+        NotSupportedError: a cylinder that is finite or whose axis is not along z.
+    """
+    if isinstance(o, geometry.Cylinder):
+        if not o.infinite_along_z:
+            raise NotSupportedError(
+                f"{where}: a Cylinder obstacle must be infinite along z (length=math.inf, "
+                f"axis along the world z), got length {o.length:g} m and axis "
+                f"{o.axis.round(6).tolist()}")
+        x, y = o.center[0], o.center[1]
+        return np.array([KIND_CIRCLE, x, y, 0.0, x, y, 0.0, o.radius])
+    if isinstance(o, geometry.Sphere):
+        return np.array([KIND_SPHERE, *o.center, *o.center, o.radius])
+    if isinstance(o, geometry.Capsule):
+        return np.array([KIND_CAPSULE, *o.a, *o.b, o.radius])
+    raise InputTypeError(
+        f"{where} must be a Cylinder, Sphere or Capsule, got {type(o).__name__}")
+
+
 def encode_obstacles(obstacles: Sequence[Obstacle]) -> np.ndarray:
-    """Obstacles as a (k, 8) float array for :func:`segment_obstacle_kernel`."""
-    for i, o in enumerate(obstacles):
-        if not isinstance(o, (Circle, Sphere, Capsule)):
-            raise InputTypeError(
-                f"obstacles[{i}] must be a Circle, Sphere or Capsule, got {type(o).__name__}")
-    if not obstacles:
+    """Obstacles as a (k, 8) float array for :func:`segment_obstacle_kernel`.
+
+    Row j is (kind, a(3), b(3), radius): a sphere's centre twice, a capsule's ends, a
+    vertical cylinder's (x, y, 0) twice.
+
+    Raises:
+        InputTypeError: an item that is not a Cylinder, Sphere or Capsule.
+        NotSupportedError: a cylinder that is finite or whose axis is not along z.
+    """
+    rows = [_row(o, f"obstacles[{i}]") for i, o in enumerate(obstacles)]
+    if not rows:
         return np.zeros((0, 8))
-    return np.ascontiguousarray(np.stack([o.encode() for o in obstacles]))
+    return np.ascontiguousarray(np.stack(rows))
 
 
 # --------------------------------------------------------------------- compiled geometry
@@ -561,6 +533,7 @@ def check_obstacles(robot, obstacles: Sequence[Obstacle], *, link_radius: float 
     Raises:
         InputError: naming the obstacle and its distance to the base.
         InputTypeError: an entry that is not an obstacle.
+        NotSupportedError: a cylinder that is finite or whose axis is not along z.
     """
     encode_obstacles(tuple(obstacles))
     base = np.array(robot.base[:3, 3], dtype=float)
@@ -583,3 +556,63 @@ def check_obstacles(robot, obstacles: Sequence[Obstacle], *, link_radius: float 
             raise InputError(
                 f"obstacles[{j}]{label} overlaps the robot base at {base.round(4).tolist()}: "
                 f"clearance {C[0, j]:.4g} m (radius {o.radius} m); move it or shrink it")
+
+
+# ------------------------------------------------------------------ deprecated names
+_INFLUENCE = geometry.DEFAULT_INFLUENCE
+
+
+def _old_circle(center: object, radius: float, influence: float = _INFLUENCE,
+                name: str = "") -> geometry.Cylinder:
+    """The old ``Circle(center (2,), radius, influence, name)``: a vertical infinite cylinder."""
+    c = as_vector(center, "center", 2)
+    return geometry.Cylinder(check_positive(radius, "radius"), math.inf,
+                             center=[c[0], c[1], 0.0], influence=influence, name=name)
+
+
+def _old_sphere(center: object, radius: float, influence: float = _INFLUENCE,
+                name: str = "") -> geometry.Sphere:
+    """The old ``Sphere(center (3,), radius, influence, name)``."""
+    return geometry.Sphere(check_positive(radius, "radius"), center=center,
+                           influence=influence, name=name)
+
+
+def _old_capsule(a: object, b: object, radius: float, influence: float = _INFLUENCE,
+                 name: str = "") -> geometry.Capsule:
+    """The old ``Capsule(a (3,), b (3,), radius, influence, name)``."""
+    return geometry.Capsule(check_positive(radius, "radius"), a=a, b=b, influence=influence,
+                            name=name)
+
+
+_CYLINDER = "Cylinder(radius, math.inf, center=[x, y, 0.0], influence=..., name=...)"
+#: Old name -> (thin constructor, the call in the shared vocabulary).
+_DEPRECATED: dict[str, tuple[Callable[..., Any], str, str]] = {
+    "Circle": (_old_circle, "Cylinder", _CYLINDER),
+    "Cylinder": (_old_circle, "Cylinder", _CYLINDER),
+    "Sphere": (_old_sphere, "Sphere", "Sphere(radius, center=..., influence=..., name=...)"),
+    "Capsule": (_old_capsule, "Capsule",
+                "Capsule(radius, a=..., b=..., influence=..., name=...)"),
+}
+_old_circle.__name__ = _old_circle.__qualname__ = "Circle"
+_old_sphere.__name__ = _old_sphere.__qualname__ = "Sphere"
+_old_capsule.__name__ = _old_capsule.__qualname__ = "Capsule"
+
+
+def _deprecated(module: str, name: str) -> Callable[..., Any]:
+    """The thin constructor of an old obstacle name, with a ``DeprecationWarning``.
+
+    Raises:
+        AttributeError: ``name`` is not an old name (``module`` has no such attribute).
+    """
+    if name not in _DEPRECATED:
+        raise AttributeError(f"module {module!r} has no attribute {name!r}")
+    build, new, call = _DEPRECATED[name]
+    warnings.warn(f"{module}.{name} is deprecated: import {new} from serialkin.model.geometry "
+                  f"(one class per shape), sizes first and placement by keyword: {call}",
+                  DeprecationWarning, stacklevel=3)
+    return build
+
+
+def __getattr__(name: str) -> Callable[..., Any]:
+    """``Circle``, ``Cylinder``, ``Sphere``, ``Capsule``: the old names (warn)."""
+    return _deprecated(__name__, name)

@@ -7,7 +7,7 @@ link frames as RGB triads (x red, y green, z blue). Planar robots
 (:attr:`~serialkin.Robot.is_planar`) are drawn in the world xy plane on ordinary 2D axes,
 every other robot on 3D axes.
 
-Obstacles are duck-typed so that the classes of :mod:`serialkin.redundancy.obstacles` and
+Obstacles are duck-typed so that the shapes of :mod:`serialkin.model.geometry` and
 plain dicts both work: anything with a ``center`` (or ``centre``) and a ``radius`` is a
 circle (2D) or a sphere (3D); with a ``height`` too it is a vertical cylinder (the chapter's
 Figure 10 model, drawn as a circle in 2D); with two end points (``a``/``b``, ``p0``/``p1``
@@ -326,7 +326,7 @@ class Obstacle:
 
 
 _ENDPOINT_NAMES = (("a", "b"), ("p0", "p1"), ("start", "end"), ("p1", "p2"))
-#: Integer ``kind`` codes of :mod:`serialkin.redundancy.obstacles` (circle, sphere, capsule).
+#: Integer ``kind`` codes of the obstacle encoding (cylinder along z, sphere, capsule).
 _KIND_CODES = {0: "cylinder", 1: "sphere", 2: "capsule"}
 _KIND_NAMES = {"circle": "cylinder", "cylinder": "cylinder", "sphere": "sphere",
                "ball": "sphere", "capsule": "capsule"}
@@ -373,8 +373,9 @@ def _kind_of(obj: object, name: str) -> str | None:
 def as_obstacle(obj: object, name: str = "obstacle") -> Obstacle:
     """Normalise an obstacle object or dict to :class:`Obstacle`.
 
-    Works with :mod:`serialkin.redundancy.obstacles` (``Circle``/``Cylinder``: an infinite
-    vertical cylinder; ``Sphere``; ``Capsule``), their ``to_dict()`` form and plain dicts.
+    Works with the shapes of :mod:`serialkin.model.geometry` (``Cylinder`` of infinite
+    length: a vertical cylinder; ``Sphere``; ``Capsule``), their scenario-file form
+    (:func:`serialkin.redundancy.obstacles.obstacle_to_dict`) and plain dicts.
     Accepted fields (attributes or mapping keys): ``center``/``centre``/``position`` (2 or 3
     coordinates; z = 0 when 2), ``radius`` (> 0), optional ``height`` (a vertical cylinder
     of that height), capsule end points ``a``/``b`` (or ``p0``/``p1``, ``start``/``end``),

@@ -24,11 +24,12 @@ from serialkin.tracking.scenario import planar_arm
 def _obstacle_objective(ctx: ReportContext) -> str:
     """Eq 45 on a planar 3-link arm and a circular obstacle, checked by brute force."""
     from serialkin import models
-    from serialkin.redundancy import Circle, obstacle_distance
+    from serialkin.model.geometry import Cylinder
+    from serialkin.redundancy import obstacle_distance
     from serialkin.redundancy.objectives import finite_difference_gradient
 
     arm = models.three_link(1.0, 0.8, 0.5)
-    obstacle = Circle(center=np.array([1.2, 1.3]), radius=0.25)
+    obstacle = Cylinder(0.25, np.inf, center=[1.2, 1.3, 0.0])  # the circle, extruded along z
     H = obstacle_distance(arm, [obstacle])
     rows = []
     for q in (np.array([0.3, 0.6, -0.4]), np.array([0.0, 0.3, 0.9]),
@@ -37,9 +38,9 @@ def _obstacle_objective(ctx: ReportContext) -> str:
         t = np.linspace(0.0, 1.0, 1001)[:, None]
         a = np.vstack([p0 + t * (p1 - p0) for p0, p1 in zip(pts[:-1], pts[1:])])
         ang = np.linspace(0.0, 2 * np.pi, 721)
-        b = obstacle.center + obstacle.radius * np.c_[np.cos(ang), np.sin(ang)]
+        b = obstacle.center[:2] + obstacle.radius * np.c_[np.cos(ang), np.sin(ang)]
         d2 = min(float(np.min(np.sum((a[:, None, :] - bj) ** 2, axis=-1))) for bj in b)
-        d_exact = np.min(np.linalg.norm(a - obstacle.center, axis=1)) - obstacle.radius
+        d_exact = np.min(np.linalg.norm(a - obstacle.center[:2], axis=1)) - obstacle.radius
         g = H.gradient(q)
         g_fd = finite_difference_gradient(H.value, q)
         rows.append((", ".join(f"{v:g}" for v in q), H.value(q), d_exact * abs(d_exact),
