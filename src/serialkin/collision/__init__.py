@@ -70,6 +70,7 @@ __all__ = [
 
 def __getattr__(name: str) -> object:
     """``Box``, ``HalfSpace``: old names of :mod:`serialkin.model.geometry` classes (warn)."""
-    from serialkin.collision.shapes import _deprecated
+    from serialkin.collision.shapes import _DEPRECATED
+    from serialkin.model.geometry import renamed
 
-    return _deprecated(__name__, name)
+    return renamed(__name__, name, _DEPRECATED)

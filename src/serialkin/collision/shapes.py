@@ -16,7 +16,6 @@ old names still build the shared classes for one release, with a ``DeprecationWa
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -100,28 +99,13 @@ def _old_halfspace(normal: object, offset: float = 0.0, name: str = "") -> geome
 _old_box.__name__ = _old_box.__qualname__ = "Box"
 _old_halfspace.__name__ = _old_halfspace.__qualname__ = "HalfSpace"
 
-#: Old name -> (thin constructor, the call in the shared vocabulary).
-_DEPRECATED: dict[str, tuple[Callable[..., Any], str]] = {
-    "Box": (_old_box, "Box(size=2 * half_extents, center=..., rotation=..., name=...)"),
-    "HalfSpace": (_old_halfspace, "HalfSpace(normal, offset, name=...)"),
+#: Old name -> (thin constructor, the class it builds, the call in the shared vocabulary).
+_DEPRECATED: dict[str, tuple[Callable[..., Any], str, str]] = {
+    "Box": (_old_box, "Box", "Box(size=2 * half_extents, center=..., rotation=..., name=...)"),
+    "HalfSpace": (_old_halfspace, "HalfSpace", "HalfSpace(normal, offset, name=...)"),
 }
-
-
-def _deprecated(module: str, name: str) -> Callable[..., Any]:
-    """The thin constructor of an old scene-shape name, with a ``DeprecationWarning``.
-
-    Raises:
-        AttributeError: ``name`` is not an old name (``module`` has no such attribute).
-    """
-    if name not in _DEPRECATED:
-        raise AttributeError(f"module {module!r} has no attribute {name!r}")
-    build, call = _DEPRECATED[name]
-    warnings.warn(f"{module}.{name} is deprecated: import {name} from serialkin.model.geometry "
-                  f"(one class per shape), sizes first and placement by keyword: {call}",
-                  DeprecationWarning, stacklevel=3)
-    return build
 
 
 def __getattr__(name: str) -> Callable[..., Any]:
     """``Box``, ``HalfSpace``: the old names, building the shared classes (warns)."""
-    return _deprecated(__name__, name)
+    return geometry.renamed(__name__, name, _DEPRECATED)

@@ -53,6 +53,7 @@ for a point of the wrong shape or not finite, a matrix that is not a rotation, a
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import KW_ONLY, dataclass, field, fields
 from typing import ClassVar
 
@@ -539,3 +540,22 @@ class LinkGeometry:
                         f"link {short_repr(self.link_name)} {kind}: expected Shape objects, "
                         f"got {type(s).__name__}")
             object.__setattr__(self, kind, shapes)
+
+
+def renamed(module: str, name: str, table: dict) -> object:
+    """The old name ``name`` of ``module`` (a module ``__getattr__``), with a warning.
+
+    ``table`` maps each old name to ``(build, new, call)``: the thin constructor keeping
+    the old signature, the name of the class of this module it builds and an example of
+    the new call. Emits a ``DeprecationWarning`` naming the new import and call.
+
+    Raises:
+        AttributeError: ``name`` is not an old name (``module`` has no such attribute).
+    """
+    if name not in table:
+        raise AttributeError(f"module {module!r} has no attribute {name!r}")
+    build, new, call = table[name]
+    warnings.warn(f"{module}.{name} is deprecated: import {new} from serialkin.model.geometry "
+                  f"(one class per shape), sizes first and placement by keyword: {call}",
+                  DeprecationWarning, stacklevel=3)
+    return build

@@ -64,6 +64,7 @@ __all__ = [
 
 def __getattr__(name: str) -> object:
     """``Circle``, ``Cylinder``, ``Sphere``, ``Capsule``: old obstacle names (warn)."""
-    from serialkin.redundancy.obstacles import _deprecated
+    from serialkin.model.geometry import renamed
+    from serialkin.redundancy.obstacles import _DEPRECATED
 
-    return _deprecated(__name__, name)
+    return renamed(__name__, name, _DEPRECATED)

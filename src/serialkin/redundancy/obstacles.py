@@ -39,7 +39,6 @@ approaches the obstacle; ``−J_ci`` is the gradient of its clearance.
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -598,21 +597,6 @@ _old_sphere.__name__ = _old_sphere.__qualname__ = "Sphere"
 _old_capsule.__name__ = _old_capsule.__qualname__ = "Capsule"
 
 
-def _deprecated(module: str, name: str) -> Callable[..., Any]:
-    """The thin constructor of an old obstacle name, with a ``DeprecationWarning``.
-
-    Raises:
-        AttributeError: ``name`` is not an old name (``module`` has no such attribute).
-    """
-    if name not in _DEPRECATED:
-        raise AttributeError(f"module {module!r} has no attribute {name!r}")
-    build, new, call = _DEPRECATED[name]
-    warnings.warn(f"{module}.{name} is deprecated: import {new} from serialkin.model.geometry "
-                  f"(one class per shape), sizes first and placement by keyword: {call}",
-                  DeprecationWarning, stacklevel=3)
-    return build
-
-
 def __getattr__(name: str) -> Callable[..., Any]:
     """``Circle``, ``Cylinder``, ``Sphere``, ``Capsule``: the old names (warn)."""
-    return _deprecated(__name__, name)
+    return geometry.renamed(__name__, name, _DEPRECATED)
