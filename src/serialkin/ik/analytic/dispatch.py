@@ -303,7 +303,7 @@ def for_class(code: int, refine: bool = False) -> ClassKernels:
     else:
         cands = {WRIST: _wrist, UR: _ur, GENERAL: _general}[code]
         one = bind(_solve_into, f"solve_into_{name}", candidates=cands, refinable=refine)
-    one = njit(cache=True, inline="always")(one)
+    one = njit(cache=True)(one)  # called from Python too: one compiled copy, linked
     return ClassKernels(
         solve_into=one,
         solve_range=njit(cache=True, nogil=True)(bind(_solve_range, f"solve_range_{name}",
