@@ -52,7 +52,7 @@ from serialkin._checks import as_vector, check_choice, short_repr
 from serialkin.errors import InputError, InputTypeError
 from serialkin.model.dh import DHLink
 from serialkin.model.joint import Joint
-from serialkin.model.robot import Robot
+from serialkin.model.robot import Robot, check_robot
 from serialkin.spatial.transforms import make_transform
 
 #: Error model kinds (see the module docstring).
@@ -310,8 +310,7 @@ def error_model(robot: Robot, kind: str = "auto", *, hayati: object = "auto",
     Raises:
         InputError: unknown kind; 'dh' for a robot without a DH table; a bad hayati list.
     """
-    if not isinstance(robot, Robot):
-        raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    check_robot(robot)
     check_choice(kind, "kind", MODEL_KINDS)
     if kind == "auto":
         kind = "dh" if robot.dh is not None else "joints"

@@ -33,7 +33,7 @@ from serialkin.errors import InputError, InputTypeError, NoClosedFormError, NotS
 from serialkin.ik.registry import METHODS, get_method
 from serialkin.ik.solver import DEFAULT_TOL, solve
 from serialkin.ik.target import check_q0, check_tol, parse_target
-from serialkin.model.robot import Robot
+from serialkin.model.robot import Robot, check_robot
 
 #: Column names of :meth:`CompareTable.to_text` / :meth:`CompareTable.to_html`.
 COLUMNS = (
@@ -225,8 +225,7 @@ def compare(
         InputError / InputTypeError: bad robot, targets, q0, tol, method names, or an
             option that a method does not accept.
     """
-    if not isinstance(robot, Robot):
-        raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    check_robot(robot)
     _check_common_options(options)
     tol_v = check_tol(tol)
     tgt = parse_target(robot, targets, options.get("mask"))

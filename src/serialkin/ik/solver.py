@@ -54,7 +54,7 @@ from serialkin.ik.target import (
 )
 from serialkin.kinematics import kernels as FK
 from serialkin.kinematics import parallel
-from serialkin.model.robot import Robot
+from serialkin.model.robot import Robot, check_robot
 from serialkin.spatial import kernels as SK
 
 #: Default tolerance on the position [m] and orientation [rad] errors.
@@ -448,15 +448,6 @@ class _Request:
     options: Mapping[str, Any]
 
 
-def _check_robot(robot: object) -> None:
-    """Raise InputTypeError unless ``robot`` is a Robot (a model name says how to build one)."""
-    if not isinstance(robot, Robot):
-        hint = (f" (a model name: serialkin.models.get({short_repr(robot, 40)}) builds it)"
-                if isinstance(robot, str) else "")
-        raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__} "
-                             f"{short_repr(robot, 40)}{hint}")
-
-
 def _check_joint_count(robot: Robot, spec: MethodSpec) -> None:
     """Raise InputError when ``robot`` has more joints than ``spec`` takes (naming others)."""
     if spec.max_joints is not None and robot.n > spec.max_joints:
@@ -481,7 +472,7 @@ def _check_batch_size(robot: Robot, target: object) -> None:
 
 def _solve_checked(robot: object, target: object, method: str, req: _Request) -> IKResult:
     """:func:`solve` past its fast path: check every argument, then run the method."""
-    _check_robot(robot)
+    check_robot(robot)
     spec = get_method(method)
     _check_joint_count(robot, spec)
     _check_batch_size(robot, target)

@@ -881,3 +881,20 @@ def robot_scale(robot: Robot) -> float:
             finite = lim[np.isfinite(lim)]
             total += float(finite.max()) if finite.size else 1.0
     return max(total, 1e-3)
+
+
+def check_robot(robot: object, name: str = "robot") -> Robot:
+    """``robot`` if it is a :class:`Robot`; else InputTypeError naming ``name``.
+
+    A string gets a hint: it looks like a model name, which ``serialkin.models.get``
+    turns into a robot.
+
+    Raises:
+        InputTypeError: ``robot`` is not a Robot.
+    """
+    if isinstance(robot, Robot):
+        return robot
+    hint = (f" (a model name: serialkin.models.get({short_repr(robot, 40)}) builds it)"
+            if isinstance(robot, str) else "")
+    raise InputTypeError(f"{name} must be a serialkin Robot, got {type(robot).__name__} "
+                         f"{short_repr(robot, 40)}{hint}")

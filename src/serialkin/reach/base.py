@@ -35,8 +35,8 @@ from serialkin._checks import (
     check_real,
     check_transform,
 )
-from serialkin.errors import InputError, InputTypeError
-from serialkin.model.robot import Robot
+from serialkin.errors import InputError
+from serialkin.model.robot import Robot, check_robot
 from serialkin.reach.chunk import restart_seed, voxel_starts
 from serialkin.reach.grid import robot_reach_box
 from serialkin.reach.solve import NumericalOptions, resolve_solver, solve_targets
@@ -132,8 +132,7 @@ def base_placement(robot: Robot, tasks: object, *, resolution: float = 0.1, yaws
         InputError: malformed tasks or region, resolution <= 0, yaws < 1, a planar robot.
         BudgetError: too many candidates × tasks for the memory budget.
     """
-    if not isinstance(robot, Robot):
-        raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    check_robot(robot)
     if robot.is_planar:
         raise InputError("base_placement places a spatial robot on a floor plane; "
                          f"{robot.name!r} is planar")

@@ -28,7 +28,7 @@ from serialkin._budget import check_allocation
 from serialkin._checks import check_choice, check_int, check_positive
 from serialkin._io import write_text_atomic
 from serialkin.errors import InputError, InputTypeError
-from serialkin.model.robot import Robot
+from serialkin.model.robot import Robot, check_robot
 from serialkin.reach import store
 from serialkin.reach.chunk import FIELDS, ReachJob, compute_chunk
 from serialkin.reach.grid import check_map_size, make_grid
@@ -144,8 +144,7 @@ def make_job(robot: Robot, resolution: float, orientations: int = 50, *,
              tol: float = 1e-6, max_iter: int | None = None, seed: int = 0,
              scene: Any = None, chunk_voxels: int = CHUNK_VOXELS) -> ReachJob:
     """Validate a map's settings and build its :class:`ReachJob` (see :func:`reachability_map`)."""
-    if not isinstance(robot, Robot):
-        raise InputTypeError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    check_robot(robot)
     task = default_task(robot) if task is None else check_choice(task, "task", TASKS)
     if task.startswith("planar") and not robot.is_planar:
         raise InputError(f"task {task!r} needs a planar robot; {robot.name!r} is spatial")

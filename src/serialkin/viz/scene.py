@@ -22,7 +22,7 @@ import numpy as np
 
 from serialkin._checks import as_float_array, check_int, short_repr
 from serialkin.errors import InputError, InputTypeError
-from serialkin.model.robot import Robot
+from serialkin.model.robot import Robot, check_robot
 from serialkin.viz.plot import Obstacle, as_obstacle
 
 if TYPE_CHECKING:
@@ -216,9 +216,7 @@ class Scene:
 
     def __post_init__(self) -> None:
         robot = self.robot
-        if not isinstance(robot, Robot):
-            raise InputTypeError(f"robot must be a serialkin Robot, got "
-                                 f"{type(robot).__name__} {short_repr(robot)}")
+        check_robot(robot)
         _set(self, "trajectory", _check_trajectory(robot, self.trajectory))
         _set(self, "path_points", _check_path_points(self.path_points))
         _set(self, "q", _check_q(robot, self.q))

@@ -83,7 +83,7 @@ from serialkin.ik.analytic.structure import (
     general_structure,
 )
 from serialkin.ik.analytic.subproblems import rigid_error
-from serialkin.model.robot import Robot
+from serialkin.model.robot import Robot, check_robot
 from serialkin.spatial.rotations import wrap_angle
 
 #: Spherical-wrist classes: (arm code, joint 3 prismatic) for ``solve_spherical_wrist``.
@@ -152,8 +152,7 @@ def structure_of(robot: Robot) -> Structure:
     Raises:
         NoClosedFormError: the robot is of no class in :data:`CLASSES`.
     """
-    if not isinstance(robot, Robot):
-        raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    check_robot(robot)
     s = _STRUCTURES.get(robot)
     if s is None:
         try:
@@ -182,8 +181,7 @@ def _prepared(robot: Robot, near_tol: float = 0.0) -> _Prepared:
     Its exact class; else (6 joints) the class it is within ``near_tol`` of (solved on
     the idealised axes, refined on the true chain); else (6R) the general solver.
     """
-    if not isinstance(robot, Robot):
-        raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    check_robot(robot)
     cache = _PREPARED.setdefault(robot, dict)
     p = cache.get(near_tol)
     if p is not None:
@@ -892,8 +890,7 @@ def _ik_all_locked(robot: Robot, target: object, free: object, order: tuple,
     ``order`` is ``(reference, weights, norm)`` of the sorting, ``solve`` the options of
     the reduced robot's solve.
     """
-    if not isinstance(robot, Robot):
-        raise InputError(f"robot must be a serialkin Robot, got {type(robot).__name__}")
+    check_robot(robot)
     reference, weights, norm = order
     reduced, idx, vals = _locked(robot, free)
     res = ik_all(reduced, target, **solve)
