@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 import serialkin as sk
 from serialkin import Robot, models
-from serialkin.errors import InputError, NoClosedFormError
+from serialkin.errors import InputError, InputTypeError, NoClosedFormError
 from serialkin.ik.analytic import CLASSES, AllSolutions, classify, ik_all
 from serialkin.model.dh import DHLink, standard_to_modified
 from serialkin.spatial import make_transform, rotx, roty, rotz
@@ -670,14 +670,14 @@ def test_bad_target(target, match):
 
 
 def test_bad_options():
-    """A non-positive tol or an unknown option raises InputError naming it."""
+    """Bad tol or option: InputError naming it; a non-robot: InputTypeError with a hint."""
     robot = models.ur5()
     T = robot.fk(np.zeros(6))
     with pytest.raises(InputError, match="tol"):
         ik_all(robot, T, tol=-1.0)
     with pytest.raises(InputError, match="unknown option"):
         ik_all(robot, T, q0=np.zeros(6))
-    with pytest.raises(InputError, match="Robot"):
+    with pytest.raises(InputTypeError, match=r"Robot.*models\.get"):
         ik_all("ur5", T)
 
 
