@@ -21,6 +21,7 @@ from serialkin.errors import InputError, InputTypeError, NoClosedFormError
 from serialkin.ik.analytic import CLASSES, AllSolutions, classify, ik_all
 from serialkin.model.dh import DHLink, standard_to_modified
 from serialkin.spatial import make_transform, rotx, roty, rotz
+from tests.ik._arms import WRIST_ARM, wrist_arm_rows
 
 H = math.pi / 2
 
@@ -274,22 +275,12 @@ def test_wrist_singular_representative():
                                atol=1e-9)
 
 
-def _zero_or_away(low: float, high: float) -> st.SearchStrategy[float]:
-    """Exactly 0 (a special structure) or well away from it (a well-conditioned one)."""
-    return st.one_of(st.just(0.0), st.floats(low, high), st.floats(-high, -low))
-
-
 @settings(max_examples=30, deadline=None)
-@given(a=st.lists(_zero_or_away(0.05, 0.5), min_size=3, max_size=3),
-       alpha=st.lists(_zero_or_away(0.2, 2.9), min_size=3, max_size=3),
-       d=st.lists(_zero_or_away(0.05, 0.5), min_size=4, max_size=4),
-       seed=st.integers(0, 2**31 - 1))
+@given(**WRIST_ARM, seed=st.integers(0, 2**31 - 1))
 def test_any_arm_with_spherical_wrist(a, alpha, d, seed):
     """Any well-conditioned R R R arm followed by a spherical wrist is solved (Pieper)."""
-    rows = [DHLink(a=a[i], alpha=alpha[i], d=d[i]) for i in range(3)]
-    rows += [DHLink(a=0.0, alpha=-H, d=d[3]), DHLink(a=0.0, alpha=H, d=0.0),
-             DHLink(a=0.0, alpha=0.0, d=0.1)]
-    robot = Robot.from_dh(rows, base=_random_transform(np.random.default_rng(seed)))
+    robot = Robot.from_dh(wrist_arm_rows(a, alpha, d),
+                          base=_random_transform(np.random.default_rng(seed)))
     try:
         kind = classify(robot)
     except NoClosedFormError as exc:  # degenerate draws: the message says which test failed
@@ -315,10 +306,7 @@ def test_base_and_tool_invariance(name, seed):
 
 
 @settings(max_examples=30, deadline=None)
-@given(a=st.lists(_zero_or_away(0.05, 0.5), min_size=3, max_size=3),
-       alpha=st.lists(_zero_or_away(0.2, 2.9), min_size=3, max_size=3),
-       d=st.lists(_zero_or_away(0.05, 0.5), min_size=4, max_size=4),
-       theta3=st.floats(-3.0, 3.0), seed=st.integers(0, 2**31 - 1))
+@given(**WRIST_ARM, theta3=st.floats(-3.0, 3.0), seed=st.integers(0, 2**31 - 1))
 def test_any_rrp_arm_with_spherical_wrist(a, alpha, d, theta3, seed):
     """Any well-conditioned R R P arm followed by a spherical wrist is solved (Stanford class)."""
     rows = [DHLink(a=a[0], alpha=alpha[0], d=d[0]), DHLink(a=a[1], alpha=alpha[1], d=d[1]),

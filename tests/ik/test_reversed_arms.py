@@ -21,6 +21,7 @@ from serialkin.errors import NoClosedFormError
 from serialkin.ik.analytic import classify, ik_all, structure_of
 from serialkin.ik.analytic.structure import joint_lines, reversed_lines
 from serialkin.model.dh import DHLink
+from tests.ik._arms import WRIST_ARM, wrist_arm_rows
 
 H = 0.5 * math.pi
 
@@ -90,20 +91,11 @@ def test_zoo_arms_read_from_the_tool_end(name):
     assert classify(backward) == classify(forward)
 
 
-def _zero_or_away(low: float, high: float) -> st.SearchStrategy[float]:
-    return st.one_of(st.just(0.0), st.floats(low, high), st.floats(-high, -low))
-
-
 @settings(max_examples=30, deadline=None)
-@given(a=st.lists(_zero_or_away(0.05, 0.5), min_size=3, max_size=3),
-       alpha=st.lists(_zero_or_away(0.2, 2.9), min_size=3, max_size=3),
-       d=st.lists(_zero_or_away(0.05, 0.5), min_size=4, max_size=4),
-       seed=st.integers(0, 2**31 - 1))
+@given(**WRIST_ARM, seed=st.integers(0, 2**31 - 1))
 def test_any_reversed_pieper_arm(a, alpha, d, seed):
     """Any R R R arm behind a spherical wrist, read from the tool end, is solved completely."""
-    rows = [DHLink(a=a[i], alpha=alpha[i], d=d[i]) for i in range(3)]
-    rows += [DHLink(a=0.0, alpha=-H, d=d[3]), DHLink(a=0.0, alpha=H, d=0.0),
-             DHLink(a=0.0, alpha=0.0, d=0.1)]
+    rows = wrist_arm_rows(a, alpha, d)
     forward = Robot.from_dh(rows)
     try:
         classify(forward)

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from serialkin._checks import as_float_array, as_vector
-from serialkin.errors import InputError, InputTypeError, NotSupportedError
+from serialkin.errors import InputError, InputTypeError
 from serialkin.model import geometry  # not its names: Box and HalfSpace here are the old ones
 
 __all__ = ["KIND_NAMES", "encode_scene"]
@@ -62,11 +62,7 @@ def encode_scene(scene: Sequence[object]) -> np.ndarray:
         elif isinstance(s, geometry.Capsule):
             r[0], r[1:4], r[4:7], r[7] = KIND_CAPSULE, s.a, s.b, s.radius
         elif isinstance(s, geometry.Cylinder):
-            if not s.infinite_along_z:
-                raise NotSupportedError(
-                    f"scene[{i}]: a Cylinder in a scene must be infinite along z "
-                    f"(length=math.inf, axis along the world z), got length {s.length:g} m "
-                    f"and axis {s.axis.round(6).tolist()}")
+            s.require_infinite_along_z(f"scene[{i}]", "in a scene")
             r[0], r[1:3], r[3] = KIND_CIRCLE, s.center[:2], s.radius
         elif isinstance(s, geometry.Box):
             r[0], r[1:4], r[4:13], r[13:16] = (KIND_BOX, s.center, s.rotation.ravel(),

@@ -60,7 +60,7 @@ from typing import ClassVar
 import numpy as np
 
 from serialkin._checks import as_vector, check_positive, check_real, check_rotation, short_repr
-from serialkin.errors import InputError, InputTypeError, RobotDefinitionError
+from serialkin.errors import InputError, InputTypeError, NotSupportedError, RobotDefinitionError
 from serialkin.model.joint import check_fixed_transform
 
 __all__ = ["DEFAULT_INFLUENCE", "Box", "Capsule", "Cylinder", "Geometry", "HalfSpace",
@@ -291,6 +291,18 @@ class Cylinder(_Solid):
         tasks accept.
         """
         return math.isinf(self.length) and abs(float(self.rotation[2, 2])) >= 1.0 - 1e-12
+
+    def require_infinite_along_z(self, where: str, role: str) -> None:
+        """Raise NotSupportedError unless :attr:`infinite_along_z` (``role``: who refuses).
+
+        ``where`` names the argument (``scene[2]``), ``role`` what it is used as ("in a
+        scene", "obstacle"): collision scenes and the obstacle tasks take no other cylinder.
+        """
+        if not self.infinite_along_z:
+            raise NotSupportedError(
+                f"{where}: a Cylinder {role} must be infinite along z (length=math.inf, axis "
+                f"along the world z), got length {self.length:g} m and axis "
+                f"{self.axis.round(6).tolist()}")
 
     @property
     def pose(self) -> np.ndarray:

@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from serialkin._checks import as_vector, check_positive
-from serialkin.errors import InputError, InputTypeError, NotSupportedError
+from serialkin.errors import InputError, InputTypeError
 from serialkin.kinematics import kernels as K
 from serialkin.model import geometry  # not its names: Sphere, Capsule here are the old ones
 from serialkin.spatial.segments import closest_segment_segment
@@ -151,11 +151,7 @@ def _row(o: object, where: str) -> np.ndarray:
         NotSupportedError: a cylinder that is finite or whose axis is not along z.
     """
     if isinstance(o, geometry.Cylinder):
-        if not o.infinite_along_z:
-            raise NotSupportedError(
-                f"{where}: a Cylinder obstacle must be infinite along z (length=math.inf, "
-                f"axis along the world z), got length {o.length:g} m and axis "
-                f"{o.axis.round(6).tolist()}")
+        o.require_infinite_along_z(where, "obstacle")
         x, y = o.center[0], o.center[1]
         return np.array([KIND_CIRCLE, x, y, 0.0, x, y, 0.0, o.radius])
     if isinstance(o, geometry.Sphere):
