@@ -113,6 +113,19 @@ def _describe(x: object) -> str:
     return f"{type(x).__name__} {short_repr(x, 100)}"
 
 
+def readonly(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a`` (no copy): the one array type a kernel input compiles for.
+
+    numba compiles a kernel once per set of argument types, and a read-only and a
+    writeable array are two types. Inputs a kernel only reads pass through this, so
+    that a user's read-only array, a broadcast view and a fresh array share one
+    compiled specialization (issue 27).
+    """
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
 def as_float_array(x: object, name: str, *, ndim: int | None = None,
                    finite: bool = True) -> np.ndarray:
     """Return ``x`` as a finite float64 array, or raise naming ``name``.

@@ -70,7 +70,13 @@ def _kinematics() -> None:
         r.fk(Q)
         r.fk(np.asfortranarray(Q))
         r.jacobian(Q)
+        r.jacobian(Q, link=2, point=[0.0, 0.0, 0.1])
+        r.hessian(Q)
+        r.jacobian_dot(Q, qd=np.ones_like(Q))
         r.manipulability(Q)
+        T = r.fk(Q)
+        sk.spatial.pose_error(T, T[::-1])
+        sk.spatial.so3_log(T[:, :3, :3])
 
 
 def _ik() -> None:
@@ -116,6 +122,7 @@ def _ik_methods() -> None:
             T = T[:, :2, 3]  # position targets in the plane
         r.ik(T[0], method=name, max_iter=5)
         r.ik(T[0], method=name, q0=Q[1], max_iter=5)
+        r.ik(T[0], method=name, q0=Q[0])  # default options: the one-target fast path
         if spec.kernel is not None:  # the compiled batch loop
             r.ik(T, method=name, max_iter=5)
 
@@ -140,11 +147,26 @@ def _ik_all_general() -> None:
 
 def _collision() -> None:
     import serialkin as sk
+    from serialkin.collision import (
+        default_acm,
+        panda_collision_model,
+        scene_clearance,
+        self_clearance,
+    )
+    from serialkin.collision.queries import body_pair_distances
+    from serialkin.model.geometry import Box, HalfSpace
 
     r = sk.models.get("panda")
-    T = r.fk(r.random_q(2, seed=0))
+    Q = r.random_q(2, seed=0)
+    T = r.fk(Q)
     r.ik(T[0], self_collision=True)
     r.ik(T, self_collision=True)
+    model = panda_collision_model()
+    acm = default_acm(model)
+    self_clearance(r, model, Q, acm)
+    body_pair_distances(r, model, Q, acm)
+    scene = [Box((0.2, 0.2, 0.2), center=[0.5, 0.0, 0.3]), HalfSpace([0.0, 0.0, 1.0])]
+    scene_clearance(r, model, Q, scene)
 
 
 def _workspace() -> None:
@@ -158,6 +180,7 @@ def _workspace() -> None:
 
 
 def _tracking() -> None:
+    from serialkin.redundancy.nullspace import dls_inverse
     from serialkin.tracking import load_scenario, track
     from serialkin.tracking.analysis import qp_resolver
 
@@ -165,6 +188,7 @@ def _tracking() -> None:
     sc = load_scenario("twenty_link_obstacles")  # weighted tasks with obstacles (eq 48)
     sc.run()
     track(sc.robot, sc.path, qp_resolver(sc), q0=sc.q0)  # the QP with hard constraints
+    dls_inverse(sc.robot.jacobian(sc.q0), 0.1)
 
 
 #: The features, in the order ``serialkin warmup --all`` starts them (longest first, so

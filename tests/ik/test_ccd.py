@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 import serialkin as sk
 from serialkin import models
+from serialkin._checks import readonly
 from serialkin.ik import ccd
 from serialkin.ik.heuristic_methods import characteristic_length
 from serialkin.spatial.pose import pose_error
@@ -26,6 +27,11 @@ TOL = 1e-6
 POSITION = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
 PLANAR = np.array([1.0, 1.0, 0.0, 0.0, 0.0, 0.0])
 PLANAR_POSE = np.array([1.0, 1.0, 0.0, 0.0, 0.0, 1.0])
+
+
+def _limit(robot, side: int) -> np.ndarray:
+    """Lower (0) or upper (1) joint limits as the solver passes them: read-only, contiguous."""
+    return readonly(np.ascontiguousarray(robot.qlim[:, side]))
 
 
 @pytest.mark.parametrize("name", ["puma560", "ur5", "panda", "stanford", "iiwa7", "scara"])
@@ -92,9 +98,8 @@ def test_one_joint_step_is_the_exact_optimum(a, alpha, d, qt, q0, w_orient, lo, 
     Tt = robot.fk(np.array([qt]))
     Tt[:3, 3] += np.array([0.05, -0.02, 0.03])  # not exactly reachable
     q = np.array([min(max(q0, lo), hi)])
-    ccd.ccd_sweep(q, robot.chain.F, robot.chain.meta, Tt, np.ones(3), 1.0, w_orient,
-                  robot.qlim[:, 0].copy(), robot.qlim[:, 1].copy(), np.empty((6, 1)),
-                  np.empty((4, 4)))
+    ccd.ccd_sweep(q, robot.chain.F, robot.chain.meta, readonly(Tt), np.ones(3), 1.0, w_orient,
+                  _limit(robot, 0), _limit(robot, 1), np.empty((6, 1)), np.empty((4, 4)))
     assert lo - 1e-12 <= q[0] <= hi + 1e-12
     grid = np.linspace(lo, hi, 4001)
     best = min(_cost(robot, g, Tt, w_orient) for g in grid)
@@ -113,9 +118,8 @@ def test_prismatic_step_is_the_clamped_projection(d, target, lo, width):
     Tt = axis_T.copy()
     Tt[:3, 3] += target * z
     q = np.array([min(max(d, lo), lo + width)])
-    ccd.ccd_sweep(q, robot.chain.F, robot.chain.meta, Tt, np.ones(3), 1.0, 0.0,
-                  robot.qlim[:, 0].copy(), robot.qlim[:, 1].copy(), np.empty((6, 1)),
-                  np.empty((4, 4)))
+    ccd.ccd_sweep(q, robot.chain.F, robot.chain.meta, readonly(Tt), np.ones(3), 1.0, 0.0,
+                  _limit(robot, 0), _limit(robot, 1), np.empty((6, 1)), np.empty((4, 4)))
     assert q[0] == pytest.approx(min(max(target, lo), lo + width), abs=1e-12)
 
 
@@ -128,7 +132,7 @@ def test_sweep_never_increases_the_cost(seed, w_orient, name):
     rng = np.random.default_rng(seed)
     q = robot.random_q(seed=rng)
     Tt = robot.fk(robot.random_q(seed=rng))
-    lo, hi = robot.qlim[:, 0].copy(), robot.qlim[:, 1].copy()
+    lo, hi = _limit(robot, 0), _limit(robot, 1)
 
     def cost(qq):
         T = robot.fk(qq)
@@ -137,8 +141,8 @@ def test_sweep_never_increases_the_cost(seed, w_orient, name):
 
     before = cost(q)
     T = np.empty((4, 4))
-    ccd.ccd_sweep(q, robot.chain.F, robot.chain.meta, Tt, np.ones(3), 1.0, w_orient, lo, hi,
-                  np.empty((6, robot.n)), T)
+    ccd.ccd_sweep(q, robot.chain.F, robot.chain.meta, readonly(Tt), np.ones(3), 1.0, w_orient,
+                  lo, hi, np.empty((6, robot.n)), T)
     assert cost(q) <= before + 1e-12
     assert robot.within_limits(q, 1e-12)
     np.testing.assert_allclose(T, robot.fk(q), atol=1e-12)

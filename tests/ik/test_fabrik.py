@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 import serialkin as sk
 from serialkin import models
+from serialkin._checks import readonly
 from serialkin.errors import NotSupportedError
 from serialkin.ik import fabrik
 
@@ -32,6 +33,11 @@ CHAINS = {
     "planar20_limited": lambda: models.planar(20, 0.01675, qlim=(-1.745, 1.745)),
     "uneven_limited": lambda: models.planar(4, [0.5, 0.3, 0.4, 0.2], qlim=(-2.0, 2.0)),
 }
+
+
+def _limit(robot, side: int) -> np.ndarray:
+    """Lower (0) or upper (1) joint limits as the solver passes them: read-only, contiguous."""
+    return readonly(np.ascontiguousarray(robot.qlim[:, side]))
 
 
 @pytest.mark.parametrize("name", sorted(CHAINS))
@@ -102,9 +108,10 @@ def test_one_pass_equals_textbook_fabrik(seed, n):
     a, e1, e2, sign = fabrik.fabrik_domain(robot)
     qq = q.copy()
     inf = np.full(n, np.inf)
-    fabrik.fabrik_pass(qq, robot.chain.F, robot.chain.meta, Tt, np.array([1.0, 1.0, 0.0]),
-                       False, a, e1, e2, sign, -inf, inf, np.empty((6, n)), np.empty((4, 4)),
-                       np.empty((n + 1, 2)), np.empty(n), np.empty(n))
+    fabrik.fabrik_pass(qq, robot.chain.F, robot.chain.meta, readonly(Tt),
+                       np.array([1.0, 1.0, 0.0]), False, a, e1, e2, sign, readonly(-inf),
+                       readonly(inf), np.empty((6, n)), np.empty((4, 4)), np.empty((n + 1, 2)),
+                       np.empty(n), np.empty(n))
     frames = robot.fk_all(qq)
     got = np.vstack([frames[:n, :2, 3], robot.fk(qq)[:2, 3]])
     np.testing.assert_allclose(got, expected, atol=1e-9)
@@ -120,8 +127,9 @@ def test_limits_are_clamped(seed):
     Tt = np.eye(4)
     Tt[:2, 3] = rng.uniform(-1.5, 1.5, 2)
     a, e1, e2, sign = fabrik.fabrik_domain(robot)
-    lo, hi = robot.qlim[:, 0].copy(), robot.qlim[:, 1].copy()
-    fabrik.fabrik_attempt(q, robot.chain.F, robot.chain.meta, Tt, np.ones(6) * [1, 1, 0, 0, 0, 0],
+    lo, hi = _limit(robot, 0), _limit(robot, 1)
+    w = readonly(np.array([1.0, 1, 0, 0, 0, 0]))  # read-only, as the solver passes its inputs
+    fabrik.fabrik_attempt(q, robot.chain.F, robot.chain.meta, readonly(Tt), w,
                           a, e1, e2, sign, lo, hi, TOL, TOL, 50, 20, 0.05)
     assert robot.within_limits(q, 1e-12)
 

@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from serialkin import models
+from serialkin._checks import readonly
 from serialkin.ik import optimize
 
 from ._numerical_helpers import (
@@ -32,19 +33,19 @@ def test_gradient_matches_finite_differences(seed, name, weights):
     Tt = robot.fk(robot.random_q(seed=rng))
     # keep the orientation error away from π, where log() switches branch
     Tt[:3, :3] = robot.fk(q + 0.3 * rng.uniform(-1, 1, robot.n))[:3, :3]
-    w = np.array(weights, dtype=float)
+    w = readonly(np.array(weights, dtype=float))  # read-only, as the solver passes its inputs
     n = robot.n
     g = np.empty(n)
     F, meta = robot.chain.F, robot.chain.meta
-    optimize.cost_and_gradient(q, F, meta, Tt, w, np.empty((6, n)), np.empty((4, 4)),
+    optimize.cost_and_gradient(q, F, meta, readonly(Tt), w, np.empty((6, n)), np.empty((4, 4)),
                                np.empty(6), g)
     h = 1e-6
     fd = np.empty(n)
     for j in range(n):
         dq = np.zeros(n)
         dq[j] = h
-        cp = optimize.cost_only(q + dq, F, meta, Tt, w, np.empty((4, 4)), np.empty(6))
-        cm = optimize.cost_only(q - dq, F, meta, Tt, w, np.empty((4, 4)), np.empty(6))
+        cp = optimize.cost_only(q + dq, F, meta, readonly(Tt), w, np.empty((4, 4)), np.empty(6))
+        cm = optimize.cost_only(q - dq, F, meta, readonly(Tt), w, np.empty((4, 4)), np.empty(6))
         fd[j] = (cp - cm) / (2 * h)
     np.testing.assert_allclose(g, fd, rtol=1e-5, atol=1e-7)
 

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 
 from serialkin._budget import check_allocation
-from serialkin._checks import MAX_ITERATIONS, ROTATION_TOL, check_int, short_repr
+from serialkin._checks import MAX_ITERATIONS, ROTATION_TOL, check_int, readonly, short_repr
 from serialkin._memo import PerObject
 from serialkin.errors import InputError, InputTypeError
 from serialkin.ik import _kernels as K
@@ -855,7 +855,7 @@ def honest_success(robot: Robot, q: np.ndarray, ok: bool, respect: bool) -> bool
     if not ok or not respect:
         return ok
     a = robot_arrays(robot)
-    return bool(K.inside_limits(np.ascontiguousarray(q, dtype=np.float64), a.lo, a.hi,
+    return bool(K.inside_limits(readonly(np.ascontiguousarray(q, dtype=np.float64)), a.lo, a.hi,
                                 LIMIT_TOL))
 
 
@@ -909,9 +909,10 @@ def _from_info(robot: Robot, tgt: Target, spec: MethodSpec, Q: np.ndarray, info:
 def _problem(robot: Robot, T: np.ndarray, tgt: Target, tol: float, respect: bool) -> IKProblem:
     lo, hi, _, _, revolute = _limits(robot, respect)
     if not respect:
-        lo = np.full(robot.n, -np.inf)
-        hi = np.full(robot.n, np.inf)
-    return IKProblem(robot=robot, T_target=np.ascontiguousarray(T), weights=tgt.weights,
+        lo = readonly(np.full(robot.n, -np.inf))
+        hi = readonly(np.full(robot.n, np.inf))
+    # read-only, as the cached limits are: the methods' kernels compile once
+    return IKProblem(robot=robot, T_target=readonly(np.ascontiguousarray(T)), weights=tgt.weights,
                      kind=tgt.kind, tol=tol, respect_limits=respect, lower=lo, upper=hi,
                      revolute=revolute)
 

@@ -24,7 +24,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from serialkin._checks import ROTATION_TOL, as_float_array, check_positive, check_transform
+from serialkin._checks import (
+    ROTATION_TOL,
+    as_float_array,
+    check_positive,
+    check_transform,
+    readonly,
+)
 from serialkin._memo import PerObject
 from serialkin.errors import InputError
 from serialkin.ik._kernels import (  # noqa: F401 (re-export)
@@ -41,7 +47,8 @@ from serialkin.spatial.kernels import transforms_valid
 KIND_WEIGHTS = {kind: task_weights(kind) for kind in TARGET_TASKS}
 
 
-def _frozen(values: tuple[float, ...]) -> np.ndarray:
+def _frozen(values: object) -> np.ndarray:
+    """A read-only float64 copy of ``values``: the kernels are compiled for read-only weights."""
     a = np.array(values, dtype=np.float64)
     a.setflags(write=False)
     return a
@@ -185,7 +192,7 @@ def parse_mask(mask: object, kind: str) -> np.ndarray:
             f"mask selects {names} but a {kind} target does not define them; "
             f"a {kind} target defines {[c for c, d in zip(TASK_COORDINATES, default) if d]}"
         )
-    return w
+    return _frozen(w)
 
 
 def parse_target(robot: Robot, target: object, mask: object = None) -> Target:
@@ -201,7 +208,7 @@ def parse_target(robot: Robot, target: object, mask: object = None) -> Target:
         # one pose or a batch: the compiled check (check_transform's criteria, no
         # temporaries); only a failing target takes the numpy path, which names the fault
         T = np.ascontiguousarray(target)
-        if transforms_valid(T.reshape(-1, 4, 4), ROTATION_TOL):
+        if transforms_valid(readonly(T.reshape(-1, 4, 4)), ROTATION_TOL):
             return Target(T, parse_mask(mask, "pose"), "pose")
     a = as_float_array(target, "target")
     if a.ndim >= 2 and a.shape[-2:] == (4, 4):
@@ -260,8 +267,9 @@ def check_q0(robot: Robot, q0: object, n_targets: int | None, respect_limits: bo
         # the common call, checked in one compiled pass (finite, inside the limits)
         arr = robot_arrays(robot)
         tol = 1e-12 if respect_limits else np.inf
-        if (inside_limits(q0, arr.lo, arr.hi, tol) if n_targets is None
-                else rows_inside_limits(q0, arr.lo, arr.hi, tol)):
+        q = readonly(q0)  # a user's read-only q0 compiles nothing more
+        if (inside_limits(q, arr.lo, arr.hi, tol) if n_targets is None
+                else rows_inside_limits(q, arr.lo, arr.hi, tol)):
             return q0
     q = robot.check_q(q0, "q0")
     if n_targets is None:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from serialkin._checks import ROTATION_TOL, check_transform
+from serialkin._checks import ROTATION_TOL, check_transform, readonly
 from serialkin.errors import InputError
 from serialkin.spatial import kernels as K
 
@@ -29,7 +29,7 @@ def _validated(x: object, name: str, check: bool) -> np.ndarray:
         and x.shape[-2:] == (4, 4)
     ):
         if not check or K.transforms_valid(
-            np.ascontiguousarray(x).reshape(-1, 4, 4), ROTATION_TOL
+            readonly(np.ascontiguousarray(x).reshape(-1, 4, 4)), ROTATION_TOL
         ):
             return x
         return check_transform(x, name)
@@ -41,7 +41,7 @@ def _validated(x: object, name: str, check: bool) -> np.ndarray:
 def _pair(
     T: object, T_target: object, check: bool
 ) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
-    """Validate two (batches of) transforms and broadcast them to (N, 4, 4) C arrays.
+    """Validate two (batches of) transforms and broadcast them to read-only (N, 4, 4) C arrays.
 
     Float64 arrays of shape (..., 4, 4) are validated by a compiled kernel; only when it
     reports a problem (or for other input types) does ``check_transform`` run, to coerce
@@ -56,8 +56,8 @@ def _pair(
             f"T and T_target batch shapes do not broadcast: T has shape {a.shape}, "
             f"T_target has shape {b.shape}"
         ) from exc
-    a = np.ascontiguousarray(np.broadcast_to(a, batch + (4, 4)).reshape(-1, 4, 4))
-    b = np.ascontiguousarray(np.broadcast_to(b, batch + (4, 4)).reshape(-1, 4, 4))
+    a = readonly(np.ascontiguousarray(np.broadcast_to(a, batch + (4, 4)).reshape(-1, 4, 4)))
+    b = readonly(np.ascontiguousarray(np.broadcast_to(b, batch + (4, 4)).reshape(-1, 4, 4)))
     return a, b, batch
 
 

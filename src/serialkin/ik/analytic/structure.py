@@ -101,6 +101,19 @@ class Structure:
     scale: float = 1.0
     reversed: bool = False
 
+    def __post_init__(self) -> None:
+        """Own read-only C copies of the arrays: every solver kernel is compiled once.
+
+        The kernels take ``W``, ``P``, ``M`` and ``aux`` as read-only arrays (the packed
+        data of :mod:`~serialkin.ik.analytic.dispatch` is read-only); a writeable array
+        passed instead would compile each of them a second time (issue 27).
+        """
+        for name, dtype in (("W", np.float64), ("P", np.float64), ("M", np.float64),
+                            ("revolute", np.bool_), ("aux", np.float64), ("order", np.int64)):
+            a = np.array(getattr(self, name), dtype=dtype, order="C")
+            a.setflags(write=False)
+            object.__setattr__(self, name, a)
+
 
 def joint_lines(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Joint lines at q = 0 in the world frame, from the compiled chain.
