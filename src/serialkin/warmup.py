@@ -94,6 +94,7 @@ def _ik() -> None:
             r.ik(np.asfortranarray(T[0]))
             r.ik(T[0], q0=Q[1])
             r.ik(T)
+            r.ik(T, q0=Q[::-1].copy())
 
 
 def _ik_all() -> None:

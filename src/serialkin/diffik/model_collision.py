@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from serialkin._checks import check_positive
+from serialkin._checks import check_positive, readonly
 from serialkin._memo import PerObject
 from serialkin.collision import kernels as CK
 from serialkin.collision.queries import shapes_to_world
@@ -232,8 +232,8 @@ class ModelCollisionAvoidance(Constraint):
         _check_model(robot, model)
         if self.self_collision:
             pa, pb = checked_shape_pairs(model, self.acm)
-        else:
-            pa = pb = np.zeros(0, dtype=np.int64)
+        else:  # read-only as the pairs are: one compiled specialization
+            pa = pb = readonly(np.zeros(0, dtype=np.int64))
         total = model.a.shape[0] * self._scene.shape[0] + pa.size
         rows = 3 * model.a.shape[0] * self._scene.shape[0] + pa.size
         st = (robot, model, np.ascontiguousarray(model.shape_frame, dtype=np.int64),

@@ -710,8 +710,8 @@ def _collision_setup(robot: Robot, spec: MethodSpec, scene: object, self_collisi
             f"{', '.join(compiled)}")
     if self_collision:
         pa, pb = checked_shape_pairs(model, acm)
-    else:
-        pa = pb = np.zeros(0, dtype=np.int64)
+    else:  # read-only as the pairs are: a scene-only solve compiles no second loop
+        pa = pb = readonly(np.zeros(0, dtype=np.int64))
     arrays = (np.ascontiguousarray(model.shape_frame), model.a, model.b, model.radius,
               model.shape_body, pa, pb, enc)
     names = tuple((getattr(s, "name", "") or f"scene[{i}]") for i, s in enumerate(scene or ()))

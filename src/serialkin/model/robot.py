@@ -27,6 +27,7 @@ from serialkin._checks import (
     check_choice,
     check_int,
     check_positive,
+    readonly,
     short_repr,
 )
 from serialkin.errors import InputError, InputTypeError, RobotDefinitionError
@@ -719,7 +720,8 @@ class Robot:
         Jd = np.empty((N, 6, self.n))
         R = np.ascontiguousarray(T[:, :3, :3])
         parallel.run(K.jacobian_dot_range,
-                     (J, np.ascontiguousarray(v.reshape(-1, self.n)), R, frame == "ee", Jd),
+                     (J, readonly(np.ascontiguousarray(v.reshape(-1, self.n))), R, frame == "ee",
+                      Jd),
                      N, grain=max(16, 3072 // self.n))
         return Jd.reshape(a.shape[:-1] + (6, self.n))
 
