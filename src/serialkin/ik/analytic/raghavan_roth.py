@@ -47,8 +47,8 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
    chain (:func:`~serialkin.ik.analytic.refine.refine_new`) to the solver's
    tolerance; duplicates are dropped.
 
-:func:`rr_candidates` reports failure (−1) when the elimination does not apply: ``Q``
-of rank below 8 or a pencil singular to rounding for all six splits (an exact special
+:func:`rr_candidates` reports failure (:data:`NEAR_SPECIAL`) when the elimination does not
+apply: ``Q`` of rank below 8 or a pencil singular to rounding for all six splits (an exact special
 pair, e.g. axes 1 and 2 intersecting, degenerates a split: the next one is tried), or a
 pencil nearly singular for every θ3 (an arm near a special class: no split is trusted);
 the 2-D search then takes over. Kernels trust their input.
@@ -465,9 +465,10 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
 
     Returns:
         the number of distinct converged solutions, one per real root of the eliminant;
-        −1 when no split applies (eliminating joint 6, 5 or 4 of the chain or of its
-        reversal, tried in turn while one degenerates exactly, :data:`EXACT_TOL`) or
-        the pencil is nearly singular for every θ3 (:data:`PIVOT_TOL`), and −1 − k
+        :data:`NEAR_SPECIAL` when no split applies (eliminating joint 6, 5 or 4 of the
+        chain or of its reversal, tried in turn while one degenerates exactly,
+        :data:`EXACT_TOL`) or the pencil is nearly singular for every θ3
+        (:data:`PIVOT_TOL`), and −1 − k
         when a root gave no new solution even after polishing (a cluster of solutions
         or a singular configuration) or belongs to several solutions
         (:data:`MULTIPLE_TOL`; the k solutions found so far are in ``out``): in both
@@ -493,10 +494,10 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
         else:
             k = _rr_split(T, Wr, Pr, Minv, not reverse, e, F, meta, tol_p, tol_r, out)
         if k == NEAR_SPECIAL:  # near a special class: no split is trusted, search
-            return -1
+            return NEAR_SPECIAL
         if k != RANK_DEFICIENT:
             return k
-    return -1
+    return NEAR_SPECIAL
 
 
 @njit(cache=True)
