@@ -246,6 +246,31 @@ def test_locked_joint_of_7r_arm(name, index):
     assert _wrapped(sols, q).min() < 1e-8
 
 
+@pytest.mark.parametrize("index", range(7))
+def test_locked_panda_joint_gives_a_set_stable_to_rounding(index):
+    """Any Panda joint locked: the set contains q and is the same for a pose moved by 1e-15."""
+    robot = models.panda().with_limits(np.tile([-np.inf, np.inf], (7, 1)))
+    rng = np.random.default_rng(10 + index)
+    for q in rng.uniform(-2.5, 2.5, (4, 7)):
+        T = robot.fk(q)
+        a = ik_all(robot, T, free={index: q[index]})
+        moved = T.copy()
+        moved[:3, 3] += rng.standard_normal(3) * 1e-15
+        b = ik_all(robot, moved, free={index: q[index]})
+        assert _wrapped(a.q, q).min() < 1e-8
+        assert len(a) == len(b)
+        for row in a.q:
+            assert _wrapped(b.q, row).min() < 1e-9
+
+
+def test_locking_the_elbow_of_a_spherical_shoulder_and_wrist_arm_is_refused():
+    """iiwa7 with joint 4 locked keeps a self-motion: a clear refusal naming the lock."""
+    robot = models.iiwa7()
+    q = np.array([0.3, 0.5, -0.2, 1.1, 0.4, -0.6, 0.2])
+    with pytest.raises(NoClosedFormError, match=r"locking joint 4 at 1\.1 .*self-motion"):
+        ik_all(robot, robot.fk(q), free={3: q[3]})
+
+
 def test_locked_joint_bad_input():
     """The free= option must map valid joint indices to finite values."""
     robot = models.panda()

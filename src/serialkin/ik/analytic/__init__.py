@@ -495,11 +495,45 @@ def _locked(robot: Robot, free: object) -> tuple[Robot, np.ndarray, np.ndarray]:
             tool = A @ tool
         del joints[i]
     reduced = Robot.from_joints(joints, base=robot.base, tool=tool,
-                                name=f"{robot.name} (joint(s) {list(idx_a + 1)} locked)")
+                                name=f"{robot.name} (joint(s) {(idx_a + 1).tolist()} locked)")
     if len(cache) > 64:
         cache.clear()
     cache[key] = reduced
     return reduced, idx_a, vals_a
+
+
+#: Relative smallest singular value below which the locked arm has lost a direction.
+_RANK_TOL = 1e-9
+
+
+def _check_no_self_motion(robot: Robot, reduced: Robot, idx: np.ndarray,
+                          vals: np.ndarray) -> None:
+    """Refuse a lock that leaves a 6-joint arm moving in fewer than six directions.
+
+    When the reduced arm's Jacobian (6, 6) is singular at every configuration (three
+    seeded random ones, σ_min < 1e-9 σ_max at each), each pose it reaches has infinitely
+    many solutions (a self-motion) and every other pose none: e.g. a 7R arm with a
+    spherical shoulder and wrist (iiwa) with its elbow locked keeps rotating about the
+    shoulder–wrist line. Raises NoClosedFormError with the singular values.
+    """
+    if reduced.n != 6 or _MOVES_FREELY.get(reduced):
+        return
+    Q = reduced.random_q(3, seed=0)
+    sv = np.linalg.svd(reduced.jacobian(Q), compute_uv=False)  # (3, 6)
+    ratio = sv[:, -1] / np.maximum(sv[:, 0], 1e-300)
+    if np.all(ratio < _RANK_TOL):
+        locked = ", ".join(f"joint {i + 1} at {v:.6g}" for i, v in zip(idx, vals, strict=True))
+        raise NoClosedFormError(
+            f"locking {locked} of robot {robot.name!r} leaves an arm that cannot move in "
+            f"every direction: its Jacobian's smallest singular value is "
+            f"{float(sv[:, -1].max()):.1e} against a largest of {float(sv[:, 0].min()):.3g} at "
+            "each of three random configurations, so every pose it reaches has infinitely "
+            "many solutions (a self-motion) and every other pose none. Lock a different "
+            f"joint, or {NUMERICAL_HINT}")
+    _MOVES_FREELY.set(reduced, True)
+
+
+_MOVES_FREELY: PerObject[bool] = PerObject()  # reduced robots that passed the check
 
 
 _LOCKED: PerObject[dict] = PerObject()  # per robot: {locked joints: reduced robot}
@@ -893,6 +927,7 @@ def _ik_all_locked(robot: Robot, target: object, free: object, order: tuple,
     check_robot(robot)
     reference, weights, norm = order
     reduced, idx, vals = _locked(robot, free)
+    _check_no_self_motion(robot, reduced, idx, vals)
     res = ik_all(reduced, target, **solve)
     q = _insert_locked(res.q, idx, vals, robot.n)
     if np.ndim(res.count) == 0:  # one target
