@@ -45,7 +45,7 @@ def test_json_report_and_non_convergence(tmp_path):
                 ).exit_code == 0
     r = _run("ur5", "--measurements", str(meas), "--json", "--sigma-rotation", "1e-4")
     assert r.exit_code == 0, r.output
-    data = json.loads(r.output)
+    data = json.loads(r.stdout)
     assert data["success"] and data["kind"] == "pose" and len(data["residuals"]["rows"]) == 30
     assert data["rms_position_after"] < data["rms_position_before"]
     report = tmp_path / "report.json"

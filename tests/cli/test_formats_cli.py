@@ -20,7 +20,7 @@ XACRO = DATA / "xacro_pkgs" / "demo_arm_description" / "urdf" / "demo_arm.urdf.x
 def _fk(args):
     res = CliRunner().invoke(cli, ["fk", *args, "--json"])
     assert res.exit_code == 0, res.output
-    return np.array(json.loads(res.output)["results"][0]["T"])
+    return np.array(json.loads(res.stdout)["results"][0]["T"])
 
 
 def test_mjcf_fk_matches_the_api():

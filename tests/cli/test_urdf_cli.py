@@ -37,7 +37,7 @@ def test_tip_link_selects_the_chain(tmp_path):
     res = CliRunner().invoke(cli, ["fk", str(path), "--param", "tip_link=b", "--q", "0.3,0.4",
                                    "--json"])
     assert res.exit_code == 0, res.output
-    T = np.array(json.loads(res.output)["results"][0]["T"])
+    T = np.array(json.loads(res.stdout)["results"][0]["T"])
     robot = sk.Robot.from_urdf(BRANCHED, tip_link="b")
     np.testing.assert_allclose(T, robot.fk([0.3, 0.4]), atol=1e-12)
 

@@ -22,7 +22,7 @@ def test_reach_command_writes_the_map_and_resumes(tmp_path):
     res = _run("reach", "three_link", "-r", "0.2", "-n", "6", "--out", str(out),
                "--chunk-voxels", "100", "--json")
     assert res.exit_code == 0, res.output
-    summary = json.loads(res.output)
+    summary = json.loads(res.stdout)
     assert summary["solver"] == "closed_form" and summary["reachable_voxels"] > 0
     assert (out / "reach_slice.png").read_bytes().startswith(b"\x89PNG")
     api = reachability_map(models.get("three_link"), 0.2, 6, chunk_voxels=100, progress=False)
@@ -55,7 +55,7 @@ def test_base_placement_command(tmp_path):
     res = _run("base-placement", "ur5", "--tasks", str(tasks), "-r", "0.3", "--yaws", "2",
                "--out", str(out), "--json")
     assert res.exit_code == 0, res.output
-    s = json.loads(res.output)
+    s = json.loads(res.stdout)
     assert s["best"]["reached"] == 2 and s["feasible_candidates"] > 0
     assert (out / "base_placement.png").exists() and (out / "base_placement.npz").exists()
     tasks.write_text("tasks:\n  - [1, 2, 3]\n")

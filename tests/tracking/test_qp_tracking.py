@@ -162,11 +162,11 @@ def test_cli_track_with_the_qp(tmp_path):
             "--json", "--out", str(tmp_path)]
     r = CliRunner().invoke(cli, args)
     assert r.exit_code == 0, r.output
-    out = json.loads(r.output)
+    out = json.loads(r.stdout)
     assert "QP" in out["solver"] and out["success"] and out["jumps"] == []
     capped = CliRunner().invoke(cli, [*args, "--max-joint-step", "0.05"])
     assert capped.exit_code == 1  # the first points need larger moves from q0 = 0
-    out = json.loads(capped.output[:capped.output.rindex("}") + 1])
+    out = json.loads(capped.stdout[:capped.stdout.rindex("}") + 1])
     assert out["jumps"] == [] and out["failures"] and out["failures"][0]["index"] == 0
     bad = CliRunner().invoke(cli, ["track", "six_link_circle", "--max-joint-step", "-1",
                                    "--out", str(tmp_path)])

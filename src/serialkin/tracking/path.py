@@ -31,6 +31,7 @@ from serialkin._checks import (
 )
 from serialkin.errors import InputError
 from serialkin.model.tasks import TARGET_TASKS, TASK_NAMES, get_task
+from serialkin.spatial.lie import so3_log
 
 __all__ = ["TASKS", "Path", "sample_parameter"]
 
@@ -154,10 +155,7 @@ class Path:
         T = check_last_dims(check_transform(poses, "path poses"), "path poses", (4, 4))
         if T.ndim != 3:
             raise InputError(f"path poses must have shape (p, 4, 4), got {T.shape}")
-        from serialkin.spatial.kernels import so3_log_batch
-
-        W = np.empty((T.shape[0], 3))
-        so3_log_batch(np.ascontiguousarray(T[:, :3, :3]), W)
+        W = so3_log(T[:, :3, :3], check=False)  # rotations checked with the poses
         par = None if parameter is None else as_float_array(parameter, "parameter", ndim=1)
         return cls(T, "pose", np.hstack([T[:, :3, 3], W]), par)
 
