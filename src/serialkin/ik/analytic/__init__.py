@@ -652,14 +652,12 @@ def _near_wrist_singular(robot: Robot, sols: np.ndarray) -> bool:
     caller then adds the general solver's rows (:func:`_with_general`); about 3 % of
     random poses are this close to the singularity.
     """
-    if robot.n != 6:
+    if robot.n != 6 or not len(sols):
         return False
-    for q in sols:
-        _, W = robot.joint_axes(q)
-        if min(np.linalg.norm(np.cross(W[3], W[5])),
-               np.linalg.norm(np.cross(W[0], W[2]))) < WRIST_SINGULAR:
-            return True
-    return False
+    W = np.array([robot.joint_axes(q)[1] for q in sols])  # (k, 6, 3) unit axes
+    # |w_i × w_j| < s  ⇔  |w_i · w_j| > √(1 − s²) for unit vectors
+    dots = np.abs(np.einsum("kij,kij->ki", W[:, [3, 0]], W[:, [5, 2]]))
+    return bool(dots.max() > math.sqrt(1.0 - WRIST_SINGULAR ** 2))
 
 
 def _sort_batch(robot: Robot, res: AllSolutions, reference: object, weights: object,
