@@ -449,6 +449,8 @@ def _locked(robot: Robot, free: object) -> tuple[Robot, np.ndarray, np.ndarray]:
 
     Returns the reduced robot, the locked indices and their values. A locked joint's
     motion is folded into the next joint's ``origin`` (or into the tool for the last).
+    Reduced robots are cached per robot and lock; one left with a self-motion is
+    refused (:func:`_check_no_self_motion`) and not cached.
     """
     if not isinstance(free, Mapping) or not free:
         raise InputError("free must be a non-empty mapping {joint index: value}, got "
@@ -496,6 +498,7 @@ def _locked(robot: Robot, free: object) -> tuple[Robot, np.ndarray, np.ndarray]:
         del joints[i]
     reduced = Robot.from_joints(joints, base=robot.base, tool=tool,
                                 name=f"{robot.name} (joint(s) {(idx_a + 1).tolist()} locked)")
+    _check_no_self_motion(robot, reduced, idx_a, vals_a)  # only arms that pass are cached
     if len(cache) > 64:
         cache.clear()
     cache[key] = reduced
@@ -516,7 +519,7 @@ def _check_no_self_motion(robot: Robot, reduced: Robot, idx: np.ndarray,
     spherical shoulder and wrist (iiwa) with its elbow locked keeps rotating about the
     shoulder–wrist line. Raises NoClosedFormError with the singular values.
     """
-    if reduced.n != 6 or _MOVES_FREELY.get(reduced):
+    if reduced.n != 6:
         return
     Q = reduced.random_q(3, seed=0)
     sv = np.linalg.svd(reduced.jacobian(Q), compute_uv=False)  # (3, 6)
@@ -530,10 +533,6 @@ def _check_no_self_motion(robot: Robot, reduced: Robot, idx: np.ndarray,
             "each of three random configurations, so every pose it reaches has infinitely "
             "many solutions (a self-motion) and every other pose none. Lock a different "
             f"joint, or {NUMERICAL_HINT}")
-    _MOVES_FREELY.set(reduced, True)
-
-
-_MOVES_FREELY: PerObject[bool] = PerObject()  # reduced robots that passed the check
 
 
 _LOCKED: PerObject[dict] = PerObject()  # per robot: {locked joints: reduced robot}
@@ -873,16 +872,15 @@ def _ik_all_fast(robot: Robot, target: np.ndarray) -> AllSolutions | None:
     out = _EMPTY(entry[5])
     conv = _ZEROS(_CONV, _I64)  # False beyond the branches
     k = entry[1](target, entry[2], entry[3], entry[4], out, conv)
-    if k >= 0 and not (entry[7] == "near" and _near_wrist_singular(robot, out[:k])):
-        return _ALL(out[:k], k, conv, entry[6], entry[7])
-    if k >= 0:  # a nearly ideal arm near its wrist singularity
-        k = -2 - k
-    if k < -1:  # a nearly ideal arm whose refined branches are doubtful
-        from serialkin.ik.analytic.general import DEFAULT_GRID
+    if k == -1:
+        return None
+    rows = out[:k] if k >= 0 else out[:-2 - k]  # k < -1: refined branches doubtful
+    if k >= 0 and not (entry[7] == "near" and _near_wrist_singular(robot, rows)):
+        return _ALL(rows, k, conv, entry[6], entry[7])
+    from serialkin.ik.analytic.general import DEFAULT_GRID  # a nearly ideal arm: merge
 
-        rows = _with_general(robot, target, out[:-2 - k], _TOL, DEFAULT_GRID)
-        return _ALL(rows, rows.shape[0], conv, entry[6], entry[7])
-    return None  # k == -1
+    rows = _with_general(robot, target, rows, _TOL, DEFAULT_GRID)
+    return _ALL(rows, rows.shape[0], conv, entry[6], entry[7])
 
 
 @dataclass(frozen=True, eq=False)
@@ -952,7 +950,6 @@ def _ik_all_locked(robot: Robot, target: object, free: object, order: tuple,
     check_robot(robot)
     reference, weights, norm = order
     reduced, idx, vals = _locked(robot, free)
-    _check_no_self_motion(robot, reduced, idx, vals)
     res = ik_all(reduced, target, **solve)
     q = _insert_locked(res.q, idx, vals, robot.n)
     if np.ndim(res.count) == 0:  # one target
