@@ -22,9 +22,18 @@ $(STAMP_RUN): pyproject.toml | $(PY)
 	$(PY) -m pip install --quiet -e .
 	touch $@
 
-$(STAMP_TEST): pyproject.toml | $(PY)
-	$(PY) -m pip install --quiet -e ".[dev,bench,docs,mesh,xacro,dist]"
-	touch $@ $(STAMP_RUN)
+# The test extras' own requirements, installed beside the project without reinstalling it
+# (so that a warm-up running meanwhile keeps its imports) and constrained to what is
+# already installed (so that nothing it imports changes under it).
+TEST_EXTRAS := dev bench docs mesh xacro dist
+
+$(STAMP_TEST): $(STAMP_RUN)
+	$(PY) -c "import tomllib; o = tomllib.load(open('pyproject.toml', 'rb'))['project']\
+	['optional-dependencies']; print('\n'.join(r for e in '$(TEST_EXTRAS)'.split() for r in o[e]))" \
+	  > $(VENV)/test-extras.txt
+	$(PY) -m pip freeze --exclude-editable > $(VENV)/installed.txt
+	$(PY) -m pip install --quiet -r $(VENV)/test-extras.txt -c $(VENV)/installed.txt
+	touch $@
 
 # `serialkin warmup` compiles the kernels into numba's on-disk cache first, one process
 # per feature on every core, with a progress bar (seconds when the cache is already
@@ -45,8 +54,16 @@ browser-deps:
 	      chromium chromium-driver ffmpeg >/dev/null) \
 	    || echo "browser-deps: could not install chromium/ffmpeg; those tests will be skipped" )
 
-test: $(STAMP_TEST) browser-deps
-	$(VENV)/bin/serialkin warmup --all
+# On a fresh machine the test extras and the browser install while the kernels compile
+# (the three overlap: downloads and unpacking wait on the network and the disk, the
+# warm-up on the CPU); the suite starts when all three are done, and fails the target
+# if any did.
+test: $(STAMP_RUN)
+	@set -e; \
+	  $(MAKE) --no-print-directory $(STAMP_TEST) & extras=$$!; \
+	  $(MAKE) --no-print-directory browser-deps & browser=$$!; \
+	  $(VENV)/bin/serialkin warmup --all; \
+	  wait $$extras; wait $$browser
 	$(PY) -m pytest -n 2 --dist loadfile
 
 lint: $(STAMP_TEST)
