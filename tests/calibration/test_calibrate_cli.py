@@ -9,7 +9,7 @@ from click.testing import CliRunner
 
 import serialkin as sk
 from serialkin.cli.main import cli
-from serialkin.model.robotfile import load_robot_file
+from serialkin.formats.robotfile import load_robot_file
 
 
 def _run(*args):

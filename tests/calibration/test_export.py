@@ -8,7 +8,7 @@ import pytest
 import serialkin as sk
 from serialkin.calibration import error_model, perturb, save_robot
 from serialkin.errors import InputError
-from serialkin.model.robotfile import load_robot_file
+from serialkin.formats.robotfile import load_robot_file
 
 
 @pytest.mark.parametrize("name", ["ur5", "panda"])

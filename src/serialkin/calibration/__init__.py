@@ -5,7 +5,9 @@
 * :mod:`~serialkin.calibration.measurements` — pose / position measurements, CSV files;
 * :mod:`~serialkin.calibration.jacobian` — residuals and the identification Jacobian;
 * :mod:`~serialkin.calibration.identifiability` — SVD, condition number, minimal set;
-* :mod:`~serialkin.calibration.fit` — :func:`calibrate` (scipy least squares);
+* :mod:`~serialkin.calibration.fit` — :func:`calibrate` (scipy least squares, staged,
+  chi-square test, covariance);
+* :mod:`~serialkin.calibration.crossval` — k-fold cross-validation of a calibration;
 * :mod:`~serialkin.calibration.selection` — choosing poses by observability indices;
 * :mod:`~serialkin.calibration.simulate` — perturbed robots and noisy measurements;
 * :mod:`~serialkin.calibration.export` — the calibrated robot as a robot file or URDF.
@@ -13,8 +15,9 @@
 See ``docs/calibration.md``.
 """
 
+from serialkin.calibration.crossval import CrossValidation, cross_validate, holdout_errors
 from serialkin.calibration.export import save_robot
-from serialkin.calibration.fit import CalibrationResult, calibrate
+from serialkin.calibration.fit import CalibrationResult, ChiSquare, calibrate
 from serialkin.calibration.identifiability import Identifiability, identifiability
 from serialkin.calibration.measurements import (
     Measurements,
@@ -24,20 +27,25 @@ from serialkin.calibration.measurements import (
 )
 from serialkin.calibration.models import ErrorModel, Parameter, error_model
 from serialkin.calibration.selection import observability, select_poses
-from serialkin.calibration.simulate import perturb, simulate_measurements
+from serialkin.calibration.simulate import perturb, perturb_joints, simulate_measurements
 
 __all__ = [
     "CalibrationResult",
+    "ChiSquare",
+    "CrossValidation",
     "ErrorModel",
     "Identifiability",
     "Measurements",
     "Parameter",
     "calibrate",
+    "cross_validate",
     "error_model",
+    "holdout_errors",
     "identifiability",
     "make_measurements",
     "observability",
     "perturb",
+    "perturb_joints",
     "read_measurements",
     "save_robot",
     "select_poses",

@@ -25,7 +25,7 @@ def save_robot(robot: Robot, path: str | os.PathLike[str]) -> Path:
         RobotDefinitionError: the DH table cannot be extracted.
     """
     from serialkin._io import write_text_atomic
-    from serialkin.model.robotfile import ROBOT_FILE_SUFFIXES, save_robot_file
+    from serialkin.formats.robotfile import ROBOT_FILE_SUFFIXES, save_robot_file
 
     p = Path(path)
     suffix = p.suffix.lower()

@@ -3,21 +3,39 @@
 ``calibrate`` minimises ``½ Σ_i ρ(‖L_i⁻¹ e_i(p)‖²)`` (``ρ`` the identity or a robust loss)
 over the parameters the identifiability analysis keeps, with the others fixed at their
 nominal values, by ``scipy.optimize.least_squares`` (trust-region reflective, the
-analytic identification Jacobian of :mod:`serialkin.calibration.jacobian`).
+analytic identification Jacobian of :mod:`serialkin.calibration.jacobian`), in rounds:
 
-Standard errors come from the Gauss–Newton covariance at the solution,
-``Cov(p̂) = s² (JᵀJ)⁻¹`` with ``s² = Σ r² / (m·k − r)`` the residual variance of the
-whitened residuals (``s ≈ 1`` when the stated sigmas are right), r the number of fitted
-parameters.
+1. the set identifiable at the nominal geometry, fitted to convergence (the step, cost and
+   gradient tolerances ``tol``);
+2. the analysis redone at the solution, the current set first in the priority: a marker
+   on the last joint axis at the nominal geometry hides that axis' tilts, off the axis
+   where the fit found it they are seen. When the set changed the fit continues from
+   there (at most :data:`MAX_ROUNDS` fits). A parameter identifiable only at the fitted
+   geometry must also be determined to :data:`PRECISION_ANGLE` (or
+   :data:`PRECISION_LENGTH` × the robot's size): a marker a few micrometres off the axis
+   (the noise of its estimate) does not make the tilts measurable. A round whose new
+   parameters make the fit fail (no convergence, implausible values) is abandoned for the
+   last converged one, those parameters fixed.
 
-A fit that does not converge, or whose residuals are not finite, is a result with
+(Fitting the base and the marker alone first was tried and dropped: the same results on
+every arm measured, in more evaluations.)
+
+Standard errors and the covariance come from the Gauss–Newton approximation at the
+solution, ``Cov(p̂) = s² (JᵀJ)⁻¹`` over the fitted set, with ``s² = Σ r² / (m·k − r)`` the
+residual variance of the whitened residuals (``s ≈ 1`` when the stated sigmas are right),
+r the number of fitted parameters.
+
+Success needs a converged solver, plausible parameters (:func:`implausible`) and a
+residual consistent with the stated noise: ``χ² = Σ r²`` against the chi-square
+distribution with ``m·k − r`` degrees of freedom (:class:`ChiSquare`). A fit that does not
+converge, or whose residuals are not finite or too large, is a result with
 ``success=False`` and a ``reason``, never an exception.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -34,6 +52,62 @@ from serialkin.model.robot import Robot, robot_scale
 LOSSES = ("linear", "huber", "soft_l1", "cauchy", "arctan")
 
 
+#: Default significance level of the chi-square test of the residual: a fit whose
+#: residual is this improbable under the stated measurement noise is not a success.
+SIGNIFICANCE = 1e-3
+_SUSPECT = ("suspect the units (positions in metres, joint values in radians or metres), "
+            "the wrong robot or robot file, the joint order of the columns q1..qn, an effect "
+            "the model does not have (joint encoder scale, compliance, backlash, thermal "
+            "drift), outliers (try loss='soft_l1'), or a stated noise (sigma_position, "
+            "sigma_rotation) smaller than the instrument's")
+
+
+@dataclass(frozen=True)
+class ChiSquare:
+    """The chi-square test of a fit's whitened residual against the stated noise.
+
+    Under the model, with the stated measurement covariances right, ``χ² = Σ r²`` over the
+    whitened residual rows follows the chi-square distribution with ``dof`` = rows − fitted
+    parameters degrees of freedom. With a robust loss the rows of measurements flagged as
+    outliers (``‖r_i‖²`` above the chi-square 1 − :data:`SIGNIFICANCE` quantile of their k
+    rows) are left out (the test is then conservative).
+
+    Attributes:
+        chi2: Σ r² over the rows tested (dimensionless).
+        dof: degrees of freedom (rows tested − fitted parameters); ≤ 0 means no test.
+        p_value: probability of a χ² this large or larger under the stated noise (NaN
+            without degrees of freedom).
+        noise_ratio: ``sqrt(χ²/dof)``, the residual in units of the stated noise (≈ 1 when
+            the model fits and the sigmas are right).
+        outliers: measurements left out as outliers (robust losses only).
+        measurements: measurements in the fit.
+    """
+
+    chi2: float
+    dof: int
+    p_value: float
+    noise_ratio: float
+    outliers: int = 0
+    measurements: int = 0
+
+    @property
+    def variance(self) -> float:
+        """``s² = χ²/dof`` (NaN without degrees of freedom)."""
+        return self.chi2 / self.dof if self.dof > 0 else float("nan")
+
+    def verdict(self, significance: float = SIGNIFICANCE) -> str:
+        """'' when the residual is consistent with the noise, else why not (what to suspect)."""
+        if self.outliers > self.measurements // 2:
+            return (f"{self.outliers} of {self.measurements} measurements are far off the "
+                    f"fitted model (more than half): {_SUSPECT}")
+        if self.dof <= 0 or not math.isfinite(self.p_value) or self.p_value >= significance:
+            return ""
+        return (f"the residual is {self.noise_ratio:.3g} times the stated measurement noise "
+                f"(chi-square {self.chi2:.4g} for {self.dof} degrees of freedom, p = "
+                f"{self.p_value:.2g} < {significance:g}): the model does not explain the "
+                f"measurements to their accuracy; {_SUSPECT}")
+
+
 @dataclass(frozen=True, eq=False)
 class CalibrationResult:
     """The outcome of :func:`calibrate`.
@@ -48,7 +122,12 @@ class CalibrationResult:
         robot: the calibrated :class:`~serialkin.Robot`.
         errors_before: (m, k) errors of the nominal model [m; rad].
         errors_after: (m, k) errors of the calibrated model [m; rad].
-        iterations: function evaluations used.
+        iterations: function evaluations used (all rounds).
+        chi_square: the :class:`ChiSquare` test of the residual against the stated noise.
+        covariance: (p, p) covariance of the parameters [m², m·rad, rad²],
+            ``s² (JᵀJ)⁻¹`` over the fitted set, NaN in the rows and columns of the
+            parameters not fitted.
+        stages: one line per solver run (what was fitted, evaluations, RMS before/after).
     """
 
     success: bool
@@ -61,6 +140,10 @@ class CalibrationResult:
     errors_before: np.ndarray
     errors_after: np.ndarray
     iterations: int
+    chi_square: ChiSquare = field(default_factory=lambda: ChiSquare(
+        float("nan"), 0, float("nan"), float("nan")))
+    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    stages: tuple[str, ...] = ()
 
     @staticmethod
     def _rms(e: np.ndarray, rows: slice) -> float:
@@ -113,10 +196,51 @@ class CalibrationResult:
         rot = (f"; rotation {math.degrees(rb):.4g}° → {math.degrees(ra):.4g}° RMS"
                if math.isfinite(rb) else "")
         head = "calibrated" if self.success else f"NOT converged ({self.reason})"
+        chi = self.chi_square
+        noise = (f"\nresidual {chi.noise_ratio:.3g} × the stated noise (chi-square "
+                 f"{chi.chi2:.4g}, {chi.dof} degrees of freedom, p = {chi.p_value:.3g})"
+                 if chi.dof > 0 else "")
         return (f"{head}: {len(self.errors_before)} {self.identifiability.kind} measurements, "
                 f"{self.identifiability.rank} parameters fitted; position "
-                f"{pb * 1e3:.4g} mm → {pa * 1e3:.4g} mm RMS{rot}\n"
+                f"{pb * 1e3:.4g} mm → {pa * 1e3:.4g} mm RMS{rot}{noise}\n"
                 + self.identifiability.summary())
+
+    def predicted_error(self, q: object = None, *, count: int = 1000,
+                        seed: None | int | np.random.Generator = 0) -> float:
+        """Expected RMS position error [m] of the calibrated robot at configurations.
+
+        ``sqrt(mean_i trace(J_i Cov J_iᵀ))`` with J_i the (3, r) position rows of the
+        identification Jacobian at configuration i over the fitted parameters and Cov
+        their :attr:`covariance`: what the parameters' uncertainty leaves at the tool
+        point (the measured one), against the real robot (not counting the noise of
+        future measurements, nor what the model does not have).
+
+        Args:
+            q: (N, n) configurations, or None for ``count`` random ones within the limits.
+            count: how many random configurations when ``q`` is None.
+            seed: for the random configurations.
+
+        Returns:
+            the RMS [m] (NaN when the fit gave no covariance).
+        """
+        from serialkin.calibration.jacobian import errors
+
+        fit = np.flatnonzero(self.identifiability.identifiable)
+        if self.covariance.shape != (self.model.size, self.model.size) or fit.size == 0:
+            return float("nan")
+        C = self.covariance[np.ix_(fit, fit)]
+        if not np.isfinite(C).all():
+            return float("nan")
+        robot = self.model.robot
+        if q is None:
+            qa = robot.random_q(check_int(count, "count", minimum=1), seed=seed)
+        else:
+            qa = robot.check_q(q).reshape(-1, robot.n)
+        meas = _generic_measurements(self.model, qa, "position")
+        _, J = errors(self.model, meas, self.params, jacobian=True)
+        Jf = J[:, :3, fit]
+        var = np.einsum("mip,pq,miq->m", Jf, C, Jf)
+        return float(np.sqrt(max(float(np.mean(var)), 0.0)))
 
 
 def _as_model(robot: object) -> ErrorModel:
@@ -134,7 +258,8 @@ def minimum_measurements(rank: int, kind: str) -> int:
 
 def calibrate(robot: Robot | ErrorModel, measurements: Measurements, *,
               loss: str = "linear", loss_scale: float = 1.0, max_evaluations: int = 200,
-              tol: float = 1e-12, rank_tol: float | None = None) -> CalibrationResult:
+              tol: float = 1e-12, rank_tol: float | None = None,
+              significance: float = SIGNIFICANCE) -> CalibrationResult:
     """Identify the robot's geometry from measurements (see the module docstring).
 
     Args:
@@ -145,10 +270,14 @@ def calibrate(robot: Robot | ErrorModel, measurements: Measurements, *,
         loss: 'linear' (least squares) or a robust loss: 'huber', 'soft_l1', 'cauchy',
             'arctan' (scipy's), applied per whitened residual row.
         loss_scale: residual size (in sigmas) where a robust loss starts to bend.
-        max_evaluations: most residual evaluations (non-convergence is a result).
-        tol: the solver's ftol, xtol and gtol.
+        max_evaluations: most residual evaluations over all rounds (non-convergence is a
+            result).
+        tol: the solver's ftol, xtol and gtol (relative cost change, relative step, and
+            scaled gradient at which a fit has converged).
         rank_tol: tolerance of the identifiability analysis (default
             :data:`~serialkin.calibration.identifiability.RANK_TOL`).
+        significance: level of the chi-square test of the residual against the stated
+            noise (:class:`ChiSquare`); 0 turns the test off.
 
     Returns:
         :class:`CalibrationResult`.
@@ -172,16 +301,18 @@ def calibrate(robot: Robot | ErrorModel, measurements: Measurements, *,
     max_evaluations = check_int(max_evaluations, "max_evaluations", minimum=1)
     tol = check_positive(tol, "tol")
     rank_tol = RANK_TOL if rank_tol is None else check_positive(rank_tol, "rank_tol")
+    significance = check_positive(significance, "significance", allow_zero=True)
+    if significance >= 1:
+        raise InputError(f"significance must be below 1, got {significance}")
     # small dense problems: a multi-threaded BLAS next to numba's thread pool costs 10-40x
     with single_threaded_blas():
         return _calibrate(model, measurements, loss, loss_scale, max_evaluations, tol,
-                          rank_tol)
+                          rank_tol, significance)
 
 
 def _calibrate(model: ErrorModel, measurements: Measurements, loss: str, loss_scale: float,
-               max_evaluations: int, tol: float, rank_tol: float) -> CalibrationResult:
-    from scipy.optimize import least_squares
-
+               max_evaluations: int, tol: float, rank_tol: float,
+               significance: float) -> CalibrationResult:
     kind = measurements.kind
     # the identifiable set at generic configurations, to say how many measurements it needs
     generic_q = model.robot.random_q(max(60, model.size), seed=0)
@@ -194,56 +325,218 @@ def _calibrate(model: ErrorModel, measurements: Measurements, loss: str, loss_sc
             f"equations but {needed} parameters of {model!r} are identifiable from {kind} "
             f"measurements; at least {minimum_measurements(needed, kind)} are needed "
             f"(several times more for accuracy)")
-    ident = identifiability(model, measurements, tol=rank_tol)
-    fit = np.flatnonzero(ident.identifiable)
     p0 = model.nominal
     e0, _ = errors(model, measurements, p0)
-
-    def fun(x: np.ndarray) -> np.ndarray:
-        p = p0.copy()
-        p[fit] = x
-        return whitened(model, measurements, p)[0]
-
-    def jac(x: np.ndarray) -> np.ndarray:
-        p = p0.copy()
-        p[fit] = x
-        return whitened(model, measurements, p, jacobian=True)[1][:, fit]
-
-    success, reason, nfev = False, "", 0
+    solver = _Solver(model, measurements, loss, loss_scale, tol, max_evaluations)
+    ident = identifiability(model, measurements, tol=rank_tol)
+    success, reason = False, ""
     params = p0.copy()
     std = np.full(model.size, np.nan)
+    cov = np.full((model.size, model.size), np.nan)
     if not np.isfinite(e0).all():
         reason = "the nominal model gives non-finite errors"
     else:
         try:
             with np.errstate(all="ignore"):
-                sol = least_squares(fun, p0[fit], jac=jac, method="trf", loss=loss,
-                                    f_scale=loss_scale, x_scale="jac", ftol=tol, xtol=tol,
-                                    gtol=tol, max_nfev=max_evaluations)
+                params, ident, success, reason = _fit_rounds(solver, ident, rank_tol)
         except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
             reason = f"the solver failed: {exc}"
-        else:
-            nfev = int(sol.nfev)
-            params[fit] = sol.x
-            finite = bool(np.isfinite(sol.fun).all() and np.isfinite(sol.x).all())
-            success = bool(sol.status > 0 and finite)
-            reason = sol.message if finite else "non-finite residuals or parameters"
-            if sol.status == 0:
-                reason = (f"not converged within {max_evaluations} evaluations "
-                          f"(the budget max_evaluations); the last iterate is returned")
-            if finite:
-                std[fit] = _standard_errors(sol.jac, sol.fun)
+            params = solver.best
     if not np.isfinite(params).all():
-        params = p0.copy()
+        params, success = p0.copy(), False
+    fit = np.flatnonzero(ident.identifiable)
+    r1, J1 = whitened(model, measurements, params, jacobian=True)
+    test, inlier = _chi_square(r1, measurements.rows, fit.size, loss)
+    if fit.size and np.isfinite(r1).all() and np.isfinite(J1).all():
+        rows = np.repeat(inlier, measurements.rows)
+        block = _parameter_covariance(J1[np.ix_(rows, fit)], test.variance)
+        cov[np.ix_(fit, fit)] = block
+        std[fit] = np.sqrt(np.maximum(np.diag(block), 0.0))
     e1, _ = errors(model, measurements, params)
+    doubt = implausible(model, params, e1) if np.isfinite(e1).all() else ""
     if success:
-        doubt = implausible(model, params, e1)
+        if not doubt and significance > 0:
+            doubt = test.verdict(significance)
         if doubt:
             success, reason = False, doubt
+    elif doubt:  # e.g. a fit that wanders off because the data are of another robot
+        reason = f"{reason}; {doubt}"
     return CalibrationResult(success=success, reason=reason, model=model, params=params,
                              std_errors=std, identifiability=ident,
                              robot=model.calibrated_robot(params), errors_before=e0,
-                             errors_after=e1, iterations=nfev)
+                             errors_after=e1, iterations=solver.nfev, chi_square=test,
+                             covariance=cov, stages=tuple(solver.log))
+
+
+class _Solver:
+    """``least_squares`` over a subset of the parameters, with one evaluation budget."""
+
+    def __init__(self, model: ErrorModel, measurements: Measurements, loss: str,
+                 loss_scale: float, tol: float, budget: int) -> None:
+        self.model, self.meas = model, measurements
+        self.loss, self.loss_scale, self.tol = loss, loss_scale, tol
+        self.budget, self.nfev = budget, 0
+        self.best = model.nominal
+        self.log: list[str] = []
+
+    def solve(self, p: np.ndarray, fit: np.ndarray, label: str) -> tuple[np.ndarray, Any]:
+        """Minimise over ``fit`` (indices) from ``p``.
+
+        Returns:
+            (params (p,), scipy's result).
+        """
+        from scipy.optimize import least_squares
+
+        model, meas, tol = self.model, self.meas, self.tol
+
+        def fun(x: np.ndarray) -> np.ndarray:
+            q = p.copy()
+            q[fit] = x
+            return whitened(model, meas, q)[0]
+
+        def jac(x: np.ndarray) -> np.ndarray:
+            q = p.copy()
+            q[fit] = x
+            return whitened(model, meas, q, jacobian=True)[1][:, fit]
+
+        before = _position_rms(model, meas, p)
+        sol = least_squares(fun, p[fit], jac=jac, method="trf", loss=self.loss,
+                            f_scale=self.loss_scale, x_scale="jac", ftol=tol, xtol=tol,
+                            gtol=tol, max_nfev=max(self.budget - self.nfev, 1))
+        self.nfev += int(sol.nfev)
+        out = p.copy()
+        out[fit] = sol.x
+        if np.isfinite(out).all():
+            self.best = out
+        after = _position_rms(model, meas, out)
+        self.log.append(f"{label}: {fit.size} parameters, {int(sol.nfev)} evaluations, "
+                        f"position {before * 1e3:.4g} mm -> {after * 1e3:.4g} mm RMS "
+                        f"(status {sol.status})")
+        return out, sol
+
+
+#: Most fits of the whole identifiable set (each after an identifiability analysis at the
+#: point the previous one reached).
+MAX_ROUNDS = 6
+
+
+def _fit_rounds(solver: _Solver, nominal_ident: Identifiability, rank_tol: float
+                ) -> tuple[np.ndarray, Identifiability, bool, str]:
+    """The identifiable set, fitted and re-analysed where each fit ends (module docstring).
+
+    Returns:
+        (params (p,), the final analysis, converged, reason).
+    """
+    model, meas = solver.model, solver.meas
+    p = model.nominal.copy()
+    # the set identifiable at the nominal geometry; then, until the set no longer changes,
+    # the set identifiable where the last fit ended (a marker off the last axis there
+    # shows that axis' tilts)
+    ident = nominal_ident
+    good: tuple[np.ndarray, np.ndarray, Any, float] | None = None  # last converged round
+    for rnd in range(MAX_ROUNDS):
+        fit = np.flatnonzero(ident.identifiable)
+        p, sol = solver.solve(p, fit, f"round {rnd + 1}")
+        failed = ""
+        if sol.status == 0:
+            failed = _not_converged(solver, sol)
+        elif not (np.isfinite(sol.fun).all() and np.isfinite(p).all()):
+            failed = "non-finite residuals or parameters"
+        elif good is not None:
+            failed = implausible(model, p, errors(model, meas, p)[0])
+        if failed and good is None:
+            return p, ident, False, failed
+        if failed:
+            # parameters seen only at the fitted geometry that make the fit fail (e.g. a
+            # wrist axis seen through a millimetre lever): back to the last converged fit
+            p0, keep0, sol0, noise0 = good
+            added = {int(k): f"{model.names[k]} is identifiable at the fitted geometry but "
+                             f"the fit with it failed ({failed.split(';')[0]}); it is fixed"
+                     for k in np.flatnonzero(ident.identifiable & ~keep0)}
+            names = ", ".join(model.names[k] for k in added)
+            solver.log.append(f"round {rnd + 1} abandoned: {names} stay fixed")
+            final = _practical(model, meas, p0, keep0, nominal_ident, rank_tol, noise0,
+                               exclude=added)
+            if np.array_equal(final.identifiable, keep0):
+                return p0, final, True, str(sol0.message)
+            return p0, final, False, failed
+        dof = sol.fun.size - fit.size
+        ratio = math.sqrt(float(sol.fun @ sol.fun) / dof) if dof > 0 else 1.0
+        noise = min(max(ratio, NOISE_FLOOR), 1.0)
+        again = _practical(model, meas, p, ident.identifiable, nominal_ident, rank_tol, noise)
+        if np.array_equal(again.identifiable, ident.identifiable):
+            return p, again, True, str(sol.message)
+        good = (p.copy(), ident.identifiable.copy(), sol, noise)
+        # parameters that became redundant go back to their nominal (data-sheet) values
+        dropped = ident.identifiable & ~again.identifiable
+        p[dropped] = model.nominal[dropped]
+        ident = again
+    return p, ident, False, (f"the identifiable set kept changing over {MAX_ROUNDS} fits "
+                             "(parameters at the edge of identifiability); the last "
+                             "iterate is returned")
+
+
+def _not_converged(solver: _Solver, sol: Any) -> str:
+    if sol.status == 0:
+        return (f"not converged within {solver.budget} evaluations (the budget "
+                f"max_evaluations); the last iterate is returned")
+    return "non-finite residuals or parameters"
+
+
+#: A parameter that becomes identifiable only through the fitted geometry (not at the
+#: nominal one, e.g. the tilt of the last axis once the marker is off it) is fitted only
+#: when its standard error (the other fitted parameters free; the residual's noise, at
+#: most the stated one and at least :data:`NOISE_FLOOR` of it) is below this angle [rad]
+#: (0.06°, a fraction of typical joint-axis errors) ...
+PRECISION_ANGLE = 1e-3
+#: ... or this fraction of the robot's size (a length).
+PRECISION_LENGTH = 1e-3
+#: The residual's noise used for those standard errors is at least this fraction of the
+#: stated one: noiseless data would otherwise admit parameters seen only through a product
+#: of two small errors (a marker a millimetre off a wrist axis), which then wander.
+NOISE_FLOOR = 0.1
+
+
+def _practical(model: ErrorModel, meas: Measurements, p: np.ndarray,
+               current: np.ndarray, nominal_ident: Identifiability, rank_tol: float,
+               noise: float, exclude: dict[int, str] | None = None) -> Identifiability:
+    """The identifiability analysis at ``p``, the ``current`` set (p,) first in the priority.
+
+    Parameters the analysis at ``p`` keeps but the nominal one did not are kept only while
+    their standard error (``noise`` × the stated sigmas' one) is below
+    :data:`PRECISION_ANGLE` or :data:`PRECISION_LENGTH` × the robot's size: a marker a
+    few micrometres off the last axis (the noise of its estimate) makes that axis' tilts
+    independent columns, but not determinable ones.
+    """
+    from serialkin.calibration.identifiability import analyse, priority_order
+    from serialkin.calibration.jacobian import identification_jacobian
+
+    J = identification_jacobian(model, meas, p)
+    order = priority_order(model)
+    order = [k for k in order if current[k]] + [k for k in order if not current[k]]
+    size = robot_scale(model.robot)
+    limit = np.array([PRECISION_LENGTH * size if par.unit == "m" else PRECISION_ANGLE
+                      for par in model.parameters])
+    weak: dict[int, str] = dict(exclude or {})
+    while True:
+        ident = analyse(J, model.names, kind=meas.kind, order=order, tol=rank_tol,
+                        exclude=weak)
+        keep = ident.identifiable
+        new = np.flatnonzero(keep & ~nominal_ident.identifiable)
+        if new.size == 0:
+            return ident
+        idx = np.flatnonzero(keep)
+        se = noise * np.sqrt(np.maximum(np.diag(np.linalg.pinv(J[:, idx].T @ J[:, idx])),
+                                        0.0))
+        pos = np.searchsorted(idx, new)
+        ratio = se[pos] / limit[new]
+        worst = int(np.argmax(ratio))
+        if ratio[worst] <= 1.0:
+            return ident
+        k = int(new[worst])
+        weak[k] = (f"{model.names[k]} is too weakly determined by these measurements at "
+                   f"the fitted geometry (standard error {se[pos[worst]]:.3g} "
+                   f"{model.parameters[k].unit})")
 
 
 #: A fitted length may move by at most this fraction of the robot's size.
@@ -285,15 +578,44 @@ def implausible(model: ErrorModel, params: np.ndarray, errors_after: np.ndarray)
     return ""
 
 
-def _standard_errors(J: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """sqrt(diag(s² (JᵀJ)⁻¹)), s² = Σr²/(rows − cols) (NaN when rows == cols)."""
-    rows, cols = J.shape
-    dof = rows - cols
-    s2 = float(r @ r) / dof if dof > 0 else float("nan")
+def _parameter_covariance(J: np.ndarray, s2: float) -> np.ndarray:
+    """``s² (JᵀJ)⁻¹`` (r, r) of a whitened Jacobian (rows, r), by the SVD (NaN if s² is)."""
     _, s, Vt = np.linalg.svd(J, full_matrices=False)
     keep = s > s[0] * 1e-12 if s.size else s > 0
-    inv = (Vt[keep].T / s[keep] ** 2) @ Vt[keep]
-    return np.sqrt(np.maximum(np.diag(inv), 0.0) * s2)
+    return (Vt[keep].T / s[keep] ** 2) @ Vt[keep] * s2
+
+
+def _chi_square(r: np.ndarray, k: int, fitted: int, loss: str
+                ) -> tuple[ChiSquare, np.ndarray]:
+    """The chi-square test of whitened residuals r (m·k,) with ``fitted`` parameters.
+
+    Returns:
+        (the test, (m,) bool mask of the measurements tested: all but a robust loss'
+        outliers).
+    """
+    from scipy.stats import chi2 as chi2_dist
+
+    rows = r.reshape(-1, k)
+    m = rows.shape[0]
+    inlier = np.ones(m, dtype=bool)
+    if not np.isfinite(rows).all():
+        return ChiSquare(float("inf"), m * k - fitted, 0.0, float("inf"), 0, m), inlier
+    norms = np.sum(rows**2, axis=1)
+    if loss != "linear":
+        inlier = norms <= chi2_dist.isf(SIGNIFICANCE, k)
+    outliers = int(m - inlier.sum())
+    chi2 = float(norms[inlier].sum())
+    dof = int(inlier.sum()) * k - fitted
+    if dof <= 0:
+        return ChiSquare(chi2, dof, float("nan"), float("nan"), outliers, m), inlier
+    return ChiSquare(chi2, dof, float(chi2_dist.sf(chi2, dof)), math.sqrt(chi2 / dof),
+                     outliers, m), inlier
+
+
+def _position_rms(model: ErrorModel, meas: Measurements, p: np.ndarray) -> float:
+    """RMS position error [m] of the model at parameters p over the measurements."""
+    e, _ = errors(model, meas, p)
+    return float(np.sqrt(np.mean(np.sum(e[:, :3] ** 2, axis=1))))
 
 
 def _generic_measurements(model: ErrorModel, q: np.ndarray, kind: str) -> Measurements:

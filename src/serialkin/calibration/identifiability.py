@@ -21,7 +21,7 @@ The identification Jacobian J (m·k, p) is scaled column by column to unit norm,
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -111,7 +111,8 @@ def _condition(s: np.ndarray) -> float:
 
 
 def analyse(J: np.ndarray, names: Sequence[str], *, kind: str = "",
-            order: Sequence[int] | None = None, tol: float = RANK_TOL) -> Identifiability:
+            order: Sequence[int] | None = None, tol: float = RANK_TOL,
+            exclude: Mapping[int, str] | None = None) -> Identifiability:
     """Identifiability from an identification Jacobian (see the module docstring).
 
     Args:
@@ -120,6 +121,8 @@ def analyse(J: np.ndarray, names: Sequence[str], *, kind: str = "",
         kind: measurement kind, for sentences.
         order: priority order of the columns (default 0..p-1).
         tol: relative norm below which a scaled column is dependent.
+        exclude: columns left out whatever their rank, each with the sentence that says
+            why (e.g. too weakly determined to be fitted).
 
     Returns:
         :class:`Identifiability`.
@@ -132,10 +135,11 @@ def analyse(J: np.ndarray, names: Sequence[str], *, kind: str = "",
     effect = norms > 1e-12 * big
     Js = J / np.where(effect, norms, 1.0)
     seq = list(range(p) if order is None else order)
+    exclude = {} if exclude is None else dict(exclude)
     keep = np.zeros(p, dtype=bool)
     basis = np.zeros((J.shape[0], 0))
     for k in seq:
-        if not effect[k]:
+        if not effect[k] or k in exclude:
             continue
         c = Js[:, k]
         r = c - basis @ (basis.T @ c)
@@ -150,6 +154,9 @@ def analyse(J: np.ndarray, names: Sequence[str], *, kind: str = "",
     idx = np.flatnonzero(keep)
     for k in seq:
         if keep[k]:
+            continue
+        if k in exclude:
+            reasons.append(exclude[k])
             continue
         if not effect[k]:
             reasons.append(f"{names[k]} has no effect on {what}")
@@ -180,9 +187,14 @@ def identifiability(model: ErrorModel, measurements: Measurements, params: objec
     from serialkin.kinematics.parallel import single_threaded_blas
 
     J = identification_jacobian(model, measurements, params)
-    groups = [p.group for p in model.parameters]
-    order = ([i for i, g in enumerate(groups) if g == "base"]
-             + [i for i, g in enumerate(groups) if g == "tool"]
-             + [i for i, g in enumerate(groups) if g not in ("base", "tool")])
     with single_threaded_blas():
-        return analyse(J, model.names, kind=measurements.kind, order=order, tol=tol)
+        return analyse(J, model.names, kind=measurements.kind, order=priority_order(model),
+                       tol=tol)
+
+
+def priority_order(model: ErrorModel) -> list[int]:
+    """Parameter indices in the analysis' priority: base, tool, then the links outwards."""
+    groups = [p.group for p in model.parameters]
+    return ([i for i, g in enumerate(groups) if g == "base"]
+            + [i for i, g in enumerate(groups) if g == "tool"]
+            + [i for i, g in enumerate(groups) if g not in ("base", "tool")])

@@ -1,7 +1,9 @@
 """Simulated calibrations: a perturbed "real" robot and noisy measurements of it.
 
 ``perturb`` draws every parameter of an error model uniformly in ``nominal ± length``
-(translations) or ``± angle`` (rotations); ``simulate_measurements`` measures a robot
+(translations) or ``± angle`` (rotations); ``perturb_joints`` makes a "real" robot without
+any error model: every joint origin moved and tilted in all six directions, and a marker
+offset on the flange; ``simulate_measurements`` measures a robot
 at configurations with Gaussian noise of standard deviation ``noise_position`` [m] per
 coordinate and ``noise_rotation`` [rad] about each axis (a rotation ``exp(n)·R`` with
 ``n ~ N(0, σ² I)``).
@@ -31,6 +33,47 @@ def perturb(model: ErrorModel, *, length: float = 1e-3, angle: float = np.radian
     rng = as_generator(seed)
     half = np.array([length if p.unit == "m" else angle for p in model.parameters])
     return model.nominal + rng.uniform(-1.0, 1.0, model.size) * half
+
+
+def perturb_joints(robot: Robot, *, length: float = 1e-3, angle: float = np.radians(0.3),
+                   marker: float = 0.0, seed: None | int | np.random.Generator = None) -> Robot:
+    """A "real" robot: ``robot`` with every joint origin moved and tilted, and a marker.
+
+    Independent of the error models: joint i's origin becomes ``origin · Txyz(t) · R(r)``
+    with each component of t uniform in ``± length`` [m] and of the rotation vector r
+    uniform in ``± angle`` [rad] (so position, axis direction and zero of every joint
+    change), and the tool becomes ``tool · Txyz(v)``: a marker offset v in a random
+    direction, its length uniform in ``[marker/2, marker]`` [m] (0: the flange itself).
+
+    Args:
+        robot: the nominal robot.
+        length: largest origin translation per axis [m].
+        angle: largest origin rotation about each axis [rad].
+        marker: largest marker offset [m].
+        seed: None, int or numpy Generator.
+
+    Returns:
+        the perturbed :class:`~serialkin.Robot` (general joints, no DH table).
+    """
+    from serialkin.model.joint import Joint
+    from serialkin.spatial.lie import so3_exp
+    from serialkin.spatial.transforms import make_transform
+
+    length = check_positive(length, "length", allow_zero=True)
+    angle = check_positive(angle, "angle", allow_zero=True)
+    marker = check_positive(marker, "marker", allow_zero=True)
+    rng = as_generator(seed)
+    joints = []
+    for j in robot.joints:
+        d = make_transform(so3_exp(rng.uniform(-angle, angle, 3)),
+                           rng.uniform(-length, length, 3))
+        joints.append(Joint(axis=j.axis, type=j.type, origin=j.origin @ d, post=j.post,
+                            offset=j.offset, qlim=j.qlim, name=j.name))
+    v = rng.normal(size=3)
+    v *= marker * rng.uniform(0.5, 1.0) / np.linalg.norm(v)
+    return Robot.from_joints(joints, base=robot.base, tool=robot.tool @ make_transform(p=v),
+                             name=f"{robot.name} (perturbed)",
+                             source=f"perturbed from {robot.name}")
 
 
 def simulate_measurements(robot: Robot, q: object, *, kind: str = "position",
