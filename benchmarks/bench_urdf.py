@@ -66,7 +66,7 @@ def meshes(repeat: int = 5) -> None:
         print("meshes: skipped (pip install -e '.[mesh]')")
         return
     from serialkin.collision.fit import collision_model_from_geometry
-    from serialkin.model.mesh import clear_mesh_cache, link_meshes
+    from serialkin.formats.mesh import clear_mesh_cache, link_meshes
 
     pkg = {"example-robot-data": robots_dir().parent}
     print(f"\n{'URDF with meshes (cold) [s]':36s} {'serialkin':>22s} {'Pinocchio':>22s} "

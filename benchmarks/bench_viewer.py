@@ -107,7 +107,7 @@ def main(argv: list[str] | None = None) -> int:
     if robots_dir() is None:
         print("skipped: example-robot-data is not installed (pip install -e '.[bench]')")
         return 0
-    from serialkin.model.mesh import clear_mesh_cache
+    from serialkin.formats.mesh import clear_mesh_cache
     from serialkin.viz import Scene, ViewerOptions
     from serialkin.viz.viewer import MESH_BUDGET, viewer_html
 

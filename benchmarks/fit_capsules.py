@@ -35,7 +35,7 @@ from tests.erd import robots_dir, urdf  # noqa: E402
 
 from serialkin import Robot, models  # noqa: E402
 from serialkin.collision.fit import collision_model_from_geometry  # noqa: E402
-from serialkin.model.mesh import clear_mesh_cache  # noqa: E402
+from serialkin.formats.mesh import clear_mesh_cache  # noqa: E402
 
 
 def load(rel: str, tip: str) -> Robot:

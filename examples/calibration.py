@@ -37,7 +37,7 @@ from serialkin.calibration import (  # noqa: E402
     simulate_measurements,
     write_measurements,
 )
-from serialkin.model.robotfile import load_robot_file  # noqa: E402
+from serialkin.formats.robotfile import load_robot_file  # noqa: E402
 
 out = Path(os.environ.get("SERIALKIN_EXAMPLE_OUT") or tempfile.mkdtemp(prefix="serialkin_"))
 out.mkdir(parents=True, exist_ok=True)

@@ -21,8 +21,8 @@ from pathlib import Path
 import numpy as np
 
 import serialkin as sk
+from serialkin.formats.robotfile import save_robot_file
 from serialkin.model.dh_extract import extract_dh, to_dh_robot
-from serialkin.model.robotfile import save_robot_file
 
 out = Path(os.environ.get("SERIALKIN_EXAMPLE_OUT") or tempfile.mkdtemp(prefix="serialkin_"))
 out.mkdir(parents=True, exist_ok=True)

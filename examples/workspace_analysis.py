@@ -13,7 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 import serialkin as sk  # noqa: E402
-from serialkin.model.robotfile import load_robot_file  # noqa: E402
+from serialkin.formats.robotfile import load_robot_file  # noqa: E402
 from serialkin.workspace import (  # noqa: E402
     constant_orientation_workspace,
     reachable_workspace,

@@ -20,10 +20,10 @@ from serialkin.errors import (
     RobotDefinitionError,
     SerialkinError,
 )
+from serialkin.formats.robotfile import load_robot_file
 from serialkin.ik.solver import MAX_RESTARTS
 from serialkin.model import limits as L
 from serialkin.model.joint import Joint
-from serialkin.model.robotfile import load_robot_file
 
 
 def _alias_bomb(depth: int = 30, width: int = 9) -> list:

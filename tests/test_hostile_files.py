@@ -33,7 +33,7 @@ from serialkin._io import STALE_AFTER, remove_stale_temporaries, write_text_atom
 from serialkin.cli.io import CLIError, read_csv_rows
 from serialkin.cli.main import cli
 from serialkin.errors import RobotDefinitionError, SerialkinError
-from serialkin.model.robotfile import load_robot_file, robot_from_dict, save_robot_file
+from serialkin.formats.robotfile import load_robot_file, robot_from_dict, save_robot_file
 from serialkin.redundancy.obstacles import obstacle_from_dict
 from serialkin.tracking import Trajectory, load_scenario, scenario_from_dict
 from serialkin.tracking.scenario import ScenarioError

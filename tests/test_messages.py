@@ -74,7 +74,7 @@ def test_a_huge_link_name_in_an_srdf_is_not_echoed():
 
 def test_dh_angles_beyond_a_turn_read_as_radians_are_refused(tmp_path):
     """A robot file with alpha: 90 in radians is refused, naming the field and the units."""
-    from serialkin.model.robotfile import load_robot_file
+    from serialkin.formats.robotfile import load_robot_file
 
     rows = ("dh:\n  - {a: 0.5, alpha: 0, d: 0, theta: 0}\n"
             "  - {a: 0.3, alpha: 90, d: 0, theta: 0}\n")

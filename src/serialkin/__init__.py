@@ -11,13 +11,11 @@ Quick start::
 """
 
 from serialkin import errors, ik, models, spatial
+from serialkin import formats as formats  # registers the readers behind Robot.from_urdf, ...
 from serialkin._version import __version__ as __version__
 from serialkin.errors import SerialkinError
 from serialkin.ik import IKResult
 from serialkin.model import DHLink, Joint, Robot
-from serialkin.warmup import install_notice
-
-install_notice()
 
 __all__ = [
     "DHLink",

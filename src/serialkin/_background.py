@@ -24,6 +24,13 @@ foreground as numba does.
 
 Environment: ``SERIALKIN_COMPILE`` = ``background`` (default), ``wait`` or ``python``
 (:func:`mode`).
+
+A first call that must compile says so on stderr, once per feature and process
+(:func:`install_notice`, installed by :func:`serialkin._jit.load_numba` when numba is
+loaded), unless ``SERIALKIN_QUIET_COMPILE`` is set to a non-empty value other than
+``0``. The features, the kernel modules each covers and their measured compile times
+are :data:`COMPILE_FEATURES`; ``serialkin warmup`` (:mod:`serialkin.warmup`) compiles
+them ahead of time.
 """
 
 from __future__ import annotations
@@ -36,6 +43,7 @@ import time
 from collections.abc import Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
+from dataclasses import dataclass
 from types import CellType, FunctionType
 from typing import Any
 
@@ -340,3 +348,134 @@ def entry(dispatcher: Any, sig: Any, args: tuple = ()) -> tuple[Any, bool]:
         return quietly(dispatcher), False
     job.result()
     return dispatcher.overloads[sig].entry_point, True
+
+
+# ---------------------------------------------------------------- the first-compile notice
+@dataclass(frozen=True)
+class CompileFeature:
+    """A group of kernels compiled together (``serialkin warmup NAME``), as the notice names it.
+
+    Attributes:
+        name: the name ``serialkin warmup NAME`` takes.
+        summary: what a user does that needs these kernels.
+        modules: prefixes of the ``serialkin`` modules whose kernels this is (the
+            compile notice names the feature of the kernel being compiled).
+        seconds: the measured cold compile time on a quiet 2-core machine [s] (the
+            estimate the notice and the warm-up's progress bar show; docs/compile-time.md).
+    """
+
+    name: str
+    summary: str
+    modules: tuple[str, ...]
+    seconds: float
+
+
+#: The features, in the order ``serialkin warmup --all`` starts them (longest first, so
+#: that the parallel processes finish together). Their ``seconds``: each feature alone in
+#: a fresh process with an empty cache (benchmarks/compile_profile.py, quiet 2-core
+#: machine); together they share kernels, so ``--all`` takes less than their sum.
+#: :data:`serialkin.warmup.FEATURES` adds to each the calls that compile it.
+COMPILE_FEATURES: dict[str, CompileFeature] = {f.name: f for f in (
+    CompileFeature("ik-all-general", "every solution of general 6R and nearly ideal "
+                   "(calibrated) arms: robot.ik_all",
+                   ("serialkin.ik.analytic.general", "serialkin.ik.analytic.raghavan_roth",
+                    "serialkin.ik.analytic.refine"), 70.0),
+    CompileFeature("ik-all", "every closed-form solution: robot.ik_all",
+                   ("serialkin.ik.analytic",), 50.0),
+    CompileFeature("ik-methods", "the numerical IK methods other than the default: "
+                   "robot.ik(method=...)",
+                   ("serialkin.ik.jacobian_methods", "serialkin.ik.ccd",
+                    "serialkin.ik.fabrik", "serialkin.ik.optimize"), 45.0),
+    CompileFeature("tracking", "path tracking and redundancy resolution: serialkin track",
+                   ("serialkin.tracking", "serialkin.redundancy"), 32.0),
+    CompileFeature("collision", "collision-aware IK and clearance queries",
+                   ("serialkin.collision", "serialkin.diffik"), 18.0),
+    CompileFeature("ik", "numerical IK: robot.ik (default method), one pose and batches",
+                   ("serialkin.ik", "serialkin.kinematics.dls", "serialkin.spatial",
+                    "serialkin.model.limits"), 12.0),
+    CompileFeature("kinematics", "forward kinematics and Jacobians: robot.fk, robot.jacobian",
+                   ("serialkin.kinematics",), 5.0),
+    CompileFeature("workspace", "workspace sampling: serialkin workspace",
+                   ("serialkin.workspace",), 2.0),
+)}
+
+
+def feature_of_module(module: str) -> CompileFeature | None:
+    """The feature whose kernels ``module`` holds (longest matching prefix), or None."""
+    best, length = None, -1
+    for f in COMPILE_FEATURES.values():
+        for prefix in f.modules:
+            if (module == prefix or module.startswith(prefix + ".")) and len(prefix) > length:
+                best, length = f, len(prefix)
+    return best
+
+
+def _quiet() -> bool:
+    return os.environ.get("SERIALKIN_QUIET_COMPILE", "") not in ("", "0")
+
+
+_NOTICE: list[object] = []
+
+
+def install_notice() -> None:
+    """Print one line to stderr when a serialkin kernel starts compiling (once per feature).
+
+    A numba event listener (``numba:compile``, which fires only when a kernel is really
+    compiled, not when it is loaded from the cache): at the outermost compile of a kernel
+    of a feature not yet announced in this process it writes, for example::
+
+        serialkin: compiling the ik kernels once (about 27 s); `serialkin warmup` does
+        this ahead of time
+
+    :func:`serialkin._jit.load_numba` installs it when it loads numba (``import
+    serialkin`` does not load numba); called earlier, it imports numba. Silenced by
+    ``SERIALKIN_QUIET_COMPILE=1``. Installing twice is harmless.
+    """
+    with _NOTICE_LOCK:
+        if _NOTICE:
+            return
+        _NOTICE.append(_listener())
+
+
+_NOTICE_LOCK = threading.Lock()
+
+
+def _listener() -> object:
+    """Register the notice's numba event listener and return it."""
+    from numba.core import event
+
+    announced: set[str] = set()
+
+    class _Notice(event.Listener):
+        depth = 0
+
+        def on_start(self, ev: event.Event) -> None:
+            self.depth += 1
+            if self.depth != 1 or _quiet():
+                return
+            module = getattr(ev.data["dispatcher"].py_func, "__module__", "") or ""
+            if not module.startswith("serialkin."):
+                return
+            f = feature_of_module(module)
+            name = f.name if f else module.removeprefix("serialkin.").split(".")[0]
+            if name in announced:
+                return
+            announced.add(name)
+            about = f"about {f.seconds:.0f} s" if f else ""
+            if mode() == "background":
+                about = f" ({about}; until then they run uncompiled, slower)" if about else \
+                    " (until then they run uncompiled, slower)"
+                print(f"serialkin: compiling the {name} kernels in the background{about}; "
+                      f"`serialkin warmup` does this ahead of time", file=sys.stderr,
+                      flush=True)
+                return
+            about = f" ({about})" if about else ""
+            print(f"serialkin: compiling the {name} kernels once{about}; "
+                  f"`serialkin warmup` does this ahead of time", file=sys.stderr, flush=True)
+
+        def on_end(self, ev: event.Event) -> None:
+            self.depth -= 1
+
+    listener = _Notice()
+    event.register("numba:compile", listener)
+    return listener

@@ -123,6 +123,38 @@ float64. A numba intrinsic once numba is loaded; in Python, :func:`fma_exact`.
 _background.PYTHON_EQUIVALENTS[id(_LAZY_FMA)] = _background.fma_exact
 
 
+def _readonly_view(a):
+    """A read-only view of the array ``a`` (no copy): :data:`as_readonly` in Python."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
+class _LazyReadonly:
+    """``as_readonly`` before numba is loaded: calling it from Python gives a read-only view."""
+
+    is_kernel_proxy = False
+
+    def __call__(self, a):
+        return _readonly_view(a)
+
+
+as_readonly = _LazyReadonly()
+_LAZY_READONLY = as_readonly  # replaced by the intrinsic when numba loads, as ``fma`` is
+as_readonly.__doc__ = """The array ``a`` typed read-only, inside a kernel: no copy, no instruction.
+
+numba compiles a kernel once per set of argument types, and a read-only and a writeable
+array are two types. Data a kernel only reads is passed read-only
+(:func:`serialkin._checks.readonly` at the Python boundary); a kernel that holds such
+data in a writeable array (a user's target that a fast path passes as it came, a
+scratch array it has just filled) passes ``as_readonly(a)`` to a kernel that only reads
+it, so that the callee compiles once (issue 27). The view shares ``a``'s memory, so it
+sees later writes to ``a``. A numba intrinsic once numba is loaded; in Python, a
+read-only view.
+"""
+_background.PYTHON_EQUIVALENTS[id(_LAZY_READONLY)] = _readonly_view
+
+
 def numba_loaded() -> bool:
     """Whether numba has been imported and the kernels made dispatchers."""
     return bool(_NUMBA)
@@ -140,45 +172,56 @@ def on_numba_load(callback: Callable[[], None]) -> None:
 def load_numba() -> None:
     """Import numba and make every :class:`Kernel` its dispatcher (once per process).
 
-    Defines what needs numba (the dispatcher class, the ``fma`` intrinsic, the cache
-    locators), then replaces every :class:`Kernel` and the lazy ``fma`` in the globals of
-    serialkin's modules and of :func:`bind` copies by the real objects, so that numba,
+    Defines what needs numba (the dispatcher class, the ``fma`` and ``as_readonly``
+    intrinsics, the cache locators), then replaces every :class:`Kernel` and the lazy
+    intrinsics in the globals of serialkin's modules and of :func:`bind` copies by the
+    real objects, so that numba,
     compiling a kernel, finds dispatchers and intrinsics among its globals; a
-    :class:`Kernel` kept elsewhere (in a container) forwards to its dispatcher.
+    :class:`Kernel` kept elsewhere (in a container) forwards to its dispatcher. Last, it
+    installs the first-compile notice (:func:`serialkin._background.install_notice`) and
+    runs the :func:`on_numba_load` callbacks.
     """
     with _LOCK:
         if _NUMBA:
             return
         import numba
 
-        real_fma = _define_numba_objects()
+        real_fma, real_readonly = _define_numba_objects()
         for k in _KERNELS:
             k._real = _compiled(numba.njit(**k.options)(k.py_func))
         namespaces = [vars(m) for name, m in list(sys.modules.items())
                       if (name == "serialkin" or name.startswith("serialkin."))
                       and m is not None]
-        lazy_fma = _LAZY_FMA  # a local: this module's own names are replaced too
+        lazy_fma = _LAZY_FMA  # locals: this module's own names are replaced too
+        lazy_readonly = _LAZY_READONLY
         for names in namespaces + _BOUND:
             for key, value in list(names.items()):
                 if type(value) is Kernel:
                     names[key] = value._real
                 elif value is lazy_fma and key != "_LAZY_FMA":
                     names[key] = real_fma
+                elif value is lazy_readonly and key != "_LAZY_READONLY":
+                    names[key] = real_readonly
         _KERNELS.clear()
         _BOUND.clear()
         _NUMBA.append(numba)
-        callbacks = list(_ON_LOAD)
+        # the first-compile notice listens from now on (numba's events need numba)
+        callbacks = [_background.install_notice, *_ON_LOAD]
         _ON_LOAD.clear()
     for callback in callbacks:
         callback()
 
 
 def _define_numba_objects():
-    """The numba-side definitions (see :func:`load_numba`); returns the ``fma`` intrinsic."""
+    """The numba-side definitions (see :func:`load_numba`); returns the two intrinsics.
+
+    ``(fma, as_readonly)``.
+    """
     import numba
     from llvmlite import ir
     from numba.core import cgutils, types
     from numba.core.dispatcher import OmittedArg
+    from numba.core.imputils import impl_ret_borrowed
     from numba.extending import intrinsic, typeof_impl
 
     class _Dispatcher(numba.core.registry.CPUDispatcher):
@@ -238,12 +281,28 @@ def _define_numba_objects():
     real_fma = intrinsic(fma_intrinsic)
     _background.PYTHON_EQUIVALENTS[id(real_fma)] = _background.fma_exact
 
+    def readonly_intrinsic(typingctx, a):
+        if not isinstance(a, types.Array):
+            return None
+        sig = a.copy(readonly=True)(a)
+
+        def codegen(context, builder, signature, args):
+            # the same array structure (the two types share numba's data model): a new
+            # reference to the same memory
+            return impl_ret_borrowed(context, builder, signature.return_type, args[0])
+
+        return sig, codegen
+
+    readonly_intrinsic.__name__ = readonly_intrinsic.__qualname__ = "as_readonly"
+    real_readonly = intrinsic(readonly_intrinsic)
+    _background.PYTHON_EQUIVALENTS[id(real_readonly)] = _readonly_view
+
     @typeof_impl.register(Kernel)
     def _typeof_kernel(val, c):  # a Kernel numba meets as a value: its dispatcher's type
         return typeof_impl(val.dispatcher, c)
 
     globals()["_UserDirLocator"], globals()["_InTreeLocator"] = _install_locators()
-    return real_fma
+    return real_fma, real_readonly
 
 
 def _compiled(decorated):

@@ -9,8 +9,11 @@ processes at a time as there are cores, with a progress bar and the time left. T
 command ``serialkin warmup`` calls it; ``make run`` and ``make test`` run it first.
 
 A first call that must compile prints one line to stderr, once per feature and process
-(:func:`install_notice`), unless ``SERIALKIN_QUIET_COMPILE`` is set to a non-empty
-value other than ``0``.
+(:func:`serialkin._background.install_notice`, installed when serialkin loads numba,
+without this module), unless ``SERIALKIN_QUIET_COMPILE`` is set to a non-empty value
+other than ``0``. The features' names, modules and estimated times are
+:data:`serialkin._background.COMPILE_FEATURES` (the notice needs them); this module adds
+the calls that compile each one.
 
 Every feature calls only public API with the argument types users pass (one pose and
 batches, C- and Fortran-ordered arrays), so what it compiles is exactly what a user's
@@ -26,14 +29,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from serialkin import _background
+from serialkin._background import COMPILE_FEATURES, CompileFeature, install_notice
+from serialkin._background import feature_of_module as _feature_of_module
 from serialkin._checks import check_choice
 
 __all__ = ["FEATURES", "Feature", "feature_of_module", "install_notice", "warmup"]
 
 
 @dataclass(frozen=True)
-class Feature:
+class Feature(CompileFeature):
     """A group of kernels compiled together, by one process.
 
     Attributes:
@@ -46,10 +50,6 @@ class Feature:
         run: calls the feature's public functions (compiling what they need).
     """
 
-    name: str
-    summary: str
-    modules: tuple[str, ...]
-    seconds: float
     run: Callable[[], object]
 
 
@@ -191,43 +191,24 @@ def _tracking() -> None:
     dls_inverse(sc.robot.jacobian(sc.q0), 0.1)
 
 
-#: The features, in the order ``serialkin warmup --all`` starts them (longest first, so
-#: that the parallel processes finish together). Their ``seconds``: each feature alone in
-#: a fresh process with an empty cache (benchmarks/compile_profile.py, quiet 2-core
-#: machine); together they share kernels, so ``--all`` takes less than their sum.
-FEATURES: dict[str, Feature] = {f.name: f for f in (
-    Feature("ik-all-general", "every solution of general 6R and nearly ideal (calibrated) "
-            "arms: robot.ik_all", ("serialkin.ik.analytic.general",
-                                   "serialkin.ik.analytic.raghavan_roth",
-                                   "serialkin.ik.analytic.refine"), 70.0, _ik_all_general),
-    Feature("ik-all", "every closed-form solution: robot.ik_all",
-            ("serialkin.ik.analytic",), 50.0, _ik_all),
-    Feature("ik-methods", "the numerical IK methods other than the default: "
-            "robot.ik(method=...)", ("serialkin.ik.jacobian_methods", "serialkin.ik.ccd",
-                                     "serialkin.ik.fabrik", "serialkin.ik.optimize"), 45.0,
-            _ik_methods),
-    Feature("tracking", "path tracking and redundancy resolution: serialkin track",
-            ("serialkin.tracking", "serialkin.redundancy"), 32.0, _tracking),
-    Feature("collision", "collision-aware IK and clearance queries",
-            ("serialkin.collision", "serialkin.diffik"), 18.0, _collision),
-    Feature("ik", "numerical IK: robot.ik (default method), one pose and batches",
-            ("serialkin.ik", "serialkin.kinematics.dls", "serialkin.spatial",
-             "serialkin.model.limits"), 12.0, _ik),
-    Feature("kinematics", "forward kinematics and Jacobians: robot.fk, robot.jacobian",
-            ("serialkin.kinematics",), 5.0, _kinematics),
-    Feature("workspace", "workspace sampling: serialkin workspace",
-            ("serialkin.workspace",), 2.0, _workspace),
-)}
+_RUNS: dict[str, Callable[[], object]] = {
+    "ik-all-general": _ik_all_general, "ik-all": _ik_all, "ik-methods": _ik_methods,
+    "tracking": _tracking, "collision": _collision, "ik": _ik, "kinematics": _kinematics,
+    "workspace": _workspace,
+}
+
+#: The features of :data:`serialkin._background.COMPILE_FEATURES` (in its order: longest
+#: first, so that the parallel processes finish together), each with the calls that
+#: compile it.
+FEATURES: dict[str, Feature] = {
+    name: Feature(f.name, f.summary, f.modules, f.seconds, _RUNS[name])
+    for name, f in COMPILE_FEATURES.items()}
 
 
 def feature_of_module(module: str) -> Feature | None:
     """The feature whose kernels ``module`` holds (longest matching prefix), or None."""
-    best, length = None, -1
-    for f in FEATURES.values():
-        for prefix in f.modules:
-            if (module == prefix or module.startswith(prefix + ".")) and len(prefix) > length:
-                best, length = f, len(prefix)
-    return best
+    f = _feature_of_module(module)
+    return None if f is None else FEATURES[f.name]
 
 
 def _run_one(name: str) -> float:
@@ -285,76 +266,3 @@ def warmup(features: Iterable[str] | None = None, *, jobs: int | None = None,
             bar.update(min(bar.total - bar.n, round(FEATURES[n].seconds / jobs)))
         bar.update(bar.total - bar.n)
     return times
-
-
-def _quiet() -> bool:
-    return os.environ.get("SERIALKIN_QUIET_COMPILE", "") not in ("", "0")
-
-
-_NOTICE: list[object] = []
-
-
-def install_notice() -> None:
-    """Print one line to stderr when a serialkin kernel starts compiling (once per feature).
-
-    A numba event listener (``numba:compile``, which fires only when a kernel is really
-    compiled, not when it is loaded from the cache): at the outermost compile of a kernel
-    of a feature not yet announced in this process it writes, for example::
-
-        serialkin: compiling the ik kernels once (about 27 s); `serialkin warmup` does
-        this ahead of time
-
-    Silenced by ``SERIALKIN_QUIET_COMPILE=1``. Installing twice is harmless.
-    """
-    if _NOTICE:
-        return
-    from serialkin._jit import numba_loaded, on_numba_load
-
-    if not numba_loaded():  # listen once numba is imported (import serialkin does not)
-        _NOTICE.append(None)
-        on_numba_load(_listen)
-        return
-    _listen()
-
-
-def _listen() -> None:
-    """Register the notice's numba event listener (numba is loaded)."""
-    import sys
-
-    from numba.core import event
-
-    announced: set[str] = set()
-
-    class _Notice(event.Listener):
-        depth = 0
-
-        def on_start(self, ev: event.Event) -> None:
-            self.depth += 1
-            if self.depth != 1 or _quiet():
-                return
-            module = getattr(ev.data["dispatcher"].py_func, "__module__", "") or ""
-            if not module.startswith("serialkin."):
-                return
-            f = feature_of_module(module)
-            name = f.name if f else module.removeprefix("serialkin.").split(".")[0]
-            if name in announced:
-                return
-            announced.add(name)
-            about = f"about {f.seconds:.0f} s" if f else ""
-            if _background.mode() == "background":
-                about = f" ({about}; until then they run uncompiled, slower)" if about else \
-                    " (until then they run uncompiled, slower)"
-                print(f"serialkin: compiling the {name} kernels in the background{about}; "
-                      f"`serialkin warmup` does this ahead of time", file=sys.stderr,
-                      flush=True)
-                return
-            about = f" ({about})" if about else ""
-            print(f"serialkin: compiling the {name} kernels once{about}; "
-                  f"`serialkin warmup` does this ahead of time", file=sys.stderr, flush=True)
-
-        def on_end(self, ev: event.Event) -> None:
-            self.depth -= 1
-
-    listener = _Notice()
-    event.register("numba:compile", listener)
-    _NOTICE[:] = [listener]

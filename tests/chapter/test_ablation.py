@@ -8,8 +8,6 @@ read from the report's text.
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
@@ -125,26 +123,34 @@ def test_eq48_by_hand_matches_the_library(runs):
 
 
 class _SlowFirst:
-    """A stand-in scenario whose first run is slow (as a first, compiling call would be)."""
+    """A stand-in scenario whose first run is slow (as a first, compiling call would be).
+
+    It advances a fake clock (``ReportContext.clock``) instead of sleeping: 20 s for the
+    first run, 10 ms for every later one.
+    """
 
     def __init__(self) -> None:
         self.calls = 0
+        self.now = 0.0
+
+    def clock(self) -> float:
+        return self.now
 
     def run(self):
         self.calls += 1
-        if self.calls == 1:
-            time.sleep(0.2)
+        self.now += 20.0 if self.calls == 1 else 0.010
         return self.calls
 
 
 def test_timed_run_reports_warm_runs_only():
     """timed_run: one untimed warm-up call, then `repeat` timed calls; the cold call is out."""
     fake = _SlowFirst()
-    ctx = ReportContext(outdir=".", quiet=True)
+    ctx = ReportContext(outdir=".", quiet=True, clock=fake.clock)
     result, timing = timed_run(ctx, fake, repeat=4)
     assert fake.calls == 5 and result == 1
     assert timing.warm and timing.n == 4
-    assert timing.high < 0.1  # the 0.2 s first call is not among the timed ones
+    # the 20 s first call is not among the timed ones: every timed run took 10 ms
+    assert [timing.low, timing.median, timing.high] == pytest.approx([0.010] * 3)
     assert ctx.timings[-1] is timing
 
 

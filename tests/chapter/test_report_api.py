@@ -58,26 +58,43 @@ def test_sympy_matrix_converts():
     assert len(list(root.iter(f"{MATHML}mtd"))) == 4
 
 
-def test_timing_warms_up_before_timing(tmp_path):
-    """A function whose first call is slow does not show in a warm Timing's runs."""
-    import time
+class _FakeClock:
+    """A clock that advances only when the timed function says so: durations are known."""
 
+    def __init__(self) -> None:
+        self.now = 100.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_timing_warms_up_before_timing(tmp_path):
+    """Warm-up calls are untimed; median and min..max come from the timed calls alone."""
+    clock = _FakeClock()
+    durations = iter([30.0, 0.003, 0.001, 0.002, 0.005, 0.004])  # first: the "compilation"
     calls = []
 
     def fn():
-        if not calls:
-            time.sleep(0.2)  # the "compilation" of the first call
+        clock.now += next(durations)
         calls.append(1)
 
-    ctx = ReportContext(outdir=tmp_path)
+    ctx = ReportContext(outdir=tmp_path, clock=clock)
     t = ctx.timing(fn, warmup=1, repeat=5)
     assert len(calls) == 6
     assert t.warm and t.n == 5
-    assert t.high < 0.2 and t.low <= t.median <= t.high
-    assert "median of 5 warm runs" in t.text and "spread" in t.text
+    assert t.median == pytest.approx(0.003) and t.low == pytest.approx(0.001)
+    assert t.high == pytest.approx(0.005)  # the 30 s warm-up call is not among the runs
+    assert t.text == "3 ms (median of 5 warm runs, spread 1–5 ms)"
     assert ctx.timings == [t]
+    even = ReportContext(outdir=tmp_path, clock=clock)
+    steps = iter([0.004, 0.001, 0.002, 0.010])
+
+    def step():
+        clock.now += next(steps)
+
+    assert even.timing(step, warmup=0, repeat=4).median == pytest.approx(0.003)  # mean of 2, 4
     cold = ReportContext(outdir=tmp_path).timing(lambda: None, warmup=0, repeat=3)
-    assert not cold.warm
+    assert not cold.warm and cold.n == 3 and 0 <= cold.low <= cold.median <= cold.high
     with pytest.raises(InputError, match="repeat"):
         ctx.timing(fn, repeat=0)
 

@@ -99,7 +99,7 @@ def test_shipped_capsules_contain_the_collision_meshes(name, rel, tip, offsets) 
 
     pytest.importorskip("trimesh")
     from serialkin import Robot
-    from serialkin.model.mesh import link_meshes
+    from serialkin.formats.mesh import link_meshes
 
     path = urdf(rel)
     if path is None:
@@ -148,8 +148,8 @@ def test_ur5_self_collision_works_out_of_the_box():
 def test_allowed_pairs_round_trip_through_dicts_and_robot_files(tmp_path):
     """A model's allowed pairs survive to_dicts/from_dicts and a robot file; unknown names fail."""
     from serialkin.errors import InputError
+    from serialkin.formats.robotfile import load_robot_file, save_robot_file
     from serialkin.model.collision_model import CollisionModel
-    from serialkin.model.robotfile import load_robot_file, save_robot_file
 
     robot = models.get("ur5")
     model = robot.collision

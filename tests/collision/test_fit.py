@@ -178,7 +178,7 @@ def _panda_from_urdf():
 
 def test_panda_meshes_are_contained_and_the_fit_reported() -> None:
     """Every Panda collision-mesh vertex lies in its link's capsules; ratio ≥ 1, gap > 0."""
-    from serialkin.model.mesh import link_meshes
+    from serialkin.formats.mesh import link_meshes
 
     robot = _panda_from_urdf()
     model, report = collision_model_from_geometry(robot)

@@ -163,7 +163,9 @@ def test_separated_witnesses_realise_the_distance():
             if d <= 1e-9:
                 continue
             assert abs(np.linalg.norm(w1 - w2) - d) < 1e-12
-            assert abs(K.segment_distance(a0, a1, w1, w1) - ra) < 1e-9
+            # points as tuples, as the library's batch kernels pass them
+            assert abs(K.segment_distance(tuple(a0), tuple(a1), tuple(w1), tuple(w1)) - ra) \
+                < 1e-9
 
 
 def test_segment_distance_brute_force():
@@ -177,7 +179,7 @@ def test_segment_distance_brute_force():
         P = a0 + s[:, None] * (a1 - a0)
         Q = b0 + s[:, None] * (b1 - b0)
         brute = np.linalg.norm(P[:, None] - Q[None], axis=2).min()
-        d = K.segment_distance(a0, a1, b0, b1)
+        d = K.segment_distance(tuple(a0), tuple(a1), tuple(b0), tuple(b1))  # as the library
         step = (np.linalg.norm(a1 - a0) + np.linalg.norm(b1 - b0)) / 400
         assert d <= brute + 1e-12
         assert brute - d <= step

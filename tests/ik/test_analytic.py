@@ -374,7 +374,7 @@ def test_sp3_slide_strokes_reach_the_distance(seed, delta):
     w /= np.linalg.norm(w)
     h = rng.uniform(-1.0, 1.0, 3)
     out = np.empty(2)
-    count = sp3_slide(w, h, delta * delta, out)
+    count = sp3_slide(tuple(w), tuple(h), delta * delta, out)  # vectors as tuples, as always
     gap = np.linalg.norm(h - (w @ h) * w)  # distance from the origin to the line h + d·w
     if count == 0:
         assert delta < gap
@@ -696,7 +696,11 @@ def test_fast_path_equals_ordinary_path(name):
 
 
 def test_tuple_vector_helpers_match_matrices():
-    """rot3, mv3, mtv3, cross3t, add3, sub3 and row3 equal the matrix/array operations."""
+    """rot3, mv3, mtv3, cross3t, add3, sub3 and row3 equal the matrix/array operations.
+
+    Vectors as tuples and row3 of a read-only array: what the solvers pass.
+    """
+    from serialkin._checks import readonly
     from serialkin.ik.analytic.subproblems import (
         add3,
         cross3t,
@@ -717,14 +721,14 @@ def test_tuple_vector_helpers_match_matrices():
         R = rotation(w, th)
         A = rng.normal(size=(4, 4))
         c, s = math.cos(th), math.sin(th)
-        assert np.allclose(rot3(w, c, s, v), R @ v, atol=1e-14)
-        assert np.allclose(rot3(w, c, -s, v), R.T @ v, atol=1e-14)
-        assert np.allclose(rot3(tuple(w), c, s, tuple(v)), R @ v, atol=1e-14)
-        assert np.allclose(mv3(A, v), A[:3, :3] @ v, atol=1e-14)
-        assert np.allclose(mtv3(A, v), A[:3, :3].T @ v, atol=1e-14)
-        assert np.allclose(cross3t(u, v), np.cross(u, v), atol=1e-14)
-        assert np.allclose(add3(u, v), u + v) and np.allclose(sub3(u, v), u - v)
-        assert row3(A, 2) == tuple(A[2, :3])
+        wt, vt, ut = tuple(w), tuple(v), tuple(u)
+        assert np.allclose(rot3(wt, c, s, vt), R @ v, atol=1e-14)
+        assert np.allclose(rot3(wt, c, -s, vt), R.T @ v, atol=1e-14)
+        assert np.allclose(mv3(A, vt), A[:3, :3] @ v, atol=1e-14)
+        assert np.allclose(mtv3(A, vt), A[:3, :3].T @ v, atol=1e-14)
+        assert np.allclose(cross3t(ut, vt), np.cross(u, v), atol=1e-14)
+        assert np.allclose(add3(ut, vt), u + v) and np.allclose(sub3(ut, vt), u - v)
+        assert row3(readonly(A), 2) == tuple(A[2, :3])
 
 
 def test_packed_entry_equals_solve_into():
@@ -768,21 +772,23 @@ def test_subproblem_cosines_match_angles():
     rng = np.random.default_rng(4)
     for _ in range(20):
         w1, w2, u = (x / np.linalg.norm(x) for x in rng.normal(size=(3, 3)))
-        th, c, s = sp1_dir_cs(w1, u, rotation(w1, 0.7) @ u)
-        assert th == sp1_dir(w1, u, rotation(w1, 0.7) @ u)
+        # vectors as tuples, as the solvers pass them
+        ru = tuple(rotation(w1, 0.7) @ u)
+        th, c, s = sp1_dir_cs(tuple(w1), tuple(u), ru)
+        assert th == sp1_dir(tuple(w1), tuple(u), ru)
         assert abs(th - 0.7) < 1e-12 and abs(c - math.cos(th)) < 1e-15 \
             and abs(s - math.sin(th)) < 1e-15
         v = rotation(w1, rng.uniform(-3, 3)) @ rotation(w2, rng.uniform(-3, 3)) @ u
         out2, out6 = np.zeros((2, 2)), np.zeros((2, 6))
-        m = sp2_dir(w1, w2, u, v, out2)
-        assert m == sp2_dir(w1, w2, u, v, out6) >= 1
+        vecs = (tuple(w1), tuple(w2), tuple(u), tuple(v))
+        m = sp2_dir(*vecs, out2)
+        assert m == sp2_dir(*vecs, out6) >= 1
         assert np.array_equal(out2[:m], out6[:m, :2])
         for t1, t2, c1, s1, c2, s2 in out6[:m]:
             assert np.allclose([c1, s1, c2, s2], [math.cos(t1), math.sin(t1), math.cos(t2),
                                                   math.sin(t2)], atol=1e-14)
             assert np.allclose(rotation(w1, t1) @ rotation(w2, t2) @ u, v, atol=1e-12)
-    assert sp1_dir_cs(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 2.0]),
-                      np.array([1.0, 0.0, 0.0])) == (0.0, 1.0, 0.0)
+    assert sp1_dir_cs((0.0, 0.0, 1.0), (0.0, 0.0, 2.0), (1.0, 0.0, 0.0)) == (0.0, 1.0, 0.0)
 
 
 def test_sp4_cosines_match_angles():
@@ -795,8 +801,9 @@ def test_sp4_cosines_match_angles():
         w /= np.linalg.norm(w)
         c = a @ rotation(w, rng.uniform(-3, 3)) @ b
         out2, out6 = np.zeros(2), np.zeros(6)
-        m = sp4(w, b, a, c, out2)
-        assert m == sp4(w, b, a, c, out6) >= 1 and np.array_equal(out2[:m], out6[:m])
+        vecs = (tuple(w), tuple(b), tuple(a))  # as tuples, as the solvers pass them
+        m = sp4(*vecs, c, out2)
+        assert m == sp4(*vecs, c, out6) >= 1 and np.array_equal(out2[:m], out6[:m])
         for i in range(m):
             th, cs, sn = out6[i], out6[2 + 2 * i], out6[3 + 2 * i]
             assert abs(cs - math.cos(th)) < 1e-14 and abs(sn - math.sin(th)) < 1e-14

@@ -10,6 +10,7 @@ from numba import njit
 
 import serialkin.ik as ik
 from serialkin import models
+from serialkin._checks import readonly
 from serialkin.errors import InputError
 from serialkin.ik import registry
 from serialkin.ik._kernels import (
@@ -148,20 +149,24 @@ def test_lm_active_set_step_is_the_reduced_solve(n, seed):
     rng = np.random.default_rng(seed)
     J = rng.normal(size=(6, n))
     e = rng.normal(size=6)
-    lo = np.full(n, -1.0)
-    hi = np.full(n, 1.0)
+    lo = readonly(np.full(n, -1.0))
+    hi = readonly(np.full(n, 1.0))
     q = rng.uniform(-0.5, 0.5, n)
     at = rng.random(n) < 0.5
     q[at] = np.where(rng.random(at.sum()) < 0.5, -1.0, 1.0)
-    revolute = np.zeros(n)  # prismatic-like: no 2π shift
+    revolute = readonly(np.zeros(n))  # prismatic-like: no 2π shift
     sw = np.ones(6)
     _, _, _, dq, _, _, _, ws, _, _ = _carve(_workspace(n))
     ws[W_JW][:] = J
     ws[W_R][:] = e
     cost = 0.5 * float(e @ e)
     lam = 0.03
-    ctx = (None, None, None, np.ones(6), sw, lo, hi, revolute, True)
-    assert step_lm(q, J, e, cost, np.array([lam]), ctx, ws, dq)
+    # the context as the IK loop passes it (the chain, target, weights and limits
+    # read-only), so that the step runs the loop's compiled specialization
+    chain = models.planar(n).chain
+    ctx = (chain.F, chain.meta, readonly(np.eye(4)), readonly(np.ones(6)), sw, lo, hi,
+           revolute, True)
+    assert step_lm(q, J, e, cost, readonly(np.array([lam])), ctx, ws, dq)
     free = ws[W_FREE] > 0.5
     frozen = ~free
     # every frozen joint sits on a limit (the step would have pushed it out)

@@ -11,8 +11,8 @@ from scipy.spatial.transform import Rotation
 
 from serialkin import Robot
 from serialkin.errors import RobotDefinitionError
+from serialkin.formats.urdf import rpy_to_matrix
 from serialkin.model.geometry import Box, Capsule, Cylinder, LinkGeometry, Mesh, Shape, Sphere
-from serialkin.model.urdf import rpy_to_matrix
 
 _ERD = (Path(sys.prefix) / "lib" / f"python{sys.version_info.major}.{sys.version_info.minor}"
         / "site-packages" / "cmeel.prefix" / "share" / "example-robot-data")

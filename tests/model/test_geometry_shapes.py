@@ -136,7 +136,7 @@ def test_bad_fields_name_the_field():
 def test_primitive_mesh_is_placed_like_its_shape():
     """primitive_mesh of a placed shape is the mesh at the origin moved by the shape's pose."""
     pytest.importorskip("trimesh")
-    from serialkin.model.mesh import primitive_mesh
+    from serialkin.formats.mesh import primitive_mesh
 
     R = _rotation(3)
     for placed, local in (

@@ -1,4 +1,4 @@
-"""Mesh loading (serialkin.model.mesh): units, scenes, scale, cache, decimation, bad files."""
+"""Mesh loading (serialkin.formats.mesh): units, scenes, scale, cache, decimation, bad files."""
 
 from __future__ import annotations
 
@@ -11,15 +11,15 @@ import pytest
 
 from serialkin import Robot
 from serialkin.errors import NotSupportedError, RobotDefinitionError
-from serialkin.model import mesh as mesh_mod
-from serialkin.model.geometry import Box, Capsule, Cylinder, Sphere
-from serialkin.model.mesh import (
+from serialkin.formats import mesh as mesh_mod
+from serialkin.formats.mesh import (
     TriangleMesh,
     decimate,
     link_meshes,
     load_mesh,
     primitive_mesh,
 )
+from serialkin.model.geometry import Box, Capsule, Cylinder, Sphere
 from tests.erd import robots_dir, urdf
 
 trimesh = pytest.importorskip("trimesh")
@@ -202,7 +202,7 @@ def test_import_serialkin_does_not_import_trimesh() -> None:
     """The mesh extra stays optional: importing serialkin (and its mesh module) loads no trimesh."""
     import subprocess
 
-    code = ("import sys, serialkin, serialkin.model.mesh, serialkin.collision; "
+    code = ("import sys, serialkin, serialkin.formats.mesh, serialkin.collision; "
             "print('trimesh' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
@@ -213,8 +213,8 @@ def test_decimate_keeps_the_surface_of_a_mesh_with_repeated_vertices():
     """Decimating a per-corner (STL-like) sphere keeps its area within 10 % (welded first)."""
     pytest.importorskip("trimesh")
     pytest.importorskip("fast_simplification")
+    from serialkin.formats.mesh import TriangleMesh, decimate, primitive_mesh
     from serialkin.model.geometry import Sphere
-    from serialkin.model.mesh import TriangleMesh, decimate, primitive_mesh
 
     sphere = primitive_mesh(Sphere(0.1), sections=48)
     corners = sphere.vertices[sphere.faces.reshape(-1)]  # every corner its own vertex

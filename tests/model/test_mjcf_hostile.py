@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-import time
+import re
 
 import pytest
 
@@ -43,10 +43,10 @@ def test_an_include_bomb_hits_the_budget(tmp_path):
         inner = "".join(f"<include file='f{level + 1}.xml'/>" for _ in range(4))
         (tmp_path / f"f{level}.xml").write_text(f"<mujoco>{inner}</mujoco>")
     (tmp_path / "f12.xml").write_text("<mujoco><worldbody/></mujoco>")
-    t0 = time.process_time()
-    with pytest.raises(BudgetError, match="include"):
+    with pytest.raises(BudgetError, match="include") as err:
         Robot.from_mjcf(tmp_path / "f0.xml")
-    assert time.process_time() - t0 < 30.0  # bounded work, not a timing target
+    # bounded work: the expansion counter stopped it (not the 4¹² files the tree asks for)
+    assert re.search(r"more than \d+ <include> expansions", str(err.value)), str(err.value)
 
 
 @pytest.mark.parametrize("depth", [1500, 5000])

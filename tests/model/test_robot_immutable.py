@@ -13,11 +13,27 @@ from serialkin.errors import InputError, InputTypeError
 from serialkin.model.robot import Robot
 
 
-def test_setting_an_attribute_warns_for_one_release():
+def test_setting_an_attribute_raises_and_says_how_to_copy():
+    """Announced with a DeprecationWarning one release ago; now an error."""
     panda = models.get("panda")
-    with pytest.warns(DeprecationWarning, match="immutable"):
+    with pytest.raises(AttributeError, match=r"Robot is immutable: cannot set 'name'.*with_tool"):
         panda.name = "renamed"
-    assert panda.name == "renamed"
+    with pytest.raises(AttributeError, match="immutable"):
+        panda.tool = np.eye(4)
+    with pytest.raises(AttributeError, match=r"cannot delete 'geometry'"):
+        del panda.geometry
+    assert panda.name == "panda" and panda.geometry == ()  # unchanged
+
+
+def test_is_planar_is_not_written_onto_the_robot():
+    three, panda = models.planar(3), models.get("panda")
+    before = dict(vars(three))
+    assert three.is_planar and not panda.is_planar
+    assert three.is_planar  # the second read is the kept value
+    assert vars(three).keys() == before.keys()
+    copy = pickle.loads(pickle.dumps(three))  # read-only again: one kernel specialization
+    assert not any(a.flags.writeable for a in (copy.chain.F, copy.chain.packed, copy.qlim))
+    assert copy.is_planar
 
 
 def test_copies_carry_link_names_geometry_and_collision():

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from serialkin import Robot, models
 from serialkin.errors import RobotDefinitionError
-from serialkin.model.robotfile import load_robot_file, robot_from_dict, save_robot_file
+from serialkin.formats.robotfile import load_robot_file, robot_from_dict, save_robot_file
 from serialkin.spatial import make_transform, rpy_to_matrix
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "robots"
@@ -89,7 +89,7 @@ def test_save_load_round_trip(tmp_path, name, suffix, units):
        st.sampled_from(["standard", "modified"]))
 def test_random_dh_round_trip(rows, convention):
     """Any DH table survives robot_to_dict / robot_from_dict (both conventions)."""
-    from serialkin.model.robotfile import robot_to_dict
+    from serialkin.formats.robotfile import robot_to_dict
 
     r = Robot.from_dh([dict(a=a, alpha=al, d=d, theta=th, type=t) for a, al, d, th, t in rows],
                       convention)

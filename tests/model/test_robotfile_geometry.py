@@ -12,13 +12,13 @@ import yaml
 
 from serialkin import models
 from serialkin.errors import RobotDefinitionError
-from serialkin.model.geometry import Box, Capsule, Cylinder, Mesh, Sphere
-from serialkin.model.robotfile import (
+from serialkin.formats.robotfile import (
     load_robot_file,
     robot_from_dict,
     robot_to_dict,
     save_robot_file,
 )
+from serialkin.model.geometry import Box, Capsule, Cylinder, Mesh, Sphere
 
 DOC = """
 name: arm
@@ -253,7 +253,7 @@ def test_relative_mesh_without_a_folder_says_where_to_look() -> None:
 @pytest.mark.parametrize("suffix", [".yaml", ".json"])
 def test_capsule_file_round_trip(tmp_path: Path, suffix: str) -> None:
     """A collision model saved to a capsule file (mm) loads back the same in metres."""
-    from serialkin.model.robotfile import load_collision_file, save_collision_file
+    from serialkin.formats.robotfile import load_collision_file, save_collision_file
 
     puma = models.puma560()
     path = save_collision_file(puma.collision, tmp_path / f"caps{suffix}", length_unit="mm")
@@ -268,7 +268,7 @@ def test_capsule_file_round_trip(tmp_path: Path, suffix: str) -> None:
 
 def test_capsule_file_errors_name_the_file(tmp_path: Path) -> None:
     """A frame beyond the robot, a missing section or a bad unit: errors naming the file."""
-    from serialkin.model.robotfile import collision_from_dict, load_collision_file
+    from serialkin.formats.robotfile import collision_from_dict, load_collision_file
 
     p = tmp_path / "caps.yaml"
     p.write_text("collision:\n  - {name: a, frame: 7, spheres: [{center: [0, 0, 0], "

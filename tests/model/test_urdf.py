@@ -33,7 +33,7 @@ def test_two_link_fk_matches_hand_computation():
     assert r.joint_names == ("j1", "j2")
     assert r.link_names == ("base", "l1", "l2", "tip")
     np.testing.assert_allclose(r.qlim, [[-1, 1], [0, 0.4]])
-    from serialkin.model.urdf import rpy_to_matrix
+    from serialkin.formats.urdf import rpy_to_matrix
 
     q = np.array([0.3, 0.2])
     O1 = sk.spatial.make_transform(p=[0, 0, 0.5])

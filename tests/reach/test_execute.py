@@ -18,6 +18,7 @@ from serialkin.errors import BudgetError, InputError
 from serialkin.models.planar import planar
 from serialkin.reach import connect, load_map, reachability_map
 from serialkin.reach.store import CHUNKS
+from tests.reach._guard import outcome
 
 SRC = str(Path(__file__).resolve().parents[2] / "src")
 ARM = (3, [1.0, 0.8, 0.3])
@@ -153,10 +154,10 @@ def test_unreachable_scheduler_fails_fast():
     with socket.socket() as s:  # a free port nobody listens on
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
-    t0 = time.monotonic()
-    with pytest.raises(InputError, match="did not answer within 2 s"):
-        connect(f"tcp://127.0.0.1:{port}", timeout=2.0)
-    assert time.monotonic() - t0 < 30  # a bound against hangs, not a timing assertion
+    # a guard against hangs, not a timing claim: the call returns, with the error
+    err = outcome(lambda: connect(f"tcp://127.0.0.1:{port}", timeout=2.0))
+    assert isinstance(err, InputError), repr(err)
+    assert "did not answer within 2 s" in str(err)
 
 
 def test_planar_task_on_spatial_robot_and_unknown_names():

@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
 
+from serialkin._checks import readonly
 from serialkin.errors import InputError
 from serialkin.spatial import kernels as K
 from serialkin.spatial import (
@@ -93,7 +94,7 @@ def test_so3_log_kernel_direct_call() -> None:
     w = np.empty(3)
     K.so3_log_into(rot[0], w)
     assert np.allclose(w, so3_log(rot[0]), atol=1e-15)
-    K.rotation_error_into(rot[0], rot[1], w)
+    K.rotation_error_into(readonly(rot[0]), readonly(rot[1]), w)  # only read: read-only
     assert np.allclose(w, so3_log(rot[1] @ rot[0].T), atol=1e-14)
 
 

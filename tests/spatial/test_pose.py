@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from serialkin import Robot
+from serialkin._checks import readonly
 from serialkin.errors import InputError
 from serialkin.spatial import kernels as K
 from serialkin.spatial import (
@@ -83,7 +84,7 @@ def test_kernel_direct_call_matches_wrapper() -> None:
     """pose_error_into (the IK kernel) writes the same 6-vector as pose_error."""
     A, B = random_poses(2, 4)
     e = np.empty(6)
-    K.pose_error_into(A, B, e)
+    K.pose_error_into(A, readonly(B), e)  # the target read-only, as the library passes it
     assert np.array_equal(e, pose_error(A, B))
 
 
@@ -150,7 +151,7 @@ def test_compiled_validity_check_agrees_with_check_transform(seed: int, entry: i
         ok = True
     except InputError:
         ok = False
-    assert K.transforms_valid(T, ROTATION_TOL) == ok
+    assert K.transforms_valid(readonly(T), ROTATION_TOL) == ok  # read-only, as the library
     assert ok == (delta < ROTATION_TOL or entry in (3, 7, 11))
 
 

@@ -182,7 +182,9 @@ def _self_distance(arm, Q):
         P = arm.fk_all(q)[:, :3, 3]
         for a in range(arm.n):
             for b in range(a + 2, arm.n):
-                s, t = closest_segment_segment(P[a], P[a + 1], P[b], P[b + 1])
+                # points as tuples, as the library passes them
+                s, t = closest_segment_segment(tuple(P[a]), tuple(P[a + 1]), tuple(P[b]),
+                                               tuple(P[b + 1]))
                 d = np.linalg.norm(P[a] + s * (P[a + 1] - P[a]) - P[b] - t * (P[b + 1] - P[b]))
                 worst = min(worst, d - 0.02)
     return worst

@@ -93,7 +93,7 @@ def test_shapes_posed_in_their_frames(body):
 
 def test_mesh_embedded_with_scale_and_all_triangles(body):
     """A mesh under the budget keeps its triangles; decoded vertices are the scaled file's."""
-    from serialkin.model.mesh import load_mesh
+    from serialkin.formats.mesh import load_mesh
 
     data = viewer_data(Scene(body))
     (m,) = data["meshes"]

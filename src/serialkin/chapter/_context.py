@@ -1,8 +1,10 @@
 """What a section builder gets: :class:`ReportContext`, :class:`Section` and formatting.
 
 The helpers described in :mod:`serialkin.chapter.report` (mathematics as MathML, warm
-timings, "Reproduce" boxes, tables, matrices and palette PNG figures); sections import them
-from :mod:`serialkin.chapter.report`, which re-exports every public name of this module.
+timings, "Reproduce" boxes, tables, matrices and palette PNG figures). Section modules
+import them from here, never from :mod:`serialkin.chapter.report` (which imports the
+sections: the dependency runs one way); the report re-exports every public name of this
+module for other callers.
 """
 
 from __future__ import annotations
@@ -163,12 +165,22 @@ def _latex_to_mathml(latex: str, display: str) -> str:
 
 @dataclass
 class ReportContext:
-    """What a section builder gets: the output folder and helpers for figures and tables."""
+    """What a section builder gets: the output folder and helpers for figures and tables.
+
+    Attributes:
+        outdir: the report's folder (figures go to ``figures/`` below it).
+        quiet: no progress output.
+        figures: the figure files written so far, relative to ``outdir``.
+        timings: the :class:`Timing` of every :meth:`timing` call so far.
+        clock: the clock :meth:`timing` reads [s] (default ``time.perf_counter``; a test
+            passes a fake one to check the arithmetic without measuring anything).
+    """
 
     outdir: Path
     quiet: bool = False
     figures: list[str] = field(default_factory=list)
     timings: list[Timing] = field(default_factory=list)
+    clock: Callable[[], float] = field(default=time.perf_counter, repr=False, compare=False)
 
     # --- mathematics -------------------------------------------------------------------------
     @staticmethod
@@ -195,7 +207,7 @@ class ReportContext:
 
     # --- timings -------------------------------------------------------------------------------
     def timing(self, fn: Callable[[], object], *, warmup: int = 1, repeat: int = 7) -> Timing:
-        """Time ``fn()``: ``warmup`` untimed calls, then ``repeat`` timed ones.
+        """Time ``fn()`` by :attr:`clock`: ``warmup`` untimed calls, then ``repeat`` timed ones.
 
         Returns:
             :class:`Timing` with the median and the full range (min..max) of the timed
@@ -206,10 +218,11 @@ class ReportContext:
         for _ in range(max(0, warmup)):
             fn()
         runs = []
+        clock = self.clock
         for _ in range(repeat):
-            t0 = time.perf_counter()
+            t0 = clock()
             fn()
-            runs.append(time.perf_counter() - t0)
+            runs.append(clock() - t0)
         t = Timing(median=float(np.median(runs)), low=float(min(runs)),
                    high=float(max(runs)), n=repeat, warm=warmup >= 1)
         self.timings.append(t)

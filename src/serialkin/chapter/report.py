@@ -17,8 +17,9 @@ What :class:`ReportContext` gives a section:
 * ``ctx.table`` / ``ctx.matrix`` / ``ctx.figure``: aligned tables without negative zeros,
   bracketed numeric matrices, PNG figures quantised to a 256-colour palette.
 
-These helpers and :class:`Section` are defined in :mod:`serialkin.chapter._context` and
-imported from here; this module assembles the page.
+These helpers and :class:`Section` are defined in :mod:`serialkin.chapter._context`,
+which the section modules import (this module imports the sections, so they never import
+it); this module assembles the page and re-exports them.
 
 Sections are numbered as in the chapter: a section's title starts with the chapter's
 number ("5.1 Analytical Jacobian"); the page header records the versions, git commit,

@@ -387,7 +387,7 @@ def models_cmd(robot: str | None, save: str | None, angle_unit: str, length_unit
             if p.suffix.lower() == ".urdf":
                 write_text_atomic(p, r.to_urdf())
             else:
-                from serialkin.model.robotfile import ROBOT_FILE_SUFFIXES, save_robot_file
+                from serialkin.formats.robotfile import ROBOT_FILE_SUFFIXES, save_robot_file
 
                 if p.suffix.lower() not in ROBOT_FILE_SUFFIXES:
                     raise CLIError(f"--save {p}: use .yaml, .yml, .json or .urdf")

@@ -5,7 +5,7 @@
 * a built-in model name (``serialkin models`` lists them; case-insensitive, aliases such
   as ``puma`` and ``planar<N>`` accepted), built by :func:`serialkin.models.get`;
   ``--param key=value`` passes keyword arguments to the model function;
-* a robot file ``*.yaml`` / ``*.yml`` / ``*.json`` (:mod:`serialkin.model.robotfile`);
+* a robot file ``*.yaml`` / ``*.yml`` / ``*.json`` (:mod:`serialkin.formats.robotfile`);
 * a URDF file ``*.urdf`` (:meth:`serialkin.Robot.from_urdf`); ``--param base_link=NAME``
   and ``--param tip_link=NAME`` choose the chain of a branching tree;
 * a MuJoCo MJCF file ``*.xml`` / ``*.mjcf`` (:meth:`serialkin.Robot.from_mjcf`);
@@ -82,7 +82,7 @@ def resolve_robot(spec: str, params: Sequence[str] = ()) -> Any:
                            "not to robot files")
         if not Path(spec).exists():
             raise CLIError(f"robot file {spec} not found")
-        from serialkin.model.robotfile import load_robot_file
+        from serialkin.formats.robotfile import load_robot_file
 
         return _load(spec, load_robot_file, {})
     if suffix in FILE_PARAMS:

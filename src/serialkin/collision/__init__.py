@@ -10,21 +10,18 @@
 * :mod:`~serialkin.collision.fit` — capsules fitted to link geometry (meshes, primitives),
   with the fitting error;
 * :mod:`~serialkin.collision.robots` — fitted models of built-in robots;
-* :mod:`~serialkin.collision.acm` — the allowed-collision matrix (default, SRDF, sampled);
+* :mod:`~serialkin.collision.acm` — the allowed-collision matrix (default, SRDF; the
+  sampled one is :func:`~serialkin.collision.queries.sampled_acm`);
 * :mod:`~serialkin.collision.srdf` — reading an SRDF;
 * :mod:`~serialkin.collision.queries` — self/scene clearance and collision checks, batched.
 """
 
-from serialkin.collision.acm import (
-    AllowedCollisionMatrix,
-    acm_from_srdf,
-    default_acm,
-    sampled_acm,
-)
+from serialkin.collision.acm import AllowedCollisionMatrix, acm_from_srdf, default_acm
 from serialkin.collision.fit import FitReport, ShapeFit, collision_model_from_geometry
 from serialkin.collision.queries import (
     Clearance,
     in_collision,
+    sampled_acm,
     scene_clearance,
     self_clearance,
 )

@@ -8,9 +8,11 @@ Three sources, combined with :meth:`AllowedCollisionMatrix.allow`:
   massless link between coincident joint axes, as in a spherical wrist) does not separate
   its neighbours;
 * :func:`acm_from_srdf` — an SRDF's ``<disable_collisions>`` pairs, added to the default;
-* :func:`sampled_acm` — pairs in contact in *every* sampled configuration (as MoveIt's
-  setup assistant finds "always in collision" pairs): ``q`` drawn uniformly within the
-  joint limits (seeded), contact meaning a signed distance ≤ ``margin``.
+* :func:`~serialkin.collision.queries.sampled_acm` — pairs in contact in *every* sampled
+  configuration (as MoveIt's setup assistant finds "always in collision" pairs): ``q``
+  drawn uniformly within the joint limits (seeded), contact meaning a signed distance
+  ≤ ``margin``. It measures distances, so it lives with the distance queries
+  (:mod:`serialkin.collision.queries`, which import this module, not the reverse).
 """
 
 from __future__ import annotations
@@ -21,12 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from serialkin._checks import as_generator, check_int, check_real, short_repr
+from serialkin._checks import short_repr
 from serialkin.collision.srdf import Srdf, read_srdf
 from serialkin.errors import InputError, RobotDefinitionError
 from serialkin.model.collision_model import CollisionModel
 
-__all__ = ["AllowedCollisionMatrix", "acm_from_srdf", "default_acm", "sampled_acm"]
+__all__ = ["AllowedCollisionMatrix", "acm_from_srdf", "default_acm"]
 
 
 @dataclass(frozen=True)
@@ -121,31 +123,3 @@ def acm_from_srdf(model: CollisionModel, srdf: Srdf | str | os.PathLike[str],
             pairs.append((a, b))
     base = default_acm(model) if acm is None else acm
     return base.allow(pairs)
-
-
-def sampled_acm(robot, model: CollisionModel, acm: AllowedCollisionMatrix | None = None, *,
-                samples: int = 1000, seed: object = 0,
-                margin: float = 0.0) -> AllowedCollisionMatrix:
-    """Add to ``acm`` (default: :func:`default_acm`) the pairs in contact in every sample.
-
-    ``samples`` configurations are drawn uniformly within ``robot.qlim`` (±π where a joint
-    is unlimited) with the generator made from ``seed``; a body pair is in contact when
-    the smallest signed distance between their shapes is ≤ ``margin`` [m].
-
-    Returns:
-        The matrix with those pairs allowed (pairs without shapes are left as they are).
-    """
-    from serialkin.collision.queries import body_pair_distances
-
-    samples = check_int(samples, "samples", minimum=1, maximum=10**7)
-    margin = check_real(margin, "margin", unit="m")
-    rng = as_generator(seed)
-    lo, hi = robot.qlim[:, 0].copy(), robot.qlim[:, 1].copy()
-    lo[~np.isfinite(lo)] = -np.pi
-    hi[~np.isfinite(hi)] = np.pi
-    q = lo + (hi - lo) * rng.random((samples, robot.n))
-    pairs, d = body_pair_distances(robot, model, q)
-    always = (d <= margin).all(axis=0)
-    base = default_acm(model) if acm is None else acm
-    return base.allow((model.body_names[i], model.body_names[j])
-                      for (i, j), yes in zip(pairs, always, strict=True) if yes)

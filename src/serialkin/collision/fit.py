@@ -32,7 +32,7 @@ the convex piece ``K ⊆ C`` it covers. For convex ``K ⊆ C`` that distance is
 capsule; a box is bounded through its 8 corners, a cylinder through two regular 64-gons
 circumscribing its end circles (so the polygonal prism contains the cylinder).
 
-Meshes are loaded with :func:`serialkin.model.mesh.load_mesh` (the ``serialkin[mesh]``
+Meshes are loaded with :func:`serialkin.formats.mesh.load_mesh` (the ``serialkin[mesh]``
 extra); convex hulls come from :class:`scipy.spatial.ConvexHull` (Qhull).
 """
 
@@ -416,8 +416,8 @@ def _exact_fit(shape: object, link_name: str, frame: int) -> ShapeFit | None:
 
 def _posed_points(shape: object, link_name: str) -> tuple[str, np.ndarray, float]:
     """Name, points (in the chain frame) whose hull holds the shape, and its volume."""
+    from serialkin.formats.mesh import load_mesh
     from serialkin.model.geometry import Mesh
-    from serialkin.model.mesh import load_mesh
 
     g, T = shape.geometry, shape.origin
     if isinstance(g, Mesh):

@@ -75,10 +75,10 @@ _INVPHI = (math.sqrt(5.0) - 1.0) / 2.0
 
 @njit(cache=True, nogil=True)
 def segment_distance(a0, a1, b0, b1):
-    """Distance [m] between segments ``a0 a1`` and ``b0 b1`` (each point shape (3,)).
+    """Distance [m] between segments ``a0 a1`` and ``b0 b1`` (each point a 3-tuple).
 
     ``min_{s,t ∈ [0,1]} ‖a0 + s (a1 − a0) − b0 − t (b1 − b0)‖``; no allocation (used by the
-    batch kernels).
+    batch kernels, which pass the points as tuples).
     """
     s, t = closest_segment_segment(a0, a1, b0, b1)
     dx = a0[0] + s * (a1[0] - a0[0]) - b0[0] - t * (b1[0] - b0[0])
@@ -117,7 +117,10 @@ def capsule_capsule(a0, a1, ra, b0, b1, rb):
     ``w1 = sa − ra u``, ``w2 = sb + rb u``, ``u = (sa − sb)/‖sa − sb‖`` (see the module
     docstring for crossing segments). Points shape (3,), radii [m]; returns (float, (3,), (3,)).
     """
-    s, t = closest_segment_segment(a0, a1, b0, b1)
+    # the points as tuples, as the batch kernels pass them: closest_segment_segment
+    # compiles once
+    s, t = closest_segment_segment((a0[0], a0[1], a0[2]), (a1[0], a1[1], a1[2]),
+                                   (b0[0], b0[1], b0[2]), (b1[0], b1[1], b1[2]))
     sa = a0 + s * (a1 - a0)
     sb = b0 + t * (b1 - b0)
     diff = sa - sb
@@ -173,7 +176,10 @@ def box_point(c, R, h, p):
 
 @njit(cache=True, nogil=True)
 def _box_sd(c, Rf, h, x, y, z):
-    """Signed distance of point (x, y, z) to the box; ``Rf[3 r + k] = R[r, k]`` (no allocation)."""
+    """Signed distance of point (x, y, z) to the box; ``Rf[3 r + k] = R[r, k]`` (no allocation).
+
+    ``c``, ``h`` (3-)tuples and ``Rf`` a 9-tuple, as :func:`_segment_box_t` passes them.
+    """
     px = x - c[0]
     py = y - c[1]
     pz = z - c[2]
@@ -195,7 +201,8 @@ def _box_sd(c, Rf, h, x, y, z):
 def _segment_box_t(a0, a1, c, Rf, h):
     """Parameter t ∈ [0, 1] minimising the convex signed distance of a0 + t(a1 − a0) to the box.
 
-    ``Rf`` is the box rotation flattened row-major (any indexable of 9 numbers).
+    Points, ``c`` and ``h`` are tuples; ``Rf`` is the box rotation flattened row-major,
+    a tuple of 9 numbers.
     """
     dx = a1[0] - a0[0]
     dy = a1[1] - a0[1]
@@ -252,7 +259,11 @@ def sphere_box(c, r, bc, R, h):
 @njit(cache=True, nogil=True)
 def capsule_box(a0, a1, r, bc, R, h):
     """Signed distance ``min_t sd_box(a0 + t(a1 − a0)) − r`` of a capsule to a box, witnesses."""
-    t = _segment_box_t(a0, a1, bc, np.ascontiguousarray(R).ravel(), h)
+    # tuples, as the batch kernels pass them (:mod:`serialkin.collision.queries`):
+    # _segment_box_t compiles once
+    t = _segment_box_t((a0[0], a0[1], a0[2]), (a1[0], a1[1], a1[2]), (bc[0], bc[1], bc[2]),
+                       (R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2], R[2, 0], R[2, 1],
+                        R[2, 2]), (h[0], h[1], h[2]))
     return sphere_box(a0 + t * (a1 - a0), r, bc, R, h)
 
 

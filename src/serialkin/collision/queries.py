@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from serialkin._checks import check_real
+from serialkin._checks import as_generator, check_int, check_real
 from serialkin.collision.acm import AllowedCollisionMatrix, default_acm
 from serialkin.collision.kernels import _box_sd, _segment_box_t, segment_distance
 from serialkin.collision.shapes import encode_scene
@@ -37,8 +37,9 @@ from serialkin.model.collision_model import CollisionModel
 from .._jit import njit
 
 __all__ = ["CHUNK", "PAIR_NONE", "PAIR_SCENE", "PAIR_SELF", "Clearance", "body_pair_distances",
-           "checked_shape_pairs", "clearance_at", "pair_distance_at", "scene_point_distance",
-           "in_collision", "scene_clearance", "self_clearance", "shapes_to_world"]
+           "check_model_fits", "checked_shape_pairs", "clearance_at", "pair_distance_at",
+           "scene_point_distance", "in_collision", "sampled_acm", "scene_clearance",
+           "self_clearance", "shapes_to_world"]
 
 #: Configurations whose link frames are computed at once (8 frames × 128 B each for a 7-axis arm).
 CHUNK = 4096
@@ -314,7 +315,17 @@ def pair_distance_at(frames, shape_frame, A, B, rad, scene, pair, W0, W1):
 
 
 # ---------------------------------------------------------------- Python front ends
-def _check_model(robot, model: CollisionModel) -> None:
+def check_model_fits(robot, model: CollisionModel) -> None:
+    """Check that ``model`` is a :class:`CollisionModel` whose bodies sit on frames of ``robot``.
+
+    Every query of this module calls it first; other layers building on the queries (the
+    collision constraint of :mod:`serialkin.diffik`) call it too, so that a model of
+    another robot is refused with the same message.
+
+    Raises:
+        InputError: ``model`` is not a CollisionModel, or one of its bodies is fixed to a
+            frame beyond ``robot``'s frames 0..n (the message names the body).
+    """
     if not isinstance(model, CollisionModel):
         raise InputError(f"model must be a CollisionModel, got {type(model).__name__}")
     if len(model.body_frames) and model.body_frames.max() > robot.n:
@@ -379,7 +390,7 @@ def self_clearance(robot, model: CollisionModel, q: object,
     Returns:
         :class:`Clearance` with ``distance`` (...,) [m] and ``pair`` (..., 2) body indices.
     """
-    _check_model(robot, model)
+    check_model_fits(robot, model)
     pa, pb = checked_shape_pairs(model, acm)
     it = _batches(robot, q)
     shape = next(it)
@@ -413,7 +424,7 @@ def body_pair_distances(robot, model: CollisionModel, q: object,
     Returns:
         The body pairs ``[(i, j), ...]`` (i < j, P of them) and distances (N, P) [m].
     """
-    _check_model(robot, model)
+    check_model_fits(robot, model)
     if acm is None:
         f = model.body_frames
         acm = AllowedCollisionMatrix(model.body_names, f[:, None] == f[None, :])
@@ -436,6 +447,32 @@ def body_pair_distances(robot, model: CollisionModel, q: object,
     return pairs, out
 
 
+def sampled_acm(robot, model: CollisionModel, acm: AllowedCollisionMatrix | None = None, *,
+                samples: int = 1000, seed: object = 0,
+                margin: float = 0.0) -> AllowedCollisionMatrix:
+    """Add to ``acm`` (default: :func:`default_acm`) the pairs in contact in every sample.
+
+    ``samples`` configurations are drawn uniformly within ``robot.qlim`` (±π where a joint
+    is unlimited) with the generator made from ``seed``; a body pair is in contact when
+    the smallest signed distance between their shapes is ≤ ``margin`` [m].
+
+    Returns:
+        The matrix with those pairs allowed (pairs without shapes are left as they are).
+    """
+    samples = check_int(samples, "samples", minimum=1, maximum=10**7)
+    margin = check_real(margin, "margin", unit="m")
+    rng = as_generator(seed)
+    lo, hi = robot.qlim[:, 0].copy(), robot.qlim[:, 1].copy()
+    lo[~np.isfinite(lo)] = -np.pi
+    hi[~np.isfinite(hi)] = np.pi
+    q = lo + (hi - lo) * rng.random((samples, robot.n))
+    pairs, d = body_pair_distances(robot, model, q)
+    always = (d <= margin).all(axis=0)
+    base = default_acm(model) if acm is None else acm
+    return base.allow((model.body_names[i], model.body_names[j])
+                      for (i, j), yes in zip(pairs, always, strict=True) if yes)
+
+
 def scene_clearance(robot, model: CollisionModel, q: object, scene) -> Clearance:
     """Smallest signed distance of any robot shape to any scene shape, and which pair.
 
@@ -450,7 +487,7 @@ def scene_clearance(robot, model: CollisionModel, q: object, scene) -> Clearance
     Returns:
         :class:`Clearance`: ``distance`` (...,) [m], ``pair`` (..., 2) = (body, scene index).
     """
-    _check_model(robot, model)
+    check_model_fits(robot, model)
     enc = encode_scene(scene)
     it = _batches(robot, q)
     shape = next(it)

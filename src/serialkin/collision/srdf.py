@@ -7,7 +7,8 @@ Only two elements are read; every other element is ignored:
   — named joint configurations (values in rad or m).
 
 The XML is parsed with the standard library (:mod:`xml.etree.ElementTree`) through the
-reader URDF import uses; the root element must be ``<robot>``.
+reader URDF import uses (:func:`serialkin.formats.xmlfile.read_robot_xml`); the root
+element must be ``<robot>``.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from dataclasses import dataclass
 
 from serialkin._checks import short_repr
 from serialkin.errors import RobotDefinitionError
-from serialkin.model.urdf import _read_xml
+from serialkin.formats.xmlfile import read_robot_xml
 
 __all__ = ["Srdf", "read_srdf"]
 
@@ -55,7 +56,7 @@ def read_srdf(path_or_string: str | os.PathLike[str]) -> Srdf:
             ``<disable_collisions>`` without both links, a joint value that is not a
             finite number (the message names the element).
     """
-    root, source = _read_xml(path_or_string)
+    root, source = read_robot_xml(path_or_string)
     disabled = []
     for k, el in enumerate(root.findall("disable_collisions")):
         a, b = el.get("link1"), el.get("link2")

@@ -34,7 +34,7 @@ from serialkin.errors import InputError
 from serialkin.kinematics import kernels as K
 from serialkin.redundancy.obstacles import (
     Obstacle,
-    _Geometry,
+    ObstacleGeometry,
     encode_obstacles,
     pair_gradient_into,
 )
@@ -190,7 +190,10 @@ def self_rows_into(q, F, L, meta, frames, P0, P1, link, pairs, radius, influence
     for p in range(pairs.shape[0]):
         a = pairs[p, 0]
         b = pairs[p, 1]
-        s, t = closest_segment_segment(P0[a], P1[a], P0[b], P1[b])
+        s, t = closest_segment_segment((P0[a, 0], P0[a, 1], P0[a, 2]),
+                                       (P1[a, 0], P1[a, 1], P1[a, 2]),
+                                       (P0[b, 0], P0[b, 1], P0[b, 2]),
+                                       (P1[b, 0], P1[b, 1], P1[b, 2]))
         dist2 = 0.0
         for c in range(3):
             nv[c] = (P0[a, c] + s * (P1[a, c] - P0[a, c])) - (P0[b, c] + t * (P1[b, c] - P0[b, c]))
@@ -280,7 +283,7 @@ class CollisionAvoidance(Constraint):
         key = id(robot)
         st = self._geo.get(key)
         if st is None or st[0] is not robot:
-            g = _Geometry(robot, self.obstacles, self.link_radius)
+            g = ObstacleGeometry(robot, self.obstacles, self.link_radius)
             s = g.P0.shape[0]
             k = len(self.obstacles)
             if isinstance(self.self_pairs, str):

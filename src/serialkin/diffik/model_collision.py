@@ -223,13 +223,13 @@ class ModelCollisionAvoidance(Constraint):
         st = self._cache.get(robot)
         if st is not None:
             return st
-        from serialkin.collision.queries import _check_model, checked_shape_pairs
+        from serialkin.collision.queries import check_model_fits, checked_shape_pairs
 
         model = self.model if self.model is not None else robot.collision
         if model is None:
             raise InputError(f"robot {robot.name!r} has no collision model: pass model= or "
                              "use robot.with_collision(...)")
-        _check_model(robot, model)
+        check_model_fits(robot, model)
         if self.self_collision:
             pa, pb = checked_shape_pairs(model, self.acm)
         else:  # read-only as the pairs are: one compiled specialization

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from serialkin._checks import MAX_ITERATIONS, check_int, check_positive, short_repr
+from serialkin._checks import MAX_ITERATIONS, check_int, check_positive, readonly, short_repr
 from serialkin.diffik.constraints import (
     CollisionAvoidance,
     PositionLimit,
@@ -235,9 +235,10 @@ class _QPState:
 
         a = self._kernel_args
         out = np.empty(q.size)
+        # the target only read: read-only, as tracking passes its path's (one compiled type)
         it, err, code = qp_point_into(np.ascontiguousarray(q, dtype=float),
-                                      np.ascontiguousarray(target, dtype=float), a[0], *a[1:],
-                                      out)
+                                      readonly(np.ascontiguousarray(target, dtype=float)), a[0],
+                                      *a[1:], out)
         reason = ""
         if code == NO_PROGRESS:
             reason = _NO_PROGRESS

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from serialkin._checks import as_float_array, check_positive, check_transform
+from serialkin._checks import as_float_array, check_positive, check_transform, readonly
 from serialkin.errors import InputError, InputTypeError
 from serialkin.kinematics import kernels as K
 from serialkin.model.tasks import task_rows
@@ -119,7 +119,8 @@ class FrameTask(Task):
 
     def set_target(self, target: object) -> None:
         """Change the target pose (4, 4) (tracking moves it along the path)."""
-        self.target = np.ascontiguousarray(check_transform(target, "target"))
+        # read-only: the kernels take targets read-only (one compiled specialization)
+        self.target = readonly(np.ascontiguousarray(check_transform(target, "target")))
 
     def rows(self, ws: Workspace, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Rows of the geometric Jacobian and of the pose error (see the class docstring)."""

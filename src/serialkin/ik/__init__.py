@@ -6,11 +6,15 @@ Use ``robot.ik(target, method="lm", ...)`` or :func:`solve`; every method return
 :func:`compare` runs several methods on the same targets and tabulates the results.
 
 Adding a method family: write a module ``serialkin/ik/<family>.py`` that calls
-:func:`~serialkin.ik.registry.register_method` at import; every public module of this
-package is imported (and so registered) the first time the registry is read.
+:func:`~serialkin.ik.registry.register_method` at import, and import it below with the
+other families (the registry imports no family: they import it).
 """
 
+# the method families register their methods when imported
+from serialkin.ik import heuristic_methods, jacobian_methods, optimization_methods  # noqa: F401
 from serialkin.ik.analytic import classify, ik_all
+from serialkin.ik.analytic import method as analytic_method  # noqa: F401
+from serialkin.ik.analytic.arm_angle import arm_angle, arm_angle_intervals, ik_arm_angle
 from serialkin.ik.compare import CompareTable, compare
 from serialkin.ik.registry import METHODS, MethodSpec, available_methods, register_method
 from serialkin.ik.result import IKResult
@@ -21,6 +25,9 @@ from serialkin.model.robot import provide
 provide("ik", solve)
 provide("ik_fast", _fast)
 provide("ik_all", ik_all)
+provide("arm_angle", arm_angle)
+provide("ik_arm_angle", ik_arm_angle)
+provide("arm_angle_intervals", arm_angle_intervals)
 
 __all__ = [
     "CompareTable",

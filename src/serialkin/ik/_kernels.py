@@ -100,7 +100,7 @@ from serialkin.model.limits import normalize as interval_normalize
 from serialkin.model.limits import project as interval_project
 from serialkin.spatial.kernels import pose_error_into, transforms_valid
 
-from .._jit import bind, dependency_stamp, njit
+from .._jit import as_readonly, bind, dependency_stamp, njit
 
 #: Layout of the configuration vector ``cfg`` (float64): the loop's slots, then the
 #: method's parameters ``cfg[N_LOOP:]`` (``CompiledMethod.params``, in order).
@@ -276,9 +276,11 @@ def pose_and_q0_valid(T, q0, lo, hi, rot_tol, has_q0):
     (:func:`~serialkin.ik.target.parse_target`, :func:`~serialkin.ik.target.check_q0`)
     run and raise the precise error.
     """
-    if not transforms_valid(T.reshape((1, 4, 4)), rot_tol):
+    # T and q0 are the caller's (writeable) arrays, only read: typed read-only, as the
+    # ordinary path passes them, so that the checks compile once
+    if not transforms_valid(as_readonly(T).reshape((1, 4, 4)), rot_tol):
         return False
-    return not has_q0 or inside_limits(q0, lo, hi, 1e-12)
+    return not has_q0 or inside_limits(as_readonly(q0), lo, hi, 1e-12)
 
 
 # ---------------------------------------------------------------- small dense algebra
@@ -309,8 +311,9 @@ def stopping_test(T, T_target, w, tol_pos, tol_orient, it, window, min_progress,
     """Stopping test of a heuristic attempt (CCD, FABRIK) after its iteration ``it`` ≥ 1.
 
     The pose error of ``T`` (4, 4) against ``T_target`` (4, 4) goes into ``e`` (6,), and
-    its norms ``e_p`` [m], ``e_o`` [rad] over the coordinates with ``w_i > 0`` (6,) are
-    tested: **converged** when ``e_p ≤ tol_pos`` and ``e_o ≤ tol_orient``; else the scaled
+    its norms ``e_p`` [m], ``e_o`` [rad] over the coordinates with ``w_i > 0`` (``w`` (6,),
+    the attempt's read-only weights: the type the IK loop passes to :func:`task_errors`)
+    are tested: **converged** when ``e_p ≤ tol_pos`` and ``e_o ≤ tol_orient``; else the scaled
     error ``s = e_p/tol_pos + e_o/tol_orient`` is compared every ``window`` iterations with
     the reference ``ref`` (``s`` at the previous check, at iteration 1 first):
     **stagnated** when ``s > (1 − min_progress)·ref``.
@@ -614,15 +617,14 @@ def _attempt(F, meta, Tt, w, sw, lo, hi, revolute, respect, p, window, ratio, to
 
 @njit(cache=True)
 def _copy(src, dst):
-    """``dst[...] = src`` for two distinct C-contiguous arrays of one shape (1-D or 2-D).
+    """``dst[:] = src`` for two distinct C-contiguous 1-D arrays of one length.
 
+    A 2-D array is passed as its flat view ``a.reshape(a.size)`` (one compiled type).
     A loop, not numba's slice assignment, which may allocate a temporary (it guards
     against overlap): the per-target loop runs without reference counting and may not.
     """
-    a = src.reshape(src.size)
-    b = dst.reshape(dst.size)
-    for i in range(a.shape[0]):
-        b[i] = a[i]
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
 
 
 @njit(cache=True)
@@ -677,8 +679,8 @@ def _polish(F, meta, Tt, w, sw, lo, hi, revolute, respect, tol, max_iter,
         if rho > 0.0 and math.isfinite(cost_n):
             quiet = quiet + 1 if cost - cost_n <= 1e-12 * cost else 0
             _copy(qn, q)
-            _copy(Jn, J)
-            _copy(Tn, T)
+            _copy(Jn.reshape(Jn.size), J.reshape(J.size))
+            _copy(Tn.reshape(16), T.reshape(16))
             _copy(en, e)
             cost = cost_n
             t = 2.0 * rho - 1.0
@@ -723,7 +725,7 @@ def _write_info(info, success, total, be, w, used, best_cost, q_out, lo, hi, cle
     info[I_ORI_ERR] = oe
     info[I_RESTARTS] = used
     info[I_COST] = best_cost
-    info[I_INSIDE] = 1.0 if inside_limits(q_out, lo, hi, LIMIT_TOL) else 0.0
+    info[I_INSIDE] = 1.0 if inside_limits(as_readonly(q_out), lo, hi, LIMIT_TOL) else 0.0
     info[I_CLEARANCE] = clearance
 
 
@@ -754,6 +756,7 @@ def _solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp):
     """
     (w, p, lo, hi, slo, shi, revolute, tol, max_iter, restarts, respect, use_q0, window,
      ratio) = _settings(cfg, box)
+    Tt = as_readonly(Tt)  # only read: the loop's kernels see read-only targets, as all do
     J, T, e, dq, q, be, sw, ws, Jn, state = _carve(wsp)
     for i in range(6):
         sw[i] = math.sqrt(w[i])
@@ -982,6 +985,7 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
     n = meta.shape[0]
     (w, p, lo, hi, slo, shi, revolute, tol, max_iter, restarts, respect, use_q0, window,
      ratio) = _settings(cfg, box)
+    Tt = as_readonly(Tt)  # only read (as in solve_one)
     margin = ccfg[K_MARGIN]
     pushes = int(ccfg[K_PUSHES])
     m = A.shape[0]

@@ -262,7 +262,7 @@ def ccd_attempt(q, F, meta, T_target, mask, w_orient, lo, hi, tol_pos, tol_orien
     ref = np.inf
     for it in range(1, max_iter + 1):
         ccd_sweep(q, F, meta, T_target, pos_sel, w_pos, w_o, lo, hi, J, T)
-        status, ref = stopping_test(T, T_target, sel, tol_pos, tol_orient, it, window,
+        status, ref = stopping_test(T, T_target, mask, tol_pos, tol_orient, it, window,
                                     min_progress, ref, e)
         if status != RUNNING:
             return it, status

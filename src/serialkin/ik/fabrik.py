@@ -299,7 +299,7 @@ def fabrik_attempt(q, F, meta, T_target, mask, a, e1, e2, sign, lo, hi, tol_pos,
         fabrik_pass(q, F, meta, T_target, pos_sel, use_orient, a, e1, e2, sign, lo, hi,
                     J, T, P, lengths, theta)
         fk_into(q, F, meta, T)
-        status, ref = stopping_test(T, T_target, sel, tol_pos, tol_orient, it, window,
+        status, ref = stopping_test(T, T_target, mask, tol_pos, tol_orient, it, window,
                                     min_progress, ref, e)
         if status != RUNNING:
             return it, status

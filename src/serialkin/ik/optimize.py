@@ -41,7 +41,6 @@ import math
 from collections.abc import Callable
 
 import numpy as np
-from scipy.optimize import minimize
 
 from serialkin.ik._kernels import task_cost, task_errors
 from serialkin.kinematics.kernels import fk_into, jacobian_into
@@ -164,6 +163,10 @@ def minimize_attempt(
         The configuration that met the tolerance, else the best one seen (lowest cost,
         always finite), and the number of iterations scipy performed.
     """
+    # imported here: scipy.optimize takes 0.1-0.3 s to import, and serialkin.ik imports
+    # this family (to register it) at every `import serialkin`
+    from scipy.optimize import minimize
+
     scipy_method = SCIPY_METHODS[method]
     n = q_start.shape[0]
     J = np.empty((6, n))

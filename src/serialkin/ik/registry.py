@@ -1,11 +1,13 @@
 """The IK method registry: method name → :class:`MethodSpec`.
 
 A method is registered once, at import of the module that implements it, with
-:func:`register_method`. Every public module of :mod:`serialkin.ik` (a ``.py`` file whose
-name does not start with ``_``, other than the skeleton's own modules) is imported the
-first time the registry is read, so adding a file that registers its methods is all a new
-family needs. The closed-form solvers (:mod:`serialkin.ik.analytic`) are served as the
-method ``'analytic'`` when that package provides ``ik_all``.
+:func:`register_method`. The built-in families are imported by name in
+``serialkin/ik/__init__.py`` (:mod:`~serialkin.ik.jacobian_methods`,
+:mod:`~serialkin.ik.heuristic_methods`, :mod:`~serialkin.ik.optimization_methods` and
+the closed-form :mod:`serialkin.ik.analytic.method`), so every import of serialkin
+registers them before any solve; a new family is a module that calls
+:func:`register_method` at import and one import line there. This module imports
+none of them: the dependency runs one way, from the families to the registry.
 
 Two kinds of methods share the same skeleton (:mod:`serialkin.ik.solver`):
 
@@ -19,8 +21,6 @@ Two kinds of methods share the same skeleton (:mod:`serialkin.ik.solver`):
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -94,7 +94,6 @@ class MethodSpec:
 
 
 _REGISTRY: dict[str, MethodSpec] = {}
-_DISCOVERED = False
 
 
 def register_method(spec: MethodSpec) -> MethodSpec:
@@ -103,40 +102,16 @@ def register_method(spec: MethodSpec) -> MethodSpec:
     return spec
 
 
-#: Modules of the skeleton itself (they register nothing).
-_SKELETON = frozenset({"registry", "solver", "target", "result", "compare"})
-
-
-def _discover() -> None:
-    """Import every public ``serialkin.ik`` module once (they register themselves)."""
-    global _DISCOVERED
-    if _DISCOVERED:
-        return
-    _DISCOVERED = True
-    import serialkin.ik as pkg
-
-    for info in pkgutil.iter_modules(pkg.__path__):
-        if not info.ispkg and not info.name.startswith("_") and info.name not in _SKELETON:
-            importlib.import_module(f"serialkin.ik.{info.name}")
-    if "analytic" not in _REGISTRY:
-        from serialkin.ik.analytic.method import register_analytic
-
-        register_analytic()
-
-
 class _MethodTable(Mapping[str, MethodSpec]):
-    """Read-only, lazily populated view of the registry (``serialkin.ik.METHODS``)."""
+    """Read-only view of the registry, in name order (``serialkin.ik.METHODS``)."""
 
     def __getitem__(self, name: str) -> MethodSpec:
-        _discover()
         return _REGISTRY[name]
 
     def __iter__(self) -> Iterator[str]:
-        _discover()
         return iter(sorted(_REGISTRY))
 
     def __len__(self) -> int:
-        _discover()
         return len(_REGISTRY)
 
     def __repr__(self) -> str:
@@ -158,10 +133,9 @@ def get_method(name: object) -> MethodSpec:
     Raises:
         InputError: unknown name; the message lists the available methods.
     """
-    if _DISCOVERED and isinstance(name, str):
+    if isinstance(name, str):
         spec = _REGISTRY.get(name)
         if spec is not None:
             return spec
-    _discover()
     check_choice(name, "method", sorted(_REGISTRY))
     return _REGISTRY[name]  # type: ignore[index]

@@ -152,7 +152,10 @@ class IKProblem:
         """
         out = np.array(q, dtype=np.float64)
         if self.respect_limits:
-            K.project_into(out, self.lower, self.upper, self.revolute)
+            # the joint types as the kernels' (5, n) box holds them (read-only float64
+            # 1.0 / 0.0), the one type project_into compiles for
+            box = robot_arrays(self.robot).box
+            K.project_into(out, self.lower, self.upper, box[K.B_REVOLUTE])
         return out
 
 
@@ -297,7 +300,7 @@ def run_attempts(spec: MethodSpec, problem: IKProblem, q0: np.ndarray | None, ma
             success = True
             break
     q = np.array(best_q, dtype=np.float64)
-    K.normalize_into(q, arrays.lo, arrays.hi, arrays.revolute)
+    K.normalize_into(q, arrays.lo, arrays.hi, arrays.box[K.B_REVOLUTE])  # the kernels' types
     success = honest_success(robot, q, success, problem.respect_limits)
     pe, oe = problem.errors(q)
     reason = "" if success else failure_reason(
@@ -585,8 +588,7 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
             return None
         target = np.ascontiguousarray(target, dtype=np.float64)
     ent = _FAST_ENTRIES.get(robot, _NO_ENTRIES).get(method)
-    # the method's spec, looked up directly (an entry exists only once the registry has
-    # been discovered): a re-registered method gets a new entry
+    # the method's spec, looked up directly: a re-registered method gets a new entry
     if ent is None or ent[0] is not _REGISTRY.get(method):
         ent = _fast_entry(robot, method)
         if ent is None:

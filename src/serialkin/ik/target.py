@@ -62,6 +62,8 @@ DEFAULT_WEIGHTS = {kind: _frozen(w) for kind, w in KIND_WEIGHTS.items()}
 class RobotArrays:
     """Contiguous per-robot arrays the solvers use (cached; robots are immutable).
 
+    All read-only (the kernels only read them, and take read-only arrays: issue 27).
+
     Attributes:
         lo, hi: (n,) joint limits (±inf where unlimited).
         slo, shi: (n,) finite sampling box for random starts (:meth:`Robot.sampling_limits`).
@@ -89,9 +91,9 @@ def robot_arrays(robot: Robot) -> RobotArrays:
         box = np.ascontiguousarray(
             np.stack([robot.qlim[:, 0], robot.qlim[:, 1], samp[:, 0], samp[:, 1],
                       revolute.astype(np.float64)]), dtype=np.float64)
+        box.setflags(write=False)  # before the row views are taken: they are read-only too
         a = RobotArrays(lo=box[0], hi=box[1], slo=box[2], shi=box[3], revolute=revolute, box=box)
-        for x in (a.revolute, a.box):
-            x.setflags(write=False)
+        a.revolute.setflags(write=False)
         _ARRAYS.set(robot, a)
     return a
 

@@ -154,13 +154,25 @@ def spd_solve_into(A, b, x, m):
 
 
 @njit(cache=True)
-def gram_into(J, M):
+def gram_into(J, M, columns=False):
     """``M = J Jᵀ`` (m, m) of J (m, n); returns ``max_i M_ii`` (0 for m = 0).
 
-    Called with the view ``J.T`` it gives ``Jᵀ J`` (n, n) (:func:`dls_factor_into`).
+    With ``columns``, ``Jᵀ J`` (n, n) into ``M[:n, :n]`` (:func:`dls_factor_into`), by the
+    same sums as ``J Jᵀ`` of the transposed view ``J.T`` (which would compile this
+    kernel a second time, for a Fortran-ordered array).
     """
     m, n = J.shape
     d = 0.0
+    if columns:
+        for i in range(n):
+            for k in range(i, n):
+                s = 0.0
+                for j in range(m):
+                    s += J[j, i] * J[j, k]
+                M[i, k] = s
+                M[k, i] = s
+            d = max(d, M[i, i])
+        return d
     for i in range(m):
         for k in range(i, m):
             s = 0.0
@@ -186,7 +198,7 @@ def dls_factor_into(J, lam2, floor, M, columns=False):
     k = J.shape[1] if columns else J.shape[0]
     l2 = lam2
     for _ in range(2):
-        d = gram_into(J.T, M) if columns else gram_into(J, M)
+        d = gram_into(J, M, columns)
         for i in range(k):
             M[i, i] += l2
         if chol_factor_into(M, k):

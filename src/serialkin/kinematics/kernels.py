@@ -35,7 +35,7 @@ import math
 
 import numpy as np
 
-from .._jit import fma, njit
+from .._jit import as_readonly, fma, njit
 
 REVOLUTE = 0
 PRISMATIC = 1
@@ -116,9 +116,12 @@ def _sincos_banks(q, off, SC, i0, i1):
 def _chain_walk(q, F, kind, off, J, record, SC):
     """Walk the chain holding the pose's 12 entries in registers; return them as a tuple.
 
-    ``F`` (n+1, 4, 4) fixed transforms (only their top three rows are read), ``kind`` and
-    ``off`` (n,) each joint's type and offset (``meta[:, 3]``, ``meta[:, 4]``, or the same
-    entries of the packed chain). ``SC`` is 2-D scratch (the caller's output array,
+    ``q`` (n,) is a writeable 1-D array typed of any layout (numba's 'A'): the single-call
+    entries take any 1-D q, and :func:`fk_into`, :func:`jacobian_into` pass ``q[::1]``,
+    the same type, so that the walk compiles once (issue 27). ``F`` (n+1, 4, 4) fixed
+    transforms (only their top three rows are read), ``kind`` and ``off`` (n,) each
+    joint's type and offset (``meta[:, 3]``, ``meta[:, 4]``, or the same entries of the
+    packed chain). ``SC`` is 2-D scratch (the caller's output array,
     overwritten later; at least two rows) for the joints' sin/cos, computed
     (:func:`_sincos_banks`) for as many joints at a time as it holds: a (4, 4) pose holds
     8, so a longer chain refills it on the way. With ``record``, each joint's world axis
@@ -181,7 +184,7 @@ def _store_pose(t, T):
 @njit(cache=True, hot=True, fastmath=False)
 def fk_into(q, F, meta, T):
     """End-effector pose (eq 11) into ``T`` (4, 4) for one configuration ``q`` (n,)."""
-    _store_pose(_chain_walk(q, F, meta[:, 3], meta[:, 4], T, False, T), T)
+    _store_pose(_chain_walk(q[::1], F, meta[:, 3], meta[:, 4], T, False, T), T)
 
 
 # --- single calls from Python: the packed chain -------------------------------------------
@@ -488,7 +491,7 @@ def jacobian_into(q, F, meta, J, T):
     (4, 4). Joint *i*'s axis and origin are those of its frame just before its motion
     (for standard DH, frame i-1: the chapter's z_{i-1}, p_{i-1}).
     """
-    t = _chain_walk(q, F, meta[:, 3], meta[:, 4], J, True, J)
+    t = _chain_walk(q[::1], F, meta[:, 3], meta[:, 4], J, True, J)
     _store_pose(t, T)
     _finish_columns(J, meta[:, 3], meta.shape[0], t[3], t[7], t[11])
 
@@ -701,7 +704,7 @@ def jacobian_dot_one(q, P, qd, ee, Jd):
         if not (math.isfinite(q[i]) and math.isfinite(qd[i])):
             return False
     J, R = _tool_jacobian(q, P)
-    jacobian_dot_into(J, qd, R, ee, Jd)
+    jacobian_dot_into(J, as_readonly(qd), R, ee, Jd)  # qd only read: as the batch passes it
     return True
 
 
@@ -714,6 +717,10 @@ def hessian_range(J, R, ee, H, start, stop):
 
 @njit(cache=True, hot=True, nogil=True)
 def jacobian_dot_range(J, Qd, R, ee, Jd, start, stop):
-    """:func:`jacobian_dot_into` for items ``start..stop-1`` of J (N, 6, n), Qd (N, n)."""
+    """:func:`jacobian_dot_into` for items ``start..stop-1`` of J (N, 6, n), Qd (N, n).
+
+    ``Qd`` read-only; each row is passed as ``Qd[k][::1]`` (typed of any layout), the
+    type :func:`jacobian_dot_one` passes, so that jacobian_dot_into compiles once.
+    """
     for k in range(start, stop):
-        jacobian_dot_into(J[k], Qd[k], R[k], ee, Jd[k])
+        jacobian_dot_into(J[k], Qd[k][::1], R[k], ee, Jd[k])

@@ -1,13 +1,18 @@
-"""Robot models: joints, DH tables, the compiled chain, link geometry and the file formats.
+"""Robot models: joints, DH tables, the compiled chain and link geometry.
 
-* :class:`Robot` (``robot.py``), built from :class:`DHLink` tables (``dh.py``), general
-  :class:`Joint` s (``joint.py``), URDF (``urdf.py``), MJCF (``mjcf.py``), xacro
-  (``xacro.py``) or robot files (``robotfile.py``);
+* :class:`Robot` (``robot.py``), built from :class:`DHLink` tables (``dh.py``) or general
+  :class:`Joint` s (``joint.py``); the file formats (URDF, MJCF, xacro, robot files,
+  meshes) are read and written by :mod:`serialkin.formats`, above this layer;
 * shapes (``geometry.py``: link visual/collision geometry, collision scenes and
-  obstacles share them) and triangle meshes (``mesh.py``; loading
-  needs the ``mesh`` extra);
+  obstacles share them) and the robot's capsule model (``collision_model.py``);
 * the built-in zoo is :mod:`serialkin.models`.
+
+The names this package re-exported from its former format modules
+(``load_robot_file``, ``load_mesh``, ...) still work for one release, with a
+DeprecationWarning: import them from :mod:`serialkin.formats`.
 """
+
+from typing import Any
 
 from serialkin.model.dh import DHLink
 from serialkin.model.geometry import (
@@ -21,14 +26,7 @@ from serialkin.model.geometry import (
     Sphere,
 )
 from serialkin.model.joint import Joint
-from serialkin.model.mesh import TriangleMesh, decimate, link_meshes, load_mesh, welded
 from serialkin.model.robot import Robot
-from serialkin.model.robotfile import (
-    load_collision_file,
-    load_robot_file,
-    save_collision_file,
-    save_robot_file,
-)
 
 __all__ = [
     "Box",
@@ -42,13 +40,33 @@ __all__ = [
     "Robot",
     "Shape",
     "Sphere",
-    "TriangleMesh",
-    "decimate",
-    "link_meshes",
-    "load_collision_file",
-    "load_mesh",
-    "load_robot_file",
-    "save_collision_file",
-    "save_robot_file",
-    "welded",
 ]
+
+#: Names re-exported here before the file formats left the model layer: their module in
+#: serialkin.formats (deprecated here; removed in the next release).
+_MOVED = {
+    "TriangleMesh": "mesh",
+    "decimate": "mesh",
+    "link_meshes": "mesh",
+    "load_mesh": "mesh",
+    "welded": "mesh",
+    "load_collision_file": "robotfile",
+    "load_robot_file": "robotfile",
+    "save_collision_file": "robotfile",
+    "save_robot_file": "robotfile",
+}
+
+
+def __getattr__(name: str) -> Any:
+    """The deprecated names of :data:`_MOVED`, from :mod:`serialkin.formats` with a warning."""
+    module = _MOVED.get(name)
+    if module is None:
+        raise AttributeError(f"module 'serialkin.model' has no attribute {name!r}")
+    import warnings
+
+    from serialkin import formats  # deprecated alias: an upward import, removed with it
+
+    warnings.warn(f"serialkin.model.{name} is deprecated: import {name} from "
+                  f"serialkin.formats (module serialkin.formats.{module})",
+                  DeprecationWarning, stacklevel=2)
+    return getattr(formats, name)

@@ -40,6 +40,13 @@ class Chain:
         """Number of joints."""
         return self.meta.shape[0]
 
+    def __setstate__(self, state: dict[str, np.ndarray]) -> None:
+        """Unpickling keeps the arrays read-only (numpy's pickles restore them writeable)."""
+        self.__dict__.update(state)
+        for a in state.values():
+            if isinstance(a, np.ndarray):
+                a.setflags(write=False)
+
 
 def z_alignment(axis: np.ndarray) -> np.ndarray:
     """A rotation ``R`` (3, 3) with ``R · e_z = axis`` (unit axis), the identity for +z.

@@ -13,7 +13,6 @@ poses are 4x4 homogeneous transforms of the end-effector (tool) in the world fra
 from __future__ import annotations
 
 import dataclasses
-import functools
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -30,6 +29,7 @@ from serialkin._checks import (
     readonly,
     short_repr,
 )
+from serialkin._memo import PerObject
 from serialkin.errors import InputError, InputTypeError, RobotDefinitionError
 from serialkin.kinematics import kernels as K
 from serialkin.kinematics import parallel
@@ -41,6 +41,7 @@ from serialkin.model.limits import DEFAULT_HALF_RANGE, inside_mask, limits_table
 from serialkin.model.tasks import TASKS, task_rows
 
 if TYPE_CHECKING:
+    from serialkin.ik.analytic import AllSolutions
     from serialkin.ik.result import IKResult
     from serialkin.model.geometry import LinkGeometry
 
@@ -102,12 +103,16 @@ _PROVIDED: dict[str, Any] = {}
 def provide(name: str, function: Any) -> None:
     """Register ``function`` as what :class:`Robot`'s method ``name`` calls.
 
-    ``Robot.ik``, ``ik_all`` and ``fit_collision`` are conveniences over functions of the
-    layers above ``model`` (``ik``, ``collision``). The model layer imports nothing above
+    ``Robot.ik``, ``ik_all``, ``fit_collision``, ``from_urdf``, ``from_mjcf``,
+    ``from_xacro`` and ``to_urdf`` are conveniences over functions of the layers above
+    ``model`` (``ik``, ``collision``, ``formats``). The model layer imports nothing above
     it: each of those packages registers its functions here when it is imported
-    (``serialkin/ik/__init__.py``, ``serialkin/collision/__init__.py``), and importing any
-    ``serialkin`` module imports them all. Names: ``"ik"`` (:func:`serialkin.ik.solve`),
-    ``"ik_fast"`` (its fast path), ``"ik_all"``, ``"fit_collision"``.
+    (``serialkin/ik/__init__.py``, ``serialkin/collision/__init__.py``,
+    ``serialkin/formats/__init__.py``), and importing any ``serialkin`` module imports
+    them all. Names: ``"ik"`` (:func:`serialkin.ik.solve`), ``"ik_fast"`` (its fast
+    path), ``"ik_all"``, ``"fit_collision"``, ``"from_urdf"``, ``"from_mjcf"``,
+    ``"from_xacro"``, ``"to_urdf"`` (the readers and the writer of
+    :mod:`serialkin.formats`).
     """
     global _SOLVE, _FAST_IK
     _PROVIDED[name] = function
@@ -124,6 +129,17 @@ def _provided(name: str) -> Any:
         raise RuntimeError(f"Robot.{name.removesuffix('_fast')} is provided by a serialkin "
                            "package not imported yet: import serialkin first")
     return function
+
+
+def _immutable(name: str, action: str) -> str:
+    """The message of an attempt to change a built robot's attribute ``name``."""
+    return (f"Robot is immutable: cannot {action} {name!r}; make a changed copy instead "
+            "(with_tool, with_base, with_limits, with_collision, or Robot(...) with the "
+            "changed parts)")
+
+
+#: Robot.is_planar per robot (computed once, kept beside the robot, not written onto it).
+_PLANAR: PerObject[bool] = PerObject()
 
 
 def _out_array(out: object, shape: tuple[int, ...]) -> np.ndarray:
@@ -227,24 +243,33 @@ class Robot:
         self._frozen = True
 
     def __setattr__(self, name: str, value: Any) -> None:
-        """A built robot is immutable: setting an attribute warns (and will raise).
+        """A built robot is immutable: setting an attribute raises AttributeError.
 
         Everything is given to the constructor (``link_names``, ``geometry``,
         ``collision`` included) or changed by a copy (:meth:`with_tool`,
-        :meth:`with_base`, :meth:`with_limits`, :meth:`with_collision`). For one release
-        an assignment still works, with a DeprecationWarning.
+        :meth:`with_base`, :meth:`with_limits`, :meth:`with_collision`).
         """
         if getattr(self, "_frozen", False):
-            import warnings
-
-            warnings.warn(f"Robot is immutable: setting {name!r} is deprecated and will raise "
-                          "in the next release; pass it to Robot(...) or use a with_* copy",
-                          DeprecationWarning, stacklevel=2)
+            raise AttributeError(_immutable(name, "set"))
         object.__setattr__(self, name, value)
 
+    def __delattr__(self, name: str) -> None:
+        """A built robot is immutable: deleting an attribute raises AttributeError."""
+        if getattr(self, "_frozen", False):
+            raise AttributeError(_immutable(name, "delete"))
+        object.__delattr__(self, name)
+
     def __setstate__(self, state: dict[str, Any]) -> None:
-        """Unpickling sets the state without the immutability warning."""
+        """Unpickling restores a built (immutable) robot, its arrays read-only again.
+
+        numpy's pickles restore arrays writeable; read-only ones keep the kernels compiled
+        for one argument type (the chain's arrays are restored by ``Chain``).
+        """
         self.__dict__.update(state)
+        for key in ("base", "tool", "qlim", "revolute"):
+            a = state.get(key)
+            if isinstance(a, np.ndarray):
+                a.setflags(write=False)
 
     # ------------------------------------------------------------------ constructors
     @classmethod
@@ -297,31 +322,28 @@ class Robot:
     def from_urdf(cls, path_or_string: str, base_link: str | None = None,
                   tip_link: str | None = None, *, package_map: Any = None,
                   search_path: Any = (), resolve_meshes: bool = False) -> Robot:
-        """Build a robot from a URDF file or string (see :mod:`serialkin.model.urdf`).
+        """Build a robot from a URDF file or string (see :mod:`serialkin.formats.urdf`).
 
         ``package_map``, ``search_path`` and ``resolve_meshes`` locate the mesh files of
-        the links' geometry, as in :func:`~serialkin.model.urdf.robot_from_urdf`.
+        the links' geometry, as in :func:`~serialkin.formats.urdf.robot_from_urdf`.
         """
-        from serialkin.model.urdf import robot_from_urdf
-
-        return robot_from_urdf(path_or_string, base_link=base_link, tip_link=tip_link,
-                               package_map=package_map, search_path=search_path,
-                               resolve_meshes=resolve_meshes)
+        return _provided("from_urdf")(
+            path_or_string, base_link=base_link, tip_link=tip_link, package_map=package_map,
+            search_path=search_path, resolve_meshes=resolve_meshes)
 
     @classmethod
     def from_mjcf(cls, path_or_string: str, base_body: str | None = None,
                   end_body: str | None = None, *, tool_site: str | None = None,
                   resolve_meshes: bool = False) -> Robot:
-        """Build a robot from a MuJoCo MJCF file or string (see :mod:`serialkin.model.mjcf`).
+        """Build a robot from a MuJoCo MJCF file or string (see :mod:`serialkin.formats.mjcf`).
 
         The chain runs from ``base_body`` (default: the world) to ``end_body`` (default:
         the end of the unbranched chain); ``tool_site`` names a site used as the tool.
         ``q`` is MuJoCo's ``qpos`` of the chain's hinge and slide joints.
         """
-        from serialkin.model.mjcf import robot_from_mjcf
-
-        return robot_from_mjcf(path_or_string, base_body=base_body, end_body=end_body,
-                               tool_site=tool_site, resolve_meshes=resolve_meshes)
+        return _provided("from_mjcf")(
+            path_or_string, base_body=base_body, end_body=end_body, tool_site=tool_site,
+            resolve_meshes=resolve_meshes)
 
     @classmethod
     def from_xacro(cls, path: str, base_link: str | None = None, tip_link: str | None = None,
@@ -331,19 +353,15 @@ class Robot:
 
         The file is expanded by the ROS ``xacro`` processor with ``mappings`` as its
         ``<xacro:arg>`` values, ``$(find pkg)`` resolved through ``package_map`` and
-        ``search_path``, then read as URDF (see :mod:`serialkin.model.xacro`).
+        ``search_path``, then read as URDF (see :mod:`serialkin.formats.xacro`).
         """
-        from serialkin.model.xacro import robot_from_xacro
-
-        return robot_from_xacro(path, base_link=base_link, tip_link=tip_link,
-                                mappings=mappings, package_map=package_map,
-                                search_path=search_path, resolve_meshes=resolve_meshes)
+        return _provided("from_xacro")(
+            path, base_link=base_link, tip_link=tip_link, mappings=mappings,
+            package_map=package_map, search_path=search_path, resolve_meshes=resolve_meshes)
 
     def to_urdf(self) -> str:
-        """Return the robot's kinematics as a URDF string (see :mod:`serialkin.model.urdf`)."""
-        from serialkin.model.urdf import robot_to_urdf
-
-        return robot_to_urdf(self)
+        """Return the robot's kinematics as a URDF string (see :mod:`serialkin.formats.urdf`)."""
+        return _provided("to_urdf")(self)
 
     def _copy(self, **changes: Any) -> Robot:
         """A new robot with some constructor arguments changed (the others kept)."""
@@ -446,14 +464,18 @@ class Robot:
     def _nonfinite(self, q: np.ndarray, name: str = "q") -> InputError:
         return InputError(f"{name} must be finite, got {short_repr(q.tolist())}")
 
-    @functools.cached_property
+    @property
     def is_planar(self) -> bool:
         """True when the tool moves in the world xy plane only (rows vz, wx, wy of J vanish).
 
-        Computed once per robot (robots are immutable); every IK call reads it.
+        Computed once per robot (robots are immutable) and kept beside it, not on it
+        (:class:`serialkin._memo.PerObject`); every IK call reads it.
         """
-        J = self.jacobian(self.random_q(3, seed=0))
-        return bool(np.allclose(J[:, [2, 3, 4]], 0.0, atol=1e-9))
+        planar = _PLANAR.get(self)
+        if planar is None:
+            J = self.jacobian(self.random_q(3, seed=0))
+            planar = _PLANAR.set(self, bool(np.allclose(J[:, [2, 3, 4]], 0.0, atol=1e-9)))
+        return planar
 
     # ------------------------------------------------------------------ kinematics
     def fk(self, q: object, *, out: np.ndarray | None = None) -> np.ndarray:
@@ -494,9 +516,9 @@ class Robot:
         check_allocation("the FK batch", shape, 8, setting="the batch size")
         T = np.empty(shape) if out is None else _out_array(out, shape)
         if a.ndim == 1:
-            K.fk_into(np.ascontiguousarray(a), self._F, self._meta, T)
+            K.fk_into(_kernel_q(a), self._F, self._meta, T)
             return T
-        flat = np.ascontiguousarray(a.reshape(-1, self.n))
+        flat = _kernel_q(a.reshape(-1, self.n))
         bad = np.zeros(1, dtype=np.int64)
         parallel.run(K.fk_checked_range, (flat, self._F, self._meta, T.reshape(-1, 4, 4), bad),
                      flat.shape[0], grain=max(256, 12288 // self.n))
@@ -514,7 +536,7 @@ class Robot:
             (..., n+1, 4, 4). For a standard-DH robot these are the DH frames 0..n.
         """
         a = self.check_q(q, finite=False)  # the kernel tests finiteness as it reads
-        flat = np.ascontiguousarray(a.reshape(-1, self.n))
+        flat = _kernel_q(a.reshape(-1, self.n))
         check_allocation("the link frames", (flat.shape[0], self.n + 1, 4, 4), 8,
                          setting="the batch size")
         out = np.empty((flat.shape[0], self.n + 1, 4, 4))
@@ -590,7 +612,7 @@ class Robot:
         """
         check_choice(frame, "frame", ("base", "ee"))
         a = self.check_q(q, finite=False)  # the kernels test finiteness as they read
-        flat = np.ascontiguousarray(a.reshape(-1, self.n))
+        flat = _kernel_q(a.reshape(-1, self.n))
         N = flat.shape[0]
         check_allocation("the Jacobian batch", (N, 6 * self.n + 16), 8, setting="the batch size")
         grain = max(16, 3072 // self.n)
@@ -735,7 +757,7 @@ class Robot:
         if a.ndim != 1:
             raise InputError(f"q must have shape ({self.n},), got {a.shape}")
         P, W = np.empty((self.n, 3)), np.empty((self.n, 3))
-        K.joint_axes_into(np.ascontiguousarray(a), self._F, self._meta, P, W)
+        K.joint_axes_into(_kernel_q(a), self._F, self._meta, P, W)
         return P, W
 
     def jacobian_planar(self, q: object, orientation: bool = False) -> np.ndarray:
@@ -850,20 +872,57 @@ class Robot:
                 return res
         return (_SOLVE or _provided("ik"))(self, target, method, q0=q0, seed=seed, **options)
 
-    def ik_all(self, target: object, **options: Any) -> Any:
+    def ik_all(self, target: object, **options: Any) -> AllSolutions:
         """Every IK solution inside the limits (see :func:`serialkin.ik.analytic.ik_all`).
 
-        One (4, 4) target gives a (k, n) array; a batch (..., 4, 4) an ``AllSolutions``
-        (padded rows and a count per target). Options: ``tol``, ``all_turns``, ``free``,
-        ``near_tol``, ``grid``, ``reference``, ``weights``, ``norm``, ``report``.
+        Always an :class:`~serialkin.ik.analytic.AllSolutions`. For one (4, 4) target it
+        is also the (k, n) array of its rows (``len``, indexing, iteration and
+        ``np.asarray`` give them); for a batch (..., 4, 4) it holds padded rows
+        (..., k_max, n) and a count per target. Options: ``tol``, ``all_turns``,
+        ``free``, ``near_tol``, ``grid``, ``reference``, ``weights``, ``norm``, ``report``.
         """
         return _provided("ik_all")(self, target, **options)
+
+    def arm_angle(self, q: object, reference: object = None) -> np.ndarray:
+        """The arm angle ψ [rad] of configurations (..., 7) of a 7R S-R-S arm (iiwa-like).
+
+        See :func:`serialkin.ik.analytic.arm_angle.arm_angle` (the conventional SEW angle
+        about the shoulder-wrist line, measured from ``reference``, default base z).
+        """
+        return _provided("arm_angle")(self, q, reference)
+
+    def ik_arm_angle(self, target: object, psi: float, reference: object = None,
+                     **options: Any) -> Any:
+        """Every configuration of a 7R S-R-S arm reaching ``target`` at arm angle ψ [rad].
+
+        Closed form, up to 8 rows with their branches
+        (:func:`serialkin.ik.analytic.arm_angle.ik_arm_angle`).
+        """
+        return _provided("ik_arm_angle")(self, target, psi, reference, **options)
+
+    def arm_angle_intervals(self, target: object, reference: object = None,
+                            **options: Any) -> Any:
+        """The arm angles [rad] at which each branch reaches ``target`` inside the limits.
+
+        See :func:`serialkin.ik.analytic.arm_angle.arm_angle_intervals`.
+        """
+        return _provided("arm_angle_intervals")(self, target, reference, **options)
 
     # ------------------------------------------------------------------ display
     def __repr__(self) -> str:
         types = "".join(self.joint_types)
         conv = f", {self.convention} DH" if self.convention else ""
         return f"Robot({self.name!r}, n={self.n}, joints={types}{conv})"
+
+
+def _kernel_q(a: np.ndarray) -> np.ndarray:
+    """Joint values as the batch kernels take them: C-ordered and writeable (one signature).
+
+    A read-only array (a path's joint values, a frozen result) is copied, as is one that
+    is not C-contiguous; others pass as they are (issue 27: a kernel compiled once).
+    """
+    c = np.ascontiguousarray(a)
+    return c if c.flags.writeable else c.copy()
 
 
 def robot_scale(robot: Robot) -> float:

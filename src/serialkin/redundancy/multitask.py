@@ -43,6 +43,7 @@ from serialkin._checks import (
     check_int,
     check_positive,
     check_transform,
+    readonly,
     short_repr,
 )
 from serialkin.errors import InputError
@@ -52,7 +53,7 @@ from serialkin.model.geometry import Capsule, Cylinder, Sphere
 from serialkin.model.limits import check_interval
 from serialkin.redundancy.objectives import task_rows
 from serialkin.redundancy.obstacles import (
-    _Geometry,
+    ObstacleGeometry,
     accumulate_obstacle_task,
     check_obstacles,
     encode_obstacles,
@@ -430,7 +431,8 @@ class MultiTaskResolver:
         if q.ndim != 1:
             raise InputError(f"q0 must have shape ({robot.n},), got {q.shape}")
         st = state if state is not None else self.prepare(robot)
-        return st.solve(np.ascontiguousarray(T, dtype=float),
+        # the target read-only, as tracking passes its path's: the kernels compile once
+        return st.solve(readonly(np.ascontiguousarray(T, dtype=float)),
                         np.array(q, dtype=float, order="C"))
 
 
@@ -444,7 +446,7 @@ class _State:
         n = robot.n
         self.lim = np.ascontiguousarray(res._limits(robot), dtype=float)
         use_limits = res.joint_limit_weight > 0 and bool(np.isfinite(self.lim).any())
-        self.geom = _Geometry(robot, res.obstacles, res.link_radius)
+        self.geom = ObstacleGeometry(robot, res.obstacles, res.link_radius)
         self.infl = np.array([o.influence for o in res.obstacles], dtype=float)
         cfg = np.zeros(17)
         cfg[[_W, _DAMP, _SING, _W0, _WL, _BUF, _WC, _KREP, _GAIN, _MAXX, _MAXQ, _TOL, _ITER,

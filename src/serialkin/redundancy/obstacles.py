@@ -56,6 +56,7 @@ from .._jit import njit_exact
 __all__ = [
     "ClosestPair",
     "Obstacle",
+    "ObstacleGeometry",
     "check_obstacles",
     "clearances",
     "closest_pairs",
@@ -222,7 +223,8 @@ def segment_obstacle_kernel(P0, P1, obs, link_radius, T, SC, B, D, C):
                     q1[r] = P1[i, r]
                     pa[r] = obs[j, 1 + r]
                     pb[r] = obs[j, 4 + r]
-                s, u = closest_segment_segment(q0, q1, pa, pb)
+                s, u = closest_segment_segment((q0[0], q0[1], q0[2]), (q1[0], q1[1], q1[2]),
+                                               (pa[0], pa[1], pa[2]), (pb[0], pb[1], pb[2]))
                 t = s
                 for r in range(3):
                     SC[i, j, r] = q0[r] + s * (q1[r] - q0[r])
@@ -247,7 +249,7 @@ def robot_segments(robot, q: object) -> tuple[np.ndarray, np.ndarray, np.ndarray
     qv = robot.check_q(q)
     if qv.ndim != 1:
         raise InputError(f"q must have shape ({robot.n},), got {qv.shape}")
-    g = _Geometry(robot, (), 0.0)
+    g = ObstacleGeometry(robot, (), 0.0)
     g.update(np.ascontiguousarray(qv))
     return g.P0.copy(), g.P1.copy(), g.link.copy(), g.frames.copy()
 
@@ -286,8 +288,23 @@ class ClosestPair:
         return None if self.gradient is None else -self.gradient
 
 
-class _Geometry:
-    """Pre-allocated buffers for link-obstacle distances of one robot and obstacle set."""
+class ObstacleGeometry:
+    """Link-obstacle distances of one robot and obstacle set, in pre-allocated buffers.
+
+    Built once per robot, obstacle set and link radius (by the queries of this module,
+    the obstacle task of :mod:`serialkin.redundancy.multitask`, the tracker and the
+    obstacle constraint of :mod:`serialkin.diffik`); each :meth:`update` recomputes every
+    buffer at a new configuration without allocating.
+
+    Attributes (after :meth:`update`; ``s`` segments, ``k`` obstacles):
+        frames: (n+1, 4, 4) link frames.
+        P0, P1: (s, 3) segment ends [m]; ``link`` (s,) the link frame each moves with.
+        T: (s, k) closest-point parameter along each segment (0..1).
+        SC, B: (s, k, 3) closest points on the segment and on the obstacle [m].
+        D: (s, k) distance between them [m]; ``C`` (s, k) clearance (``D`` minus the
+            link radius) [m].
+        enc: the obstacles encoded for the kernels (:func:`encode_obstacles`).
+    """
 
     def __init__(self, robot, obstacles: Sequence[Obstacle], link_radius: float) -> None:
         self.robot = robot
@@ -314,6 +331,7 @@ class _Geometry:
         self.Tee = np.empty((4, 4))
 
     def update(self, q: np.ndarray) -> None:
+        """Recompute frames, segments and every closest pair at ``q`` (n,), contiguous."""
         r = self.robot
         c = r.chain
         update_geometry_into(q, c.F, c.L, c.meta, self.has_tool, self.enc, self.link_radius,
@@ -459,7 +477,7 @@ def clearances(robot, q: object, obstacles: Sequence[Obstacle], *,
     if qv.ndim != 1:
         raise InputError(f"q must have shape ({robot.n},), got {qv.shape}")
     check_positive(link_radius, "link_radius", allow_zero=True)
-    g = _Geometry(robot, obstacles, link_radius)
+    g = ObstacleGeometry(robot, obstacles, link_radius)
     g.update(np.ascontiguousarray(qv))
     return g.C.copy()
 
@@ -482,7 +500,7 @@ def closest_pairs(robot, q: object, obstacles: Sequence[Obstacle], *,
     if qv.ndim != 1:
         raise InputError(f"q must have shape ({robot.n},), got {qv.shape}")
     check_positive(link_radius, "link_radius", allow_zero=True)
-    g = _Geometry(robot, obstacles, link_radius)
+    g = ObstacleGeometry(robot, obstacles, link_radius)
     g.update(qv)
     out = []
     for i in range(g.C.shape[0]):

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 
-from .._jit import njit
+from .._jit import as_readonly, njit
 
 #: Below this rotation angle [rad] θ/sin θ is replaced by its series 1 + θ²/6 + 7θ⁴/360.
 SMALL_ANGLE = 1e-3
@@ -105,7 +105,10 @@ def so3_log_into(R, w):
 
 @njit(cache=True)
 def _rotation_error_parts(A, B):
-    """log(A · Bᵀ)^∨ for the upper-left 3x3 blocks of A and B (any 2-D arrays ≥ 3x3)."""
+    """log(A · Bᵀ)^∨ for the upper-left 3x3 blocks of A and B (any 2-D arrays ≥ 3x3).
+
+    Both read-only (C-contiguous float64): the one type every caller passes.
+    """
     m00 = A[0, 0] * B[0, 0] + A[0, 1] * B[0, 1] + A[0, 2] * B[0, 2]
     m01 = A[0, 0] * B[1, 0] + A[0, 1] * B[1, 1] + A[0, 2] * B[1, 2]
     m02 = A[0, 0] * B[2, 0] + A[0, 1] * B[2, 1] + A[0, 2] * B[2, 2]
@@ -123,7 +126,7 @@ def rotation_error_into(R, R_target, w):
     """Orientation error ``w = log(R_target · Rᵀ)^∨`` (3,) [rad], world frame.
 
     ``R`` and ``R_target`` may be (3, 3) rotations or (4, 4) transforms (only their
-    rotation blocks are read). No temporary arrays are allocated.
+    rotation blocks are read), both read-only. No temporary arrays are allocated.
     """
     wx, wy, wz = _rotation_error_parts(R_target, R)
     w[0] = wx
@@ -143,11 +146,15 @@ def pose_error_into(T, T_target, e):
     For a small displacement the error equals the small twist that moves ``T`` onto
     ``T_target`` (position part: the translation; rotation part: ``R_target = exp(ω) R``),
     so a Newton / Levenberg-Marquardt step solves ``J dq = e``. Allocation free.
+
+    Argument types (one compiled specialization): ``T`` the writeable array the caller
+    computed the pose into, ``T_target`` read-only (a caller holding a target in a
+    writeable array passes ``as_readonly(T_target)``), ``e`` writeable.
     """
     e[0] = T_target[0, 3] - T[0, 3]
     e[1] = T_target[1, 3] - T[1, 3]
     e[2] = T_target[2, 3] - T[2, 3]
-    wx, wy, wz = _rotation_error_parts(T_target, T)
+    wx, wy, wz = _rotation_error_parts(T_target, as_readonly(T))
     e[3] = wx
     e[4] = wy
     e[5] = wz
@@ -162,9 +169,22 @@ def so3_log_batch(R, W):
 
 @njit(cache=True)
 def pose_error_batch(T, T_target, E):
-    """Pose errors ``E`` (N, 6) between ``T`` (N, 4, 4) and ``T_target`` (N, 4, 4)."""
+    """Pose errors ``E`` (N, 6) between ``T`` (N, 4, 4) and ``T_target`` (N, 4, 4).
+
+    :func:`pose_error_into`'s formula, written out: here both poses are read-only input
+    (:func:`serialkin.spatial.pose.pose_error`), where pose_error_into reads a pose its
+    caller computed into a writeable array.
+    """
     for k in range(T.shape[0]):
-        pose_error_into(T[k], T_target[k], E[k])
+        A = T[k]
+        B = T_target[k]
+        E[k, 0] = B[0, 3] - A[0, 3]
+        E[k, 1] = B[1, 3] - A[1, 3]
+        E[k, 2] = B[2, 3] - A[2, 3]
+        wx, wy, wz = _rotation_error_parts(B, A)
+        E[k, 3] = wx
+        E[k, 4] = wy
+        E[k, 5] = wz
 
 
 @njit(cache=True)

@@ -19,11 +19,14 @@ def closest_segment_segment(p0, p1, a, b):
     (C. Ericson, *Real-Time Collision Detection*, 2005, §5.1.9). Parallel segments
     (``aa·ee − bb² ≈ 0``) take s = 0; zero-length segments are points.
 
+    Points are ``(x, y, z)`` tuples: every caller passes its points as tuples (registers,
+    no array views), so that the kernel compiles once.
+
     Args:
-        p0: (3,) first end of the first segment [m].
-        p1: (3,) second end of the first segment [m].
-        a: (3,) first end of the second segment [m].
-        b: (3,) second end of the second segment [m].
+        p0: first end of the first segment [m].
+        p1: second end of the first segment [m].
+        a: first end of the second segment [m].
+        b: second end of the second segment [m].
 
     Returns:
         (s, t), each in [0, 1].

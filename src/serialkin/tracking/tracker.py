@@ -50,7 +50,7 @@ from serialkin.model.limits import project as interval_project
 from serialkin.model.tasks import get_task
 from serialkin.redundancy.multitask import MultiTaskResolver
 from serialkin.redundancy.objectives import task_rows
-from serialkin.redundancy.obstacles import _Geometry, check_obstacles, encode_obstacles
+from serialkin.redundancy.obstacles import ObstacleGeometry, check_obstacles, encode_obstacles
 from serialkin.spatial.kernels import pose_error_into
 from serialkin.tracking.path import Path
 from serialkin.tracking.trajectory import JointJump, PathFailure, Trajectory
@@ -437,7 +437,7 @@ def _assemble(robot, path: Path, Q, ITER, ERR, TIMES, obstacles, link_radius, ac
     for k in range(count):  # serial: the parallel batch kernel costs ms of thread start-up
         K.fk_into(np.ascontiguousarray(Q[k]), robot.chain.F, robot.chain.meta, poses[k])
     if obstacles and count:
-        g = _Geometry(robot, obstacles, link_radius)
+        g = ObstacleGeometry(robot, obstacles, link_radius)
         clear = np.empty((count, len(obstacles)))
         for k in range(count):
             g.update(np.ascontiguousarray(Q[k]))

@@ -24,8 +24,8 @@ and matrix), ``linkOrigins()``, ``fk(q)``, ``setFrame(k)``, ``play()``, ``pause(
 is drawn with its visual shapes, each fixed to its chain frame ``f`` at its origin, so a
 vertex ``p`` of a shape is drawn at ``fk_all(q)[f] · origin · p``. Boxes, cylinders,
 spheres and capsules become three.js geometries; mesh files are loaded with
-:func:`serialkin.model.mesh.load_mesh` (the ``mesh`` extra), decimated
-(:func:`serialkin.model.mesh.decimate`) so that all meshes together hold at most
+:func:`serialkin.formats.mesh.load_mesh` (the ``mesh`` extra), decimated
+(:func:`serialkin.formats.mesh.decimate`) so that all meshes together hold at most
 ``ViewerOptions.mesh_budget`` triangles (each mesh gets a share proportional to its own
 triangle count; a mesh used by several links counts once), and embedded compactly: vertex
 positions quantised to 16 bits per coordinate over the mesh's bounding box (error at most
@@ -217,7 +217,7 @@ def _visual_data(robot: Robot, meshes: bool, mesh_budget: int,
     """The visual shapes (posed in their chain frames) and the encoded meshes they use.
 
     Mesh files are loaded once per (file, scale); ``meshes=False`` leaves mesh shapes out
-    (primitives stay). Raises what :func:`serialkin.model.mesh.load_mesh` raises, with the
+    (primitives stay). Raises what :func:`serialkin.formats.mesh.load_mesh` raises, with the
     link named.
     """
     from serialkin.model.geometry import Mesh
@@ -250,7 +250,7 @@ def _visual_data(robot: Robot, meshes: bool, mesh_budget: int,
             shapes.append(entry)
     encoded = []
     if loaded:
-        from serialkin.model.mesh import TriangleMesh, decimate, welded
+        from serialkin.formats.mesh import TriangleMesh, decimate, welded
 
         shares = _face_shares([m.faces.shape[0] for m in loaded], mesh_budget)
         for m, share in zip(loaded, shares, strict=True):
@@ -264,7 +264,7 @@ def _visual_data(robot: Robot, meshes: bool, mesh_budget: int,
 def _load_visual_mesh(link: str, g: Any) -> Any:
     """Load one visual mesh file (scale applied), its vertices welded for decimation."""
     from serialkin.errors import RobotDefinitionError
-    from serialkin.model.mesh import load_mesh, welded
+    from serialkin.formats.mesh import load_mesh, welded
 
     try:
         m = load_mesh(g.filename, g.scale)

@@ -15,7 +15,7 @@ import numpy as np
 import sympy as sp
 
 from serialkin import models
-from serialkin.chapter.report import Html, ReportContext, Section, format_number
+from serialkin.chapter._context import Html, ReportContext, Section, format_number
 from serialkin.kinematics.symbolic import SymbolicKinematics, derive
 from serialkin.model.dh import link_transform, standard_to_modified
 from serialkin.model.robot import Robot

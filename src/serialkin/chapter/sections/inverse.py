@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from serialkin import models
-from serialkin.chapter.report import Html, ReportContext, Section
+from serialkin.chapter._context import Html, ReportContext, Section
 
 #: A general 6R arm (standard DH: a [m], α [rad], d [m]) and a configuration whose pose
 #: has 16 real solutions, the most a 6R arm can have (Raghavan & Roth 1993); found by a

@@ -14,7 +14,7 @@ import numpy as np
 import sympy as sp
 
 from serialkin import models
-from serialkin.chapter.report import ReportContext, Section
+from serialkin.chapter._context import ReportContext, Section
 from serialkin.kinematics.symbolic import derive
 from serialkin.model.robot import Robot
 

@@ -16,7 +16,7 @@ import html
 import numpy as np
 
 from serialkin import models
-from serialkin.chapter.report import ReportContext, Section
+from serialkin.chapter._context import ReportContext, Section
 from serialkin.ik.compare import COLUMNS, CompareTable, compare
 
 #: Tolerance of the comparison (the accuracy bar of the IK issue) [m, rad].

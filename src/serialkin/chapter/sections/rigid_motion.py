@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from serialkin.chapter.report import ReportContext, Section, format_vector
+from serialkin.chapter._context import ReportContext, Section, format_vector
 from serialkin.spatial import (
     inv_transform,
     make_transform,

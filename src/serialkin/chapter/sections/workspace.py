@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from serialkin import models
-from serialkin.chapter.report import ReportContext, Section
+from serialkin.chapter._context import ReportContext, Section
 from serialkin.model.robot import Robot
 from serialkin.spatial import rpy_to_matrix
 from serialkin.workspace import (

@@ -704,6 +704,8 @@ def _as_poses(a: np.ndarray) -> np.ndarray:
     from serialkin.ik.analytic.subproblems import rigid_errors_into
 
     T = np.ascontiguousarray(a, dtype=float)
+    if not T.flags.writeable:  # one array type for the kernels, as in _as_pose
+        T = T.copy()
     err = np.empty(T.shape[0])
     rigid_errors_into(T, err)
     if T.shape[0] and err.max() > ROTATION_TOL:

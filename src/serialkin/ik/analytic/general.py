@@ -52,6 +52,7 @@ from serialkin.ik.analytic.subproblems import (
     mtv,
     mv,
     rotation,
+    row3,
     screw,
     sp1_dir,
     transform_point,
@@ -128,7 +129,7 @@ def search_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r
     w6 = W[5].copy()
     r6 = P[5].copy()
     Ts = inv_rigid(T) if reverse else T
-    TMinv = mm(Ts, inv_rigid(M))
+    TMinv = mm(Ts, inv_rigid(M.copy()))  # a writeable copy, as T is: inv_rigid compiles once
     nb = np.zeros((N, N), dtype=np.int64)
     res = np.full((N, N, 4), np.inf)
     Q = np.zeros((N, N, 4, 4))
@@ -142,6 +143,8 @@ def search_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r
     w1 = W[0].copy()
     w2 = W[1].copy()
     w3 = W[2].copy()
+    w4t = row3(W, 3)  # w4, u4 as tuples for sp1_dir (the subproblems' vector type)
+    u4t = row3(aux, aux.shape[0] - 1)
     for i5 in range(N):
         # G = A6·E5 is applied to c, w4, u4 only: E5's part once per row, no 4 × 4 product
         e5c = transform_point(E5[i5], c)
@@ -164,7 +167,7 @@ def search_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r
                 Q[i5, i6, b, 0] = arm3[b, 0]
                 Q[i5, i6, b, 1] = arm3[b, 1]
                 Q[i5, i6, b, 2] = arm3[b, 2]
-                Q[i5, i6, b, 3] = sp1_dir(w4, u4, xu)
+                Q[i5, i6, b, 3] = sp1_dir(w4t, u4t, (xu[0], xu[1], xu[2]))
     local = np.zeros((N, N, 4), dtype=np.bool_)  # residual below every neighbour's
     for i5 in range(N):
         for i6 in range(N):

@@ -1,7 +1,7 @@
 """The IK method ``'analytic'``: every closed-form solution, then the one nearest q0.
 
-The closed-form family registers and implements its own method here (the registry
-calls :func:`register_analytic` when it is first read): ``robot.ik(target,
+The closed-form family registers and implements its own method here, at import
+(:mod:`serialkin.ik` imports this module): ``robot.ik(target,
 method="analytic", q0=...)`` solves with :func:`serialkin.ik.analytic.ik_all` and
 returns the solution nearest ``q0`` (:func:`serialkin.ik.analytic.sort_by_reference`:
 revolute joints moved by 2π towards ``q0`` inside their limits, weighted L2 or L∞
@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from serialkin.ik.analytic import NEAR_TOL
+from serialkin.ik.registry import MethodSpec, register_method
 from serialkin.model.robot import Robot
 
 #: Options of the method, with their defaults (passed on to ``ik_all``).
@@ -57,9 +58,7 @@ def analytic_solve(robot: Robot, problem: Any, q0: np.ndarray | None,
 
 
 def register_analytic() -> None:
-    """Register the method ``'analytic'`` (called by the registry when first read)."""
-    from serialkin.ik.registry import MethodSpec, register_method
-
+    """Register the method ``'analytic'`` (done once, when this module is imported)."""
     register_method(MethodSpec(
         name="analytic", family="analytic",
         summary="all closed-form solutions (section 4.1; general 6R by search), the one "
@@ -67,3 +66,6 @@ def register_analytic() -> None:
         limits="only solutions inside the limits are returned by ik_all",
         max_iter=1, restarts=0, options=dict(OPTIONS), solve=analytic_solve,
     ))
+
+
+register_analytic()

@@ -23,11 +23,12 @@ import math
 import numpy as np
 
 from serialkin.ik.analytic.subproblems import (
-    cross3,
+    cross3t,
     dot3,
     finalize,
-    mv,
+    mv3,
     planar2r,
+    row3,
     target_point,
 )
 
@@ -59,20 +60,24 @@ def planar_candidates(T, W, P, M, order, w, e1, out):
     i0 = order[0]
     i1 = order[1]
     sol = np.empty((2, 2))
+    wt = (w[0], w[1], w[2])  # vectors as tuples, the subproblems' type
+    e1t = (e1[0], e1[1], e1[2])
     if nr == 3:
         c3 = P[order[2]].copy()
         t, Rg = target_point(T, M, c3)
-        v = mv(Rg, e1)
-        s = math.atan2(dot3(w, cross3(e1, v)), dot3(e1, v))
-        k = planar2r(w, e1, P[i0].copy(), P[i1].copy(), c3, t, sol)
+        v = mv3(Rg, e1t)
+        s = math.atan2(dot3(wt, cross3t(e1t, v)), dot3(e1t, v))
+        k = planar2r(wt, e1t, row3(P, i0), row3(P, i1), (c3[0], c3[1], c3[2]),
+                     (t[0], t[1], t[2]), sol)
     else:
         s = 0.0
-        k = planar2r(w, e1, P[i0].copy(), P[i1].copy(), M[:3, 3].copy(), T[:3, 3].copy(), sol)
+        k = planar2r(wt, e1t, row3(P, i0), row3(P, i1), (M[0, 3], M[1, 3], M[2, 3]),
+                     (T[0, 3], T[1, 3], T[2, 3]), sol)
     for r in range(k):
-        out[r, i0] = dot3(W[i0], w) * sol[r, 0]
-        out[r, i1] = dot3(W[i1], w) * sol[r, 1]
+        out[r, i0] = dot3(row3(W, i0), wt) * sol[r, 0]
+        out[r, i1] = dot3(row3(W, i1), wt) * sol[r, 1]
         if nr == 3:
-            out[r, order[2]] = dot3(W[order[2]], w) * (s - sol[r, 0] - sol[r, 1])
+            out[r, order[2]] = dot3(row3(W, order[2]), wt) * (s - sol[r, 0] - sol[r, 1])
     return k
 
 

@@ -479,7 +479,7 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
     Wf = W.copy()
     Pf = P.copy()
     Mf = M.copy()
-    Minv = inv_rigid(M)
+    Minv = inv_rigid(Mf)
     Wr = np.empty((6, 3))  # the reversed chain: joint j is joint 7 − j about the line
     Pr = np.empty((6, 3))  # (−R_Mᵀ w, M⁻¹ p), tool pose M⁻¹, target T⁻¹
     for j in range(6):
@@ -751,7 +751,7 @@ def _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u, reverse, A, q):
     x = mv(G, x)
     for j in range(e):
         x = mtv(rotation(W[j], qs[j]), x)
-    qs[e] = sp1_dir(W[e], u, x)
+    qs[e] = sp1_dir((W[e, 0], W[e, 1], W[e, 2]), (u[0], u[1], u[2]), (x[0], x[1], x[2]))
     for j in range(6):
         q[j] = qs[5 - j] if reverse else qs[j]
     return second

@@ -23,7 +23,7 @@ from serialkin.kinematics.dls import dls_step_into
 from serialkin.kinematics.kernels import jacobian_into
 from serialkin.spatial.kernels import pose_error_into
 
-from ..._jit import njit
+from ..._jit import as_readonly, njit
 
 #: Largest Newton step, any joint [rad or m]; larger steps are scaled down.
 MAX_STEP = 0.5
@@ -81,7 +81,7 @@ def newton_refine_known(q, T, F, meta, tol_p, tol_r, max_iter, known, k, radius)
     dq = np.empty(n)
     for _ in range(max_iter + 1):
         jacobian_into(q, F, meta, J, Tq)
-        pose_error_into(Tq, T, e)
+        pose_error_into(Tq, as_readonly(T), e)  # the target only read (read-only, as for all)
         ep = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
         er = math.sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5])
         if not (math.isfinite(ep) and math.isfinite(er)):

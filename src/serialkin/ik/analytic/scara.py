@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from serialkin.ik.analytic.planar import MAX_SOLUTIONS, planar_candidates
-from serialkin.ik.analytic.subproblems import dot3, finalize
+from serialkin.ik.analytic.subproblems import dot3, finalize, row3, sub3
 
 from ..._jit import njit
 
@@ -51,8 +51,9 @@ def solve_scara(T, W, P, M, order, w, e1, revolute, qlim, mid, F, meta, check_ro
     """
     n = W.shape[0]
     ip = order[order.shape[0] - 1]
-    wp = W[ip].copy()
-    d = dot3(w, T[:3, 3] - M[:3, 3]) / dot3(w, wp)
+    wp = row3(W, ip)
+    wt = (w[0], w[1], w[2])  # vectors as tuples, the subproblems' type
+    d = dot3(wt, sub3((T[0, 3], T[1, 3], T[2, 3]), (M[0, 3], M[1, 3], M[2, 3]))) / dot3(wt, wp)
     Tl = T.copy()
     for i in range(3):
         Tl[i, 3] -= d * wp[i]

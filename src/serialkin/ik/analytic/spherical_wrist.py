@@ -63,6 +63,7 @@ from serialkin.ik.analytic.subproblems import (
     sp4,
     sub3,
     target_rotation,
+    tup3,
 )
 
 from ..._jit import njit
@@ -146,11 +147,11 @@ def puma_positions(pw, W, P, aux, slack, out):
     q1s = buf[0:6]  # angles, then the cosine and sine of each (sp4)
     sol = buf[6:10].reshape((2, 2))
     frame = planar2r_frame(w, e1, c2, c3, c)  # joints 2, 3 carrying c, once, not per branch
-    d = sub3(pw, r1)
+    d = sub3((pw[0], pw[1], pw[2]), r1)
     n1 = sp4(w1, w, d, dot3(w, sub3(c, r1)), q1s)
     k = 0
-    s2 = dot3(W[1], w)
-    s3 = dot3(W[2], w)
+    s2 = dot3(row3(W, 1), w)
+    s3 = dot3(row3(W, 2), w)
     for i in range(n1):
         q1 = q1s[i]
         x = add3(rot3(w1, q1s[2 + 2 * i], -q1s[3 + 2 * i], d), r1)  # exp(−ξ1 q1)·pw
@@ -172,21 +173,21 @@ def intersecting_positions(pw, W, P, aux, prismatic3, out):
     joint 3 (``pieper_intersecting``), :func:`~serialkin.ik.analytic.subproblems.sp3_slide`
     for a prismatic one (``prismatic3``, ``stanford``). Up to two values of q3; q1, q2
     then carry the moved centre onto ``p_w`` (subproblem 2, two solutions each).
-    Returns the count.
+    Returns the count. The subproblems take their vectors as tuples (:func:`row3`,
+    :func:`tup3`).
     """
     c = aux[0].copy()
     o = aux[1].copy()
-    w1 = W[0].copy()
-    w2 = W[1].copy()
     w3 = W[2].copy()
     r3 = P[2].copy()
     h = c - o
     g = pw - o
+    gt = tup3(g)
     q3s = np.empty(2)
     if prismatic3:
-        n3 = sp3_slide(w3, h, dot3(g, g), q3s)
+        n3 = sp3_slide(tup3(w3), tup3(h), dot3(gt, gt), q3s)
     else:
-        n3 = sp3(w3, r3, c, o, np.sqrt(dot3(g, g)), q3s)
+        n3 = sp3(tup3(w3), tup3(r3), tup3(c), tup3(o), np.sqrt(dot3(gt, gt)), q3s)
     sol = np.empty((2, 2))
     k = 0
     for i in range(n3):
@@ -195,7 +196,7 @@ def intersecting_positions(pw, W, P, aux, prismatic3, out):
             x = h + q3 * w3
         else:
             x = rotate_point(w3, r3, q3, c) - o
-        m = sp2_dir(w1, w2, x, g, sol)
+        m = sp2_dir(row3(W, 0), row3(W, 1), tup3(x), gt, sol)
         for j in range(m):
             out[k, 0] = sol[j, 0]
             out[k, 1] = sol[j, 1]
@@ -243,28 +244,35 @@ def general_positions(pw, W, P, aux, prismatic3, out):
     When axes 1 and 2 are parallel (sα = 0) the second invariant reads w2·u = cα·w1·(p_w − r1)
     instead: θ3 by :func:`~serialkin.ik.analytic.subproblems.sp4` (two values) or d directly
     (one), and g2 = ±sqrt(|u|² − (w2·u)² − g1²) (two values of θ2 each).
+
+    The subproblems take their vectors as tuples (:func:`row3`, :func:`tup3`); the
+    intermediate vectors stay in arrays, so that no rounding changes (fused operations
+    across the tuples would).
     """
     c = aux[0].copy()
     r1 = aux[1].copy()
     r2 = aux[2].copy()
-    n = aux[3].copy()
-    m = aux[4].copy()
-    w1 = W[0].copy()
+    n = row3(aux, 3)
+    m = row3(aux, 4)
+    w1 = row3(W, 0)
     w2 = W[1].copy()
+    w2t = row3(W, 1)
     w3 = W[2].copy()
+    w3t = row3(W, 2)
     r3 = P[2].copy()
-    a1 = dot3(r2 - r1, n)
-    ca = dot3(w1, w2)
+    d = tup3(pw - r1)
+    a1 = dot3(tup3(r2 - r1), n)
+    ca = dot3(w1, w2t)
     sa = dot3(w1, m)
-    rho2 = dot3(pw - r1, pw - r1)
-    h = dot3(w1, pw - r1)
+    rho2 = dot3(d, d)
+    h = dot3(w1, d)
     h0 = c - r2
     parallel = abs(sa) < 1e-9
     thetas = np.empty(4)
     if prismatic3:
-        nt = _quartic_stroke(h0, w3, w2, a1, ca, sa, rho2, h, parallel, thetas)
+        nt = _quartic_stroke(tup3(h0), w3t, w2t, a1, ca, sa, rho2, h, parallel, thetas)
     elif parallel:  # axes 1 ∥ 2: w2·u(θ3) = cα·h fixes θ3 (two values), g2 = ±sqrt(..)
-        nt = sp4(w3, c - r3, w2, ca * h - dot3(w2, r3 - r2), thetas)
+        nt = sp4(w3t, tup3(c - r3), w2t, ca * h - dot3(w2t, tup3(r3 - r2)), thetas)
     else:
         nt = _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas)
     k = 0
@@ -274,8 +282,9 @@ def general_positions(pw, W, P, aux, prismatic3, out):
             u = h0 + th * w3
         else:
             u = mv(rotation(w3, th), c - r3) + r3 - r2
-        uu = dot3(u, u)
-        wu = dot3(w2, u)
+        ut = tup3(u)
+        uu = dot3(ut, ut)
+        wu = dot3(w2t, ut)
         g1 = (rho2 - uu - a1 * a1) / (2.0 * a1)
         if parallel:
             g2sq = uu - wu * wu - g1 * g1
@@ -288,9 +297,9 @@ def general_positions(pw, W, P, aux, prismatic3, out):
             ng = 1
         for j in range(ng):
             gj = g2 if j == 0 else -g2
-            th2 = math.atan2(gj, g1) - math.atan2(dot3(m, u), dot3(n, u))
+            th2 = math.atan2(gj, g1) - math.atan2(dot3(m, ut), dot3(n, ut))
             x = mv(rotation(w2, th2), u) + r2
-            th1 = sp1_dir(w1, x - r1, pw - r1)
+            th1 = sp1_dir(w1, tup3(x - r1), d)
             if k == out.shape[0]:
                 return k
             out[k, 0] = th1
@@ -371,7 +380,8 @@ def _quartic_stroke(h0, b, w2, a1, ca, sa, rho2, h, parallel, strokes):
     |u|² − (w2·u)² = N2 d² + N1 d + N0, so E(d) = g1² + g2² − (N2 d² + N1 d + N0) is a
     quartic, solved by :func:`~serialkin.ik.analytic.subproblems.poly_roots`; the real
     roots are polished by Newton's method and kept when E vanishes there. With ``parallel``
-    axes 1, 2 the height w2·u(d) = cα·h gives the one stroke d directly.
+    axes 1, 2 the height w2·u(d) = cα·h gives the one stroke d directly. ``h0``, ``b``,
+    ``w2`` tuples.
     """
     wb = dot3(w2, b)
     wh = dot3(w2, h0)

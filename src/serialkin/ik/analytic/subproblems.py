@@ -21,8 +21,16 @@ the same few geometric subproblems (Paden–Kahan; R. M. Murray, Z. Li, S. S. Sa
 Every function writes its (at most two) solutions into ``out`` and returns their
 count; the count is 0 when the sub-target is out of reach. Arguments slightly outside
 the domain of arccos (within :data:`CLAMP`) are clamped, so targets on the workspace
-boundary keep their (double) solution. Angles in radians, lengths in metres; all
-vectors are (3,) float64 arrays. Kernels trust their input.
+boundary keep their (double) solution. Angles in radians, lengths in metres. Kernels
+trust their input.
+
+Vectors: the subproblems and the small helpers of the section "3-vectors as tuples"
+take 3-vectors as ``(x, y, z)`` tuples of floats, always (numba compiles a function
+once per set of argument types, and a tuple and an array are two: issue 27); a solver
+holding a vector in an array row passes :func:`row3` of its (read-only) structure
+array, one in a (3,) array of its own :func:`tup3`. The helpers that return new arrays
+(:func:`cross3`, :func:`mv`, :func:`rotation`, :func:`rotate_point`, ...) take (3,)
+float64 arrays.
 """
 
 from __future__ import annotations
@@ -104,15 +112,23 @@ def mtv(A, v):
 # --- 3-vectors as tuples ------------------------------------------------------------------
 #
 # A numba function that returns a new (3,) array pays for a heap allocation (30-50 ns),
-# which dominated the closed forms (about 100 per pose). The hot paths instead carry
-# vectors as (x, y, z) tuples, which live in registers; the functions below take tuples
-# or array rows alike (anything indexable by 0, 1, 2).
+# which dominated the closed forms (about 100 per pose). The closed forms instead carry
+# vectors as (x, y, z) tuples, which live in registers. The functions below take their
+# vectors as tuples only (never array rows: each kind of argument compiles a function
+# once more); :func:`row3` reads a row of the solvers' read-only (m, 3) arrays as one,
+# :func:`tup3` a (3,) array the array-based solvers computed.
 
 
 @njit(cache=True)
 def row3(a, i):
-    """Row i of an (m, 3) array (or the first three entries of row i) as a tuple."""
+    """Row i of a read-only (m, 3) array (or the first three entries of row i) as a tuple."""
     return (a[i, 0], a[i, 1], a[i, 2])
+
+
+@njit(cache=True)
+def tup3(a):
+    """A (3,) array as a tuple (the array-based solvers' own fresh, writeable arrays)."""
+    return (a[0], a[1], a[2])
 
 
 @njit(cache=True)
@@ -377,19 +393,21 @@ def sp3(w, r, p, q, delta, out):
 
     Projected on the plane ⟂ w: ``|u'|² + |v'|² − 2|u'||v'| cos(θ − θ0) = δ'²`` with
     ``u = p − r``, ``v = q − r``, ``δ'² = δ² − (w·(p − q))²``. Writes θ into ``out``
-    (2,), returns 0, 1 or 2 (0 also when p or q lies on the axis).
+    (2,), returns 0, 1 or 2 (0 also when p or q lies on the axis). Vectors as tuples.
     """
-    u = p - r
-    v = q - r
-    up = u - dot3(w, u) * w
-    vp = v - dot3(w, v) * w
+    u = sub3(p, r)
+    v = sub3(q, r)
+    wu = dot3(w, u)
+    up = (u[0] - wu * w[0], u[1] - wu * w[1], u[2] - wu * w[2])
+    wv = dot3(w, v)
+    vp = (v[0] - wv * w[0], v[1] - wv * w[1], v[2] - wv * w[2])
     nu = math.sqrt(dot3(up, up))
     nv = math.sqrt(dot3(vp, vp))
     if nu < 1e-12 or nv < 1e-12:
         return 0
-    h = dot3(w, p - q)
+    h = dot3(w, sub3(p, q))
     d2 = delta * delta - h * h
-    theta0 = math.atan2(dot3(w, cross3(up, vp)), dot3(up, vp))
+    theta0 = math.atan2(dot3(w, cross3t(up, vp)), dot3(up, vp))
     c = _acos_clamped((nu * nu + nv * nv - d2) / (2.0 * nu * nv))
     if math.isnan(c):
         return 0
@@ -407,7 +425,7 @@ def sp3_slide(w, h, delta2, out):
     ``d² + 2 (w·h) d + |h|² − δ² = 0``, so d = −w·h ± sqrt((w·h)² − |h|² + δ²); a
     discriminant slightly negative (within :data:`CLAMP`·max(|h|², 1)) counts as zero.
     Takes ``delta2`` = δ² [m²]; writes d [m] into ``out`` (2,) (the + root first),
-    returns 0, 1 or 2.
+    returns 0, 1 or 2. ``w``, ``h`` tuples.
     """
     b = dot3(w, h)
     hh = dot3(h, h)

@@ -74,9 +74,9 @@ def ur_candidates(T, W, P, M, aux, slack, out):
     tg = (T[0, 3] - mt[0], T[1, 3] - mt[1], T[2, 3] - mt[2])
     p5 = add3(mv3(Rg, p56), tg)
     w6t = mv3(Rg, w6)
-    s2 = dot3(W[1], w)
-    s3 = dot3(W[2], w)
-    s4 = dot3(W[3], w)
+    s2 = dot3(row3(W, 1), w)
+    s3 = dot3(row3(W, 2), w)
+    s4 = dot3(row3(W, 3), w)
     frame = planar2r_frame(w, e, c2, c3, x4)  # joints 2, 3 carrying x4, once, not per branch
     x4r5 = sub3(x4, r5)
     r5r6 = sub3(r5, r6)

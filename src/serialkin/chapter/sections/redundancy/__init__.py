@@ -18,7 +18,7 @@ joint limits and collision constraints (:mod:`serialkin.diffik`).
 
 from __future__ import annotations
 
-from serialkin.chapter.report import ReportContext, Section
+from serialkin.chapter._context import ReportContext, Section
 from serialkin.chapter.sections.redundancy._common import eq48_by_hand, timed_run
 from serialkin.chapter.sections.redundancy.nullspace import _nullspace_part, _six_link_part
 from serialkin.chapter.sections.redundancy.qp import _qp_part, side_by_side

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin.chapter.report import ReportContext, Timing
+from serialkin.chapter._context import ReportContext, Timing
 from serialkin.redundancy import (
     joint_limit_weights,
     obstacle_jacobian,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from serialkin.chapter.report import Html, ReportContext, Section
+from serialkin.chapter._context import Html, ReportContext, Section
 from serialkin.chapter.sections.redundancy._common import (
     DEG,
     EQ,

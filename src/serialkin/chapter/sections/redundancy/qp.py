@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from serialkin.chapter.report import ReportContext, Section, Timing
+from serialkin.chapter._context import ReportContext, Section, Timing
 from serialkin.chapter.sections.redundancy._common import (
     DEG,
     _mm,

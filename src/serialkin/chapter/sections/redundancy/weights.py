@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin.chapter.report import Html, ReportContext, Section
+from serialkin.chapter._context import Html, ReportContext, Section
 from serialkin.chapter.sections.redundancy._common import (
     DEG,
     EQ,

@@ -1,0 +1,279 @@
+"""7-DOF arms: S-R-S arms by their arm angle (closed form, feasible ψ), others by a sweep."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from serialkin import Robot, models
+from serialkin.errors import InputError, NoClosedFormError
+from serialkin.ik.analytic.arm_angle import (
+    arm_angle,
+    arm_angle_intervals,
+    ik_arm_angle,
+    srs_structure,
+)
+from serialkin.ik.sweep import joint_sweep
+from serialkin.model.dh import DHLink
+
+
+def _wrapped(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.abs((np.asarray(a) - b + np.pi) % (2 * np.pi) - np.pi)
+
+
+def _reaches(robot: Robot, Q: np.ndarray, T: np.ndarray) -> float:
+    F = robot.fk(Q)
+    return float(max(np.abs(F[..., :3, 3] - T[:3, 3]).max(),
+                     np.abs(F[..., :3, :3] - T[:3, :3]).max()))
+
+
+def _transform(rng: np.random.Generator) -> np.ndarray:
+    A = rng.normal(size=(3, 3))
+    R, _ = np.linalg.qr(A)
+    T = np.eye(4)
+    T[:3, :3] = R * np.sign(np.linalg.det(R))
+    T[:3, 3] = rng.uniform(-0.2, 0.2, 3)
+    return T
+
+
+def _random_srs(seed: int, orthogonal: bool = False) -> Robot:
+    """A random S-R-S arm: standard DH with a = 0 and d = 0 where the shoulder and wrist meet.
+
+    Axes 1–3 meet when a1 = a2 = d2 = 0, axes 5–7 when a5 = a6 = d6 = 0; the twists
+    (±90° when ``orthogonal``, as on the iiwa), the elbow's offsets (a3, a4, d3, d4, d5)
+    and base and tool are random. No joint limits.
+    """
+    rng = np.random.default_rng(seed)
+
+    def twist() -> float:
+        size = math.pi / 2 if orthogonal else rng.uniform(0.3, math.pi - 0.3)
+        return float(rng.choice([-1, 1]) * size)
+
+    rows = [DHLink(a=0.0, alpha=twist(), d=rng.uniform(0.1, 0.4)),
+            DHLink(a=0.0, alpha=twist(), d=0.0),
+            DHLink(a=rng.uniform(-0.1, 0.1), alpha=twist(), d=rng.uniform(0.2, 0.5)),
+            DHLink(a=rng.uniform(-0.1, 0.1), alpha=twist(), d=rng.uniform(-0.1, 0.1)),
+            DHLink(a=0.0, alpha=twist(), d=rng.uniform(0.2, 0.5)),
+            DHLink(a=0.0, alpha=twist(), d=0.0),
+            DHLink(a=0.0, alpha=0.0, d=rng.uniform(0.05, 0.2))]
+    return Robot.from_dh(rows, "standard", base=_transform(rng), tool=_transform(rng),
+                         name=f"srs{seed}")
+
+
+def test_iiwa_generating_configuration_is_among_the_solutions_at_its_arm_angle():
+    """iiwa7: ik_arm_angle(fk(q), ψ(q)) contains q; every row reaches T and has arm angle ψ."""
+    robot = models.get("iiwa7")
+    Q = robot.random_q(100, seed=5)
+    for q in Q:
+        T = robot.fk(q)
+        psi = float(arm_angle(robot, q))
+        sols = ik_arm_angle(robot, T, psi)
+        assert 1 <= len(sols) <= 8
+        assert _wrapped(sols.q, q).max(axis=1).min() < 1e-9
+        assert _reaches(robot, sols.q, T) < 1e-10
+        assert _wrapped(arm_angle(robot, sols.q), psi).max() < 1e-9
+        assert len(set(sols.branch.tolist())) == len(sols)
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), qseed=st.integers(0, 2**31 - 1),
+       reference=st.sampled_from([None, (1.0, 0.0, 0.0), (0.3, -0.5, 0.8)]))
+def test_random_srs_arms_contain_the_generating_configuration(seed, qseed, reference):
+    """Random S-R-S arms (random twists, elbow offsets, base, tool), any reference: q found."""
+    robot = _random_srs(seed)
+    q = np.random.default_rng(qseed).uniform(-math.pi, math.pi, 7)
+    T = robot.fk(q)
+    psi = float(arm_angle(robot, q, reference))
+    sols = ik_arm_angle(robot, T, psi, reference)
+    assert _wrapped(sols.q, q).max(axis=1).min() < 1e-8
+    assert _reaches(robot, sols.q, T) < 1e-9
+    assert _wrapped(arm_angle(robot, sols.q, reference), psi).max() < 1e-8
+
+
+def test_unlimited_srs_arm_has_eight_distinct_solutions_at_a_generic_pose():
+    """Orthogonal twists, no limits: a generic pose has 8 configurations at each ψ.
+
+    (With other twists a spherical shoulder or wrist does not reach every direction, so
+    some branches exist only on part of the circle of ψ.)
+    """
+    robot = _random_srs(11, orthogonal=True)
+    T = robot.fk(np.full(7, 0.4))
+    for psi in (-2.0, 0.0, 1.3):
+        sols = ik_arm_angle(robot, T, psi)
+        assert sorted(sols.branch.tolist()) == list(range(8))
+        d = _wrapped(sols.q[:, None, :], sols.q[None, :, :]).max(axis=2)
+        assert d[~np.eye(8, dtype=bool)].min() > 1e-6
+
+
+def test_branches_are_continuous_in_the_arm_angle():
+    """Following one branch along ψ never jumps: a large step shrinks when ψ's step does."""
+    robot = _random_srs(3, orthogonal=True)
+    T = robot.fk(np.full(7, 0.7))
+
+    def rows(psi: float) -> dict[int, np.ndarray]:
+        sols = ik_arm_angle(robot, T, psi)
+        assert len(sols) == 8
+        return dict(zip(sols.branch.tolist(), sols.q))
+
+    psis = np.linspace(-1.0, 1.0, 101)
+    prev = rows(psis[0])
+    for a, b in zip(psis[:-1], psis[1:]):
+        cur = rows(b)
+        for j in range(8):
+            step = _wrapped(cur[j], prev[j]).max()
+            if step > 0.05:  # fast motion (near a shoulder or wrist singularity) or a jump?
+                fine = [rows(x)[j] for x in np.linspace(a, b, 21)]
+                finer = max(_wrapped(u, v).max() for u, v in zip(fine[:-1], fine[1:]))
+                assert finer < 0.5 * step, (b, j, step, finer)
+        prev = cur
+
+
+def test_intervals_agree_with_dense_sampling_and_end_on_a_limit():
+    """ψ is feasible iff ik_arm_angle finds a row there; each inner interval end is a limit."""
+    robot = models.get("iiwa7")
+    lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
+    for seed in range(4):
+        T = robot.fk(robot.random_q(1, seed=40 + seed)[0])
+        iv = arm_angle_intervals(robot, T)
+        assert not iv.singular
+        rng = np.random.default_rng(seed)
+        for psi in rng.uniform(-math.pi, math.pi, 300):
+            sols = ik_arm_angle(robot, T, psi)
+            near_end = any(min(abs(psi - a), abs(psi - b)) < 1e-7
+                           for spans in iv.branches.values() for a, b in spans)
+            if near_end:
+                continue
+            assert iv.contains(psi) == (len(sols) > 0), psi
+            for j in range(8):
+                assert iv.contains(psi, j) == (j in sols.branch), (psi, j)
+        for j, spans in iv.branches.items():
+            for a, b in spans:
+                for end in (a, b):
+                    if abs(abs(end) - math.pi) < 1e-12:
+                        continue  # the ±π seam, not a limit
+                    sols = ik_arm_angle(robot, T, end)
+                    row = sols.q[sols.branch == j]
+                    assert len(row) == 1, (j, end)
+                    gap = np.minimum(np.abs(row[0] - lo), np.abs(row[0] - hi)).min()
+                    assert gap < 1e-7, (j, end, gap)
+
+
+def test_generating_arm_angle_lies_in_the_feasible_intervals():
+    """The arm angle of a configuration inside the limits is feasible on its branch's pose."""
+    robot = models.get("iiwa7")
+    for q in robot.random_q(20, seed=9):
+        iv = arm_angle_intervals(robot, robot.fk(q))
+        assert iv.contains(float(arm_angle(robot, q)))
+
+
+def test_out_of_reach_pose_has_no_solution_and_no_interval():
+    """A pose beyond the arm's reach: no row at any ψ, no feasible interval."""
+    robot = models.get("iiwa7")
+    T = np.eye(4)
+    T[:3, 3] = [3.0, 0.0, 0.5]
+    assert len(ik_arm_angle(robot, T, 0.0)) == 0
+    iv = arm_angle_intervals(robot, T)
+    assert iv.feasible == [] and iv.branches == {}
+
+
+def test_stretched_arm_pose_is_singular():
+    """The arm straight up (elbow on the line S-W, which is the reference z): ψ undefined."""
+    robot = models.get("iiwa7")
+    T = robot.fk(np.zeros(7))
+    assert arm_angle_intervals(robot, T).singular
+    assert float(arm_angle(robot, np.zeros(7))) == 0.0
+    sols = ik_arm_angle(robot, T, 0.5)
+    assert len(sols) >= 1 and _reaches(robot, sols.q, T) < 1e-10
+
+
+def test_structure_of_iiwa_and_refusal_of_offset_arms():
+    """iiwa7 is S-R-S (shoulder at d1, wrist at d1 + d3 + d5); the Panda is refused, saying why."""
+    arm = srs_structure(models.get("iiwa7"))
+    assert np.allclose(arm.S, [0, 0, 0.34], atol=1e-12)
+    assert np.allclose(arm.W0, [0, 0, 1.14], atol=1e-12)
+    with pytest.raises(NoClosedFormError, match="axes 5, 6, 7 do not meet|axes 1, 2, 3"):
+        srs_structure(models.get("panda"))
+    with pytest.raises(NoClosedFormError, match="7 joints|6 joints"):
+        srs_structure(models.get("ur5"))
+
+
+def test_bad_input_is_named():
+    """Bad ψ, pose, reference and resolution raise errors naming the argument."""
+    robot = models.get("iiwa7")
+    T = robot.fk(np.zeros(7))
+    with pytest.raises(InputError, match="psi"):
+        ik_arm_angle(robot, T, float("nan"))
+    with pytest.raises(InputError, match="reference"):
+        ik_arm_angle(robot, T, 0.0, reference=(0.0, 0.0, 0.0))
+    with pytest.raises(InputError, match="T"):
+        ik_arm_angle(robot, np.eye(3), 0.0)
+    with pytest.raises(InputError, match="T must be one"):
+        ik_arm_angle(robot, np.stack([T, T]), 0.0)
+    with pytest.raises(InputError, match="resolution"):
+        arm_angle_intervals(robot, T, resolution=0.0)
+
+
+# ------------------------------------------------- offset 7R arms: a sweep of one joint
+
+def test_panda_sweep_contains_the_generating_configuration_on_one_branch():
+    """Panda, joint 7 swept: the generating q lies on a branch; every row reaches T."""
+    robot = models.get("panda")
+    for seed in range(3):
+        q = robot.random_q(1, seed=60 + seed)[0]
+        T = robot.fk(q)
+        values = np.linspace(q[6] - 0.3, q[6] + 0.3, 31)  # q[6] is the middle value
+        sweep = joint_sweep(robot, T, 6, values)
+        rows = sweep.q[15][sweep.valid[15]]
+        assert _wrapped(rows, q).max(axis=1).min() < 1e-9
+        assert _reaches(robot, sweep.q[sweep.valid], T) < 1e-9
+        assert np.all(sweep.q[sweep.valid][:, 6] == np.repeat(values, sweep.valid.sum(1)))
+
+
+def test_sweep_branches_never_jump_and_match_a_fine_sweep():
+    """Along each branch neighbouring rows differ by at most max_jump; a finer grid agrees."""
+    robot = models.get("panda")
+    q = robot.random_q(1, seed=71)[0]
+    T = robot.fk(q)
+    sweep = joint_sweep(robot, T, 6, resolution=math.radians(3.0))
+    assert sweep.branches >= 1
+    for k in range(sweep.branches):
+        v, rows = sweep.branch(k)
+        assert np.all(np.diff(np.flatnonzero(sweep.valid[:, k])) == 1)  # one run
+        if len(rows) > 1:
+            assert _wrapped(rows[1:], rows[:-1]).max() <= sweep.max_jump
+    # the generating value is feasible, and feasibility agrees with fresh solves
+    assert any(a <= q[6] <= b for a, b in sweep.feasible)
+    for a, b in sweep.feasible:
+        if a > sweep.values[0]:
+            assert len(robot.ik_all(T, free={6: a - 1e-6})) == 0
+            assert len(robot.ik_all(T, free={6: a + 1e-7})) > 0
+        if b < sweep.values[-1]:
+            assert len(robot.ik_all(T, free={6: b + 1e-6})) == 0
+            assert len(robot.ik_all(T, free={6: b - 1e-7})) > 0
+
+
+def test_sweep_bad_input_is_named():
+    """A bad joint index, unsorted values or a non-positive jump name their argument."""
+    robot = models.get("panda")
+    T = robot.fk(np.zeros(7))
+    with pytest.raises(InputError, match="joint"):
+        joint_sweep(robot, T, 7)
+    with pytest.raises(InputError, match="values"):
+        joint_sweep(robot, T, 6, [0.2, 0.1])
+    with pytest.raises(InputError, match="max_jump"):
+        joint_sweep(robot, T, 6, max_jump=0.0)
+
+
+def test_robot_methods_are_the_module_functions():
+    """robot.arm_angle / ik_arm_angle / arm_angle_intervals give the functions' results."""
+    robot = models.get("iiwa7")
+    q = np.array([0.3, 0.6, -0.2, -1.2, 0.4, 0.8, 0.1])
+    T = robot.fk(q)
+    psi = robot.arm_angle(q)
+    assert psi == arm_angle(robot, q)
+    assert np.array_equal(robot.ik_arm_angle(T, psi).q, ik_arm_angle(robot, T, psi).q)
+    assert robot.arm_angle_intervals(T).feasible == arm_angle_intervals(robot, T).feasible
