@@ -25,7 +25,7 @@ $(STAMP_RUN): pyproject.toml | $(PY)
 # The test extras' own requirements, installed beside the project without reinstalling it
 # (so that a warm-up running meanwhile keeps its imports) and constrained to what is
 # already installed (so that nothing it imports changes under it).
-TEST_EXTRAS := dev bench docs mesh xacro dist
+TEST_EXTRAS := dev bench docs mesh xacro dist paths
 
 $(STAMP_TEST): $(STAMP_RUN)
 	$(PY) -c "import tomllib; o = tomllib.load(open('pyproject.toml', 'rb'))['project']\

@@ -38,6 +38,9 @@ GOALS = {
     "27.1": "cold start in a fresh process: import <= 1 s, fk/jacobian <= 2 s, Panda ik "
             "<= 4 s (300 targets <= 6 s, self-collision <= 8 s), UR5 ik_all <= 6 s; CLI "
             "warm <= 0.7 s",
+    "30.6": "7-DOF: S-R-S solutions at one arm angle <= 10 us, feasible intervals <= 50 us, "
+            "Panda sweep of joint 7 at 1 degree <= 1 ms",
+    "31.b": "joint path of 1,000 samples: UR5 <= 20 ms, Panda <= 50 ms; timing <= 50 ms",
 }
 
 

@@ -16,8 +16,8 @@ from serialkin import Robot, models
 from serialkin.cli.io import CLIError, read_csv_rows, write_text_atomic
 from serialkin.cli.main import cli
 
-SUBCOMMANDS = ("chapter", "models", "fk", "jacobian", "ik", "ik-compare", "track", "workspace",
-               "view")
+SUBCOMMANDS = ("chapter", "models", "fk", "jacobian", "ik", "ik-compare", "track", "path",
+               "workspace", "view")
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "robots"
 
 
@@ -380,7 +380,7 @@ def test_view_scenario(tmp_path):
 
 def test_robotfile_yaml_equivalent_to_from_dh(tmp_path):
     """A robot file written by save_robot_file works as ROBOT for fk."""
-    from serialkin.model.robotfile import save_robot_file
+    from serialkin.formats.robotfile import save_robot_file
 
     r = Robot.from_dh([dict(a=0.3, alpha=0.2, d=0.1, theta=0.0)] * 2, name="tiny")
     p = save_robot_file(r, tmp_path / "tiny.json")
@@ -432,7 +432,7 @@ def test_ik_mask_q0_degrees_and_no_limits():
 
 
 def test_track_unreachable_points_exit_1(tmp_path):
-    """A path partly out of reach: exit 1, each failed point on stderr, JSON success false."""
+    """A path partly out of reach: exit 1, the failed points on stderr, JSON success false."""
     sc = tmp_path / "far.yaml"
     sc.write_text("name: far\nrobot: {planar: {links: 3, length: 0.1}}\n"
                   "path: {type: circle, center: [0.25, 0], radius: 0.1, step: 0.5}\n")
@@ -441,8 +441,30 @@ def test_track_unreachable_points_exit_1(tmp_path):
     data = as_json(res)
     assert data["success"] is False and data["computed"] == data["path_points"]
     assert data["failures"] and all(f["error"] > 0.005 for f in data["failures"])
-    assert res.stderr.count("not reached") == len(data["failures"])
+    failed = [f["index"] for f in data["failures"]]
+    assert data["failed_points"] == failed and data["reached"] == data["computed"] - len(failed)
+    assert f"{len(failed)} path points not reached: " in res.stderr  # one line, indices
+    assert res.stderr.count("not reached") == 1
     assert (tmp_path / "o" / "far.csv").is_file()  # nothing of the trajectory is lost
+
+
+def test_track_summary_is_short_and_says_what_was_reached(tmp_path):
+    """Text summary: 'reached K of N', errors in mm apart, at most 15 lines; --verbose all."""
+    sc = tmp_path / "far.yaml"
+    sc.write_text("name: far\nrobot: {planar: {links: 3, length: 0.1}}\n"
+                  "path: {type: circle, center: [0.25, 0], radius: 0.1, step: 0.1}\n")
+    res = run("track", sc, "--out", tmp_path / "o", "--no-animation", "--no-figures", code=1)
+    summary = [ln for ln in res.stdout.splitlines() if not ln.startswith("  wrote ")]
+    assert len(summary) <= 15
+    reached = int(summary[0].split()[1])
+    total = int(summary[0].split()[3])
+    assert summary[0].startswith("reached ") and reached < total
+    assert any(ln.startswith("position error: max ") and " mm" in ln for ln in summary)
+    assert any("more failures" in ln for ln in summary)
+    full = run("track", sc, "--out", tmp_path / "o2", "--no-animation", "--no-figures",
+               "--verbose", code=1)
+    listed = [ln for ln in full.stdout.splitlines() if ln.startswith("path point ")]
+    assert len(listed) == total - reached
 
 
 def test_models_show_and_save(tmp_path):

@@ -114,6 +114,7 @@ def _register() -> None:
     from serialkin.cli.calibrate_cmd import calibrate_cmd
     from serialkin.cli.commands import fk_cmd, ik_cmd, jacobian_cmd, models_cmd
     from serialkin.cli.compare_cmd import compare_cmd
+    from serialkin.cli.path_cmd import path_cmd
     from serialkin.cli.reach_cmd import base_placement_cmd, reach_cmd
     from serialkin.cli.track_cmd import track_cmd
     from serialkin.cli.view_cmd import view_cmd
@@ -121,7 +122,7 @@ def _register() -> None:
     from serialkin.cli.workspace_cmd import workspace_cmd
 
     for command in (models_cmd, fk_cmd, jacobian_cmd, ik_cmd, compare_cmd, track_cmd,
-                    workspace_cmd, view_cmd, calibrate_cmd, reach_cmd, base_placement_cmd,
+                    path_cmd, workspace_cmd, view_cmd, calibrate_cmd, reach_cmd, base_placement_cmd,
                     warmup_cmd):
         cli.add_command(command)
 

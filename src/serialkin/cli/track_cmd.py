@@ -72,13 +72,16 @@ _TRACK_HELP = command_help(
               help="Report joint jumps between path points above this [rad]; a hard bound "
                    "with --solver qp.")
 @click.option("--list", "list_only", is_flag=True, help="List the shipped scenarios.")
+@click.option("--verbose", "-v", is_flag=True,
+              help="List every failed point and joint jump in the summary (default: the "
+                   "first three of each and how many more).")
 @json_option
 @quiet_option
 @memory_budget_option
 @handle_errors
 def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_animation: bool,
               mp4: bool, fps: float, max_frames: int, viewer: bool, solver: str,
-              max_joint_step: float | None, list_only: bool, as_json: bool,
+              max_joint_step: float | None, list_only: bool, verbose: bool, as_json: bool,
               quiet: bool) -> None:
     """Track a scenario's path and write trajectory, figures and animation."""
     from serialkin.tracking import list_scenarios, load_scenario
@@ -120,13 +123,15 @@ def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_ani
     if as_json:
         click.echo(dumps_json(summary), nl=False)
     elif not quiet:
-        click.echo(traj.summary())
+        click.echo(traj.summary(verbose=verbose))
         for v in files.values():
             click.echo(f"  wrote {v}")
-    for f in traj.failures:
-        click.echo(str(f), err=True)
-    for j in traj.jumps:
-        click.echo(str(j), err=True)
+    for items, what in ((traj.failures, "path points not reached"),
+                        (traj.jumps, "joint jumps at points")):
+        if items:
+            idx = [x.index for x in items]
+            more = f" and {len(idx) - 10} more" if len(idx) > 10 else ""
+            click.echo(f"{len(idx)} {what}: {', '.join(map(str, idx[:10]))}{more}", err=True)
     if not traj.complete:
         raise SystemExit(EXIT_NOT_REACHED)
 
@@ -263,7 +268,12 @@ def _summary(sc: Any, traj: Any, files: dict[str, str]) -> dict[str, Any]:
         "computed": len(traj),
         "reached": int(np.sum(traj.reached)),
         "tolerance": traj.tolerance,
+        "failed_points": [f.index for f in traj.failures],
         "max_error": traj.max_error,
+        "max_position_error_m": float(traj.position_errors.max()) if len(traj) else None,
+        "max_orientation_error_rad": (float(traj.orientation_errors.max())
+                                      if len(traj) and traj.orientation_errors is not None
+                                      else None),
         "min_clearance": traj.min_clearance,
         "min_limit_margin": traj.min_limit_margin,
         "solver": traj.solver,

@@ -52,7 +52,7 @@ from typing import Any
 import numpy as np
 
 from serialkin._checks import MAX_ITERATIONS, MAX_JOINTS, MAX_LENGTH, beyond_a_turn, short_repr
-from serialkin._files import MAX_ITEMS, Field, load_document
+from serialkin._files import MAX_ITEMS, MISSING, Field, load_document
 from serialkin.errors import InputError, InputTypeError, SerialkinError
 from serialkin.model.tasks import TARGET_TASKS, get_task
 from serialkin.redundancy.multitask import MultiTaskResolver
@@ -110,10 +110,17 @@ _MT_FIELDS = {"weight", "obstacle_weight", "joint_limit_weight", "limit_buffer",
               "singularity_damping", "manipulability_threshold", "repulsive_gain", "gain",
               "max_task_step", "max_step", "tol", "max_iter", "link_radius"}
 _ROBOT_KINDS = ("planar", "dh", "model", "urdf")
+_POSE_STEPS = ("max_step", "max_angle", "max_angle_deg")
 _PATH_FIELDS = {"circle": {"center", "radius", "start", "stop", "step"},
                 "points": {"points"},
                 "polyline": {"waypoints", "step"},
-                "wave": {"start", "end", "amplitude", "periods", "step"}}
+                "wave": {"start", "end", "amplitude", "periods", "step"},
+                # pose paths (serialkin.tracking.poses): steps in metres and in radians
+                # ('max_angle') or degrees ('max_angle_deg'), never guessed
+                "line": {"start", "end", "orientation", *_POSE_STEPS},
+                "arc": {"start", "center", "axis", "angle", "angle_deg", "orientation",
+                        "end_rotation", *_POSE_STEPS},
+                "waypoints": {"poses", "blend", *_POSE_STEPS}}
 #: tasks of point paths (the target kinds given as [x, y], [x, y, φ] or [x, y, z])
 _TASKS = tuple(name for name in TARGET_TASKS if get_task(name).point_size <= 3)
 
@@ -159,9 +166,10 @@ class Scenario:
                      on_unreachable=self.on_unreachable, **self.options)
 
 
-def _robot(f: Field, base_dir: FsPath | None):
+def robot_from_field(f: Field, base_dir: FsPath | None):
+    """The robot of a scenario's ``robot`` field: planar, DH table, zoo model or URDF file."""
+    from serialkin.formats.robotfile import dh_rows_from_field
     from serialkin.model.robot import Robot
-    from serialkin.model.robotfile import dh_rows_from_field
 
     r = f.mapping({*_ROBOT_KINDS, "joint_limits_deg", "name"})
     kinds = [k for k in _ROBOT_KINDS if k in r]
@@ -221,10 +229,82 @@ def _point(f: Field, what: str = "[x, y]") -> np.ndarray:
     return a
 
 
+def _angle(f: Field, key: str, *, default: Any = None, lo: float = -1e6,
+           hi: float = 1e6) -> Any:
+    """The angle given as ``key`` [rad] or ``key_deg`` [deg] (not both) in radians."""
+    rad, deg = f[key], f[f"{key}_deg"]
+    if rad.present and deg.present:
+        raise rad.fail(f"and '{key}_deg' are both given; use one (radians or degrees)")
+    if deg.present:
+        return math.radians(deg.number(lo=math.degrees(lo), hi=math.degrees(hi), unit="deg"))
+    return rad.number(lo=lo, hi=hi, unit="rad", default=default)
+
+
+def pose_from_field(f: Field, robot=None, q0: np.ndarray | None = None) -> np.ndarray:
+    """A (4, 4) pose from ``{position: [x, y, z], rpy: [...]}`` (or ``rpy_deg``), or 'q0'.
+
+    ``position`` in metres; the rotation as roll-pitch-yaw angles in radians (``rpy``)
+    or degrees (``rpy_deg``), absent for no rotation; ``'q0'`` is the tool pose at the
+    scenario's start configuration.
+    """
+    from serialkin.spatial.rotations import rpy_to_matrix
+
+    if f.value == "q0" and robot is not None:
+        return robot.fk(q0)
+    m = f.mapping({"position", "rpy", "rpy_deg"}, ("position",),
+                  what="a pose {position: [x, y, z], rpy: [..] or rpy_deg: [..]} or 'q0'")
+    T = np.eye(4)
+    T[:3, 3] = m["position"].vector(3, lo=-MAX_LENGTH, hi=MAX_LENGTH)
+    if m["rpy"].present and m["rpy_deg"].present:
+        raise m["rpy"].fail("and 'rpy_deg' are both given; use one (radians or degrees)")
+    if m["rpy_deg"].present:
+        T[:3, :3] = rpy_to_matrix(np.radians(m["rpy_deg"].vector(3, lo=-1e4, hi=1e4)))
+    elif m["rpy"].present:
+        T[:3, :3] = rpy_to_matrix(m["rpy"].vector(3, lo=-100.0, hi=100.0))
+    return T
+
+
+def _pose_path(p: Field, kind: str, robot, q0: np.ndarray) -> Path:
+    """A line, arc or waypoint path of poses (serialkin.tracking.poses) from its fields."""
+    from serialkin.tracking import poses
+
+    steps = {"max_step": p["max_step"].number(lo=0.0, lo_open=True, hi=MAX_LENGTH,
+                                              default=0.005, unit="m"),
+             "max_angle": _angle(p, "max_angle", default=math.radians(1.0), lo=1e-9,
+                                 hi=math.pi)}
+    if kind == "line":
+        return poses.line(pose_from_field(p["start"].require(), robot, q0),
+                          pose_from_field(p["end"].require(), robot, q0),
+                          orientation=p["orientation"].string(choices=("slerp", "fixed"),
+                                                              default="slerp"), **steps)
+    if kind == "arc":
+        end = p["end_rotation"]
+        return poses.arc(pose_from_field(p["start"].require(), robot, q0),
+                         p["center"].require().vector(3, lo=-MAX_LENGTH, hi=MAX_LENGTH),
+                         p["axis"].require().vector(3, lo=-1e6, hi=1e6),
+                         _angle(p, "angle", default=MISSING, lo=-2 * math.pi, hi=2 * math.pi),
+                         end_rotation=(pose_from_field(end)[:3, :3] if end.present
+                                       else None),
+                         orientation=p["orientation"].string(
+                             choices=("follow", "fixed", "slerp"), default="follow"),
+                         **steps)
+    ws = np.stack([pose_from_field(w, robot, q0) for w in
+                   p["poses"].require().items(min_len=2, max_len=MAX_ITEMS)])
+    blend = p["blend"].number(lo=0.0, hi=MAX_LENGTH, default=0.0, unit="m")
+    return poses.waypoints(ws, blend=blend, **steps)
+
+
 def _path(f: Field, robot, q0: np.ndarray) -> Path:
     p = f.mapping()
     kind = p["type"].string(choices=_PATH_FIELDS)
     p.mapping(_PATH_FIELDS[kind] | {"type", "task"})
+    if kind in ("line", "arc", "waypoints"):
+        try:
+            return _pose_path(p, kind, robot, q0)
+        except (InputError, InputTypeError) as exc:
+            if isinstance(exc, ScenarioError):
+                raise
+            raise f.fail(f"is invalid: {exc}") from exc
     task = p["task"].string(choices=_TASKS, default=None)
     try:
         if kind == "circle":
@@ -368,7 +448,7 @@ def scenario_from_dict(data: object, source: str = "<dict>",
     """
     doc = Field(data, "", f"scenario {source!r}", ScenarioError)
     doc.mapping(_ROOT_FIELDS, ("robot", "path"))
-    robot = _robot(doc["robot"], FsPath(base_dir) if base_dir is not None else None)
+    robot = robot_from_field(doc["robot"], FsPath(base_dir) if base_dir is not None else None)
     n = robot.n
     if doc["q0"].present and doc["q0_deg"].present:
         raise doc["q0"].fail("and 'q0_deg' are both given; use one")

@@ -2,7 +2,9 @@
 
 Per path point (step) ``k`` a trajectory holds the joint values ``q[k]`` (n,), the reached
 end-effector pose ``poses[k]`` (4, 4), the target ``targets[k]`` (4, 4), the tracking error
-``errors[k]`` (norm of the task error [m]), the iterations used, whether the point was
+``errors[k]`` (norm of the task error; position and orientation errors apart by
+:attr:`Trajectory.position_errors` [m] and :attr:`Trajectory.orientation_errors` [rad]),
+the iterations used, whether the point was
 reached within the tolerance, the minimum clearance to every obstacle ``clearance[k]``
 (k_obs,) [m] and the margin of every joint to its nearer limit ``limit_margin[k]`` (n,)
 [rad or m; +inf when unlimited].
@@ -25,7 +27,21 @@ import numpy as np
 from serialkin._io import write_bytes_atomic
 from serialkin.errors import InputError
 
-__all__ = ["JointJump", "PathFailure", "Trajectory"]
+__all__ = ["JointJump", "PathFailure", "Trajectory", "format_duration"]
+
+
+def format_duration(seconds: float) -> str:
+    """A duration with a unit that suits it: '12.3 µs', '4.56 ms', '7.8 s', '3 min 20 s'."""
+    if not np.isfinite(seconds):
+        return str(seconds)
+    if seconds < 1e-3:
+        return f"{seconds * 1e6:.3g} µs"
+    if seconds < 1.0:
+        return f"{seconds * 1e3:.3g} ms"
+    if seconds < 120.0:
+        return f"{seconds:.3g} s"
+    minutes, rest = divmod(round(seconds), 60)
+    return f"{minutes} min {rest} s"
 
 
 @dataclass(frozen=True)
@@ -74,7 +90,9 @@ class Trajectory:
         q: (p, n) joint values.
         poses: (p, 4, 4) end-effector poses reached.
         targets: (p, 4, 4) path targets.
-        errors: (p,) task-error norms [m].
+        errors: (p,) task-error norms (for a 'pose' task the norm of [position error m,
+            rotation vector rad]; :attr:`position_errors` [m] and
+            :attr:`orientation_errors` [rad] give them apart).
         iterations: (p,) solver iterations per point.
         reached: (p,) error ≤ tolerance.
         clearance: (p, k) minimum clearance per obstacle [m] (k = 0 without obstacles).
@@ -142,25 +160,65 @@ class Trajectory:
         """Every path point was computed and reached."""
         return not self.stopped and len(self) == self.path_length and not self.failures
 
-    def summary(self) -> str:
-        """A one-paragraph human-readable report."""
-        lines = [
-            f"{len(self)}/{self.path_length} path points computed with {self.solver}; "
-            f"max tracking error {self.max_error * 1e3:.4g} mm "
-            f"(tolerance {self.tolerance * 1e3:.4g} mm); "
-            f"{int(self.iterations.sum())} iterations, {self.times.sum() * 1e3:.3g} ms"]
+    @property
+    def position_errors(self) -> np.ndarray:
+        """(p,) distance of each reached position from its target [m] (planar tasks: in x, y)."""
+        d = self.poses[:, :3, 3] - self.targets[:, :3, 3]
+        if self.task in ("planar", "planar_pose"):
+            d = d[:, :2]
+        return np.linalg.norm(d, axis=1)
+
+    @property
+    def orientation_errors(self) -> np.ndarray | None:
+        """(p,) rotation angle between reached and target orientation [rad], or None.
+
+        None for tasks that do not constrain the orientation ('planar', 'position');
+        for 'planar_pose' the angle about z, for 'pose' the full rotation angle.
+        """
+        if self.task not in ("pose", "planar_pose"):
+            return None
+        R = np.swapaxes(self.targets[:, :3, :3], -1, -2) @ self.poses[:, :3, :3]
+        if self.task == "planar_pose":
+            return np.abs(np.arctan2(R[:, 1, 0], R[:, 0, 0]))
+        c = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+        return np.arccos(c)
+
+    def summary(self, verbose: bool = False) -> str:
+        """A short report (at most 15 lines), or every failure and jump with ``verbose``.
+
+        Says how many path points were reached (not merely computed), the largest and
+        median position error [mm] and, for orientation tasks, orientation error [deg],
+        separately; the time with a unit that suits it; clearances and joint-limit
+        margins; then the failures, jumps and notes (the first few, and how many more).
+        """
+        reached = int(np.sum(self.reached))
+        head = f"reached {reached} of {self.path_length} path points with {self.solver}"
+        if self.stopped:
+            head += f" (stopped after point {len(self) - 1}: the next could not be reached)"
+        lines = [head]
+        if len(self):
+            pos = self.position_errors * 1e3
+            lines.append(f"position error: max {pos.max():.4g} mm, median "
+                         f"{np.median(pos):.4g} mm (tolerance {self.tolerance * 1e3:.4g} mm)")
+            rot = self.orientation_errors
+            if rot is not None:
+                lines.append(f"orientation error: max {np.degrees(rot.max()):.4g} deg, "
+                             f"median {np.degrees(np.median(rot)):.4g} deg")
+            lines.append(f"time: {format_duration(float(self.times.sum()))} in all, "
+                         f"{format_duration(float(np.median(self.times)))} per point "
+                         f"(median); {int(self.iterations.sum())} iterations")
         if self.clearance.size:
             lines.append(f"min clearance {self.min_clearance * 1e3:.4g} mm")
         if np.isfinite(self.min_limit_margin):
             lines.append(f"min joint-limit margin {np.degrees(self.min_limit_margin):.4g} deg")
-        for f in self.failures:
-            lines.append(str(f))
-        for jmp in self.jumps:
-            lines.append(str(jmp))
-        lines.extend(self.notes)
-        if self.stopped:
-            lines.append("tracking stopped at the first unreachable point")
-        return "; ".join(lines)
+        for items, what in ((self.failures, "failures"), (self.jumps, "jumps"),
+                            (self.notes, "notes")):
+            shown = items if verbose else items[:3]
+            lines.extend(str(x) for x in shown)
+            if len(items) > len(shown):
+                lines.append(f"... and {len(items) - len(shown)} more {what} "
+                             "(summary(verbose=True), or --verbose, lists them all)")
+        return "\n".join(lines)
 
     # ------------------------------------------------------------------ files
     def _meta(self) -> dict:
