@@ -38,16 +38,11 @@ __all__ = ["FEATURES", "Feature", "feature_of_module", "install_notice", "warmup
 
 @dataclass(frozen=True)
 class Feature(CompileFeature):
-    """A group of kernels compiled together, by one process.
+    """A :class:`~serialkin._background.CompileFeature` with what compiles it, in one process.
 
     Attributes:
-        name: the name ``serialkin warmup NAME`` takes.
-        summary: what a user does that needs these kernels.
-        modules: prefixes of the ``serialkin`` modules whose kernels this is (the
-            compile notice names the feature of the kernel being compiled).
-        seconds: the measured cold compile time on a quiet 2-core machine [s] (the
-            estimate the notice and the progress bar show; docs/compile-time.md).
-        run: calls the feature's public functions (compiling what they need).
+        run: calls the feature's public functions (compiling what they need); the other
+            attributes are :class:`~serialkin._background.CompileFeature`'s.
     """
 
     run: Callable[[], object]
