@@ -82,6 +82,9 @@ def dual_active_set(H, c, A, b, x, max_iter):
         (status, iterations): status OPTIMAL (1), INFEASIBLE (−1), ITERATION_LIMIT (−4) or
         NOT_CONVEX (−5, H not positive definite).
     """
+    # One piece over 80 lines: the dual active-set iteration (Goldfarb-Idnani) updates one
+    # factorisation and one active set in a single loop; split into compiled calls it would add
+    # levels that each re-link and re-optimise their callees (docs/compile-time.md).
     n = H.shape[0]
     m = A.shape[0]
     L = np.zeros((n, n))

@@ -85,6 +85,9 @@ def qp_point_into(q, target, rows, F, L, meta, lo, hi, cfg, has_tool, enc, influ
         (iterations, best error [m], code): code CONVERGED, NO_PROGRESS, CONFLICT, BUDGET
         or the QP solver's negative status.
     """
+    # One piece over 80 lines: the QP iterations share their buffers, Cholesky factor and active
+    # set from step to step; split into compiled calls it would add levels that each re-link and
+    # re-optimise their callees (docs/compile-time.md).
     n = q.shape[0]
     m = rows.shape[0]
     w_post = cfg[0]

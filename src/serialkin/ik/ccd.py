@@ -139,6 +139,9 @@ def ccd_sweep(q, F, meta, T_target, pos_sel, w_pos, w_orient, lo, hi, J, T):
         J: (6, n) work array.
         T: (4, 4) receives the end-effector pose after the sweep.
     """
+    # One piece over 80 lines: each joint's exact update reads the pose the previous joint's
+    # update wrote; split into compiled calls it would add levels that each re-link and
+    # re-optimise their callees (docs/compile-time.md).
     n = q.shape[0]
     jacobian_into(q, F, meta, J, T)
     p0x = T[0, 3]

@@ -158,6 +158,9 @@ def fabrik_pass(q, F, meta, T_target, pos_sel, use_orient, a, e1, e2, sign, lo, 
     Returns:
         True when the target was beyond the chain's reach (the chain was stretched).
     """
+    # One piece over 80 lines: the forward and backward reaching and the angle recovery work on
+    # the same point buffers in one pass; split into compiled calls it would add levels that
+    # each re-link and re-optimise their callees (docs/compile-time.md).
     n = q.shape[0]
     jacobian_into(q, F, meta, J, T)
     px = T[0, 3]

@@ -166,6 +166,9 @@ def step_lm(q, J, e, cost, p, ctx, ws, dq):
     triangular substitutions (its column of A⁻¹) and S's small system, not a new normal
     matrix and factorisation.
     """
+    # One piece over 80 lines: the active set re-solves the same damped system with the joints
+    # at a limit removed; split into compiled calls it would add levels that each re-link and
+    # re-optimise their callees (docs/compile-time.md).
     lo = ctx[5]
     hi = ctx[6]
     revolute = ctx[7]

@@ -120,6 +120,9 @@ def search_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r
     Returns:
         the number of distinct converged solutions.
     """
+    # One piece over 80 lines: the grid scan and the Newton refinement of its sign changes share
+    # their buffers; split into compiled calls it would add levels that each re-link and
+    # re-optimise their callees (docs/compile-time.md).
     N = grid
     c = aux[0].copy()
     u4 = aux[aux.shape[0] - 1].copy()

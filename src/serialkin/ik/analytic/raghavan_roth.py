@@ -513,6 +513,10 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
     in general ``U·exp(−ξ_D θ_D)·V·exp(−ξ_E θ_E)·W'·x`` on the right with U, V, W'
     each I or G; the point ``o`` is on the first left axis.
     """
+    # One piece over 80 lines: one elimination (the equations, the matrix polynomial, its
+    # eigenproblem and the back-substitution) shares its scratch arrays; split into compiled
+    # calls it would add levels that each re-link and re-optimise their callees
+    # (docs/compile-time.md).
     scale = 0.0
     for j in range(6):
         for i in range(3):
