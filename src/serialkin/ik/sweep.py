@@ -25,10 +25,9 @@ from serialkin._checks import check_transform
 from serialkin.errors import InputError
 from serialkin.ik.analytic import ik_all
 from serialkin.model.robot import Robot
+from serialkin.spatial.rotations import wrap_angle
 
 __all__ = ["JointSweep", "joint_sweep"]
-
-_TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True, eq=False)
@@ -131,9 +130,7 @@ def _values(robot: Robot, j: int, values: object, resolution: float) -> np.ndarr
 
 def _distance(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """(a, b) the largest change of any joint between rows of A and B (angles wrapped)."""
-    d = A[:, None, :] - B[None, :, :]
-    d = np.abs((d + math.pi) % _TWO_PI - math.pi)
-    return d.max(axis=2)
+    return np.abs(wrap_angle(A[:, None, :] - B[None, :, :])).max(axis=2)
 
 
 def _connect(rows: list[np.ndarray], n: int, max_jump: float) -> tuple[np.ndarray, np.ndarray]:

@@ -28,12 +28,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from serialkin._checks import check_positive
+from serialkin._checks import check_positive, check_transform
 from serialkin.errors import InputError, NoClosedFormError
 from serialkin.ik.analytic import ik_all
 from serialkin.ik.analytic.arm_angle import arm_angle, ik_arm_angle_path, srs_structure
 from serialkin.model.robot import Robot
 from serialkin.spatial.pose import pose_error
+from serialkin.spatial.rotations import wrap_angle
 from serialkin.tracking.path import Path
 
 __all__ = ["JointPath", "joint_path"]
@@ -126,8 +127,6 @@ def _poses(path: Path | object) -> np.ndarray:
             raise InputError(f"path must be a pose path (task 'pose'), got task {path.task!r}: "
                              "build one with serialkin.paths.line, arc or waypoints")
         return path.targets
-    from serialkin._checks import check_transform
-
     T = check_transform(path, "path")
     if T.ndim != 3:
         raise InputError(f"path poses must have shape (p, 4, 4), got {T.shape}")
@@ -193,6 +192,13 @@ def _reference(robot: Robot, T: np.ndarray) -> np.ndarray:
 
 # ---------------------------------------------------------- dynamic programming
 
+def _joint_change(robot: Robot, d: np.ndarray) -> np.ndarray:
+    """Joint changes (..., n) with the revolute ones wrapped to (−π, π] (the shortest turn)."""
+    d = np.array(d, dtype=float)
+    d[..., robot.revolute] = wrap_angle(d[..., robot.revolute])
+    return d
+
+
 def _dynamic_programme(robot: Robot, rows: list[np.ndarray], start, bound: float):
     """(chosen rows (m, n), failed_at, reason) by Bellman's recursion over allowed edges.
 
@@ -208,18 +214,15 @@ def _dynamic_programme(robot: Robot, rows: list[np.ndarray], start, bound: float
         valid[i, :len(r)] = True
     if not valid[0].any():
         return np.zeros((0, n)), 0, _unreachable(0)
-    D = R[1:, None, :, :] - R[:-1, :, None, :]                  # (p − 1, K, K, n): a → b
-    rev = robot.revolute
-    D[..., rev] = (D[..., rev] + math.pi) % _TWO_PI - math.pi
+    D = _joint_change(robot, R[1:, None, :, :] - R[:-1, :, None, :])  # (p − 1, K, K, n)
     A = np.abs(D)
     step = A.max(axis=3)
     allowed = (step <= bound) & valid[:-1, :, None] & valid[1:, None, :]
     edge = np.where(allowed, A.sum(axis=3), np.inf)
     cost = np.where(valid[0], 0.0, np.inf)
     if start is not None:
-        d0 = R[0] - start
-        d0[:, rev] = (d0[:, rev] + math.pi) % _TWO_PI - math.pi
-        cost = np.where(valid[0], np.abs(d0).sum(axis=1), np.inf)
+        cost = np.where(valid[0], np.abs(_joint_change(robot, R[0] - start)).sum(axis=1),
+                        np.inf)
     back = np.zeros((p, K), dtype=np.int64)
     cols = np.arange(K)
     reach = valid.any(axis=1)
@@ -274,9 +277,7 @@ def _unwrap(robot: Robot, Q: np.ndarray, start) -> np.ndarray:
         lo, hi = robot.qlim[rev, 0], robot.qlim[rev, 1]
         ok = (moved >= lo) & (moved <= hi)
         out[0, rev] = np.where(ok, moved, out[0, rev])
-    d = np.diff(out, axis=0)
-    d[:, rev] = (d[:, rev] + math.pi) % _TWO_PI - math.pi
-    out[1:] = out[0] + np.cumsum(d, axis=0)
+    out[1:] = out[0] + np.cumsum(_joint_change(robot, np.diff(out, axis=0)), axis=0)
     return out
 
 
@@ -322,8 +323,7 @@ def _numerical(robot: Robot, T: np.ndarray, start, bound: float, seed) -> JointP
                            bound, "numerical", (None, None))
         q = np.asarray(res.q, dtype=float)
         if prev is not None:
-            d = q - prev
-            d[robot.revolute] = (d[robot.revolute] + math.pi) % _TWO_PI - math.pi
+            d = _joint_change(robot, q - prev)
             if i > 0 and np.abs(d).max() > bound:
                 j = int(np.argmax(np.abs(d)))
                 return _result(robot, T, np.array(out).reshape(-1, robot.n), i,

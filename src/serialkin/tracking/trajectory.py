@@ -26,6 +26,7 @@ import numpy as np
 
 from serialkin._io import write_bytes_atomic
 from serialkin.errors import InputError
+from serialkin.spatial.lie import so3_log
 
 __all__ = ["JointJump", "PathFailure", "Trajectory", "format_duration"]
 
@@ -180,8 +181,7 @@ class Trajectory:
         R = np.swapaxes(self.targets[:, :3, :3], -1, -2) @ self.poses[:, :3, :3]
         if self.task == "planar_pose":
             return np.abs(np.arctan2(R[:, 1, 0], R[:, 0, 0]))
-        c = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-        return np.arccos(c)
+        return np.linalg.norm(so3_log(R, check=False), axis=-1)  # accurate near 0, unlike acos
 
     def summary(self, verbose: bool = False) -> str:
         """A short report (at most 15 lines), or every failure and jump with ``verbose``.

@@ -43,6 +43,7 @@ from serialkin._memo import PerObject
 from serialkin.errors import InputError, NoClosedFormError
 from serialkin.model.robot import Robot, robot_scale
 from serialkin.spatial.pose import pose_error
+from serialkin.spatial.rotations import wrap_angle
 
 __all__ = ["ArmAngleIntervals", "ArmAngleSolutions", "SRSArm", "arm_angle",
            "arm_angle_intervals", "ik_arm_angle", "ik_arm_angle_path", "srs_structure"]
@@ -126,8 +127,8 @@ class ArmAngleIntervals:
     singular: bool
 
     def contains(self, psi: float, branch: int | None = None) -> bool:
-        """Whether ψ [rad] (wrapped to [−π, π)) is feasible, on ``branch`` or on any."""
-        x = (float(psi) + math.pi) % _TWO_PI - math.pi
+        """Whether ψ [rad] (wrapped to (−π, π]) is feasible, on ``branch`` or on any."""
+        x = float(wrap_angle(float(psi)))
         spans = self.feasible if branch is None else self.branches.get(int(branch), [])
         return any(lo - 1e-12 <= x <= hi + 1e-12 for lo, hi in spans)
 
