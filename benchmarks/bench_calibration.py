@@ -13,8 +13,9 @@ analysis (two SVD-based passes); the 2-point variant is given the fitted set.
 
 Issue 33: the staged fit on truth robots made without the error models (every joint origin
 moved ≤ 1 mm and tilted ≤ 0.3°, an 8 cm marker; ``perturb_joints``), UR5 from 80 positions
-with 50 µm noise and from 1,000: time and validation RMS (no baseline: one stage of the
-old kind does not reach the truth).
+with 50 µm noise and from 1,000: time (median [10–90 %] of the repeats) and validation RMS
+(no baseline: one stage of the old kind does not reach the truth); goal 33.b in
+``run_all.py``.
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ from serialkin.calibration.jacobian import whitened  # noqa: E402
 from serialkin.kinematics.parallel import single_threaded_blas  # noqa: E402
 
 TARGET_S = 1.0  # a fit should take at most a second
+TARGET_LARGE_S = 5.0  # ... and 1,000 measurements at most five
 
 
 def _fd_fit(model, meas, keep):
@@ -107,8 +109,9 @@ def _staged(label, robot, count, repeat):
     print(f"{label:44s} {a.fmt(4):>26s} {'':>26s} {'':>7s}   "
           f"{np.sqrt(np.mean(err**2)) * 1e3:.4f} mm  ({res.identifiability.rank} params, "
           f"{res.iterations} evaluations, success {res.success})")
-    record("16.1", f"calibration fit {label} [s]", a.median, "s", f"<= {TARGET_S:g} s",
-           a.median <= TARGET_S)
+    target = TARGET_S if count <= 100 else TARGET_LARGE_S
+    record("33.b", f"time to calibrate {label} [s]", a.median, "s", f"<= {target:g} s",
+           a.median <= target)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -9,7 +9,6 @@ from click.testing import CliRunner
 
 import serialkin as sk
 from serialkin.cli.main import cli
-from serialkin.formats.robotfile import load_robot_file
 
 
 def _run(*args):
@@ -28,10 +27,12 @@ def test_simulate_then_calibrate(tmp_path):
              "--report", str(report))
     assert r.exit_code == 0, r.output
     assert "d1 and base z cannot be separated" in r.output
-    assert "note: the calibrated axes are not exactly DH" in r.output
+    # Hayati's β on the UR5: a DH table would need tens of metres; the URDF is written
+    assert f"note: {out} not written" in r.output and "nearly parallel" in r.output
+    assert not out.exists()
     real = sk.Robot.from_urdf(str(truth))
     q = real.random_q(200, seed=5)
-    for robot in (load_robot_file(out), sk.Robot.from_urdf(str(urdf))):
+    for robot in (sk.Robot.from_urdf(str(urdf)),):
         err = np.linalg.norm(robot.fk(q)[:, :3, 3] - real.fk(q)[:, :3, 3], axis=1)
         assert np.sqrt(np.mean(err**2)) < 1e-4
     rows = report.read_text().splitlines()

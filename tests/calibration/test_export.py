@@ -14,9 +14,13 @@ from serialkin.formats.robotfile import load_robot_file
 @pytest.mark.parametrize("name", ["ur5", "panda"])
 @pytest.mark.parametrize("suffix", [".yaml", ".json", ".urdf"])
 def test_saved_robot_has_the_calibrated_kinematics(tmp_path, name, suffix):
-    """Reading the written file back gives the calibrated forward kinematics."""
+    """Reading the written file back gives the calibrated kinematics (UR5 DH: refused)."""
     model = error_model(sk.models.get(name))
     robot = model.calibrated_robot(perturb(model, seed=1))
+    if name == "ur5" and suffix != ".urdf":  # β links: DH would need tens of metres
+        with pytest.raises(InputError, match="nearly parallel"):
+            save_robot(robot, tmp_path / f"cal{suffix}")
+        return
     path = save_robot(robot, tmp_path / f"cal{suffix}")
     back = sk.Robot.from_urdf(str(path)) if suffix == ".urdf" else load_robot_file(path)
     q = robot.random_q(20, seed=2)

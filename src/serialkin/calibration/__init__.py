@@ -10,13 +10,14 @@
 * :mod:`~serialkin.calibration.crossval` — k-fold cross-validation of a calibration;
 * :mod:`~serialkin.calibration.selection` — choosing poses by observability indices;
 * :mod:`~serialkin.calibration.simulate` — perturbed robots and noisy measurements;
-* :mod:`~serialkin.calibration.export` — the calibrated robot as a robot file or URDF.
+* :mod:`~serialkin.calibration.export` — the calibrated robot: the user's URDF patched, a
+  URDF, or a robot file (refused when its DH table would not be physical).
 
 See ``docs/calibration.md``.
 """
 
 from serialkin.calibration.crossval import CrossValidation, cross_validate, holdout_errors
-from serialkin.calibration.export import save_robot
+from serialkin.calibration.export import UrdfPatch, patch_urdf, save_robot
 from serialkin.calibration.fit import CalibrationResult, ChiSquare, calibrate
 from serialkin.calibration.identifiability import Identifiability, identifiability
 from serialkin.calibration.measurements import (
@@ -37,6 +38,7 @@ __all__ = [
     "Identifiability",
     "Measurements",
     "Parameter",
+    "UrdfPatch",
     "calibrate",
     "cross_validate",
     "error_model",
@@ -44,6 +46,7 @@ __all__ = [
     "identifiability",
     "make_measurements",
     "observability",
+    "patch_urdf",
     "perturb",
     "perturb_joints",
     "read_measurements",

@@ -18,7 +18,11 @@ analytic identification Jacobian of :mod:`serialkin.calibration.jacobian`), in r
    last converged one, those parameters fixed.
 
 (Fitting the base and the marker alone first was tried and dropped: the same results on
-every arm measured, in more evaluations.)
+every arm measured, in more evaluations.) With ``frame='unknown'`` (the measuring
+device's frame anywhere) the fit starts from a base pose estimated first: the rigid
+transform that best maps the nominal model's tool positions onto the measured ones
+(Kabsch / Horn, by the SVD of their cross-covariance), the base translation then free of
+the plausibility bound on lengths.
 
 Standard errors and the covariance come from the Gauss–Newton approximation at the
 solution, ``Cov(p̂) = s² (JᵀJ)⁻¹`` over the fitted set, with ``s² = Σ r² / (m·k − r)`` the
@@ -205,6 +209,25 @@ class CalibrationResult:
                 f"{pb * 1e3:.4g} mm → {pa * 1e3:.4g} mm RMS{rot}{noise}\n"
                 + self.identifiability.summary())
 
+    @property
+    def encoder_scale(self) -> np.ndarray:
+        """(n,) identified factors ``1 + s_i`` (1 where no scale is modelled or fitted)."""
+        return self.model.encoder_scale(self.params)
+
+    @property
+    def marker_offsets(self) -> np.ndarray:
+        """(K, 3) identified marker offsets [m] in the tool frame (marker 1 at the origin)."""
+        return self.model.marker_offsets(self.params)
+
+    def joint_values(self, q: object) -> np.ndarray:
+        """The calibrated :attr:`robot`'s joint values (…, n) for recorded ones: ``q · scale``.
+
+        ``robot.fk(result.joint_values(q))`` is the calibrated pose of the tool at recorded
+        (encoder) values q; without encoder scales in the model it is q itself.
+        """
+        qa = self.model.robot.check_q(q)
+        return qa * self.encoder_scale
+
     def predicted_error(self, q: object = None, *, count: int = 1000,
                         seed: None | int | np.random.Generator = 0) -> float:
         """Expected RMS position error [m] of the calibrated robot at configurations.
@@ -259,7 +282,7 @@ def minimum_measurements(rank: int, kind: str) -> int:
 def calibrate(robot: Robot | ErrorModel, measurements: Measurements, *,
               loss: str = "linear", loss_scale: float = 1.0, max_evaluations: int = 200,
               tol: float = 1e-12, rank_tol: float | None = None,
-              significance: float = SIGNIFICANCE) -> CalibrationResult:
+              significance: float = SIGNIFICANCE, frame: str = "nominal") -> CalibrationResult:
     """Identify the robot's geometry from measurements (see the module docstring).
 
     Args:
@@ -278,6 +301,10 @@ def calibrate(robot: Robot | ErrorModel, measurements: Measurements, *,
             :data:`~serialkin.calibration.identifiability.RANK_TOL`).
         significance: level of the chi-square test of the residual against the stated
             noise (:class:`ChiSquare`); 0 turns the test off.
+        frame: the measuring device's frame: 'nominal' (the robot's base pose in it is
+            known roughly; the fit starts there) or 'unknown' (anywhere: the base pose is
+            first estimated by a rigid registration of the nominal tool positions to the
+            measured ones, then identified with the rest; needs the six base errors).
 
     Returns:
         :class:`CalibrationResult`.
@@ -296,6 +323,14 @@ def calibrate(robot: Robot | ErrorModel, measurements: Measurements, *,
     if measurements.q.shape[1] != model.robot.n:
         raise InputError(f"the measurements have {measurements.q.shape[1]} joint values each "
                          f"but robot {model.robot.name!r} has {model.robot.n} joints")
+    if len(measurements) and int(measurements.markers.max()) >= model.markers:
+        raise InputError(f"the measurements name marker {int(measurements.markers.max()) + 1} "
+                         f"but the error model has {model.markers} marker(s) (expected "
+                         f"error_model(..., markers={int(measurements.markers.max()) + 1}))")
+    check_choice(frame, "frame", FRAMES)
+    if frame == "unknown" and sum(p.group == "base" for p in model.parameters) != 6:
+        raise InputError("frame='unknown' identifies the base pose: the error model needs "
+                         "its six base errors (error_model(..., base=True))")
     check_choice(loss, "loss", LOSSES)
     loss_scale = check_positive(loss_scale, "loss_scale")
     max_evaluations = check_int(max_evaluations, "max_evaluations", minimum=1)
@@ -307,12 +342,48 @@ def calibrate(robot: Robot | ErrorModel, measurements: Measurements, *,
     # small dense problems: a multi-threaded BLAS next to numba's thread pool costs 10-40x
     with single_threaded_blas():
         return _calibrate(model, measurements, loss, loss_scale, max_evaluations, tol,
-                          rank_tol, significance)
+                          rank_tol, significance, frame)
+
+
+#: The measuring device's frame (:func:`calibrate`'s ``frame``).
+FRAMES = ("nominal", "unknown")
+
+
+def registered_base(model: ErrorModel, measurements: Measurements) -> np.ndarray:
+    """Parameters (p,): nominal, the base errors set to the best rigid registration.
+
+    The rotation R and translation t minimising ``Σ ‖R x_i + t − y_i‖²`` between the
+    nominal model's tool positions x_i and the measured y_i (Kabsch 1976 / Horn 1987:
+    ``R = U diag(1, 1, det UVᵀ) Vᵀ`` from the SVD ``U S Vᵀ`` of the centred
+    cross-covariance ``Σ (y_i − ȳ)(x_i − x̄)ᵀ``, ``t = ȳ − R x̄``); with the nominal base
+    B0 the base error is ``E = B0⁻¹ · [R t] · B0``, written as ``Txyz · Rz · Ry · Rx``.
+    An unknown marker only blurs it by its length: the fit refines it.
+    """
+    from serialkin.spatial import matrix_to_rpy
+
+    p = model.nominal.copy()
+    x = model.fk(np.asarray(measurements.q), p)[:, :3, 3]
+    y = np.asarray(measurements.positions)
+    xc, yc = x - x.mean(axis=0), y - y.mean(axis=0)
+    U, _, Vt = np.linalg.svd(yc.T @ xc)
+    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Vt)) or 1.0])
+    G = np.eye(4)
+    G[:3, :3] = U @ D @ Vt
+    G[:3, 3] = y.mean(axis=0) - G[:3, :3] @ x.mean(axis=0)
+    B0 = model.robot.base
+    E = np.linalg.inv(B0) @ G @ B0
+    roll, pitch, yaw = matrix_to_rpy(E[:3, :3], check=False)
+    values = {"base x": E[0, 3], "base y": E[1, 3], "base z": E[2, 3], "base rz": yaw,
+              "base ry": pitch, "base rx": roll}
+    for k, name in enumerate(model.names):
+        if name in values:
+            p[k] = values[name]
+    return p
 
 
 def _calibrate(model: ErrorModel, measurements: Measurements, loss: str, loss_scale: float,
                max_evaluations: int, tol: float, rank_tol: float,
-               significance: float) -> CalibrationResult:
+               significance: float, frame: str) -> CalibrationResult:
     kind = measurements.kind
     # the identifiable set at generic configurations, to say how many measurements it needs
     generic_q = model.robot.random_q(max(60, model.size), seed=0)
@@ -327,8 +398,10 @@ def _calibrate(model: ErrorModel, measurements: Measurements, loss: str, loss_sc
             f"(several times more for accuracy)")
     p0 = model.nominal
     e0, _ = errors(model, measurements, p0)
+    start = registered_base(model, measurements) if frame == "unknown" else p0
+    free_base = frame == "unknown"
     solver = _Solver(model, measurements, loss, loss_scale, tol, max_evaluations)
-    ident = identifiability(model, measurements, tol=rank_tol)
+    ident = identifiability(model, measurements, start, tol=rank_tol)
     success, reason = False, ""
     params = p0.copy()
     std = np.full(model.size, np.nan)
@@ -338,7 +411,8 @@ def _calibrate(model: ErrorModel, measurements: Measurements, loss: str, loss_sc
     else:
         try:
             with np.errstate(all="ignore"):
-                params, ident, success, reason = _fit_rounds(solver, ident, rank_tol)
+                params, ident, success, reason = _fit_rounds(solver, ident, rank_tol, start,
+                                                             free_base)
         except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
             reason = f"the solver failed: {exc}"
             params = solver.best
@@ -353,7 +427,8 @@ def _calibrate(model: ErrorModel, measurements: Measurements, loss: str, loss_sc
         cov[np.ix_(fit, fit)] = block
         std[fit] = np.sqrt(np.maximum(np.diag(block), 0.0))
     e1, _ = errors(model, measurements, params)
-    doubt = implausible(model, params, e1) if np.isfinite(e1).all() else ""
+    doubt = implausible(model, params, e1, free_base=free_base) if np.isfinite(e1).all() \
+        else ""
     if success:
         if not doubt and significance > 0:
             doubt = test.verdict(significance)
@@ -420,15 +495,18 @@ class _Solver:
 MAX_ROUNDS = 6
 
 
-def _fit_rounds(solver: _Solver, nominal_ident: Identifiability, rank_tol: float
+def _fit_rounds(solver: _Solver, nominal_ident: Identifiability, rank_tol: float,
+                start: np.ndarray, free_base: bool = False
                 ) -> tuple[np.ndarray, Identifiability, bool, str]:
     """The identifiable set, fitted and re-analysed where each fit ends (module docstring).
+
+    ``start`` (p,) is where the first round starts (nominal, or with a registered base).
 
     Returns:
         (params (p,), the final analysis, converged, reason).
     """
     model, meas = solver.model, solver.meas
-    p = model.nominal.copy()
+    p = start.copy()
     # the set identifiable at the nominal geometry; then, until the set no longer changes,
     # the set identifiable where the last fit ended (a marker off the last axis there
     # shows that axis' tilts)
@@ -443,7 +521,7 @@ def _fit_rounds(solver: _Solver, nominal_ident: Identifiability, rank_tol: float
         elif not (np.isfinite(sol.fun).all() and np.isfinite(p).all()):
             failed = "non-finite residuals or parameters"
         elif good is not None:
-            failed = implausible(model, p, errors(model, meas, p)[0])
+            failed = implausible(model, p, errors(model, meas, p)[0], free_base=free_base)
         if failed and good is None:
             return p, ident, False, failed
         if failed:
@@ -467,9 +545,9 @@ def _fit_rounds(solver: _Solver, nominal_ident: Identifiability, rank_tol: float
         if np.array_equal(again.identifiable, ident.identifiable):
             return p, again, True, str(sol.message)
         good = (p.copy(), ident.identifiable.copy(), sol, noise)
-        # parameters that became redundant go back to their nominal (data-sheet) values
+        # parameters that became redundant go back to their start (data-sheet) values
         dropped = ident.identifiable & ~again.identifiable
-        p[dropped] = model.nominal[dropped]
+        p[dropped] = start[dropped]
         ident = again
     return p, ident, False, (f"the identifiable set kept changing over {MAX_ROUNDS} fits "
                              "(parameters at the edge of identifiability); the last "
@@ -516,7 +594,7 @@ def _practical(model: ErrorModel, meas: Measurements, p: np.ndarray,
     order = [k for k in order if current[k]] + [k for k in order if not current[k]]
     size = robot_scale(model.robot)
     limit = np.array([PRECISION_LENGTH * size if par.unit == "m" else PRECISION_ANGLE
-                      for par in model.parameters])
+                      for par in model.parameters])  # 'rad', and '1' (a relative scale)
     weak: dict[int, str] = dict(exclude or {})
     while True:
         ident = analyse(J, model.names, kind=meas.kind, order=order, tol=rank_tol,
@@ -544,6 +622,8 @@ MOVE_LIMIT = 1.0
 #: A fitted joint-axis angle may move by at most this much [rad] (base and tool rotations
 #: are free: the measurement frame and the marker may sit at any angle).
 ANGLE_LIMIT = math.pi / 4
+#: A fitted encoder scale error may be at most this (10 %: a wrong gear ratio or units).
+SCALE_LIMIT = 0.1
 #: The RMS position residual after the fit may be at most this fraction of the robot's
 #: size (1 cm on a 1 m arm: far above any real measurement noise).
 RESIDUAL_LIMIT = 0.01
@@ -551,17 +631,26 @@ _CAUSES = ("are the positions in metres (not millimetres), is it the right robot
            "the joint columns q1..qn in the robot's joint order and in radians?")
 
 
-def implausible(model: ErrorModel, params: np.ndarray, errors_after: np.ndarray) -> str:
+def implausible(model: ErrorModel, params: np.ndarray, errors_after: np.ndarray, *,
+                free_base: bool = False) -> str:
     """Why a converged fit cannot describe this robot ('' when it can).
 
-    A length moved by more than :data:`MOVE_LIMIT` × the robot's size, a joint axis turned
-    by more than :data:`ANGLE_LIMIT`, or an RMS position residual after the fit above
+    A length moved by more than :data:`MOVE_LIMIT` × the robot's size (the base
+    translation excepted with ``free_base``: the device frame unknown), a joint axis
+    turned by more than :data:`ANGLE_LIMIT`, an encoder scale off by more than
+    :data:`SCALE_LIMIT`, or an RMS position residual after the fit above
     :data:`RESIDUAL_LIMIT` × the size: the measurements then belong to other units, another
     robot or another joint order (the message says so).
     """
     size = robot_scale(model.robot)
     moved = params - model.nominal
     for k, par in enumerate(model.parameters):
+        if par.unit == "1" and abs(moved[k]) > SCALE_LIMIT:
+            return (f"the fit changed the encoder scale {par.name!r} by {moved[k]:.3g} (more "
+                    f"than {SCALE_LIMIT:g}): the measurements do not fit this robot; "
+                    + _CAUSES)
+        if free_base and par.group == "base":
+            continue
         if par.unit == "m" and abs(moved[k]) > MOVE_LIMIT * size:
             return (f"the fit moved {par.name!r} by {moved[k]:.4g} m, more than the robot's "
                     f"size ({size:.3g} m): the measurements do not fit this robot; " + _CAUSES)
@@ -622,6 +711,7 @@ def _generic_measurements(model: ErrorModel, q: np.ndarray, kind: str) -> Measur
     from serialkin.calibration.measurements import make_measurements
 
     T = model.fk(q)
+    markers = np.arange(len(q)) % model.markers  # every marker seen (their offsets count)
     if kind == "position":
-        return make_measurements(model.robot, q, positions=T[:, :3, 3])
-    return make_measurements(model.robot, q, poses=T)
+        return make_measurements(model.robot, q, positions=T[:, :3, 3], markers=markers)
+    return make_measurements(model.robot, q, poses=T, markers=markers)

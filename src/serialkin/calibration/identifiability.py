@@ -193,8 +193,9 @@ def identifiability(model: ErrorModel, measurements: Measurements, params: objec
 
 
 def priority_order(model: ErrorModel) -> list[int]:
-    """Parameter indices in the analysis' priority: base, tool, then the links outwards."""
+    """Parameter indices in the analysis' priority: base, tool, markers, the links outwards."""
     groups = [p.group for p in model.parameters]
     return ([i for i, g in enumerate(groups) if g == "base"]
             + [i for i, g in enumerate(groups) if g == "tool"]
-            + [i for i, g in enumerate(groups) if g not in ("base", "tool")])
+            + [i for i, g in enumerate(groups) if g == "marker"]
+            + [i for i, g in enumerate(groups) if g not in ("base", "tool", "marker")])

@@ -3,14 +3,17 @@
 With the extended chain of :mod:`serialkin.calibration.models`, parameter k is the value
 of a virtual joint, so ``∂T/∂p_k`` is that joint's geometric-Jacobian column
 ``[z_k × (p − o_k); z_k]`` (rotation) or ``[z_k; 0]`` (translation) in the world frame
-(eqs 33-36), computed by the compiled batch kernels through ``robot.jacobian``. For a
+(eqs 33-36), computed by the compiled batch kernels through ``robot.jacobian``, times the
+parameter's regressor ``g_k(q)`` (1, or ``q_i`` for an encoder scale; see
+:meth:`~serialkin.calibration.models.ErrorModel.regressors`). For a
 measurement with pose error ``e = [p_model − p; φ]``, ``φ = log(R_model · Rᵀ)^∨``::
 
     ∂e/∂p_k = [v_k; J_l(φ)⁻¹ · ω_k]
 
 (the left Jacobian of SO(3) turns a world angular velocity into the rate of φ; it is the
 identity at φ = 0). Whitened residuals ``r = L⁻¹ e`` and their Jacobian ``L⁻¹ ∂e/∂p``
-are what the fit minimises.
+are what the fit minimises. With several markers, marker j is at ``T · w_j``: the chain's
+columns become ``v + ω × R w_j`` and ``∂e/∂w_j = [R; 0]`` on marker j's rows.
 """
 
 from __future__ import annotations
@@ -36,11 +39,18 @@ def errors(model: ErrorModel, measurements: Measurements, params: object = None,
         (e (m, k), J (m, k, p) or None).
     """
     p = model.nominal if params is None else model.check_params(params)
-    Q = model.extended_q(np.asarray(measurements.q), p)
+    q = np.asarray(measurements.q)
+    Q = model.extended_q(q, p)
     T = model.extended.fk(Q)
     k = measurements.rows
     e = np.empty((len(measurements), k))
-    e[:, :3] = T[:, :3, 3] - measurements.positions
+    point = T[:, :3, 3]
+    Rw = None
+    if model.markers > 1:  # marker j at T · w_j (w_1 = 0)
+        w = model.marker_offsets(p)[measurements.markers]
+        Rw = np.einsum("mij,mj->mi", T[:, :3, :3], w)
+        point = point + Rw
+    e[:, :3] = point - measurements.positions
     phi = None
     if k == 6:
         Rerr = T[:, :3, :3] @ np.swapaxes(measurements.rotations, -1, -2)
@@ -49,6 +59,16 @@ def errors(model: ErrorModel, measurements: Measurements, params: object = None,
     if not jacobian:
         return e, None
     J = model.extended.jacobian(Q)[:, :, model.param_index]
+    if model.has_regressors:  # ∂Q_k/∂p_k = g_k(q)
+        J *= model.regressors(q)[:, None, :]
+    if Rw is not None:
+        # the chain's columns at the marker point (v + ω × R w), and ∂point/∂w_j = R
+        J[:, :3] += np.cross(J[:, 3:], Rw[:, :, None], axisa=1, axisb=1, axisc=1)
+        Jm = np.zeros((len(measurements), 6, 3 * (model.markers - 1)))
+        for j in range(1, model.markers):
+            rows = measurements.markers == j
+            Jm[rows, :3, 3 * (j - 1):3 * j] = T[rows, :3, :3]
+        J = np.concatenate([J, Jm], axis=2)
     if k == 3:
         return e, np.ascontiguousarray(J[:, :3])
     J[:, 3:] = so3_left_jacobian_inv(phi) @ J[:, 3:]

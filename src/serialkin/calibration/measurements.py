@@ -15,9 +15,14 @@ the least-squares cost is ``½ Σ eᵀ C⁻¹ e``. Without covariances, C is dia
 ``sigma_position²`` [m²] and ``sigma_rotation²`` [rad²], divided by the measurement's
 weight.
 
+Several markers on the tool (a position set): ``markers`` (m,) says which marker
+(0-based; marker 0 is the tool origin) each row measured; the error model has their
+offsets (``error_model(..., markers=K)``).
+
 CSV files (:func:`read_measurements`, :func:`write_measurements`) have a header line
 naming the columns ``q1 … qn, x, y, z`` [rad or m; m] and, for poses, the scalar-first
-unit quaternion ``quat_w, quat_x, quat_y, quat_z``; an optional ``weight`` column last.
+unit quaternion ``quat_w, quat_x, quat_y, quat_z``; an optional ``marker`` column (the
+marker number, 1..K) and an optional ``weight`` column last.
 ``#`` comments and blank lines are skipped; a bad row is reported by its line number.
 """
 
@@ -64,6 +69,7 @@ class Measurements:
         whitening: (m, k, k) ``L⁻¹`` per measurement (k = 3 or 6), ``C = L·Lᵀ``.
         lines: (m,) source line of each measurement (0 when not read from a file).
         source: where the measurements come from (a file name), for messages.
+        markers: (m,) 0-based index of the marker each row measured (all 0: one marker).
     """
 
     kind: str
@@ -73,6 +79,13 @@ class Measurements:
     whitening: np.ndarray
     lines: np.ndarray
     source: str = ""
+    markers: np.ndarray = None  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        if self.markers is None:
+            z = np.zeros(self.q.shape[0], dtype=int)
+            z.setflags(write=False)
+            object.__setattr__(self, "markers", z)
 
     def __len__(self) -> int:
         """Number of measurements m."""
@@ -88,7 +101,7 @@ class Measurements:
         i = np.asarray(index)
         return Measurements(self.kind, self.q[i], self.positions[i],
                             None if self.rotations is None else self.rotations[i],
-                            self.whitening[i], self.lines[i], self.source)
+                            self.whitening[i], self.lines[i], self.source, self.markers[i])
 
     def poses(self) -> np.ndarray:
         """(m, 4, 4) measured poses (rotation identity for positions)."""
@@ -109,7 +122,8 @@ def make_measurements(robot: Robot, q: object, *, positions: object = None,
                       poses: object = None, weights: object = None,
                       sigma_position: float = SIGMA_POSITION,
                       sigma_rotation: float = SIGMA_ROTATION, covariance: object = None,
-                      lines: object = None, source: str = "") -> Measurements:
+                      lines: object = None, source: str = "",
+                      markers: object = None) -> Measurements:
     """Validated :class:`Measurements` from arrays.
 
     Args:
@@ -125,6 +139,7 @@ def make_measurements(robot: Robot, q: object, *, positions: object = None,
             of the sigmas (k = 3 positions, 6 poses: [position; rotation]).
         lines: (m,) source line numbers (for messages), default 0.
         source: the file name (for messages).
+        markers: (m,) 0-based marker index of each row (default all 0: one marker).
 
     Raises:
         InputError: wrong joint count, shapes that disagree, non-finite values (naming the
@@ -164,9 +179,10 @@ def make_measurements(robot: Robot, q: object, *, positions: object = None,
     if weights is not None:
         L = L / np.sqrt(_checked_weights(weights, m))[:, None, None]
     W = np.linalg.inv(L)
+    mk = np.zeros(m, dtype=int) if markers is None else _checked_markers(markers, m)
     out = Measurements(kind, qa.copy(), np.ascontiguousarray(pos), rot, np.ascontiguousarray(W),
-                       ln, source)
-    for a in (out.q, out.positions, out.whitening, out.lines):
+                       ln, source, mk)
+    for a in (out.q, out.positions, out.whitening, out.lines, out.markers):
         a.setflags(write=False)
     return out
 
@@ -189,6 +205,19 @@ def _covariance_factor(covariance: object, m: int, k: int) -> np.ndarray:
         return np.linalg.cholesky(C)
     except np.linalg.LinAlgError:
         raise InputError("covariance must be positive definite") from None
+
+
+def _checked_markers(markers: object, m: int) -> np.ndarray:
+    """``markers`` as (m,) non-negative ints; InputError naming the first bad one."""
+    a = as_float_array(markers, "markers", ndim=1)
+    if a.shape != (m,):
+        raise InputError(f"markers must have shape ({m},) like q, got {a.shape}")
+    bad = ~np.isfinite(a) | (a < 0) | (a != np.round(a))
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InputError(f"markers must be integers >= 0 (0-based marker indices), got "
+                         f"{a[i]!r} for measurement {i}")
+    return a.astype(int)
 
 
 def _checked_weights(weights: object, m: int) -> np.ndarray:
@@ -233,8 +262,17 @@ def read_measurements(path: str | os.PathLike[str], robot: Robot, *,
     if w is not None and not (w > 0).all():
         i = int(np.argmax(w <= 0))
         raise InputError(f"{label}, line {lines[i]}: weight must be > 0, got {w[i]!r}")
+    mk = None
+    if "marker" in col:
+        mk = a[:, col["marker"]]
+        bad = (mk < 1) | (mk != np.round(mk))
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise InputError(f"{label}, line {lines[i]}, column 'marker': expected a marker "
+                             f"number 1, 2, ..., got {mk[i]!r}")
+        mk = mk - 1
     common = dict(weights=w, sigma_position=sigma_position, sigma_rotation=sigma_rotation,
-                  lines=lines, source=label)
+                  lines=lines, source=label, markers=mk)
     if "quat_w" not in col:
         return make_measurements(robot, q, positions=pos, **common)
     T = _poses(a[:, [col[c] for c in _QUAT]], pos, label, lines)
@@ -328,12 +366,13 @@ def _check_header(header: list[str], robot: Robot, label: str, lineno: int) -> N
     if len(joints) != robot.n:
         raise InputError(f"{label}: the measurements have {len(joints)} joint columns "
                          f"(q1..q{len(joints)}) but robot {robot.name!r} has {robot.n} joints")
-    allowed = {f"q{i + 1}" for i in range(robot.n)} | {"x", "y", "z", "weight", *_QUAT}
+    allowed = {f"q{i + 1}" for i in range(robot.n)} | {"x", "y", "z", "weight", "marker",
+                                                        *_QUAT}
     unknown = [h for h in header if h not in allowed]
     if unknown:
         raise InputError(f"{label}, line {lineno}: unknown column(s) "
                          f"{', '.join(short_repr(u, 30) for u in unknown[:5])}; allowed: "
-                         f"q1..q{robot.n}, x, y, z, {', '.join(_QUAT)}, weight")
+                         f"q1..q{robot.n}, x, y, z, {', '.join(_QUAT)}, marker, weight")
     missing = [h for h in ("x", "y", "z") if h not in header]
     quat = [h for h in _QUAT if h in header]
     if quat and len(quat) != 4:
@@ -361,6 +400,9 @@ def write_measurements(path: str | os.PathLike[str], measurements: Measurements,
     if measurements.rotations is not None:
         header += list(_QUAT)
         cols.append(matrix_to_quaternion(measurements.rotations, check=False))
+    if measurements.markers.any():
+        header.append("marker")
+        cols.append(measurements.markers.reshape(-1, 1) + 1.0)
     if weights is not None:
         header.append("weight")
         cols.append(np.asarray(weights, dtype=float).reshape(-1, 1))

@@ -31,6 +31,24 @@ Models (:func:`error_model`):
 * base and tool — ``B = B0 · Txyz(x, y, z) · Rz · Ry · Rx`` (the robot-file xyz/rpy
   convention, as an error about the nominal B0; likewise the tool). The tool translation
   is the unknown marker offset of position measurements.
+* several markers (``markers=K``) — markers 2..K at unknown offsets ``w_k`` (3,) [m] in
+  the tool frame: marker k is at ``T(q, p) · w_k`` (marker 1 is the tool origin). These
+  3(K−1) parameters are not virtual joints: their Jacobian is the tool rotation, and the
+  chain's columns are moved to the marker point (``v + ω × R w_k``).
+
+Non-geometric terms. A parameter's virtual joint moves by ``p_k · g_k(q)``: its
+*regressor* ``g_k`` is 1 for a geometric error and the joint value ``q_i`` for an encoder
+scale (``scale=True``: joint i turns by ``q_i + s_i q_i``, ``s_i`` the relative scale
+error, a virtual joint on the same axis right after the real one), so
+``∂T/∂p_k = g_k(q) · (the virtual joint's Jacobian column)``
+(:meth:`ErrorModel.regressors`). A joint offset is the geometric θ_i / ``offset``
+parameter. **Compliance** is the same construction with another regressor: a joint of
+stiffness ``k_i`` under the gravity torque ``τ_i(q)`` deflects by ``c_i τ_i(q)``
+(``c_i = 1/k_i`` [rad/(N·m)]), i.e. a parameter on joint i's axis with regressor
+``τ_i(q)`` from a dynamic model (link masses and centres, and the payload). To add it:
+a builder step like the scale's (:func:`_add_scale`) with ``regressor`` naming the term,
+and its column in :meth:`ErrorModel.regressors`; the fit, the identifiability analysis,
+the covariance and the pose selection then treat it like any other parameter.
 
 Redundancies (the analysis in :mod:`serialkin.calibration.identifiability` finds them
 numerically; typical ones): standard DH — d_1 with base z and θ_1 with base rz (both
@@ -69,15 +87,20 @@ class Parameter:
     Attributes:
         name: its name in the user's terms ('d1', 'beta2', 'base z', 'tool rx',
             'shoulder origin x', 'elbow offset').
-        unit: 'm' (a translation) or 'rad' (a rotation).
-        nominal: its value in the nominal robot [m or rad] (0 for base and tool errors).
-        group: 'base', 'tool' or the index (0-based) of the joint it belongs to.
+        unit: 'm' (a translation), 'rad' (a rotation) or '1' (a relative encoder scale
+            error, dimensionless).
+        nominal: its value in the nominal robot [m, rad or 1] (0 for base and tool errors
+            and scales).
+        group: 'base', 'tool', 'marker' or the index (0-based) of the joint it belongs to.
+        regressor: the index of the joint whose value multiplies the parameter's motion
+            (an encoder scale), or -1 (a constant: geometric errors).
     """
 
     name: str
     unit: str
     nominal: float
     group: str | int
+    regressor: int = -1
 
 
 @dataclass(frozen=True)
@@ -100,16 +123,19 @@ class ErrorModel:
         hayati: indices (0-based) of the links that carry Hayati's β.
         extended: the extended chain as a :class:`~serialkin.Robot` (``n + p`` joints).
         joint_index: (n,) positions of the real joints among the extended chain's joints.
-        param_index: (p,) positions of the parameters among the extended chain's joints.
+        param_index: (c,) positions of the chain parameters (the first c, all but the
+            marker offsets) among the extended chain's joints.
+        markers: number of markers K (markers 2..K have offset parameters, last).
     """
 
     def __init__(self, robot: Robot, kind: str, parameters: Sequence[Parameter],
                  steps: Sequence[tuple[_Step, Joint]], tool: np.ndarray,
-                 hayati: Sequence[int]) -> None:
+                 hayati: Sequence[int], markers: int = 1) -> None:
         self.robot = robot
         self.kind = kind
         self.parameters = tuple(parameters)
         self.hayati = tuple(hayati)
+        self.markers = int(markers)
         joints = [j for _, j in steps]
         self.extended = Robot.from_joints(joints, base=robot.base, tool=tool,
                                           name=f"{robot.name} (error model)")
@@ -137,12 +163,63 @@ class ErrorModel:
         """``params`` as a finite float64 (p,) vector, or raise naming it."""
         return as_vector(params, name, self.size)
 
+    @property
+    def chain_size(self) -> int:
+        """Number c of parameters that are virtual joints of the extended chain."""
+        return len(self.param_index)
+
+    @property
+    def has_regressors(self) -> bool:
+        """Whether some parameter has a regressor other than 1 (e.g. encoder scales)."""
+        return any(p.regressor >= 0 for p in self.parameters)
+
+    def regressors(self, q: np.ndarray) -> np.ndarray:
+        """(m, c) regressors ``g_k(q)`` of the chain parameters at configurations q (m, n).
+
+        The virtual joint of parameter k moves by ``p_k · g_k(q)`` (module docstring): 1
+        for geometric errors, ``q_i`` for the encoder scale of joint i. This is the
+        extension point of non-geometric terms: a compliance parameter of joint i would
+        return the gravity torque ``τ_i(q)`` [N·m] here (and carry unit 'rad/(N·m)');
+        :func:`~serialkin.calibration.jacobian.errors` multiplies the Jacobian column by
+        it, so nothing else changes.
+        """
+        c = self.chain_size
+        g = np.ones((q.shape[0], c))
+        for k, par in enumerate(self.parameters[:c]):
+            if par.regressor >= 0:
+                g[:, k] = q[:, par.regressor]
+        return g
+
     def extended_q(self, q: np.ndarray, params: np.ndarray) -> np.ndarray:
-        """Joint values of the extended chain, (m, n + p): q in the real joints, p in the rest."""
+        """Joint values (m, n + c) of the extended chain at q (m, n) and params (p,).
+
+        q in the real joints, ``p_k g_k(q)`` in the chain parameters' virtual joints (the
+        marker offsets are not in the chain).
+        """
         Q = np.empty((q.shape[0], self.extended.n))
         Q[:, self.joint_index] = q
-        Q[:, self.param_index] = params
+        c = self.chain_size
+        if self.has_regressors:
+            Q[:, self.param_index] = params[:c] * self.regressors(q)
+        else:
+            Q[:, self.param_index] = params[:c]
         return Q
+
+    def encoder_scale(self, params: object) -> np.ndarray:
+        """(n,) factors ``1 + s_i`` of the joint values at parameters ``params`` (1 without)."""
+        p = self.check_params(params)
+        out = np.ones(self.robot.n)
+        for k, par in enumerate(self.parameters):
+            if par.regressor >= 0:
+                out[par.regressor] += p[k]
+        return out
+
+    def marker_offsets(self, params: object) -> np.ndarray:
+        """(K, 3) offsets [m] of the markers in the tool frame (marker 1: the origin, 0)."""
+        p = self.check_params(params)
+        out = np.zeros((self.markers, 3))
+        out[1:] = p[self.chain_size:].reshape(-1, 3)
+        return out
 
     def fk(self, q: object, params: object = None) -> np.ndarray:
         """Tool poses (m, 4, 4) of configurations ``q`` (m, n) with parameters ``params`` (p,).
@@ -156,6 +233,9 @@ class ErrorModel:
     def calibrated_robot(self, params: object, name: str | None = None) -> Robot:
         """The robot with parameter values ``params`` (p,), as a :class:`~serialkin.Robot`.
 
+        Encoder scales and marker offsets are not part of a robot
+        (:meth:`encoder_scale`, :meth:`marker_offsets`): the robot is the geometry, to be
+        driven with the joint values times the scales, its tool at marker 1.
         A DH model without β gives a DH robot (the same convention, base and tool updated),
         which a robot file can hold; otherwise a robot of general joints (each joint's
         origin is the product of the fixed and parameter motions before it), which a URDF
@@ -183,8 +263,9 @@ class ErrorModel:
         joints: list[Joint] = []
         pending = np.eye(4)
         for step, j in self._steps:
-            if step.param >= 0 and self.parameters[step.param].group in ("base", "tool"):
-                continue
+            if step.param >= 0 and (self.parameters[step.param].group in ("base", "tool")
+                                    or self.parameters[step.param].regressor >= 0):
+                continue  # a scale's motion commutes with its joint's: the joint values
             if step.joint >= 0:
                 nominal = self.robot.joints[step.joint]
                 joints.append(Joint(axis=j.axis, type=j.type, origin=pending @ j.origin,
@@ -236,10 +317,11 @@ class _Builder:
         self.pending = self.pending @ T
 
     def param(self, name: str, axis: str | np.ndarray, kind: str, nominal: float,
-              group: str | int) -> None:
+              group: str | int, regressor: int = -1) -> None:
         ax = np.array(_AXES[axis]) if isinstance(axis, str) else axis
-        unit = "m" if kind == "P" else "rad"
-        self.params.append(Parameter(name=name, unit=unit, nominal=float(nominal), group=group))
+        unit = "1" if regressor >= 0 else "m" if kind == "P" else "rad"
+        self.params.append(Parameter(name=name, unit=unit, nominal=float(nominal), group=group,
+                                     regressor=regressor))
         self.steps.append((_Step(param=len(self.params) - 1),
                            Joint(axis=ax, type=kind, origin=self.pending, name=name)))
         self.pending = np.eye(4)
@@ -290,7 +372,8 @@ def _hayati_links(robot: Robot, hayati: object) -> list[int]:
 
 
 def error_model(robot: Robot, kind: str = "auto", *, hayati: object = "auto",
-                base: bool = True, tool: bool = True) -> ErrorModel:
+                base: bool = True, tool: bool = True, scale: bool = False,
+                markers: int = 1) -> ErrorModel:
     """The error model of ``robot`` (see the module docstring for the equations).
 
     Args:
@@ -303,6 +386,10 @@ def error_model(robot: Robot, kind: str = "auto", *, hayati: object = "auto",
         base: include the six base-pose errors.
         tool: include the six tool-pose errors (the tool translation is the marker offset
             of position measurements).
+        scale: include each joint's encoder scale error ``s_i`` (joint i moves by
+            ``(1 + s_i) q_i``; module docstring).
+        markers: number K of markers measured (``Measurements.markers`` says which); the
+            offsets of markers 2..K from the tool origin are parameters (3 each).
 
     Returns:
         :class:`ErrorModel`.
@@ -310,8 +397,11 @@ def error_model(robot: Robot, kind: str = "auto", *, hayati: object = "auto",
     Raises:
         InputError: unknown kind; 'dh' for a robot without a DH table; a bad hayati list.
     """
+    from serialkin._checks import check_int
+
     check_robot(robot)
     check_choice(kind, "kind", MODEL_KINDS)
+    markers = check_int(markers, "markers", minimum=1)
     if kind == "auto":
         kind = "dh" if robot.dh is not None else "joints"
     if kind == "dh" and robot.dh is None:
@@ -323,34 +413,48 @@ def error_model(robot: Robot, kind: str = "auto", *, hayati: object = "auto",
     links: list[int] = []
     if kind == "dh":
         links = _hayati_links(robot, hayati)
-        _dh_chain(b, robot, links)
+        _dh_chain(b, robot, links, scale)
     else:
-        _joint_chain(b, robot)
+        _joint_chain(b, robot, scale)
     b.fixed(robot.tool)
     if tool:
         b.pose_errors("tool")
-    return ErrorModel(robot, kind, b.params, b.steps, b.pending, links)
+    for k in range(2, markers + 1):  # not virtual joints: after the chain's parameters
+        for axis in "xyz":
+            b.params.append(Parameter(name=f"marker {k} {axis}", unit="m", nominal=0.0,
+                                      group="marker"))
+    return ErrorModel(robot, kind, b.params, b.steps, b.pending, links, markers)
 
 
-def _joint_and_offset(b: _Builder, i: int, r: DHLink, name: str) -> None:
-    """Joint i about z and its θ offset, in the order the chain applies them.
+def _add_scale(b: _Builder, i: int, axis: np.ndarray, kind: str, name: str) -> None:
+    """Joint i's encoder scale: a virtual joint on its axis right after it, moving ``s q_i``."""
+    b.param(name, axis, kind, 0.0, i, regressor=i)
 
-    A revolute joint turns by ``q + θ``: the joint, then the offset θ_i; a prismatic one
-    turns by θ_i first, then slides.
+
+def _joint_and_offset(b: _Builder, i: int, r: DHLink, name: str, scale: bool) -> None:
+    """Joint i about z (its scale) and its θ offset, in the order the chain applies them.
+
+    A revolute joint turns by ``q + s q + θ``: the joint, its scale, then the offset θ_i;
+    a prismatic one turns by θ_i first, then slides (and slides by its scale).
     """
+    z = np.array(_AXES["z"])
     if r.type == "R":
-        b.joint(i, np.array(_AXES["z"]), "R", name)
+        b.joint(i, z, "R", name)
+        if scale:
+            _add_scale(b, i, z, "R", f"scale{i + 1}")
         b.param(f"theta{i + 1}", "z", "R", r.theta, i)
     else:
         b.param(f"theta{i + 1}", "z", "R", r.theta, i)
-        b.joint(i, np.array(_AXES["z"]), "P", name)
+        b.joint(i, z, "P", name)
+        if scale:
+            _add_scale(b, i, z, "P", f"scale{i + 1}")
 
 
-def _dh_chain(b: _Builder, robot: Robot, hayati: Sequence[int]) -> None:
+def _dh_chain(b: _Builder, robot: Robot, hayati: Sequence[int], scale: bool) -> None:
     for i, r in enumerate(robot.dh):
         k, name = i + 1, robot.joint_names[i]
         if robot.convention == "standard":
-            _joint_and_offset(b, i, r, name)
+            _joint_and_offset(b, i, r, name, scale)
             if i in hayati:  # d_i slides along an axis parallel to the next: fixed
                 b.fixed(make_transform(p=[0.0, 0.0, r.d]))
             else:
@@ -364,14 +468,14 @@ def _dh_chain(b: _Builder, robot: Robot, hayati: Sequence[int]) -> None:
                 b.param(f"beta{k}", "y", "R", 0.0, i)
             b.param(f"alpha{k}", "x", "R", r.alpha, i)
             b.param(f"a{k}", "x", "P", r.a, i)
-            _joint_and_offset(b, i, r, name)
+            _joint_and_offset(b, i, r, name, scale)
             if i + 1 in hayati:  # joint i+1 is parallel to this one: d_i is fixed
                 b.fixed(make_transform(p=[0.0, 0.0, r.d]))
             else:
                 b.param(f"d{k}", "z", "P", r.d, i)
 
 
-def _joint_chain(b: _Builder, robot: Robot) -> None:
+def _joint_chain(b: _Builder, robot: Robot, scale: bool) -> None:
     for i, j in enumerate(robot.joints):
         name = robot.joint_names[i]
         b.fixed(j.origin)
@@ -379,5 +483,7 @@ def _joint_chain(b: _Builder, robot: Robot) -> None:
                                   ("rz", "z", "R"), ("ry", "y", "R"), ("rx", "x", "R")):
             b.param(f"{name} origin {label}", axis, kind, 0.0, i)
         b.joint(i, j.axis, j.type, name)
+        if scale:
+            _add_scale(b, i, j.axis.copy(), j.type, f"{name} scale")
         b.param(f"{name} offset", j.axis.copy(), j.type, j.offset, i)
         b.fixed(j.post)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from serialkin._checks import as_generator, check_choice, check_int, check_positive
+from serialkin._checks import as_generator, as_vector, check_choice, check_int, check_positive
 from serialkin.calibration.measurements import (
     KINDS,
     SIGMA_POSITION,
@@ -22,16 +22,24 @@ from serialkin.calibration.measurements import (
     make_measurements,
 )
 from serialkin.calibration.models import ErrorModel
+from serialkin.errors import InputError
 from serialkin.model.robot import Robot
 
 
 def perturb(model: ErrorModel, *, length: float = 1e-3, angle: float = np.radians(0.5),
+            scale: float = 1e-3,
             seed: None | int | np.random.Generator = None) -> np.ndarray:
-    """Parameters (p,) drawn uniformly in ``nominal ± length`` [m] / ``± angle`` [rad]."""
+    """Parameters (p,) drawn uniformly in ``nominal ± length / angle / scale``.
+
+    ``length`` [m] for translations, ``angle`` [rad] for rotations, ``scale``
+    (dimensionless) for encoder scale errors.
+    """
     length = check_positive(length, "length", allow_zero=True)
     angle = check_positive(angle, "angle", allow_zero=True)
+    scale = check_positive(scale, "scale", allow_zero=True)
     rng = as_generator(seed)
-    half = np.array([length if p.unit == "m" else angle for p in model.parameters])
+    half = np.array([length if p.unit == "m" else angle if p.unit == "rad" else scale
+                     for p in model.parameters])
     return model.nominal + rng.uniform(-1.0, 1.0, model.size) * half
 
 
@@ -80,8 +88,14 @@ def simulate_measurements(robot: Robot, q: object, *, kind: str = "position",
                           noise_position: float = 5e-5, noise_rotation: float = 0.0,
                           sigma_position: float | None = None,
                           sigma_rotation: float | None = None,
+                          joint_scale: object = None, markers: object = None,
                           seed: None | int | np.random.Generator = None) -> Measurements:
     """Noisy measurements of ``robot``'s tool at configurations ``q``.
+
+    The robot is at ``q``; the joint values recorded are ``q / joint_scale`` (what
+    encoders with those scale factors read). With ``markers`` (K, 3) the measured point of
+    row i is marker ``i mod K`` at ``T(q) · markers[k]`` (offsets [m] in the tool frame;
+    give marker 0 as zeros for the tool origin), and the measurements say which.
 
     Args:
         robot: the "real" robot (e.g. ``model.calibrated_robot(perturb(model))``).
@@ -92,6 +106,9 @@ def simulate_measurements(robot: Robot, q: object, *, kind: str = "position",
         sigma_position: the sigma stated in the measurements (default the noise, or
             :data:`~serialkin.calibration.measurements.SIGMA_POSITION` when 0).
         sigma_rotation: likewise for rotations.
+        joint_scale: (n,) factors ``1 + s_i`` of the real joint values over the recorded
+            ones (default 1).
+        markers: (K, 3) marker offsets [m] in the tool frame, or None (the tool origin).
         seed: None, int or numpy Generator.
 
     Returns:
@@ -108,11 +125,25 @@ def simulate_measurements(robot: Robot, q: object, *, kind: str = "position",
     else:
         qa = robot.check_q(q).reshape(-1, robot.n)
     T = robot.fk(qa)
+    which = None
+    if markers is not None:
+        from serialkin._checks import as_float_array
+
+        w = as_float_array(markers, "markers", ndim=2)
+        if w.shape[1] != 3 or w.shape[0] < 1:
+            raise InputError(f"markers must have shape (K, 3), got {w.shape}")
+        which = np.arange(len(qa)) % w.shape[0]
+        T[:, :3, 3] += np.einsum("mij,mj->mi", T[:, :3, :3], w[which])
+    recorded = qa
+    if joint_scale is not None:
+        recorded = qa / as_vector(joint_scale, "joint_scale", robot.n)
     sp = sigma_position or (npos if npos > 0 else SIGMA_POSITION)
     sr = sigma_rotation or (nrot if nrot > 0 else SIGMA_ROTATION)
     pos = T[:, :3, 3] + rng.normal(0.0, 1.0, (len(qa), 3)) * npos
     if kind == "position":
-        return make_measurements(robot, qa, positions=pos, sigma_position=sp)
+        return make_measurements(robot, recorded, positions=pos, sigma_position=sp,
+                                 markers=which)
     T[:, :3, 3] = pos
     T[:, :3, :3] = so3_exp(rng.normal(0.0, 1.0, (len(qa), 3)) * nrot) @ T[:, :3, :3]
-    return make_measurements(robot, qa, poses=T, sigma_position=sp, sigma_rotation=sr)
+    return make_measurements(robot, recorded, poses=T, sigma_position=sp, sigma_rotation=sr,
+                             markers=which)

@@ -28,7 +28,10 @@ _HELP = command_help(
     "\n\nThe measurement CSV has a header q1..qn,x,y,z (positions, metres) and optionally "
     "quat_w,quat_x,quat_y,quat_z (poses) and weight. With --simulate N the robot is "
     "perturbed instead and N noisy measurements of it are written to --measurements (and "
-    "the perturbed robot to --truth). ROBOT is " + ROBOT_HELP + ".",
+    "the perturbed robot to --truth). A URDF ROBOT is written by patching its file: only "
+    "the changed joint origins differ. A robot file (.yaml/.json) holds a DH table; when "
+    "the calibrated axes make it unphysical (nearly parallel axes) a .urdf is written "
+    "instead, and the output says so. ROBOT is " + ROBOT_HELP + ".",
     ["serialkin calibrate ur5 --simulate 60 --measurements meas.csv --truth real.urdf",
      "serialkin calibrate ur5 --measurements meas.csv --out calibrated.yaml",
      "serialkin calibrate arm.urdf --measurements meas.csv --out cal.urdf --report res.csv",
@@ -53,6 +56,11 @@ _HELP = command_help(
               show_default=True, help="Hayati's β on links with (nearly) parallel axes.")
 @click.option("--no-base", is_flag=True, help="Keep the base pose fixed.")
 @click.option("--no-tool", is_flag=True, help="Keep the tool pose (marker offset) fixed.")
+@click.option("--scale", "encoder_scale", is_flag=True,
+              help="Also identify each joint's encoder scale.")
+@click.option("--frame", "frame", type=click.Choice(["nominal", "unknown"]), default="nominal",
+              show_default=True,
+              help="The measuring device's frame: near the robot's base, or anywhere.")
 @click.option("--loss", type=click.Choice(["linear", "huber", "soft_l1", "cauchy", "arctan"]),
               default="linear", show_default=True, help="Least squares or a robust loss.")
 @click.option("--loss-scale", type=float, default=3.0, show_default=True,
@@ -86,10 +94,11 @@ _HELP = command_help(
 @handle_errors
 def calibrate_cmd(robot: str, measurements: str, out: str | None, urdf: str | None,
                   report: str | None, kind: str, hayati: str, no_base: bool, no_tool: bool,
-                  loss: str, loss_scale: float, sigma_position: float, sigma_rotation: float,
+                  encoder_scale: bool, frame: str, loss: str, loss_scale: float,
+                  sigma_position: float, sigma_rotation: float,
                   max_evaluations: int, simulate: int | None, **opts: Any) -> None:
     """Calibrate a robot from measurements, or simulate measurements (see the help)."""
-    from serialkin.calibration import calibrate, error_model, read_measurements, save_robot
+    from serialkin.calibration import calibrate, error_model, read_measurements
 
     if simulate is not None:
         given = [o for o, v in (("--out", out), ("--urdf", urdf), ("--report", report)) if v]
@@ -103,28 +112,33 @@ def calibrate_cmd(robot: str, measurements: str, out: str | None, urdf: str | No
     _check_suffix("--out", out, (".yaml", ".yml", ".json", ".urdf"))
     _check_suffix("--report", report, (".csv", ".json"))
     _check_suffix("--truth", opts["truth"], (".yaml", ".yml", ".json", ".urdf"))
-    r = resolve_robot(robot, opts.pop("params"))
-    model = error_model(r, kind, hayati=hayati, base=not no_base, tool=not no_tool)
+    params = opts.pop("params")
+    r = resolve_robot(robot, params)
     as_json, quiet = opts.pop("as_json"), opts.pop("quiet")
     say = (lambda text: None) if quiet or as_json else click.echo
     if simulate is not None:
+        model = error_model(r, kind, hayati=hayati, base=not no_base, tool=not no_tool,
+                            scale=encoder_scale)
         _simulate(model, simulate, measurements, say, as_json, **opts)
         return
     meas = read_measurements(measurements, r, sigma_position=sigma_position,
                              sigma_rotation=sigma_rotation)
+    markers = int(meas.markers.max()) + 1 if len(meas) else 1
+    model = error_model(r, kind, hayati=hayati, base=not no_base, tool=not no_tool,
+                        scale=encoder_scale, markers=markers)
     res = calibrate(model, meas, loss=loss, loss_scale=loss_scale,
-                    max_evaluations=max_evaluations)
+                    max_evaluations=max_evaluations, frame=frame)
+    notes: list[str] = []
+    source = robot if Path(robot).suffix.lower() == ".urdf" else None
+    links = _link_params(params)
     written = []
-    if out:
-        written.append(save_robot(res.robot, out))
-        if res.robot.dh is None and Path(out).suffix.lower() != ".urdf":
-            say("note: the calibrated axes are not exactly DH (Hayati β or joint errors); "
-                f"{out} holds the DH table extracted from them, exact but with long offsets "
-                "for nearly parallel axes: a URDF (--urdf) keeps the identified joints")
-    if urdf:
-        written.append(save_robot(res.robot, Path(urdf).with_suffix(".urdf")
-                                  if Path(urdf).suffix.lower() != ".urdf" else urdf))
+    for option, path in (("--out", out), ("--urdf", urdf)):
+        if path:
+            written.append(_write_robot(res, path, option, source, links, [robot, measurements],
+                                        notes))
     data = _report(res)
+    data["notes"] = notes
+    data["written"] = [str(w) for w in written]
     if report:
         if Path(report).suffix.lower() == ".csv":
             header, rows = res.residual_table()
@@ -136,10 +150,53 @@ def calibrate_cmd(robot: str, measurements: str, out: str | None, urdf: str | No
     else:
         say(res.summary())
         say(_parameter_lines(res))
+        for note in notes:
+            say(f"note: {note}")
         for w in written:
             say(f"wrote {w}")
     if not res.success:
         raise SystemExit(EXIT_NOT_REACHED)
+
+
+def _link_params(params: Any) -> dict[str, str]:
+    """base_link / tip_link of the --param pairs (how a URDF robot was read)."""
+    out = {}
+    for p in params or ():
+        k, _, v = str(p).partition("=")
+        if k.strip() in ("base_link", "tip_link"):
+            out[k.strip()] = v.strip()
+    return out
+
+
+def _write_robot(res: Any, path: str, option: str, source: str | None,
+                 links: dict[str, str], inputs: list[str], notes: list[str]) -> Path:
+    """Write the calibrated robot for ``option``: the URDF patched, a URDF, or a robot file.
+
+    A robot file whose DH table would not be physical becomes a .urdf beside it (never
+    over an input), and ``notes`` says so.
+    """
+    from serialkin.calibration.export import patch_urdf, save_robot, unphysical_dh
+
+    p = Path(path)
+    if p.suffix.lower() != ".urdf":
+        if option == "--urdf":
+            p = p.with_suffix(".urdf")
+        else:
+            dh, why = unphysical_dh(res.robot)
+            if dh is not None:
+                return save_robot(dh, p)
+            alt = p.with_suffix(".urdf")
+            for given in inputs:
+                if alt.exists() and Path(given).exists() and alt.samefile(given):
+                    raise CLIError(f"{option} {path}: {why}; and {alt} is an input")
+            notes.append(f"{path} not written: {why}; wrote {alt} (per-joint origins) instead")
+            p = alt
+    if source is not None:
+        patch = patch_urdf(source, res, p, base_link=links.get("base_link"),
+                           tip_link=links.get("tip_link"))
+        notes.extend(n for n in patch.notes if n not in notes)
+        return patch.path
+    return save_robot(res.robot, p)
 
 
 def _check_suffix(option: str, path: str | None, allowed: tuple[str, ...]) -> None:
@@ -158,10 +215,29 @@ def _report(res: Any) -> dict[str, Any]:
             "rms_rotation_before": None if math.isnan(rb) else rb,
             "rms_rotation_after": None if math.isnan(ra) else ra,
             "condition_number": res.identifiability.condition_number,
+            "chi_square": _chi_square(res),
+            "encoder_scale": res.encoder_scale.tolist(),
+            "marker_offsets": res.marker_offsets.tolist(),
+            "predicted_error": _finite(res.predicted_error(count=200)),
             "not_identifiable": list(res.identifiability.reasons),
             "parameters": [{k: (None if isinstance(v, float) and math.isnan(v) else v)
                             for k, v in row.items()} for row in res.parameter_table()],
             "residuals": {"columns": header, "rows": rows.tolist()}}
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def _chi_square(res: Any) -> dict[str, Any]:
+    """The chi-square test of the residual (fit.ChiSquare) with its verdict, for JSON."""
+    from serialkin.calibration.fit import SIGNIFICANCE
+
+    c = res.chi_square
+    return {"chi2": _finite(c.chi2), "dof": c.dof, "p_value": _finite(c.p_value),
+            "noise_ratio": _finite(c.noise_ratio), "outliers": c.outliers,
+            "significance": SIGNIFICANCE, "consistent_with_noise": not c.verdict(SIGNIFICANCE),
+            "verdict": c.verdict(SIGNIFICANCE)}
 
 
 def _parameter_lines(res: Any) -> str:
@@ -172,6 +248,9 @@ def _parameter_lines(res: Any) -> str:
         if row["unit"] == "m":
             lines.append(f"  {row['name']:<22} {row['change'] * 1e3:+.4f} mm "
                          f"± {row['std_error'] * 1e3:.4f}")
+        elif row["unit"] == "1":
+            lines.append(f"  {row['name']:<22} {row['change'] * 1e6:+.2f} ppm "
+                         f"± {row['std_error'] * 1e6:.2f}")
         else:
             lines.append(f"  {row['name']:<22} {math.degrees(row['change']):+.5f}° "
                          f"± {math.degrees(row['std_error']):.5f}")
