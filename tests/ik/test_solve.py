@@ -242,6 +242,31 @@ def test_analytic_method_nearest_to_q0(name):
         assert res.iterations == 1 and res.restarts == 0
 
 
+@pytest.mark.parametrize("name", ["ur5", "puma560", "two_link"])
+def test_analytic_batch_is_the_single_answers(name):
+    """Method 'analytic' on a batch (one ik_all batch) answers each target as a single call."""
+    pytest.importorskip("serialkin.ik.analytic")
+    robot = models.get(name)
+    rng = np.random.default_rng(7)
+    Q = robot.random_q(12, seed=91)
+    targets = robot.fk(Q)
+    # per-target references near each truth, inside the limits
+    q0 = np.clip(Q + rng.normal(scale=0.3, size=Q.shape), robot.qlim[:, 0], robot.qlim[:, 1])
+    if robot.n == 2:  # planar 2R: (x, y) targets, plus one out of reach
+        targets = np.vstack([targets[:, :2, 3], [[5.0, 0.0]]])
+        q0 = np.vstack([q0, np.zeros(2)])
+    batch = robot.ik(targets, method="analytic", q0=q0)
+    for k in range(len(targets)):
+        one = robot.ik(targets[k], method="analytic", q0=q0[k])
+        assert batch.success[k] == one.success
+        assert np.array_equal(batch.q[k], one.q)
+        assert batch.reason[k] == one.reason
+        assert batch.position_error[k] == one.position_error
+    assert batch.success[:12].all() and np.allclose(batch.q[:12], Q, atol=1e-6)
+    if robot.n == 2:
+        assert not batch.success[-1] and "no closed-form solution" in batch.reason[-1]
+
+
 def test_analytic_method_errors(panda, two_link):
     """'analytic' on a robot without closed form raises; an unreachable target fails cleanly."""
     pytest.importorskip("serialkin.ik.analytic")

@@ -63,11 +63,12 @@ class MethodSpec:
             columns) or O(n²) function evaluations would run for hours on the longest
             chains serialkin allows; those robots are refused with the names of the
             methods that scale.
-        solve: a callable that solves one target entirely on its own (the closed-form
-            method, which needs neither restarts nor iterations), or None:
-            ``solve(robot, problem, q0, options) -> (q, success, iterations, reason)``
-            with ``problem`` an :class:`~serialkin.ik.solver.IKProblem` and ``q0`` (n,)
-            or None.
+        solve: a callable that solves every target at once entirely on its own (the
+            closed-form method, which needs neither restarts nor iterations), or None:
+            ``solve(robot, T, kind, q0, options) -> (q, found, reason)`` with ``T``
+            (N, 4, 4) the targets, ``kind`` their target kind, ``q0`` (N, n) or None;
+            ``q`` (N, n) the answers, ``found`` (N,) bool and ``reason`` the sentence
+            of a target not found. The solver measures the errors and decides success.
 
     Raises:
         InputError: not exactly one of ``kernel``, ``attempt``, ``solve`` given.

@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -52,6 +52,7 @@ from serialkin.ik.target import (
     parse_target,
     robot_arrays,
 )
+from serialkin.ik.turns import nearest_turn, wide_joints
 from serialkin.kinematics import kernels as FK
 from serialkin.kinematics import parallel
 from serialkin.model.robot import Robot, check_robot
@@ -502,12 +503,44 @@ def _solve_checked(robot: object, target: object, method: str, req: _Request) ->
     q0a = None if req.q0 is None else check_q0(robot, req.q0, n_targets, respect)
     stream = _stream_seed(req.seed)
     if coll is not None and coll.active:
-        return _solve_collision(robot, tgt, spec, q0a, tol_v, iters, nrest, stream, respect,
-                                opts, coll)
-    if spec.kernel is not None:
-        return _solve_compiled(robot, tgt, spec, q0a, tol_v, iters, nrest, stream, respect,
-                               opts)
-    return _solve_python(robot, tgt, spec, q0a, tol_v, iters, nrest, stream, respect, opts)
+        res = _solve_collision(robot, tgt, spec, q0a, tol_v, iters, nrest, stream, respect,
+                               opts, coll)
+    elif spec.kernel is not None:
+        res = _solve_compiled(robot, tgt, spec, q0a, tol_v, iters, nrest, stream, respect,
+                              opts)
+    else:
+        res = _solve_python(robot, tgt, spec, q0a, tol_v, iters, nrest, stream, respect, opts)
+    return with_nearest_turns(robot, res, q0a)
+
+
+#: Per robot: the (n,) mask of joints wider than a turn, or False when there is none.
+_WIDE: PerObject[Any] = PerObject()
+
+
+def with_nearest_turns(robot: Robot, res: IKResult, q0: np.ndarray | None) -> IKResult:
+    """``res`` with q moved by whole turns to the representative nearest ``q0`` (or zero).
+
+    Only revolute joints whose range exceeds 2π move, and only inside their limits
+    (:func:`serialkin.ik.turns.nearest_turn`); ``res`` itself when nothing moves. The
+    errors and the flags stay those of the solve: the pose is the same to rounding.
+
+    Args:
+        robot: the robot solved for.
+        res: the solver's result (single or batch).
+        q0: the initial guess, (n,) or (N, n), or None (the reference is then zero).
+    """
+    wide = _WIDE.get(robot)
+    if wide is None:
+        mask = wide_joints(robot.qlim[:, 0], robot.qlim[:, 1], robot.revolute)
+        wide = _WIDE.set(robot, mask if mask.any() else False)
+    if wide is False:
+        return res
+    q = nearest_turn(res.q, robot.qlim[:, 0], robot.qlim[:, 1], wide, q0)
+    if np.array_equal(q, res.q):
+        return res
+    if not np.asarray(res.q).flags.writeable:
+        q.setflags(write=False)
+    return replace(res, q=q)
 
 
 def _fast_entry(robot: object, method: str) -> tuple | None:
@@ -622,12 +655,13 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
         d["orientation_error"] = oe
         d["restarts"] = used
         d["method"] = name
-        return r
+        return r if _WIDE.get(robot) is False else with_nearest_turns(robot, r, q0)
     if status < 0:
         return None
     reason = failure_reason(pe, oe, DEFAULT_TOL, used + 1, its, "pose",
                             failure_hint(robot, q, DEFAULT_WEIGHTS["pose"], True, target))
-    return IKResult.make(q, False, its, pe, oe, reason, used, name)
+    return with_nearest_turns(robot, IKResult.make(q, False, its, pe, oe, reason, used, name),
+                              q0)
 
 
 def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | None,
@@ -922,20 +956,19 @@ def _problem(robot: Robot, T: np.ndarray, tgt: Target, tol: float, respect: bool
 def _solve_python(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | None,
                   tol: float, max_iter: int, restarts: int, seed: int, respect: bool,
                   opts: Mapping[str, Any]) -> IKResult:
+    """A Python method's solve, for one target or a batch.
+
+    The shared attempt loop per target, or the method's own ``solve`` over every target
+    at once (then errors and success are measured here, :func:`_solve_whole`).
+    """
     Ts = tgt.T[None] if not tgt.batch else tgt.T
+    if spec.solve is not None:
+        return _solve_whole(robot, tgt, spec, Ts, q0, tol, respect, opts)
     rows = []
     for k in range(Ts.shape[0]):
         problem = _problem(robot, Ts[k], tgt, tol, respect)
         qk = None if q0 is None else (q0 if q0.ndim == 1 else q0[k])
-        if spec.attempt is not None:
-            rows.append(run_attempts(spec, problem, qk, max_iter, restarts, seed, opts))
-        else:
-            q, ok, its, reason = spec.solve(robot, problem, qk, opts)
-            q = np.asarray(q, dtype=np.float64)
-            pe, oe = problem.errors(q)
-            if ok and not honest_success(robot, q, True, respect):
-                ok, reason = False, _OUTSIDE
-            rows.append((q, bool(ok), int(its), pe, oe, "" if ok else str(reason), 0))
+        rows.append(run_attempts(spec, problem, qk, max_iter, restarts, seed, opts))
     if not tgt.batch:
         q, ok, its, pe, oe, reason, used = rows[0]
         return IKResult(q=q, success=ok, iterations=its, position_error=pe,
@@ -950,3 +983,42 @@ def _solve_python(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | 
         restarts=np.array([r[6] for r in rows], dtype=np.int64),
         method=spec.name,
     )
+
+
+#: Why a closed-form answer that does not reproduce its target failed.
+_NOT_REPRODUCED = "the closed-form solution does not reproduce the target within tol"
+
+
+def _solve_whole(robot: Robot, tgt: Target, spec: MethodSpec, Ts: np.ndarray,
+                 q0: np.ndarray | None, tol: float, respect: bool,
+                 opts: Mapping[str, Any]) -> IKResult:
+    """Run ``spec.solve`` on every target ``Ts`` (N, 4, 4) at once; measure and judge.
+
+    Errors are those of :meth:`IKProblem.errors` (the selected coordinates of
+    ``[p_t − p; log(R_t Rᵀ)^∨]``), for all answers at once; a found answer succeeds when
+    both errors are within ``tol`` and, with ``respect``, it lies inside the limits.
+    """
+    from serialkin.spatial.pose import pose_error
+
+    N = Ts.shape[0]
+    q0s = None if q0 is None else np.broadcast_to(q0, (N, robot.n))
+    Q, found, why = spec.solve(robot, Ts, tgt.kind, q0s, opts)
+    Q = np.ascontiguousarray(Q, dtype=np.float64)
+    E = pose_error(robot.fk(Q), Ts, check=False)  # (N, 6)
+    sel = tgt.weights > 0.0
+    pe = np.linalg.norm(E[:, :3] * sel[:3], axis=1)
+    oe = np.linalg.norm(E[:, 3:] * sel[3:], axis=1)
+    ok = found & (pe <= tol) & (oe <= tol)
+    reasons = np.where(found, _NOT_REPRODUCED, why)
+    if respect:
+        inside = np.asarray(robot.within_limits(Q, LIMIT_TOL))
+        reasons = np.where(found & ~inside, _OUTSIDE, reasons)
+        ok &= inside
+    reasons = np.where(ok, "", reasons)
+    if not tgt.batch:
+        return IKResult(q=Q[0], success=bool(ok[0]), iterations=int(found[0]),
+                        position_error=float(pe[0]), orientation_error=float(oe[0]),
+                        reason=str(reasons[0]), restarts=0, method=spec.name)
+    return IKResult(q=Q, success=ok, iterations=found.astype(np.int64), position_error=pe,
+                    orientation_error=oe, reason=reasons.astype(str),
+                    restarts=np.zeros(N, dtype=np.int64), method=spec.name)

@@ -90,8 +90,8 @@ from serialkin.spatial.rotations import wrap_angle
 _WRIST_ARMS = {"puma": (0, False), "pieper_intersecting": (1, False), "stanford": (1, True),
                "pieper_general": (2, False), "stanford_general": (2, True)}
 
-__all__ = ["CLASSES", "AllSolutions", "classify", "ik_all", "sort_by_reference",
-           "structure_of"]
+__all__ = ["CLASSES", "AllSolutions", "classify", "ik_all", "shift_toward",
+           "sort_by_reference", "structure_of"]
 
 _STRUCTURES: PerObject[Structure | NoClosedFormError] = PerObject()
 
@@ -547,16 +547,68 @@ def _insert_locked(sols: np.ndarray, idx: np.ndarray, vals: np.ndarray, n: int) 
     return out
 
 
+def shift_toward(robot: Robot, q: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """``q`` with each revolute joint moved by the multiple of 2π nearest ``reference``.
+
+    Per joint ``j`` and row, ``q_j + 2π·t`` with ``t = round((r_j − q_j) / 2π)``, stepped
+    back towards ``t = 0`` (up to three turns) while the shifted value leaves the joint
+    limits (tolerance 1e-12); a row whose every candidate leaves them keeps its value.
+    Prismatic joints are unchanged. A joint whose range is wider than 2π has several
+    representatives: the one nearest the reference is taken.
+
+    Args:
+        robot: the robot (joint kinds and limits).
+        q: (..., n) configurations [rad / m] (trusted finite float64).
+        reference: (..., n) reference configurations, broadcastable against ``q``.
+
+    Returns:
+        (..., n) a new array, the shifted configurations.
+    """
+    q = np.array(q, dtype=np.float64)
+    ref = np.broadcast_to(reference, q.shape)
+    lo, hi = robot.qlim[:, 0] - 1e-12, robot.qlim[:, 1] + 1e-12
+    turns = np.where(robot.revolute, np.round((ref - q) / (2 * np.pi)), 0.0)
+    for _ in range(3):  # step back towards the original value while outside the limits
+        shifted = q + 2 * np.pi * turns
+        bad = (shifted < lo) | (shifted > hi)
+        if not bad.any():
+            return shifted
+        turns = np.where(bad, turns - np.sign(turns), turns)
+    shifted = q + 2 * np.pi * turns
+    return np.where((shifted >= lo) & (shifted <= hi), shifted, q)
+
+
+def _distance_args(robot: Robot, reference: object, weights: object,
+                   norm: str) -> tuple[np.ndarray, np.ndarray]:
+    """The checked ``reference`` (n,) and ``weights`` (n,) of :func:`sort_by_reference`."""
+    from serialkin._checks import check_choice
+
+    check_choice(norm, "norm", ("l2", "linf"))
+    ref = robot.check_q(reference).reshape(robot.n)
+    w = np.ones(robot.n) if weights is None else as_float_array(weights, "weights")
+    if w.shape != (robot.n,) or not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise InputError(f"weights must be {robot.n} finite non-negative numbers, got "
+                         f"{np.asarray(weights)!r}")
+    return ref, w
+
+
+def reference_distance(d: np.ndarray, w: np.ndarray, norm: str) -> np.ndarray:
+    """Distances ``sqrt(Σ_j w_j d_j²)`` (``'l2'``) or ``max_j w_j |d_j|`` (``'linf'``).
+
+    ``d`` (..., n) joint differences, ``w`` (n,) weights; returns (...,).
+    """
+    return np.sqrt((w * d * d).sum(axis=-1)) if norm == "l2" else (w * np.abs(d)).max(axis=-1)
+
+
 def sort_by_reference(robot: Robot, sols: np.ndarray, reference: object, *,
                       weights: object = None, norm: str = "l2",
                       return_order: bool = False) -> Any:
     """Solutions ordered by distance to a reference configuration, nearest first.
 
     Each revolute joint of each row is first moved by the multiple of 2π that brings it
-    nearest the reference while staying inside its limits (a joint with a range wider
-    than 2π has several representatives: the nearest is taken). The distance is
-    ``sqrt(Σ w_j d_j²)`` (``norm='l2'``) or ``max_j w_j |d_j|`` (``norm='linf'``),
-    ``d = q − reference`` after that shift.
+    nearest the reference while staying inside its limits (:func:`shift_toward`). The
+    distance is ``sqrt(Σ w_j d_j²)`` (``norm='l2'``) or ``max_j w_j |d_j|``
+    (``norm='linf'``), ``d = q − reference`` after that shift.
 
     Args:
         robot: the robot (joint kinds and limits).
@@ -570,33 +622,12 @@ def sort_by_reference(robot: Robot, sols: np.ndarray, reference: object, *,
         (k, n) the shifted rows, nearest first (stable for ties); with ``return_order``
         also the (k,) indices of ``sols`` in that order.
     """
-    from serialkin._checks import check_choice
-
-    check_choice(norm, "norm", ("l2", "linf"))
-    ref = robot.check_q(reference).reshape(robot.n)
-    w = np.ones(robot.n) if weights is None else as_float_array(weights, "weights")
-    if w.shape != (robot.n,) or not np.all(np.isfinite(w)) or np.any(w < 0):
-        raise InputError(f"weights must be {robot.n} finite non-negative numbers, got "
-                         f"{np.asarray(weights)!r}")
+    ref, w = _distance_args(robot, reference, weights, norm)
     q = np.array(sols, dtype=float).reshape(-1, robot.n)
     if q.shape[0] == 0:
         return (q, np.zeros(0, dtype=np.int64)) if return_order else q
-    rev = robot.revolute
-    lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
-    for j in np.flatnonzero(rev):
-        turns = np.round((ref[j] - q[:, j]) / (2 * np.pi))
-        for _ in range(3):  # step back towards the original value while outside the limits
-            shifted = q[:, j] + 2 * np.pi * turns
-            bad = (shifted < lo[j] - 1e-12) | (shifted > hi[j] + 1e-12)
-            if not bad.any():
-                break
-            turns = np.where(bad, turns - np.sign(turns), turns)
-        shifted = q[:, j] + 2 * np.pi * turns
-        ok = (shifted >= lo[j] - 1e-12) & (shifted <= hi[j] + 1e-12)
-        q[:, j] = np.where(ok, shifted, q[:, j])
-    d = q - ref
-    dist = np.sqrt((w * d * d).sum(axis=1)) if norm == "l2" else (w * np.abs(d)).max(axis=1)
-    order = np.argsort(dist, kind="stable")
+    q = shift_toward(robot, q, ref)
+    order = np.argsort(reference_distance(q - ref, w, norm), kind="stable")
     if return_order:
         return q[order], order
     return q[order]
@@ -661,18 +692,21 @@ def _near_wrist_singular(robot: Robot, sols: np.ndarray) -> bool:
 
 def _sort_batch(robot: Robot, res: AllSolutions, reference: object, weights: object,
                 norm: str) -> AllSolutions:
-    """``res`` with each target's rows sorted by :func:`sort_by_reference` (flags too)."""
+    """``res`` with each target's rows sorted by :func:`sort_by_reference` (flags too).
+
+    All targets at once: padding rows (beyond each ``count``) stay zero and last.
+    """
+    ref, w = _distance_args(robot, reference, weights, norm)
     k_max, n = res.q.shape[-2], res.q.shape[-1]
-    q = res.q.reshape(-1, k_max, n).copy()
-    counts = np.asarray(res.count).reshape(-1)
-    cont = None if res.continuous is None else res.continuous.reshape(-1, k_max).copy()
-    for i in range(q.shape[0]):
-        k = int(counts[i])
-        if k:
-            q[i, :k], order = sort_by_reference(robot, q[i, :k], reference, weights=weights,
-                                                norm=norm, return_order=True)
-            if cont is not None:
-                cont[i, :k] = cont[i, :k][order]
+    q = res.q.reshape(-1, k_max, n)
+    valid = np.arange(k_max) < np.asarray(res.count).reshape(-1, 1)  # (N, k_max)
+    shifted = np.where(valid[..., None], shift_toward(robot, q, ref), 0.0)
+    dist = np.where(valid, reference_distance(shifted - ref, w, norm), np.inf)
+    order = np.argsort(dist, axis=1, kind="stable")
+    q = np.take_along_axis(shifted, order[..., None], axis=1)
+    cont = None
+    if res.continuous is not None:
+        cont = np.take_along_axis(res.continuous.reshape(-1, k_max), order, axis=1)
     return res.replaced(q=q.reshape(res.q.shape),
                         continuous=None if cont is None else cont.reshape(res.continuous.shape))
 

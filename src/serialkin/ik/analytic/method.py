@@ -3,9 +3,10 @@
 The closed-form family registers and implements its own method here, at import
 (:mod:`serialkin.ik` imports this module): ``robot.ik(target,
 method="analytic", q0=...)`` solves with :func:`serialkin.ik.analytic.ik_all` and
-returns the solution nearest ``q0`` (:func:`serialkin.ik.analytic.sort_by_reference`:
-revolute joints moved by 2π towards ``q0`` inside their limits, weighted L2 or L∞
-distance), or the middle of the joint ranges without ``q0``.
+returns the solution nearest ``q0`` (revolute joints moved by 2π towards ``q0`` inside
+their limits, :func:`serialkin.ik.analytic.shift_toward`; weighted L2 or L∞ distance),
+or nearest the middle of the joint ranges without ``q0``; a batch of targets is one
+``ik_all`` batch.
 """
 
 from __future__ import annotations
@@ -15,7 +16,13 @@ from typing import Any
 
 import numpy as np
 
-from serialkin.ik.analytic import NEAR_TOL
+from serialkin.ik.analytic import (
+    NEAR_TOL,
+    _distance_args,
+    ik_all,
+    reference_distance,
+    shift_toward,
+)
 from serialkin.ik.registry import MethodSpec, register_method
 from serialkin.model.robot import Robot
 
@@ -23,38 +30,64 @@ from serialkin.model.robot import Robot
 OPTIONS: dict[str, Any] = {"weights": None, "norm": "l2", "near_tol": NEAR_TOL, "grid": None}
 
 
-def analytic_solve(robot: Robot, problem: Any, q0: np.ndarray | None,
-                   options: Mapping[str, Any]) -> tuple[np.ndarray, bool, int, str]:
-    """Solve ``problem`` (an :class:`~serialkin.ik.solver.IKProblem`) by ``ik_all``.
+#: Why a target has no answer.
+NOT_FOUND = ("no closed-form solution inside the joint limits: the target is out of reach or "
+             "reachable only outside the joint limits")
 
-    Returns ``(q, success, iterations, reason)``: the solution nearest ``q0`` (or the
-    middle of the ranges); without any solution inside the limits, ``q0`` (or the
-    middle) with success False and a reason.
+
+def _every_solution(robot: Robot, T: np.ndarray, kind: str,
+                    options: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+    """Every solution of each target: rows (N, k_max, n), zero padded, and counts (N,).
+
+    Pose targets go to ``ik_all`` as one batch (every core); the other kinds, whose
+    target is a vector, one by one.
     """
-    from serialkin.ik.analytic import ik_all, sort_by_reference
+    opts = {"near_tol": options["near_tol"], "grid": options["grid"]}
+    if kind == "pose":
+        res = ik_all(robot, T, **opts)
+        return np.asarray(res.q, dtype=np.float64), np.asarray(res.count).reshape(-1)
+    rows = []
+    for Tk in T:
+        if kind == "position":
+            target: object = Tk[:3, 3].copy()
+        elif kind == "planar":
+            target = Tk[:2, 3].copy()
+        else:
+            target = np.array([Tk[0, 3], Tk[1, 3], np.arctan2(Tk[1, 0], Tk[0, 0])])
+        rows.append(np.asarray(ik_all(robot, target, **opts), dtype=np.float64)
+                    .reshape(-1, robot.n))
+    counts = np.array([len(r) for r in rows], dtype=np.int64)
+    Q = np.zeros((len(rows), max(1, int(counts.max(initial=0))), robot.n))
+    for i, r in enumerate(rows):
+        Q[i, :len(r)] = r
+    return Q, counts
 
-    T = problem.T_target
-    if problem.kind == "pose":
-        target: object = T
-    elif problem.kind == "position":
-        target = T[:3, 3].copy()
-    elif problem.kind == "planar":
-        target = T[:2, 3].copy()
-    else:
-        target = np.array([T[0, 3], T[1, 3], np.arctan2(T[1, 0], T[0, 0])])
-    sols = np.asarray(ik_all(robot, target, near_tol=options["near_tol"],
-                             grid=options["grid"]), dtype=np.float64).reshape(-1, robot.n)
-    ref = q0 if q0 is not None else robot.sampling_limits().mean(axis=1)
-    if sols.shape[0] == 0:
-        return ref.copy(), False, 0, (
-            "no closed-form solution inside the joint limits: the target is out of reach or "
-            "reachable only outside the limits")
-    best = sort_by_reference(robot, sols, ref, weights=options["weights"],
-                             norm=options["norm"])[0]
-    ok = problem.converged(best) and (not problem.respect_limits
-                                      or bool(robot.within_limits(best, 1e-12)))
-    reason = "" if ok else "the closed-form solution does not reproduce the target within tol"
-    return best, ok, 1, reason
+
+def analytic_solve(robot: Robot, T: np.ndarray, kind: str, q0: np.ndarray | None,
+                   options: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray, str]:
+    """Solve the targets ``T`` (N, 4, 4) by ``ik_all``, each answer the nearest ``q0``.
+
+    The reference ``r`` is ``q0`` (N, n) or the middle of the joint ranges; each target's
+    solutions are shifted by 2π towards it (:func:`~serialkin.ik.analytic.shift_toward`)
+    and the nearest in the ``weights``/``norm`` distance
+    (:func:`~serialkin.ik.analytic.reference_distance`) is returned. All targets at once:
+    one ``ik_all`` batch and array operations, no loop per target for pose targets.
+
+    Returns:
+        ``(q (N, n), found (N,) bool, reason)``: a target without any solution inside
+        the limits answers its reference, ``found`` False and ``reason`` says why.
+    """
+    mid = robot.sampling_limits().mean(axis=1)
+    ref = np.broadcast_to(mid, (T.shape[0], robot.n)) if q0 is None else q0
+    _, w = _distance_args(robot, mid, options["weights"], options["norm"])
+    Q, counts = _every_solution(robot, T, kind, options)
+    valid = np.arange(Q.shape[1]) < counts[:, None]  # (N, k_max)
+    shifted = shift_toward(robot, Q, ref[:, None, :])
+    dist = np.where(valid, reference_distance(shifted - ref[:, None, :], w, options["norm"]),
+                    np.inf)
+    best = np.take_along_axis(shifted, dist.argmin(axis=1)[:, None, None], axis=1)[:, 0]
+    found = counts > 0
+    return np.where(found[:, None], best, ref), found, NOT_FOUND
 
 
 def register_analytic() -> None:
