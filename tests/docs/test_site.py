@@ -219,3 +219,80 @@ def test_docs_open_in_chromium(site):
         import shutil
 
         shutil.rmtree(profile, ignore_errors=True)
+
+
+def _chromium_page(site: Path, page: str):
+    """A headless Chromium (1100 × 760) showing ``page`` of ``site`` from file://."""
+    from tests._browser import start_chromium
+
+    driver, profile = start_chromium()
+    driver.get((site / page).as_uri())
+    return driver, profile
+
+
+def _close(driver, profile) -> None:
+    import shutil
+
+    driver.quit()
+    shutil.rmtree(profile, ignore_errors=True)
+
+
+def test_search_answers_from_disk(site):
+    """Opened from file://, typing in the search box lists sections that link to real pages."""
+    import time
+
+    driver, profile = _chromium_page(site, "ik.html")
+    try:
+        box = driver.find_element("css selector", "[data-md-component=search-query]")
+        box.click()
+        box.send_keys("jacobian")
+        deadline = time.monotonic() + 20
+        links: list[str] = []
+        while time.monotonic() < deadline and not links:
+            time.sleep(0.2)
+            links = [a.get_attribute("href") for a in
+                     driver.find_elements("css selector", ".md-search-result__list li a")]
+        assert links, "no search results for 'jacobian' on the site opened from disk"
+        for href in links:
+            target = Path(unquote(urlsplit(href).path))
+            assert target.is_file() and site in target.parents, href
+        first = driver.find_element("css selector", ".md-search-result__list li a")
+        assert first.is_displayed(), "the results are listed but not shown"
+        titles = [h.text for h in driver.find_elements("css selector",
+                                                        ".md-search-result__list h1")]
+        assert any("acobian" in t for t in titles), titles
+    finally:
+        _close(driver, profile)
+
+
+#: Tokens of inline code inside table cells whose characters lie on two lines (JavaScript):
+#: a token is a run without white space, cut after each hyphen (a break after a hyphen is
+#: the usual typographic one).
+_BROKEN_TOKENS = """
+var bad = [];
+document.querySelectorAll('.md-typeset table code').forEach(function (c) {
+  c.childNodes.forEach(function (t) {
+    if (t.nodeType !== 3) return;
+    var re = /[^\\s-]+-?/g, m;
+    while ((m = re.exec(t.data))) {
+      var r = document.createRange();
+      r.setStart(t, m.index); r.setEnd(t, m.index + m[0].length);
+      var tops = new Set(Array.from(r.getClientRects()).filter(function (x) {
+        return x.width > 0; }).map(function (x) { return Math.round(x.top); }));
+      if (tops.size > 1) bad.push(m[0]);
+    }
+  });
+});
+return bad;
+"""
+
+
+@pytest.mark.parametrize("page", ["coming-from.html", "ik.html", "cli.html"])
+def test_code_in_tables_never_breaks_inside_a_token(site, page):
+    """Inline code in table cells wraps only between words, never inside an identifier."""
+    driver, profile = _chromium_page(site, page)
+    try:
+        broken = driver.execute_script(_BROKEN_TOKENS)
+        assert not broken, f"{page}: code broken across lines: {broken[:10]}"
+    finally:
+        _close(driver, profile)
