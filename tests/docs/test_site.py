@@ -5,6 +5,8 @@ mkdocstrings or griffe fails the build), exactly as ``make docs`` does, into a t
 Python blocks fenced as ```` ```python ```` on the hand-written guide pages are run, page by
 page in one namespace (as a reader pastes them one after the other); fragments
 that are not meant to run (excerpts of the library's source) are fenced as ```` ```py ````.
+Blocks fenced ```` ```python exec="on" ... ```` are also run by the build itself
+(markdown-exec), which shows what they print under them: the output a page shows is real.
 """
 
 from __future__ import annotations
@@ -175,7 +177,7 @@ def test_gallery_shows_every_example_with_its_figures(site):
 
 
 GUIDE_PAGES = sorted(p for p in DOCS.glob("*.md"))
-_BLOCK = re.compile(r"^```python\n(.*?)^```", re.S | re.M)
+_BLOCK = re.compile(r"^```python(?: [^\n]*)?\n(.*?)^```", re.S | re.M)
 
 
 @pytest.mark.parametrize("page", GUIDE_PAGES, ids=[p.name for p in GUIDE_PAGES])
