@@ -1,23 +1,28 @@
-"""Fit the Panda's and UR5's capsules of serialkin.collision.robots with the library's fit.
+"""Fit the Panda's and UR5's capsules of serialkin.collision.robots to the vendor meshes.
 
 The numbers of :mod:`serialkin.collision.robots` for the Panda and the UR5 come from this
-script (it needs example-robot-data, the ``bench`` extra, and trimesh, the ``mesh`` extra):
+script (it needs Pinocchio with coal and example-robot-data, the ``bench`` extra, and
+trimesh, the ``mesh`` extra):
 
     PYTHONPATH=src python benchmarks/fit_capsules.py
 
-1. the URDF is loaded with its meshes resolved (``Robot.from_urdf(..., resolve_meshes=True)``)
-   and capsules are fitted to every link's collision geometry
-   (:func:`serialkin.collision.fit.collision_model_from_geometry` with ``merge=True``:
-   a bounding capsule of all of a link's shapes, a second one when it saves 20 % of the
-   volume);
-2. the Panda's fingers hang on prismatic joints, outside the arm's chain: a second robot
-   ending at each finger is fitted the same way and its finger frame is fixed to frame 7
-   with the finger joint at 0.04 m (fully open);
-3. each URDF chain frame is mapped to the zoo model's frame (:mod:`serialkin.models`, DH
-   frames) by the transform ``X_f = F_zoo[f]⁻¹ · F_urdf[f]``, checked to be the same at
-   three random configurations (the UR5's URDF joint 1 reads q1 + π);
-4. the fit is reported: per body the mesh volume, the capsules' volume and the ratio, the
-   largest gap (Hausdorff distance capsule ↔ hull), and the fit time.
+1. the vendor URDF is loaded by Pinocchio (:class:`serialkin.collision.reference.CoalReference`),
+   so that every collision shape coal checks is fitted, the UR5's ``ee_link`` cube and the
+   Panda's finger boxes included;
+2. each shape's surface is subdivided to edges ≤ 3 mm and moved into the zoo frame of
+   its link (same joint values; the fixed transforms are those checked by
+   :func:`~serialkin.collision.reference.frame_offsets`); a finger is taken at 21
+   openings 0..0.04 m (every 2 mm), so its capsule holds it at any opening;
+3. a link's points are cut into ``SLICES`` equal lengths along the axis of its bounding
+   capsule and each piece gets its bounding capsule
+   (:func:`serialkin.collision.fit.bounding_capsule`):
+   the union of the capsules holds every surface point, and a triangle cut between two
+   pieces lies within 3 mm / √3 of its corners, so the radii are grown by 1.8 mm, then
+   rounded up to 0.1 mm (and 0.1 mm more for the ends rounded to 0.1 mm).
+
+The slice counts were chosen by the false-positive rate against coal (3,000
+configurations, ``benchmarks/bench_self_collision.py``): one capsule per link gave 5.6 %
+(Panda) and 9.5 % (UR5) at a 5 mm margin, the slices below 3.9 % and 3.8 %.
 """
 
 from __future__ import annotations
@@ -29,102 +34,78 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-from tests.erd import robots_dir, urdf  # noqa: E402
+from serialkin import models  # noqa: E402
+from serialkin.collision.fit import bounding_capsule  # noqa: E402
 
-from serialkin import Robot, models  # noqa: E402
-from serialkin.collision.fit import collision_model_from_geometry  # noqa: E402
-from serialkin.formats.mesh import clear_mesh_cache  # noqa: E402
-
-
-def load(rel: str, tip: str) -> Robot:
-    """The URDF robot ending at ``tip``, mesh paths resolved.
-
-    The right finger's ``<mimic>`` (not supported: serialkin chains have independent
-    joints) is dropped: the finger is placed at 0.04 m by hand anyway.
-    """
-    text = urdf(rel).read_text().replace('<mimic joint="panda_finger_joint1"/>', "")
-    return Robot.from_urdf(text, tip_link=tip, resolve_meshes=True,
-                           package_map={"example-robot-data": robots_dir().parent})
+EDGE = 0.003
+SLICES = {"panda": 6, "ur5": 4}
 
 
-def frame_map(zoo: Robot, robot: Robot, offsets=None, extra=(), seed: int = 0) -> np.ndarray:
-    """(n+1, 4, 4): X_f with F_zoo[f] · X_f = F_urdf[f], checked at three configurations.
+def clouds(name: str) -> dict[str, tuple[np.ndarray, int]]:
+    """Surface points of every vendor collision shape in its zoo link frame, per link."""
+    import pinocchio as pin
+    import trimesh
 
-    ``extra`` are the values of the URDF chain's joints beyond the zoo's n (a finger).
-    """
-    rng = np.random.default_rng(seed)
-    X = None
-    for _ in range(3):
-        q = rng.uniform(-1.5, 1.5, zoo.n)
-        qu = np.concatenate([q + (0.0 if offsets is None else np.asarray(offsets)), extra])
-        Xi = np.linalg.inv(zoo.fk_all(q)) @ robot.fk_all(qu)[: zoo.n + 1]
-        if X is not None and np.abs(Xi - X).max() > 1e-9:
-            raise RuntimeError(f"frames of {zoo.name} and its URDF do not correspond")
-        X = Xi
-    return X
+    from serialkin.collision.reference import CoalReference
 
-
-def rows_of(model, report, X: np.ndarray, frame_of=None):
-    """(body, zoo frame, [(a, b, r)], shape volume, capsule volume, gap) per body."""
-    out = []
-    for i, body in enumerate(model.body_names):
-        f = int(model.body_frames[i]) if frame_of is None else frame_of
-        T = X[int(model.body_frames[i])]
-        caps = [(T[:3, :3] @ model.a[s] + T[:3, 3], T[:3, :3] @ model.b[s] + T[:3, 3],
-                 float(model.radius[s])) for s in np.flatnonzero(model.shape_body == i)]
-        fits = [fit for fit in report.fits if fit.link_name == body]
-        out.append((body, f, caps, sum(fit.shape_volume for fit in fits),
-                    sum(fit.capsule_volume for fit in fits), max(fit.max_gap for fit in fits)))
-    return out
-
-
-def panda_rows():
-    """Capsules of the Panda's arm, hand and both fingers in the zoo's frames."""
-    zoo, arm = models.panda(), load("panda_description/urdf/panda.urdf", "panda_hand")
-    model, report = collision_model_from_geometry(arm, merge=True)
-    rows = rows_of(model, report, frame_map(zoo, arm))
-    for finger in ("panda_leftfinger", "panda_rightfinger"):
-        r = load("panda_description/urdf/panda.urdf", finger)
-        m, rep = collision_model_from_geometry(r, links=[finger], merge=True)
-        q = np.zeros(r.n)
-        q[-1] = 0.04  # fully open
-        F = r.fk_all(q)
-        X = frame_map(zoo, r, extra=[0.04])
-        X8 = X[7] @ np.linalg.inv(F[7]) @ F[8]  # finger frame in zoo frame 7
-        rows += rows_of(m, rep, np.array([X8] * (r.n + 1)), frame_of=7)
-    return rows
+    robot, ref = models.get(name), CoalReference(name)
+    frame_of = dict(zip(robot.collision.body_names, robot.collision.body_frames, strict=True))
+    frame_of.setdefault("ee_link", robot.n)  # the UR5's cube rides on the flange link
+    q = np.random.default_rng(1).uniform(-1.0, 1.0, robot.n)
+    F = robot.fk_all(q)
+    openings = [np.array([[t]]) for t in np.linspace(0.0, 0.04, 21)] if ref.spec.extra else [
+        np.zeros((1, 0))]
+    surface: dict[str, np.ndarray] = {}
+    out: dict[str, list[np.ndarray]] = {}
+    for k, extra in enumerate(openings):
+        pin.forwardKinematics(ref.model, ref.data, ref.vendor_q(q, extra)[0])
+        for go in ref.geom.geometryObjects:
+            link = go.name.rpartition("_")[0]
+            if k and "finger" not in link:
+                continue
+            if go.name not in surface:
+                g = go.geometry
+                m = (trimesh.creation.box(extents=2.0 * np.asarray(g.halfSide))
+                     if hasattr(g, "halfSide") else trimesh.load(go.meshPath, force="mesh"))
+                v = np.asarray(m.vertices) * (1.0 if hasattr(g, "halfSide")
+                                              else np.asarray(go.meshScale))
+                surface[go.name] = trimesh.remesh.subdivide_to_size(v, m.faces, EDGE)[0]
+            W = ref.spec.T_base_vroot() @ (ref.data.oMi[go.parentJoint] * go.placement).homogeneous
+            Z = np.linalg.inv(F[frame_of[link]]) @ W
+            out.setdefault(link, []).append(surface[go.name] @ Z[:3, :3].T + Z[:3, 3])
+    return {k: (np.vstack(v), int(frame_of[k])) for k, v in out.items()}
 
 
-def ur5_rows():
-    """Capsules of the UR5's links in the zoo's frames."""
-    zoo, robot = models.ur5(), load("ur_description/urdf/ur5_robot.urdf", "tool0")
-    links = [lg.link_name for lg in robot.geometry
-             if lg.collision and lg.link_name != "ee_link"]  # ee_link: a 1 cm marker cube
-    model, report = collision_model_from_geometry(robot, links=links, merge=True)
-    return rows_of(model, report, frame_map(zoo, robot, offsets=[np.pi, 0, 0, 0, 0, 0]))
+def sliced(P: np.ndarray, count: int) -> list[tuple[np.ndarray, np.ndarray, float]]:
+    """Bounding capsules of ``count`` equal slices of ``P`` along its bounding capsule's axis."""
+    a, b, r = bounding_capsule(P)
+    L = float(np.linalg.norm(b - a))
+    if count == 1 or L < 1e-9:
+        return [(a, b, r)]
+    t = (P - a) @ ((b - a) / L)
+    edges = np.linspace(t.min(), t.max(), count + 1)
+    return [bounding_capsule(P[(t >= lo - 1e-9) & (t <= hi + 1e-9)])
+            for lo, hi in zip(edges[:-1], edges[1:], strict=True)]
 
 
 def main() -> None:
-    if urdf("panda_description/urdf/panda.urdf") is None:
-        sys.exit("example-robot-data is not installed: pip install -e '.[bench]'")
-    for name, fn in (("panda", panda_rows), ("ur5", ur5_rows)):
-        clear_mesh_cache()
+    from serialkin.collision.reference import vendor_files
+
+    for name in ("panda", "ur5"):
+        files = vendor_files(name)
+        if isinstance(files, str):
+            sys.exit(files)
         t = time.perf_counter()
-        rows = fn()
-        dt = time.perf_counter() - t
-        print(f"# {name}: fitted in {dt:.2f} s (meshes loaded cold); body, frame, a, b, radius "
-              "[m]; mesh volume -> capsule volume [l], ratio, largest gap [mm]")
-        for body, f, caps, vol, cap, gap in rows:
+        rows = [(link, f, sliced(P, SLICES[name])) for link, (P, f) in clouds(name).items()]
+        print(f"# {name}: fitted in {time.perf_counter() - t:.1f} s; body, frame, a, b, "
+              "radius [m]")
+        for link, f, caps in rows:
             for a, b, r in caps:
-                # ends rounded to 0.1 mm move by at most 0.09 mm: the radius is rounded
-                # up and grown by 0.1 mm so that the printed capsule still holds the mesh
-                r_out = math.ceil(r * 1e4) / 1e4 + 1e-4
-                print(f'    ("{body}", {f}, {np.round(a, 4).tolist()}, '
+                r_out = math.ceil((r + EDGE / math.sqrt(3.0)) * 1e4) / 1e4 + 1e-4
+                print(f'    ("{link}", {f}, {np.round(a, 4).tolist()}, '
                       f"{np.round(b, 4).tolist()}, {r_out:.4f}),")
-            print(f"    # {vol * 1e3:.2f} l -> {cap * 1e3:.2f} l, x{cap / vol:.2f}, "
-                  f"gap {gap * 1e3:.0f} mm")
 
 
 if __name__ == "__main__":

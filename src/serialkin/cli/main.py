@@ -112,6 +112,7 @@ def chapter(out: str, quiet: bool, sections: tuple[str, ...], jobs: int | None) 
 def _register() -> None:
     """Add the subcommands of this package to :data:`cli`."""
     from serialkin.cli.calibrate_cmd import calibrate_cmd
+    from serialkin.cli.collide_cmd import collide_cmd
     from serialkin.cli.commands import fk_cmd, ik_cmd, jacobian_cmd, models_cmd
     from serialkin.cli.compare_cmd import compare_cmd
     from serialkin.cli.path_cmd import path_cmd
@@ -123,7 +124,7 @@ def _register() -> None:
 
     for command in (models_cmd, fk_cmd, jacobian_cmd, ik_cmd, compare_cmd, track_cmd,
                     path_cmd, workspace_cmd, view_cmd, calibrate_cmd, reach_cmd, base_placement_cmd,
-                    warmup_cmd):
+                    warmup_cmd, collide_cmd):
         cli.add_command(command)
 
 

@@ -13,10 +13,22 @@
 * :mod:`~serialkin.collision.acm` — the allowed-collision matrix (default, SRDF; the
   sampled one is :func:`~serialkin.collision.queries.sampled_acm`);
 * :mod:`~serialkin.collision.srdf` — reading an SRDF;
-* :mod:`~serialkin.collision.queries` — self/scene clearance and collision checks, batched.
+* :mod:`~serialkin.collision.queries` — self/scene clearance and collision checks, batched;
+* :mod:`~serialkin.collision.checks` — the same for a robot's own model, pairs named
+  (``Robot.clearance``, ``Robot.in_collision``, ``serialkin collide``);
+* :mod:`~serialkin.collision.reference` — agreement with Pinocchio + coal on the vendor
+  meshes (optional peers).
 """
 
 from serialkin.collision.acm import AllowedCollisionMatrix, acm_from_srdf, default_acm
+from serialkin.collision.checks import (
+    NamedClearance,
+    PairDistance,
+    clearance,
+    closest_pairs,
+    in_collision_of,
+    robot_acm,
+)
 from serialkin.collision.fit import FitReport, ShapeFit, collision_model_from_geometry
 from serialkin.collision.queries import (
     Clearance,
@@ -39,23 +51,31 @@ from serialkin.model.collision_model import CollisionModel
 from serialkin.model.robot import provide
 
 provide("fit_collision", collision_model_from_geometry)  # Robot.fit_collision calls it
+provide("clearance", clearance)  # Robot.clearance
+provide("in_collision", in_collision_of)  # Robot.in_collision
 
 __all__ = [
     "AllowedCollisionMatrix",
     "Clearance",
     "CollisionModel",
     "FitReport",
+    "NamedClearance",
+    "PairDistance",
     "ShapeFit",
     "Srdf",
     "acm_from_srdf",
+    "clearance",
+    "closest_pairs",
     "collision_model_from_geometry",
     "default_acm",
     "iiwa7_collision_model",
     "in_collision",
+    "in_collision_of",
     "panda_collision_model",
     "planar_collision_model",
     "puma560_collision_model",
     "read_srdf",
+    "robot_acm",
     "sampled_acm",
     "scara_collision_model",
     "scene_clearance",

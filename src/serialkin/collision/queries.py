@@ -449,12 +449,14 @@ def body_pair_distances(robot, model: CollisionModel, q: object,
 
 def sampled_acm(robot, model: CollisionModel, acm: AllowedCollisionMatrix | None = None, *,
                 samples: int = 1000, seed: object = 0,
-                margin: float = 0.0) -> AllowedCollisionMatrix:
+                margin: float = 0.0, never: bool = False) -> AllowedCollisionMatrix:
     """Add to ``acm`` (default: :func:`default_acm`) the pairs in contact in every sample.
 
     ``samples`` configurations are drawn uniformly within ``robot.qlim`` (±π where a joint
     is unlimited) with the generator made from ``seed``; a body pair is in contact when
-    the smallest signed distance between their shapes is ≤ ``margin`` [m].
+    the smallest signed distance between their shapes is ≤ ``margin`` [m]. With
+    ``never=True`` the pairs in contact in *no* sample are allowed too (MoveIt's setup
+    assistant's "never in collision": they cost checks and find nothing).
 
     Returns:
         The matrix with those pairs allowed (pairs without shapes are left as they are).
@@ -467,7 +469,8 @@ def sampled_acm(robot, model: CollisionModel, acm: AllowedCollisionMatrix | None
     hi[~np.isfinite(hi)] = np.pi
     q = lo + (hi - lo) * rng.random((samples, robot.n))
     pairs, d = body_pair_distances(robot, model, q)
-    always = (d <= margin).all(axis=0)
+    contact = d <= margin
+    always = contact.all(axis=0) | (~contact.any(axis=0) if never else False)
     base = default_acm(model) if acm is None else acm
     return base.allow((model.body_names[i], model.body_names[j])
                       for (i, j), yes in zip(pairs, always, strict=True) if yes)

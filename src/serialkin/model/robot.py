@@ -424,6 +424,27 @@ class Robot:
             self, kind, max_capsules=max_capsules, loose=loose, gain=gain, merge=merge)
         return self.with_collision(model), report
 
+    def clearance(self, q: object, scene: object = None, **options: Any) -> Any:
+        """Smallest signed distance [m] to itself and to ``scene``, with the pair named.
+
+        Uses :attr:`collision`; ``options``: ``acm``, ``srdf`` (its disabled pairs are
+        added), ``skip_links``, ``self_collision`` — see
+        :func:`serialkin.collision.checks.clearance`, which returns a
+        :class:`~serialkin.collision.checks.NamedClearance` of shape (...,) for
+        ``q`` (..., n).
+
+        Raises:
+            InputError: the robot has no collision model.
+        """
+        return _provided("clearance")(self, q, scene, **options)
+
+    def in_collision(self, q: object, scene: object = None, **options: Any) -> Any:
+        """(...,) bool: :meth:`clearance` below ``margin`` (default 0 m: shapes overlap).
+
+        ``options`` as for :meth:`clearance`, and ``margin`` [m].
+        """
+        return _provided("in_collision")(self, q, scene, **options)
+
     def with_tool(self, tool: object) -> Robot:
         """A copy of this robot with another tool transform (4, 4)."""
         return self._copy(tool=tool)
