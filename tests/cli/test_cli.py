@@ -427,7 +427,7 @@ def test_ik_mask_q0_degrees_and_no_limits():
                        "--max-iter", "200", "--restarts", "5", "--no-limits", "--json"))
     assert data["success"]
     np.testing.assert_allclose(r.fk(np.array(data["results"][0]["q"]))[:3, 3], p, atol=1e-8)
-    res = run("ik", "ur5", "-t", target, "--mask", "0,0,0,0,0,0", code=2)
+    res = run("ik", "ur5", "-t", target, "-d", "--mask", "0,0,0,0,0,0", code=2)
     assert "mask" in res.stderr
 
 

@@ -214,7 +214,9 @@ quiet_option = click.option("--quiet", "-q", is_flag=True, help=_QUIET_HELP)
 #: For commands with a --q option, where a short -q would be confusing.
 quiet_long_option = click.option("--quiet", is_flag=True, help=_QUIET_HELP)
 degrees_option = click.option("--degrees", "-d", is_flag=True,
-                              help="Joint angles, rpy and φ in degrees (input and table).")
+                              help="Joint angles, rpy and φ in degrees (input and table); "
+                                   "without it they are radians, and a value beyond a full "
+                                   "turn is refused as a likely slip.")
 out_option = click.option("--out", "-o", "out", type=click.Path(dir_okay=False),
                           help="Also write the results to this file (.json or .csv), "
                                "atomically.")
@@ -238,6 +240,37 @@ def _angle_factor(robot: Any, degrees: bool) -> np.ndarray:
     return f
 
 
+def refuse_joint_turns(robot: Any, Q: np.ndarray, option: str) -> None:
+    """Refuse joint values read as radians that only make sense as degrees.
+
+    A revolute value beyond a full turn and outside the joint's limits is almost surely
+    in degrees: CLIError naming ``option``, the joint and the value, with the hint
+    ``--degrees``.
+    """
+    Q = np.asarray(Q, dtype=float).reshape(-1, robot.n)
+    lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
+    wild = robot.revolute & beyond_a_turn(Q) & ((Q < lo) | (Q > hi))
+    if wild.any():
+        i, j = np.argwhere(wild)[0]
+        raise CLIError(f"{option}: joint {j + 1} = {Q[i, j]:g} rad is beyond a full turn and "
+                       f"its limits [{lo[j]:g}, {hi[j]:g}]; values are radians (for "
+                       "degrees add --degrees)")
+
+
+def refuse_angle_turns(values: Any, option: str, what: str = "angle", *,
+                       hint: str = "add --degrees") -> None:
+    """Refuse fixed angles (rpy, φ, a yaw) read as radians beyond a full turn (2π).
+
+    Such a value is almost surely in degrees: CLIError naming ``option``, what it is and
+    the value, ending with ``hint`` (how to give degrees).
+    """
+    v = np.asarray(values, dtype=float)
+    wild = beyond_a_turn(v)
+    if wild.any():
+        raise CLIError(f"{option}: {what} {v[wild].flat[0]:g} rad is beyond a full turn (2π); "
+                       f"it is read in radians (are these degrees? {hint})")
+
+
 def read_q(robot: Any, q_texts: tuple[str, ...], q_file: str | None, degrees: bool) -> np.ndarray:
     """Configurations (N, n) [SI] from ``--q`` options and/or a CSV file (zeros if neither)."""
     rows = [parse_numbers(t, "--q", robot.n) for t in q_texts]
@@ -247,13 +280,7 @@ def read_q(robot: Any, q_texts: tuple[str, ...], q_file: str | None, degrees: bo
     if Q.shape[0] == 0:
         Q = np.zeros((1, robot.n))
     if not degrees:  # radians are read: a value beyond a turn and the limits is a slip
-        lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
-        wild = robot.revolute & beyond_a_turn(Q) & ((Q < lo) | (Q > hi))
-        if wild.any():
-            i, j = np.argwhere(wild)[0]
-            raise CLIError(f"--q: joint {j + 1} = {Q[i, j]:g} rad is beyond a full turn and "
-                           f"its limits [{lo[j]:g}, {hi[j]:g}]; values are radians (for "
-                           "degrees add --degrees)")
+        refuse_joint_turns(robot, Q, "--q")
     return Q * _angle_factor(robot, degrees)
 
 
@@ -315,11 +342,47 @@ _MODELS_CMD_HELP = command_help(
 )
 
 
-def _robot_detail(r: Any) -> dict[str, Any]:
+def _frames_record(name: str) -> dict[str, Any] | None:
+    """The documented base/flange frames of zoo model ``name`` (None for other robots)."""
+    from serialkin.models.frames import FRAMES, VENDOR_SUFFIX
+
+    f = FRAMES.get(name.removesuffix(VENDOR_SUFFIX))
+    if f is None:
+        return None
+    rec: dict[str, Any] = {"base": f.base, "flange": f.flange}
+    if f.vendor is not None:
+        v = f.vendor
+        rec["vendor"] = {"description": v.description, "base_link": v.base_link,
+                         "tip_link": v.tip_link, "T_vbase_base": v.T_vbase_base,
+                         "T_flange_vtip": v.T_flange_vtip, "note": v.note,
+                         "variant": name.removesuffix(VENDOR_SUFFIX) + VENDOR_SUFFIX
+                         if f.variant else None}
+    else:
+        rec["vendor"] = None
+        rec["no_vendor"] = f.no_vendor
+    return rec
+
+
+def _show_frames(rec: dict[str, Any], indent: str = "") -> None:
+    click.echo(f"{indent}base frame: {rec['base']}")
+    click.echo(f"{indent}flange frame: {rec['flange']}")
+    v = rec["vendor"]
+    if v is None:
+        click.echo(f"{indent}vendor frames: none ({rec['no_vendor']})")
+        return
+    click.echo(f"{indent}vendor frames ({v['description']}): {v['base_link']} -> "
+               f"{v['tip_link']} = T_vbase_base . fk(q) . T_flange_vtip; {v['note']}"
+               + (f"; in these frames: {v['variant']}" if v["variant"] else ""))
+
+
+def _robot_detail(r: Any, spec: str = "") -> dict[str, Any]:
     info = _robot_info(r)
     info["qlim"] = r.qlim
     info["base"] = r.base
     info["tool"] = r.tool
+    frames = _frames_record(_zoo_name(spec)) if spec else None
+    if frames is not None:
+        info["frames"] = frames
     if r.dh is not None:
         info["dh"] = [{"a": d.a, "alpha": d.alpha, "d": d.d, "theta": d.theta, "type": d.type,
                        "qlim": list(d.qlim), "name": d.name} for d in r.dh]
@@ -329,11 +392,23 @@ def _robot_detail(r: Any) -> dict[str, Any]:
     return info
 
 
-def _show_robot(r: Any) -> None:
+def _zoo_name(spec: str) -> str:
+    """The catalog name of a ROBOT argument naming a zoo model ('' for a file)."""
+    from pathlib import Path
+
+    from serialkin.models import canonical_name
+
+    return "" if Path(spec).suffix else (canonical_name(spec) or "")
+
+
+def _show_robot(r: Any, spec: str = "") -> None:
     click.echo(f"{r.name}: {r.n} joints {''.join(r.joint_types)}"
                + (f", {r.convention} DH" if r.convention else ""))
     if r.source:
         click.echo(f"source: {r.source}")
+    frames = _frames_record(_zoo_name(spec)) if spec else None
+    if frames is not None:
+        _show_frames(frames)
 
     def lim(lo: float, hi: float, revolute: bool) -> str:
         if not (np.isfinite(lo) and np.isfinite(hi)):
@@ -395,9 +470,9 @@ def models_cmd(robot: str | None, save: str | None, angle_unit: str, length_unit
             if not as_json:
                 click.echo(f"wrote {p}")
         if as_json:
-            click.echo(dumps_json(_robot_detail(r)), nl=False)
+            click.echo(dumps_json(_robot_detail(r, robot)), nl=False)
         elif not save:
-            _show_robot(r)
+            _show_robot(r, robot)
         return
     if save:
         raise CLIError("--save needs ROBOT, e.g. serialkin models ur5 --save ur5.yaml")
@@ -412,6 +487,7 @@ def models_cmd(robot: str | None, save: str | None, angle_unit: str, length_unit
             "summary": info.summary,
             "source": built.source if built else "planar<N>: N unit links (or --param "
                                                  "lengths=[...])",
+            "frames": _frames_record(info.name),
         })
     if as_json:
         click.echo(dumps_json({"models": entries}), nl=False)
@@ -422,8 +498,13 @@ def models_cmd(robot: str | None, save: str | None, angle_unit: str, length_unit
     click.echo("\nSources:")
     for e in entries:
         click.echo(f"  {e['name']}: {e['source']}")
-    click.echo("\nAlso: planar<N> (e.g. planar6), a robot file (.yaml/.json) or a URDF. "
-               "Details of one: serialkin models <name>.")
+    click.echo("\nFrames (fk(q) is the flange frame in the base frame):")
+    for e in entries:
+        click.echo(f"  {e['name']}:")
+        _show_frames(e["frames"], indent="    ")
+    click.echo(f"\nIn the vendor's frames: {', '.join(models.vendor_variants())} "
+               "(e.g. serialkin fk ur5_vendor). Also: planar<N> (e.g. planar6), a robot file "
+               "(.yaml/.json) or a URDF. Details of one: serialkin models <name>.")
 
 
 # ---------------------------------------------------------------------------- fk
@@ -603,20 +684,29 @@ def jacobian_cmd(robot: str, q_texts: tuple[str, ...], q_file: str | None, frame
 
 
 # ---------------------------------------------------------------------------- ik
-def _target_rows(robot: Any, values: list[np.ndarray], degrees: bool, planar: bool
-                 ) -> list[Any]:
-    """Turn rows of numbers into IK targets (see ``serialkin ik --help``)."""
+def _target_rows(robot: Any, values: list[np.ndarray], degrees: bool, planar: bool,
+                 option: str = "--target") -> list[Any]:
+    """Turn rows of numbers into IK targets (see ``serialkin ik --help``).
+
+    Angles (roll, pitch, yaw; a planar φ) are degrees with ``degrees``, else radians, and
+    then a value beyond a full turn is refused (CLIError hinting at --degrees).
+    """
     from serialkin.spatial import make_transform, rpy_to_matrix
 
     out: list[Any] = []
-    for row in values:
+    for i, row in enumerate(values):
         k = row.shape[0]
+        where = f"{option} {i + 1}" if len(values) > 1 else option
         if k == 16:
             out.append(row.reshape(4, 4))
         elif k == 6:
+            if not degrees:
+                refuse_angle_turns(row[3:], where, "roll/pitch/yaw")
             rpy = np.radians(row[3:]) if degrees else row[3:]
             out.append(make_transform(rpy_to_matrix(rpy), row[:3]))
         elif k == 3 and planar:
+            if not degrees:
+                refuse_angle_turns(row[2], where, "φ")
             out.append(np.array([row[0], row[1], np.radians(row[2]) if degrees else row[2]]))
         elif k in (2, 3):
             out.append(row.copy())
@@ -669,7 +759,9 @@ _IK_CMD_HELP = command_help(
               help="CSV file with one target per row (same forms as --target).")
 @click.option("--method", "-m", default="lm", show_default=True,
               help="IK method (see --list-methods).")
-@click.option("--q0", default=None, metavar="Q1,Q2,...", help="Initial guess (n values).")
+@click.option("--q0", default=None, metavar="Q1,Q2,...",
+              help="Initial guess (n values); the answer is the 2π-representative nearest "
+                   "it (nearest zero without --q0) on joints whose range exceeds a turn.")
 @click.option("--mask", default=None, metavar="W1,...,W6",
               help="Weights of [vx,vy,vz,wx,wy,wz] (0 drops a coordinate).")
 @click.option("--tol", type=float, default=None, help="Tolerance on position [m] and "
@@ -713,7 +805,10 @@ def ik_cmd(robot: str | None, targets: tuple[str, ...], target_file: str | None,
         raise CLIError("no target: give --target (repeatable) or --target-file")
     tgts = _target_rows(r, rows, degrees, planar)
     f = _angle_factor(r, degrees)
-    q0v = parse_numbers(q0, "--q0", r.n) * f if q0 is not None else None
+    q0v = parse_numbers(q0, "--q0", r.n) if q0 is not None else None
+    if q0v is not None and not degrees:
+        refuse_joint_turns(r, q0v, "--q0")
+    q0v = q0v * f if q0v is not None else None
     maskv = parse_numbers(mask, "--mask", 6) if mask is not None else None
     opts = _ik_options(options)
     info = _robot_info(r)

@@ -12,6 +12,7 @@ from serialkin._checks import check_int, short_repr
 from serialkin.cli.commands import (
     _target_rows,
     _target_sizes,
+    degrees_option,
     handle_errors,
     json_option,
     memory_budget_option,
@@ -93,6 +94,7 @@ def _write_table(out: str, data: dict[str, Any]) -> Any:
 @click.option("--no-limits", is_flag=True, help="Do not enforce the joint limits.")
 @click.option("--option", "options", multiple=True, metavar="METHOD:KEY=VALUE",
               help="A method-specific option, e.g. dls:damping=0.05 (repeatable).")
+@degrees_option
 @param_option
 @json_option
 @out_option
@@ -102,7 +104,8 @@ def _write_table(out: str, data: dict[str, Any]) -> Any:
 def compare_cmd(robot: str, count: int, kind: str, target_file: str | None,
                 methods: str | None, seed: int, tol: float, max_iter: int | None,
                 restarts: int | None, no_limits: bool, options: tuple[str, ...],
-                params: tuple[str, ...], as_json: bool, out: str | None, quiet: bool) -> None:
+                degrees: bool, params: tuple[str, ...], as_json: bool, out: str | None,
+                quiet: bool) -> None:
     """Compare IK methods on the same targets."""
     from serialkin.ik.compare import compare
 
@@ -110,7 +113,7 @@ def compare_cmd(robot: str, count: int, kind: str, target_file: str | None,
     planar = bool(r.is_planar)
     if target_file:
         rows = list(read_csv_rows(target_file, "targets", _target_sizes(planar)))
-        targets: Any = np.array(_target_rows(r, rows, False, planar))
+        targets: Any = np.array(_target_rows(r, rows, degrees, planar, "--target-file row"))
     else:
         count = check_int(count, "--targets", minimum=1)
         check_allocation("the random targets", (count, r.n + 16), 8, setting="--targets")

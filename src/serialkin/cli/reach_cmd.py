@@ -16,6 +16,7 @@ from serialkin.cli.commands import (
     json_option,
     memory_budget_option,
     quiet_option,
+    refuse_angle_turns,
 )
 from serialkin.cli.io import CLIError, command_help, dumps_json, ensure_dir, parse_numbers
 from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot, robot_argument
@@ -174,11 +175,13 @@ def reach_cmd(robot: str, resolution: float, orientations: int, sampling: str, r
         click.echo(f"map: {files['map']}")
 
 
-def read_tasks(path: str) -> np.ndarray:
+def read_tasks(path: str, degrees: bool = False) -> np.ndarray:
     """Task poses from a .npy file ((M, 4, 4)) or a YAML/JSON list.
 
     The list (or ``{tasks: [...]}``) holds 4×4 matrices (nested or 16 numbers
-    row-major) or ``[x, y, z, roll, pitch, yaw]`` [m, rad].
+    row-major) or ``[x, y, z, roll, pitch, yaw]`` [m, and rad, or deg with ``degrees``
+    or a ``units: {angle: deg}`` key beside ``tasks``]. Angles read as radians beyond a
+    full turn are refused (most likely degrees).
     """
     if Path(path).suffix.lower() == ".npy":
         try:
@@ -193,6 +196,18 @@ def read_tasks(path: str) -> np.ndarray:
     items = doc.get("tasks") if isinstance(doc, dict) else doc
     if not isinstance(items, list) or not items:
         raise CLIError(f"--tasks {path}: expected a list of poses (or 'tasks: [...]')")
+    units = doc.get("units") if isinstance(doc, dict) else None
+    if units is not None:
+        unit = units.get("angle") if isinstance(units, dict) else None
+        if unit not in ("rad", "deg") or set(units) - {"angle", "length"} or \
+                units.get("length", "m") != "m":
+            raise CLIError(f"--tasks {path}: units must be {{angle: rad | deg}} (lengths are "
+                           f"metres), got {short_repr(units)}")
+        if unit == "deg" and not degrees:
+            degrees = True
+        elif unit == "rad" and degrees:
+            raise CLIError(f"--tasks {path}: the file says units: {{angle: rad}} but "
+                           "--degrees is given; drop one")
     out = []
     for i, item in enumerate(items):
         try:
@@ -202,8 +217,12 @@ def read_tasks(path: str) -> np.ndarray:
         if v.size == 16:
             out.append(v.reshape(4, 4))
         elif v.size == 6:
+            if not degrees:
+                refuse_angle_turns(v[3:], f"--tasks {path}: tasks[{i}]", "roll/pitch/yaw",
+                                   hint="add --degrees or units: {angle: deg} to the file")
             T = np.eye(4)
-            T[:3, :3], T[:3, 3] = rpy_to_matrix(v[3:]), v[:3]
+            rpy = np.radians(v[3:]) if degrees else v[3:]
+            T[:3, :3], T[:3, 3] = rpy_to_matrix(rpy), v[:3]
             out.append(T)
         else:
             raise CLIError(f"--tasks {path}: tasks[{i}] has {v.size} numbers; expected 16 "
@@ -243,6 +262,9 @@ _BASE_HELP = command_help(
 @click.option("--out", "-o", "out", type=click.Path(file_okay=False), default="out/base",
               show_default=True, help="Output folder.")
 @click.option("--no-plot", is_flag=True, help="Do not draw the figure.")
+@click.option("--degrees", "-d", is_flag=True,
+              help="Roll, pitch, yaw of the --tasks file in degrees (or units: {angle: deg} "
+                   "in the file); the printed yaw is always in degrees, JSON in radians.")
 @param_option
 @json_option
 @quiet_option
@@ -250,8 +272,8 @@ _BASE_HELP = command_help(
 @handle_errors
 def base_placement_cmd(robot: str, tasks_file: str, resolution: float, yaws: int,
                        region: str | None, floor_z: float, solver: str, seed: int,
-                       scene: str | None, out: str, no_plot: bool, params: tuple[str, ...],
-                       as_json: bool, quiet: bool) -> None:
+                       scene: str | None, out: str, no_plot: bool, degrees: bool,
+                       params: tuple[str, ...], as_json: bool, quiet: bool) -> None:
     """Find base poses that reach every task pose."""
     import io
     import json
@@ -260,7 +282,7 @@ def base_placement_cmd(robot: str, tasks_file: str, resolution: float, yaws: int
     from serialkin.reach import base_placement
 
     r = resolve_robot(robot, params)
-    T = read_tasks(tasks_file)
+    T = read_tasks(tasks_file, degrees)
     reg = None if region is None else parse_numbers(region, "--region", 4).reshape(2, 2)
     obstacles = read_scene(scene)
     check_out_folder(out)

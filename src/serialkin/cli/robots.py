@@ -6,8 +6,13 @@
   as ``puma`` and ``planar<N>`` accepted), built by :func:`serialkin.models.get`;
   ``--param key=value`` passes keyword arguments to the model function;
 * a robot file ``*.yaml`` / ``*.yml`` / ``*.json`` (:mod:`serialkin.formats.robotfile`);
-* a URDF file ``*.urdf`` (:meth:`serialkin.Robot.from_urdf`); ``--param base_link=NAME``
-  and ``--param tip_link=NAME`` choose the chain of a branching tree;
+* a URDF file ``*.urdf`` (:func:`serialkin.formats.urdf.robot_from_urdf`);
+  ``--param base_link=NAME`` and ``--param tip_link=NAME`` choose the chain of a branching
+  tree; without ``tip_link`` the tip is chosen by the rule of
+  :func:`~serialkin.formats.urdf.choose_chain` (``--param srdf=FILE``: the SRDF's end
+  effector; else a single leaf, a link named like a TCP/tool/flange/ee, the deepest
+  chain), and the command says on stderr which it chose; ``package://`` mesh paths
+  resolve from the file's ancestors and the ROS paths;
 * a MuJoCo MJCF file ``*.xml`` / ``*.mjcf`` (:meth:`serialkin.Robot.from_mjcf`);
   ``--param base_body=NAME``, ``end_body=NAME`` and ``tool_site=NAME`` choose the chain;
 * a xacro file ``*.xacro`` / ``*.urdf.xacro`` (:meth:`serialkin.Robot.from_xacro`, needs
@@ -38,7 +43,7 @@ ROBOT_HELP = (
 
 #: --param keys each description file takes (xacro also takes arg:NAME and package:NAME).
 FILE_PARAMS = {
-    ".urdf": ("base_link", "tip_link"),
+    ".urdf": ("base_link", "tip_link", "srdf"),
     ".xml": ("base_body", "end_body", "tool_site"),
     ".mjcf": ("base_body", "end_body", "tool_site"),
     ".xacro": ("base_link", "tip_link", "search_path", "arg:NAME", "package:NAME"),
@@ -67,8 +72,11 @@ def parse_params(params: Sequence[str]) -> dict[str, Any]:
     return out
 
 
-def resolve_robot(spec: str, params: Sequence[str] = ()) -> Any:
+def resolve_robot(spec: str, params: Sequence[str] = (), *, whole_tree: bool = False) -> Any:
     """Build the robot named by ``spec`` (see the module docstring).
+
+    ``whole_tree`` (for the viewer): a URDF robot also carries the geometry of the links
+    off its chain (fingers), posed at rest.
 
     Raises:
         CLIError: unknown model (nearest names suggested), unreadable or malformed file
@@ -88,7 +96,15 @@ def resolve_robot(spec: str, params: Sequence[str] = ()) -> Any:
     if suffix in FILE_PARAMS:
         if not Path(spec).exists():
             raise CLIError(f"robot file {spec} not found")
-        return _load(spec, _file_loader(suffix), _file_kwargs(suffix, kwargs))
+        file_kwargs = _file_kwargs(suffix, kwargs)
+        if suffix == ".urdf":
+            from serialkin.formats.urdf import choose_chain, robot_from_urdf
+
+            chain_kwargs = {k: file_kwargs[k] for k in ("base_link", "tip_link", "srdf")
+                            if k in file_kwargs}
+            announce_tip(spec, _load(spec, choose_chain, chain_kwargs))
+            return _load(spec, robot_from_urdf, dict(file_kwargs, whole_tree=whole_tree))
+        return _load(spec, _file_loader(suffix), file_kwargs)
     from serialkin import models
 
     try:
@@ -108,6 +124,20 @@ def resolve_robot(spec: str, params: Sequence[str] = ()) -> Any:
             msg += (f" (A file {short_repr(spec)}? Robot files end in .yaml, .yml or .json; "
                     "URDF in .urdf, MJCF in .xml or .mjcf, xacro in .xacro.)")
         raise CLIError(msg) from exc
+
+
+def announce_tip(spec: str, choice: Any) -> None:
+    """Say on stderr which tip link a rule chose for a branching URDF (not with --quiet)."""
+    if choice.rule in ("given", "single_leaf"):
+        return
+    ctx = click.get_current_context(silent=True)
+    if ctx is not None and ctx.params.get("quiet"):
+        return
+    others = f"; other ends: {', '.join(choice.others[:6])}" + (
+        f" and {len(choice.others) - 6} more" if len(choice.others) > 6 else "") \
+        if choice.others else ""
+    click.echo(f"serialkin: {Path(spec).name}: chain {choice.base} -> {choice.tip}: tip "
+               f"{choice.reason}{others} (another: --param tip_link=NAME)", err=True)
 
 
 def _file_loader(suffix: str) -> Any:
@@ -166,6 +196,7 @@ robot_argument = click.argument("robot", metavar="ROBOT")
 param_option = click.option(
     "--param", "params", multiple=True, metavar="KEY=VALUE",
     help="Keyword argument for a built-in model (e.g. --param l1=0.4); base_link=/tip_link= "
-         "for a URDF or xacro file (xacro also arg:NAME=, package:NAME=, search_path=); "
+         "for a URDF or xacro file (URDF also srdf=FILE: its end effector is the tip; "
+         "xacro also arg:NAME=, package:NAME=, search_path=); "
          "base_body=/end_body=/tool_site= for an MJCF file; repeatable.",
 )

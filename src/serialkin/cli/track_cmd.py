@@ -17,6 +17,7 @@ from serialkin.cli.commands import (
     json_option,
     memory_budget_option,
     quiet_option,
+    refuse_angle_turns,
 )
 from serialkin.cli.io import (
     EXIT_NOT_REACHED,
@@ -71,6 +72,8 @@ _TRACK_HELP = command_help(
 @click.option("--max-joint-step", type=float, default=None,
               help="Report joint jumps between path points above this [rad]; a hard bound "
                    "with --solver qp.")
+@click.option("--max-joint-step-deg", type=float, default=None,
+              help="The same in degrees.")
 @click.option("--list", "list_only", is_flag=True, help="List the shipped scenarios.")
 @click.option("--verbose", "-v", is_flag=True,
               help="List every failed point and joint jump in the summary (default: the "
@@ -81,8 +84,8 @@ _TRACK_HELP = command_help(
 @handle_errors
 def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_animation: bool,
               mp4: bool, fps: float, max_frames: int, viewer: bool, solver: str,
-              max_joint_step: float | None, list_only: bool, verbose: bool, as_json: bool,
-              quiet: bool) -> None:
+              max_joint_step: float | None, max_joint_step_deg: float | None,
+              list_only: bool, verbose: bool, as_json: bool, quiet: bool) -> None:
     """Track a scenario's path and write trajectory, figures and animation."""
     from serialkin.tracking import list_scenarios, load_scenario
 
@@ -94,8 +97,15 @@ def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_ani
     # every option is checked before anything is computed or written
     fps = check_positive(fps, "--fps")
     max_frames = check_int(max_frames, "--max-frames", minimum=1, maximum=MAX_FRAMES)
-    if max_joint_step is not None:
+    if max_joint_step is not None and max_joint_step_deg is not None:
+        raise CLIError("--max-joint-step and --max-joint-step-deg are both given; use one "
+                       "(radians or degrees)")
+    if max_joint_step_deg is not None:
+        max_joint_step = np.radians(check_positive(max_joint_step_deg, "--max-joint-step-deg"))
+    elif max_joint_step is not None:
         max_joint_step = check_positive(max_joint_step, "--max-joint-step")
+        refuse_angle_turns(max_joint_step, "--max-joint-step", "joint step",
+                           hint="use --max-joint-step-deg")
     check_out_folder(out)
     sc = _with_solver(load_scenario(scenario), solver, max_joint_step)
     stem = Path(scenario).stem if Path(scenario).suffix else scenario

@@ -16,6 +16,7 @@ from serialkin.cli.commands import (
     json_option,
     memory_budget_option,
     quiet_long_option,
+    refuse_joint_turns,
 )
 from serialkin.cli.io import CLIError, command_help, dumps_json, ensure_dir, parse_numbers
 from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot
@@ -84,7 +85,6 @@ def _urdf_with_meshes(spec: str, params: tuple[str, ...], packages: tuple[str, .
                       mesh_paths: tuple[str, ...]) -> Any:
     """A URDF robot whose mesh paths are looked up with --package and --mesh-path."""
     from serialkin.cli.robots import parse_params
-    from serialkin.model.robot import Robot
 
     if Path(spec).suffix.lower() != ".urdf":
         raise CLIError(f"--package and --mesh-path apply to a URDF file (.urdf), not "
@@ -94,12 +94,17 @@ def _urdf_with_meshes(spec: str, params: tuple[str, ...], packages: tuple[str, .
     for folder in mesh_paths:
         if not Path(folder).is_dir():
             raise CLIError(f"--mesh-path {folder}: folder not found")
+    from serialkin.cli.robots import announce_tip
+    from serialkin.formats.urdf import choose_chain, robot_from_urdf
+
     links = {k: str(v) for k, v in parse_params(params).items()}
-    if set(links) - {"base_link", "tip_link"}:
-        raise CLIError(f"--param for a URDF takes base_link=NAME and tip_link=NAME only, got "
-                       f"{', '.join(sorted(set(links) - {'base_link', 'tip_link'}))}")
-    return Robot.from_urdf(spec, **links, package_map=_parse_packages(packages),
-                           search_path=list(mesh_paths))
+    keys = {"base_link", "tip_link", "srdf"}
+    if set(links) - keys:
+        raise CLIError(f"--param for a URDF takes base_link=, tip_link= and srdf= only, got "
+                       f"{', '.join(sorted(set(links) - keys))}")
+    announce_tip(spec, choose_chain(spec, **links))
+    return robot_from_urdf(spec, **links, package_map=_parse_packages(packages),
+                           search_path=list(mesh_paths), whole_tree=True)
 
 
 def _is_serialkin_csv(p: Path) -> bool:
@@ -143,6 +148,9 @@ def _is_serialkin_csv(p: Path) -> bool:
                    "(Robot.fit_collision).")
 @click.option("--srdf", type=click.Path(dir_okay=False), default=None,
               help="SRDF whose <disable_collisions> pairs the in-page check skips.")
+@click.option("--skip-links", "skip_links", default=None, metavar="LINK1,LINK2",
+              help="SRDF links without a collision body (pairs naming them are skipped); "
+                   "needs --srdf.")
 @click.option("--points", "points_file", type=click.Path(dir_okay=False), default=None,
               help="CSV of x,y,z or x,y,z,r,g,b rows [m; colours in 0..1] drawn as points.")
 @click.option("--points-label", default=None, help="Name of the point layer in the page "
@@ -156,6 +164,7 @@ def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
              scenario: str | None, title: str | None, out: str, open_browser: bool,
              degrees: bool, meshes: bool, mesh_budget: int | None, packages: tuple[str, ...],
              mesh_paths: tuple[str, ...], show_collision: bool, srdf: str | None,
+             skip_links: str | None,
              points_file: str | None, points_label: str | None, params: tuple[str, ...],
              as_json: bool, quiet: bool) -> None:
     """Write the interactive viewer page (and open it with --open)."""
@@ -164,13 +173,16 @@ def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
     if sc is not None:
         title = title or sc.name
     # every input is checked before the scenario runs and before the page is written
-    q = parse_numbers(q_text, "--q", r.n) * _angle_factor(r, degrees) if q_text else None
+    q = parse_numbers(q_text, "--q", r.n) if q_text else None
+    if q is not None and not degrees:
+        refuse_joint_turns(r, q, "--q")
+    q = q * _angle_factor(r, degrees) if q is not None else None
     if Path(out).is_dir():
         raise CLIError(f"--out {out}: is a folder; give the page's file name (.html)")
     check_out_folder(Path(out).parent)
     Q, path_points = _view_motion(r, sc, trajectory)
     r, fitted = _with_collision(r, show_collision)
-    acm = _srdf_acm(r, srdf)
+    acm = _srdf_acm(r, srdf, skip_links)
     points, colors, points_label = _point_layer(points_file, points_label)
     ensure_dir(Path(out).parent)
     from serialkin.viz.scene import Scene, ViewerOptions
@@ -205,7 +217,7 @@ def _view_robot(robot: str | None, scenario: str | None, params: tuple[str, ...]
         raise CLIError("missing ROBOT (or --scenario): " + ROBOT_HELP)
     if packages or mesh_paths:
         return _urdf_with_meshes(robot, params, packages, mesh_paths), None
-    return resolve_robot(robot, params), None
+    return resolve_robot(robot, params, whole_tree=True), None
 
 
 def _view_motion(r: Any, sc: Any, trajectory: str | None,
@@ -233,16 +245,11 @@ def _with_collision(r: Any, show_collision: bool) -> tuple[Any, bool]:
     return fitted, True
 
 
-def _srdf_acm(r: Any, srdf: str | None) -> Any:
-    """The allowed-collision matrix of --srdf for the robot's collision model, or None."""
-    if srdf is None:
-        return None
-    if r.collision is None:
-        raise CLIError(f"--srdf: robot {short_repr(r.name)} has no collision model to "
-                       "check")
-    from serialkin.collision import acm_from_srdf
+def _srdf_acm(r: Any, srdf: str | None, skip_links: str | None = None) -> Any:
+    """The allowed-collision matrix of --srdf/--skip-links for the collision model, or None."""
+    from serialkin.cli.collide_cmd import srdf_acm
 
-    return acm_from_srdf(r.collision, srdf)
+    return srdf_acm(r, srdf, skip_links)
 
 
 def _point_layer(points_file: str | None, points_label: str | None,

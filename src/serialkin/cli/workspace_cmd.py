@@ -16,6 +16,7 @@ from serialkin.cli.commands import (
     json_option,
     memory_budget_option,
     quiet_option,
+    refuse_angle_turns,
 )
 from serialkin.cli.io import (
     CLIError,
@@ -49,6 +50,8 @@ def _orientation(text: str | None, planar: bool, degrees: bool) -> Any:
         return v.reshape(3, 3)
     if degrees:
         v = np.radians(v)
+    else:
+        refuse_angle_turns(v, "--orientation", "φ" if planar else "roll/pitch/yaw")
     if planar:
         return float(v[0])
     from serialkin.spatial import rpy_to_matrix
@@ -134,6 +137,8 @@ def workspace_cmd(robot: str, kind: str, samples: int | None, seed: int, cell: f
     margin = check_positive(margin, "--margin", allow_zero=True)
     if max_angle is not None:
         max_angle = check_positive(max_angle, "--max-angle", allow_zero=True)
+        if not degrees:
+            refuse_angle_turns(max_angle, "--max-angle")
     if slices and planar:
         raise CLIError("--slice applies to spatial robots; this robot is planar")
     parsed_slices = [_parse_slice(s) for s in slices]

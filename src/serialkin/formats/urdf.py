@@ -5,6 +5,23 @@ parser is well kept and adds no dependency. The serial chain between ``base_link
 ``tip_link`` is extracted; fixed joints are merged into the neighbouring transforms
 (those before the first moving joint into its origin, those after the last into the tool).
 
+Which chain: ``base_link`` defaults to the tree's root. Without ``tip_link`` the tip is
+chosen by a stated rule (:func:`choose_chain`, its reason in ``robot.source``):
+
+1. the ``parent_link`` of the ``<end_effector>`` of an SRDF, when ``srdf=`` is given;
+2. the single leaf, when the tree below the base does not branch;
+3. a link named like a tool point: ``tcp``, then ``tool``/``tool0``, then ``flange``, then
+   ``ee``/``eef``/``end_effector`` (a word of its name, e.g. ``panda_hand_tcp``,
+   ``tool0``); the deepest such link when several share the best kind;
+4. else the leaf at the end of the chain with the most moving joints (the deepest chain),
+   when it is the only one that deep.
+
+``package://NAME/rest`` mesh paths resolve (:class:`MeshResolver`) from ``package_map``,
+then the search folders, then an ancestor folder of the file named ``NAME`` or holding a
+``package.xml`` whose ``<name>`` is ``NAME``, then ``$ROS_PACKAGE_PATH`` (``ROOT/NAME``,
+or ``ROOT`` or a folder just below it whose ``package.xml`` names it) and
+``$AMENT_PREFIX_PATH`` (``PREFIX/share/NAME``).
+
 URDF conventions: a joint's ``<origin xyz rpy>`` is the pose of the joint frame in the
 parent link frame with ``R = Rz(yaw)·Ry(pitch)·Rx(roll)``; the motion is about/along
 ``<axis xyz>`` (default x) in the joint frame; the child link frame is the joint frame
@@ -32,7 +49,8 @@ from serialkin.model.joint import Joint
 from serialkin.model.robot import Robot
 from serialkin.spatial.transforms import make_transform, rotx, roty, rotz
 
-__all__ = ["MeshResolver", "robot_from_urdf", "robot_to_urdf", "rpy_to_matrix"]
+__all__ = ["ChainChoice", "MeshResolver", "choose_chain", "package_folders", "robot_from_urdf",
+           "robot_to_urdf", "rpy_to_matrix"]
 
 _MOVING = {"revolute": "R", "continuous": "R", "prismatic": "P"}
 _UNSUPPORTED = {"floating", "planar"}
@@ -115,19 +133,27 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
                     tip_link: str | None = None, *,
                     package_map: Mapping[str, str | os.PathLike[str]] | None = None,
                     search_path: Sequence[str | os.PathLike[str]] = (),
-                    resolve_meshes: bool = False) -> Robot:
+                    resolve_meshes: bool = False,
+                    srdf: str | os.PathLike[str] | None = None,
+                    whole_tree: bool = False) -> Robot:
     """Build a :class:`~serialkin.Robot` from the serial chain of a URDF.
 
     Args:
         path_or_string: a URDF file path, or the XML text itself.
         base_link: link whose frame is the robot's base (default: the tree's root).
-        tip_link: link whose frame is the tool (default: the single leaf).
+        tip_link: link whose frame is the tool (default: chosen by the rule of
+            :func:`choose_chain`, stated in ``robot.source``).
         package_map: package name -> folder, for mesh paths ``package://NAME/rest``.
         search_path: folders where ``package://NAME/rest`` is looked up as
             ``FOLDER/NAME/rest`` and a relative mesh path as ``FOLDER/path`` (after the
-            URDF's own folder).
+            URDF's own folder); ancestors and ROS paths are searched after them
+            (:class:`MeshResolver`).
         resolve_meshes: if true, a mesh path that does not resolve to an existing file is
             an error; otherwise it is kept as written.
+        srdf: an SRDF (path or text) whose ``<end_effector parent_link>`` is the default tip.
+        whole_tree: also give the geometry of the links off the chain that hang on it
+            through moving joints (a gripper's fingers), posed with those joints at 0
+            (or the nearest limit): for a viewer of the whole robot.
 
     Returns:
         Robot with one joint per moving (revolute, continuous, prismatic) URDF joint,
@@ -144,17 +170,19 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
     """
     root, source = read_robot_xml(path_or_string)
     tree = _read_tree(root, source)
-    base, tip = _chain_ends(tree, base_link, tip_link, source)
+    choice = _choose(tree, base_link, tip_link, srdf, source)
+    base, tip = choice.base, choice.tip
     chain = _chain_between(tree, base, tip, source)
     out, link_names, fixed = _moving_joints(chain, base, tip, source)
     folder = None if source == "<string>" else Path(source).resolve().parent
-    places = _link_frames(base, chain, tree.children, tree.by_child)
+    places = _link_frames(base, chain, tree.children, tree.by_child, whole_tree)
     resolver = MeshResolver(folder, package_map or {}, search_path, resolve_meshes)
     geometry = tuple(
         _link_geometry(el, places[el.get("name")], source, resolver)
         for el in root.findall("link") if el.get("name") in places)
+    how = "" if choice.rule == "given" else f"; tip: {choice.reason}"
     return Robot(out, tool=fixed, name=root.get("name") or "urdf_robot",
-                 source=f"URDF {source} ({base} -> {tip})",
+                 source=f"URDF {source} ({base} -> {tip}{how})",
                  link_names=tuple(link_names) + ((tip,) if link_names[-1] != tip else ()),
                  geometry=geometry)
 
@@ -215,26 +243,128 @@ def _read_tree(root: ET.Element, source: str) -> _Tree:
     return _Tree(links, link_set, by_child, children, roots[0])
 
 
-def _chain_ends(tree: _Tree, base_link: str | None, tip_link: str | None,
-                source: str) -> tuple[str, str]:
-    """The base and tip links of the chain (defaults: the root, the single leaf below base)."""
+@dataclass(frozen=True)
+class ChainChoice:
+    """The chain of a URDF a robot is built on, and why that tip.
+
+    Attributes:
+        base: the base link.
+        tip: the tip link.
+        rule: 'given', 'srdf', 'single_leaf', 'named' or 'deepest'.
+        reason: the rule in words, e.g. "'panda_hand_tcp', a link named like a TCP".
+        others: the other leaves below the base (empty when the tree does not branch).
+    """
+
+    base: str
+    tip: str
+    rule: str
+    reason: str
+    others: tuple[str, ...] = ()
+
+
+#: Kinds of tool-point link names, best first: (kind, words of a link name that match).
+TIP_NAMES = (("a TCP", ("tcp",)), ("a tool", ("tool",)), ("a flange", ("flange",)),
+             ("an end effector", ("ee", "eef", "end_effector", "endeffector")))
+
+
+def _tip_kind(name: str) -> int | None:
+    """Index in :data:`TIP_NAMES` of the kind ``name`` is named like, or None."""
+    low = name.lower()
+    words = [re.sub(r"\d+$", "", w) for w in re.split(r"[^a-z0-9]+", low) if w]
+    for k, (_, keys) in enumerate(TIP_NAMES):
+        for key in keys:
+            if "_" in key:
+                if key in low:
+                    return k
+            elif key in words:
+                return k
+    return None
+
+
+def _srdf_tip(srdf: str | os.PathLike[str], source: str) -> str:
+    """The ``parent_link`` of the first ``<end_effector>`` of an SRDF."""
+    root, where = read_robot_xml(srdf)
+    for el in root.iter("end_effector"):
+        link = el.get("parent_link")
+        if link:
+            return link
+    raise RobotDefinitionError(f"{where}: the SRDF has no <end_effector parent_link=...>; "
+                               f"pass tip_link= for {source}")
+
+
+def _depth(link: str, base: str, by_child: dict[str, _UJoint]) -> tuple[int, int]:
+    """(moving joints, all joints) from ``base`` down to ``link``."""
+    moving = total = 0
+    while link != base and link in by_child:
+        j = by_child[link]
+        total += 1
+        moving += j.type != "fixed"
+        link = j.parent
+    return moving, total
+
+
+def choose_chain(path_or_string: str | os.PathLike[str], base_link: str | None = None,
+                 tip_link: str | None = None, *,
+                 srdf: str | os.PathLike[str] | None = None) -> ChainChoice:
+    """The base and tip links :func:`robot_from_urdf` uses, and the rule that chose the tip.
+
+    The rule (without ``tip_link``): the SRDF's end effector; the single leaf; a link
+    named like a TCP, a tool, a flange, an end effector (in that order, the deepest of
+    the best kind); the deepest chain (most moving joints). See the module docstring.
+
+    Raises:
+        RobotDefinitionError: an unknown link, an SRDF without an end effector, or two
+            chains equally deep and no link named like a tool point (the message lists the
+            leaves and says to pass ``tip_link=``).
+    """
+    root, source = read_robot_xml(path_or_string)
+    return _choose(_read_tree(root, source), base_link, tip_link, srdf, source)
+
+
+def _choose(tree: _Tree, base_link: str | None, tip_link: str | None,
+            srdf: str | os.PathLike[str] | None, source: str) -> ChainChoice:
     base = base_link or tree.root
     if base not in tree.link_set:
         raise RobotDefinitionError(
             f"{source}: base_link {short_repr(base)} is not a link of the robot")
-    if tip_link is None:
-        leaves = [n for n in tree.links if not tree.children[n] and n != base]
-        below = [n for n in leaves if _is_below(n, base, tree.by_child)]
-        if len(below) != 1:
+    leaves = [n for n in tree.links if not tree.children[n] and n != base
+              and _is_below(n, base, tree.by_child)]
+    if tip_link is not None:
+        if tip_link not in tree.link_set:
             raise RobotDefinitionError(
-                f"{source}: the tree below {short_repr(base)} branches into {len(below)} leaves "
-                f"({_names(below)}); pass tip_link= one of them"
-            )
-        return base, below[0]
-    if tip_link not in tree.link_set:
-        raise RobotDefinitionError(
-            f"{source}: tip_link {short_repr(tip_link)} is not a link of the robot")
-    return base, tip_link
+                f"{source}: tip_link {short_repr(tip_link)} is not a link of the robot")
+        return ChainChoice(base, tip_link, "given", f"{tip_link!r}, as given")
+    if srdf is not None:
+        tip = _srdf_tip(srdf, source)
+        if tip not in tree.link_set:
+            raise RobotDefinitionError(
+                f"{source}: the SRDF's end effector link {short_repr(tip)} is not a link of "
+                "the robot")
+        return ChainChoice(base, tip, "srdf", f"{tip!r}, the SRDF's end effector",
+                           tuple(n for n in leaves if n != tip))
+    if len(leaves) == 1:
+        return ChainChoice(base, leaves[0], "single_leaf", f"{leaves[0]!r}, the single leaf")
+    below = [n for n in tree.links if n != base and _is_below(n, base, tree.by_child)
+             and _depth(n, base, tree.by_child)[0] > 0]
+    named = [(k, n) for n in below if (k := _tip_kind(n)) is not None]
+    if named:
+        best = min(k for k, _ in named)
+        tip = max((n for k, n in named if k == best),
+                  key=lambda n: _depth(n, base, tree.by_child))
+        return ChainChoice(base, tip, "named", f"{tip!r}, a link named like "
+                           f"{TIP_NAMES[best][0]}", tuple(n for n in leaves if n != tip))
+    depth = {n: _depth(n, base, tree.by_child)[0] for n in leaves}
+    deepest = max(depth.values(), default=0)
+    top = [n for n in leaves if depth[n] == deepest]
+    if len(top) == 1:
+        return ChainChoice(base, top[0], "deepest", f"{top[0]!r}, the end of the deepest "
+                           f"chain ({deepest} moving joints)",
+                           tuple(n for n in leaves if n != top[0]))
+    raise RobotDefinitionError(
+        f"{source}: the tree below {short_repr(base)} branches into {len(leaves)} leaves "
+        f"({_names(leaves)}), {len(top)} of them equally deep and none named like a tool "
+        "point (tcp, tool, flange, ee); pass tip_link= one of them"
+    )
 
 
 def _chain_between(tree: _Tree, base: str, tip: str, source: str) -> list[_UJoint]:
@@ -286,9 +416,27 @@ def _moving_joints(chain: list[_UJoint], base: str, tip: str,
     return out, link_names, fixed
 
 
+def _at_rest(j: _UJoint) -> np.ndarray:
+    """The pose of ``j``'s child in its parent with the joint at 0 (clamped to its limits)."""
+    if j.type == "fixed":
+        return j.origin
+    v = min(max(0.0, j.lower), j.upper)
+    if j.type == "prismatic":
+        return j.origin @ make_transform(p=j.axis / np.linalg.norm(j.axis) * v)
+    c, s = np.cos(v), np.sin(v)
+    k = j.axis / np.linalg.norm(j.axis)
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return j.origin @ make_transform(np.eye(3) + s * K + (1.0 - c) * (K @ K))
+
+
 def _link_frames(base: str, chain: list[_UJoint], children: dict[str, list[str]],
-                 by_child: dict[str, _UJoint]) -> dict[str, tuple[int, np.ndarray]]:
-    """Chain frame index and pose in it of every chain link and its fixed-joint descendants."""
+                 by_child: dict[str, _UJoint], whole_tree: bool = False
+                 ) -> dict[str, tuple[int, np.ndarray]]:
+    """Chain frame index and pose in it of every chain link and its fixed-joint descendants.
+
+    With ``whole_tree``, links below through moving joints too, those joints at rest
+    (:func:`_at_rest`).
+    """
     places: dict[str, tuple[int, np.ndarray]] = {base: (0, np.eye(4))}
     frame, T = 0, np.eye(4)
     for j in chain:
@@ -303,19 +451,64 @@ def _link_frames(base: str, chain: list[_UJoint], children: dict[str, list[str]]
         frame, T = places[link]
         for c in children[link]:
             j = by_child[c]
-            if c not in places and j.type == "fixed":
-                places[c] = (frame, T @ j.origin)
+            if c not in places and (j.type == "fixed" or (whole_tree and j.type in _MOVING)):
+                places[c] = (frame, T @ _at_rest(j))
                 todo.append(c)
     return places
+
+
+def _package_xml_name(folder: Path) -> str | None:
+    """The ``<name>`` of ``folder/package.xml``, or None (no file, unreadable, no name)."""
+    f = folder / "package.xml"
+    try:
+        if not f.is_file() or f.stat().st_size > 1_000_000:
+            return None
+        m = re.search(r"<name>\s*([^<\s]+)\s*</name>", f.read_text(encoding="utf-8",
+                                                                   errors="replace"))
+    except (OSError, ValueError):
+        return None
+    return m.group(1) if m else None
+
+
+def package_folders(name: str, start: Path | None) -> list[Path]:
+    """Folders that may be ROS package ``name``, in the order :class:`MeshResolver` tries them.
+
+    An ancestor of ``start`` (the description's folder, itself included) named ``name`` or
+    holding a ``package.xml`` whose ``<name>`` is ``name``; then for each root of
+    ``$ROS_PACKAGE_PATH``: ``ROOT/name``, ``ROOT`` or a folder just below it whose
+    ``package.xml`` names it; then ``PREFIX/share/name`` for each prefix of
+    ``$AMENT_PREFIX_PATH``.
+    """
+    out: list[Path] = []
+    if start is not None:
+        for d in (start, *start.parents):
+            if d.name == name or _package_xml_name(d) == name:
+                out.append(d)
+    for root in filter(None, os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep)):
+        r = Path(root)
+        out.append(r / name)
+        if _package_xml_name(r) == name:
+            out.append(r)
+        try:
+            subs = sorted(p for p in r.iterdir() if p.is_dir())[:10_000] if r.is_dir() else []
+        except OSError:
+            subs = []
+        out.extend(p for p in subs if p.name != name and _package_xml_name(p) == name)
+    for prefix in filter(None, os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep)):
+        out.append(Path(prefix) / "share" / name)
+    return list(dict.fromkeys(out))
 
 
 class MeshResolver:
     """Turn a mesh path into an existing absolute path (or keep it, or refuse it).
 
     Used by URDF import and robot files: ``package://NAME/rest`` is looked up in
-    ``package_map[NAME]/rest`` then ``FOLDER/NAME/rest`` for each search folder; a
-    relative path in ``folder`` (the description's folder) then in each search folder;
-    ``file://`` and absolute paths as they are.
+    ``package_map[NAME]/rest``, then ``FOLDER/NAME/rest`` for each search folder, then in
+    the package folders found from the description's folder and the ROS environment
+    (:func:`package_folders`: an ancestor named ``NAME`` or with a ``package.xml`` naming
+    it, ``$ROS_PACKAGE_PATH``, ``$AMENT_PREFIX_PATH``); a relative path in ``folder``
+    (the description's folder) then in each search folder; ``file://`` and absolute paths
+    as they are.
     """
 
     def __init__(self, folder: Path | None, package_map: Mapping[str, object],
@@ -328,13 +521,17 @@ class MeshResolver:
             search_path = [search_path]
         self.search = [Path(str(p)) for p in search_path]
         self.strict = strict
+        self._found: dict[str, list[Path]] = {}
 
     def candidates(self, name: str) -> list[Path]:
         """The files ``name`` may denote, in the order they are tried."""
         if name.startswith("package://"):
             pkg, _, rest = name[len("package://"):].partition("/")
             out = [self.package_map[pkg] / rest] if pkg in self.package_map else []
-            return out + [d / pkg / rest for d in self.search]
+            out += [d / pkg / rest for d in self.search]
+            if pkg and pkg not in self._found:
+                self._found[pkg] = package_folders(pkg, self.folder)
+            return out + [d / rest for d in self._found.get(pkg, [])]
         if name.startswith("file://"):
             return [Path(name[len("file://"):])]
         p = Path(name)

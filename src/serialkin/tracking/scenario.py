@@ -10,6 +10,7 @@ Schema (fields marked * are required)::
 
     name: str
     description: str
+    units: {angle: rad | deg}    # unit of every angle field without _deg (default rad)
     robot: *                     # exactly one of:
       planar: {links: int, length: float [m]}   # n-link planar arm (standard DH, a = L)
       dh: [{a, alpha, d, theta, type?}]         # standard DH table
@@ -38,6 +39,13 @@ Schema (fields marked * are required)::
       manipulability_threshold, repulsive_gain, gain, max_task_step, link_radius (multitask)
     tolerance: float [m]            (default 0.005)
     on_unreachable: continue | stop (default continue)
+
+Angles: every angle field (``q0``, ``rpy``, ``angle``, ``max_angle``, a circle's ``start``,
+``stop`` and ``step``, DH ``alpha``/``theta``, the φ column of ``planar_pose`` points) is
+in the unit of ``units: {angle: ...}``, radians when ``units`` is absent; a ``*_deg`` field
+(``q0_deg``, ``rpy_deg``, ``angle_deg``, ``max_angle_deg``) is in degrees whatever
+``units`` says. A fixed angle (q0, rpy, DH) read in radians beyond a full turn is refused
+with a hint to declare degrees: it is almost surely degrees.
 """
 
 from __future__ import annotations
@@ -101,8 +109,23 @@ def planar_arm(links: int, length: float, *, name: str | None = None,
     return planar(links, float(length), qlim, name=name).with_collision(None)
 
 
-_ROOT_FIELDS = {"name", "description", "robot", "q0", "q0_deg", "path", "obstacles", "solver",
-                "tolerance", "on_unreachable"}
+_ROOT_FIELDS = {"name", "description", "units", "robot", "q0", "q0_deg", "path", "obstacles",
+                "solver", "tolerance", "on_unreachable"}
+#: Angle units of ``units: {angle: ...}`` and their factor to radians.
+ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0}
+_DEGREES_HINT = ("are these degrees? write units: {angle: deg} at the top of the file, or "
+                 "the field's _deg form")
+
+
+def _angle_unit(f: Field) -> str:
+    """The scenario's angle unit: ``units: {angle: rad|deg}`` (length, if given, 'm')."""
+    if not f.present:
+        return "rad"
+    u = f.mapping({"angle", "length"}, ("angle",),
+                  what="a mapping {angle: rad | deg} (lengths are metres)")
+    if u["length"].present:
+        u["length"].string(choices=("m",))
+    return u["angle"].string(choices=tuple(ANGLE_UNITS))
 _DLS_FIELDS = {"damping", "tol", "max_iter", "max_step", "max_joint_step"}
 _QP_FIELDS = {"safety", "collision_gain", "self_collision", "posture_weight", "damping",
               "max_step", "max_joint_step", "tol", "max_iter", "link_radius", "backend"}
@@ -166,8 +189,11 @@ class Scenario:
                      on_unreachable=self.on_unreachable, **self.options)
 
 
-def robot_from_field(f: Field, base_dir: FsPath | None):
-    """The robot of a scenario's ``robot`` field: planar, DH table, zoo model or URDF file."""
+def robot_from_field(f: Field, base_dir: FsPath | None, angle_unit: str = "rad"):
+    """The robot of a scenario's ``robot`` field: planar, DH table, zoo model or URDF file.
+
+    ``angle_unit`` ('rad' or 'deg') is the unit of a DH table's ``alpha`` and ``theta``.
+    """
     from serialkin.formats.robotfile import dh_rows_from_field
     from serialkin.model.robot import Robot
 
@@ -185,7 +211,7 @@ def robot_from_field(f: Field, base_dir: FsPath | None):
         L = p["length"].number(lo=0.0, lo_open=True, hi=MAX_LENGTH, unit="m")
         robot = planar_arm(n, L, name=name)
     elif kind == "dh":
-        rows = dh_rows_from_field(sub, angle_unit="rad", length_unit="m")
+        rows = dh_rows_from_field(sub, angle_unit=angle_unit, length_unit="m")
         robot = Robot.from_dh(rows, name=name or "robot")
     else:
         text = sub.string(max_len=4096)
@@ -230,22 +256,37 @@ def _point(f: Field, what: str = "[x, y]") -> np.ndarray:
 
 
 def _angle(f: Field, key: str, *, default: Any = None, lo: float = -1e6,
-           hi: float = 1e6) -> Any:
-    """The angle given as ``key`` [rad] or ``key_deg`` [deg] (not both) in radians."""
-    rad, deg = f[key], f[f"{key}_deg"]
-    if rad.present and deg.present:
-        raise rad.fail(f"and '{key}_deg' are both given; use one (radians or degrees)")
+           hi: float = 1e6, angle_unit: str = "rad") -> Any:
+    """The angle ``key`` [angle_unit] or ``key_deg`` [deg] (not both), in radians.
+
+    ``lo`` and ``hi`` are in radians; a radian value outside them that is inside them
+    as degrees is refused with the hint to declare degrees.
+    """
+    plain, deg = f[key], f[f"{key}_deg"]
+    if plain.present and deg.present:
+        raise plain.fail(f"and '{key}_deg' are both given; use one (radians or degrees)")
     if deg.present:
         return math.radians(deg.number(lo=math.degrees(lo), hi=math.degrees(hi), unit="deg"))
-    return rad.number(lo=lo, hi=hi, unit="rad", default=default)
+    if angle_unit == "deg":
+        v = plain.number(lo=math.degrees(lo), hi=math.degrees(hi), unit="deg",
+                         default=MISSING if default is MISSING else None)
+        return default if v is None else math.radians(v)
+    if plain.present and isinstance(plain.value, int | float) and \
+            not isinstance(plain.value, bool) and not lo <= plain.value <= hi and \
+            lo <= math.radians(plain.value) <= hi:
+        raise plain.fail(f"= {plain.value:g} rad is outside [{lo:.4g}, {hi:.4g}] rad; "
+                         + _DEGREES_HINT)
+    return plain.number(lo=lo, hi=hi, unit="rad", default=default)
 
 
-def pose_from_field(f: Field, robot=None, q0: np.ndarray | None = None) -> np.ndarray:
+def pose_from_field(f: Field, robot=None, q0: np.ndarray | None = None,
+                    angle_unit: str = "rad") -> np.ndarray:
     """A (4, 4) pose from ``{position: [x, y, z], rpy: [...]}`` (or ``rpy_deg``), or 'q0'.
 
-    ``position`` in metres; the rotation as roll-pitch-yaw angles in radians (``rpy``)
-    or degrees (``rpy_deg``), absent for no rotation; ``'q0'`` is the tool pose at the
-    scenario's start configuration.
+    ``position`` in metres; the rotation as roll-pitch-yaw angles in ``angle_unit``
+    (``rpy``; 'rad' or 'deg') or degrees (``rpy_deg``), absent for no rotation; ``'q0'``
+    is the tool pose at the scenario's start configuration. ``rpy`` in radians beyond a
+    full turn is refused (most likely degrees).
     """
     from serialkin.spatial.rotations import rpy_to_matrix
 
@@ -259,48 +300,56 @@ def pose_from_field(f: Field, robot=None, q0: np.ndarray | None = None) -> np.nd
         raise m["rpy"].fail("and 'rpy_deg' are both given; use one (radians or degrees)")
     if m["rpy_deg"].present:
         T[:3, :3] = rpy_to_matrix(np.radians(m["rpy_deg"].vector(3, lo=-1e4, hi=1e4)))
+    elif m["rpy"].present and angle_unit == "deg":
+        T[:3, :3] = rpy_to_matrix(np.radians(m["rpy"].vector(3, lo=-1e4, hi=1e4, unit="deg")))
     elif m["rpy"].present:
-        T[:3, :3] = rpy_to_matrix(m["rpy"].vector(3, lo=-100.0, hi=100.0))
+        rpy = m["rpy"].vector(3, lo=-1e4, hi=1e4, unit="rad")
+        if beyond_a_turn(rpy).any():
+            raise m["rpy"].fail(f"= {[float(x) for x in rpy]} rad has an angle beyond a full "
+                                f"turn (2π); " + _DEGREES_HINT + " (rpy_deg)")
+        T[:3, :3] = rpy_to_matrix(rpy)
     return T
 
 
-def _pose_path(p: Field, kind: str, robot, q0: np.ndarray) -> Path:
+def _pose_path(p: Field, kind: str, robot, q0: np.ndarray, unit: str = "rad") -> Path:
     """A line, arc or waypoint path of poses (serialkin.tracking.poses) from its fields."""
     from serialkin.tracking import poses
 
     steps = {"max_step": p["max_step"].number(lo=0.0, lo_open=True, hi=MAX_LENGTH,
                                               default=0.005, unit="m"),
              "max_angle": _angle(p, "max_angle", default=math.radians(1.0), lo=1e-9,
-                                 hi=math.pi)}
+                                 hi=math.pi, angle_unit=unit)}
     if kind == "line":
-        return poses.line(pose_from_field(p["start"].require(), robot, q0),
-                          pose_from_field(p["end"].require(), robot, q0),
+        return poses.line(pose_from_field(p["start"].require(), robot, q0, unit),
+                          pose_from_field(p["end"].require(), robot, q0, unit),
                           orientation=p["orientation"].string(choices=("slerp", "fixed"),
                                                               default="slerp"), **steps)
     if kind == "arc":
         end = p["end_rotation"]
-        return poses.arc(pose_from_field(p["start"].require(), robot, q0),
+        return poses.arc(pose_from_field(p["start"].require(), robot, q0, unit),
                          p["center"].require().vector(3, lo=-MAX_LENGTH, hi=MAX_LENGTH),
                          p["axis"].require().vector(3, lo=-1e6, hi=1e6),
-                         _angle(p, "angle", default=MISSING, lo=-2 * math.pi, hi=2 * math.pi),
-                         end_rotation=(pose_from_field(end)[:3, :3] if end.present
-                                       else None),
+                         _angle(p, "angle", default=MISSING, lo=-2 * math.pi, hi=2 * math.pi,
+                                angle_unit=unit),
+                         end_rotation=(pose_from_field(end, angle_unit=unit)[:3, :3]
+                                       if end.present else None),
                          orientation=p["orientation"].string(
                              choices=("follow", "fixed", "slerp"), default="follow"),
                          **steps)
-    ws = np.stack([pose_from_field(w, robot, q0) for w in
+    ws = np.stack([pose_from_field(w, robot, q0, unit) for w in
                    p["poses"].require().items(min_len=2, max_len=MAX_ITEMS)])
     blend = p["blend"].number(lo=0.0, hi=MAX_LENGTH, default=0.0, unit="m")
     return poses.waypoints(ws, blend=blend, **steps)
 
 
-def _path(f: Field, robot, q0: np.ndarray) -> Path:
+def _path(f: Field, robot, q0: np.ndarray, unit: str = "rad") -> Path:
     p = f.mapping()
+    ang = ANGLE_UNITS[unit]
     kind = p["type"].string(choices=_PATH_FIELDS)
     p.mapping(_PATH_FIELDS[kind] | {"type", "task"})
     if kind in ("line", "arc", "waypoints"):
         try:
-            return _pose_path(p, kind, robot, q0)
+            return _pose_path(p, kind, robot, q0, unit)
         except (InputError, InputTypeError) as exc:
             if isinstance(exc, ScenarioError):
                 raise
@@ -310,15 +359,18 @@ def _path(f: Field, robot, q0: np.ndarray) -> Path:
         if kind == "circle":
             c = _point(p["center"])
             radius = p["radius"].number(lo=0.0, lo_open=True, hi=MAX_LENGTH, unit="m")
-            start = p["start"].number(default=0.0, unit="rad")
-            stop = p["stop"].number(default=2 * math.pi, unit="rad")
-            step = p["step"].number(lo=0.0, lo_open=True, default=0.2, unit="rad")
+            start = p["start"].number(default=0.0, unit=unit) * ang
+            stop = p["stop"].number(default=2 * math.pi / ang, unit=unit) * ang
+            step = p["step"].number(lo=0.0, lo_open=True, default=0.2 / ang, unit=unit) * ang
             _count_points(p["step"], abs(stop - start), step)
             return Path.circle(c, radius, start=start, stop=stop, step=step)
         if kind == "points":
             pts = p["points"].require().array(
                 what="a list of [x, y] or [x, y, z] points", ndim=2, cols=(2, 3),
                 max_items=3 * MAX_PATH_POINTS, lo=-MAX_LENGTH, hi=MAX_LENGTH)
+            if task == "planar_pose" and pts.shape[1] == 3:  # (x, y, φ): φ in the unit
+                pts = pts.copy()
+                pts[:, 2] *= ang
             return Path.from_points(pts, task=task)
         if kind == "polyline":
             w = p["waypoints"].require().array(
@@ -448,12 +500,14 @@ def scenario_from_dict(data: object, source: str = "<dict>",
     """
     doc = Field(data, "", f"scenario {source!r}", ScenarioError)
     doc.mapping(_ROOT_FIELDS, ("robot", "path"))
-    robot = robot_from_field(doc["robot"], FsPath(base_dir) if base_dir is not None else None)
+    unit = _angle_unit(doc["units"])
+    robot = robot_from_field(doc["robot"], FsPath(base_dir) if base_dir is not None else None,
+                             unit)
     n = robot.n
     if doc["q0"].present and doc["q0_deg"].present:
         raise doc["q0"].fail("and 'q0_deg' are both given; use one")
     q0 = np.zeros(n)
-    for key, scale in (("q0", 1.0), ("q0_deg", math.pi / 180)):
+    for key, scale in (("q0", ANGLE_UNITS[unit]), ("q0_deg", math.pi / 180)):
         qf = doc[key]
         if qf.present:
             a = qf.array(what=f"one number or a list of {n} numbers", scalar_ok=True,
@@ -462,11 +516,11 @@ def scenario_from_dict(data: object, source: str = "<dict>",
                 a = np.full(n, float(a))
             if a.shape != (n,):
                 raise qf.fail(f"must have {n} values (one per joint), got shape {a.shape}")
-            if key == "q0" and beyond_a_turn(a[robot.revolute]).any():
+            if key == "q0" and unit == "rad" and beyond_a_turn(a[robot.revolute]).any():
                 raise qf.fail("has a revolute joint value beyond a full turn; q0 is in "
-                              "radians (for degrees write q0_deg)")
-            q0 = a * scale
-    path = _path(doc["path"], robot, q0)
+                              "radians (for degrees write q0_deg, or units: {angle: deg})")
+            q0 = np.where(robot.revolute, a * scale, a)
+    path = _path(doc["path"], robot, q0, unit)
     obs_f = doc["obstacles"]
     obstacles = tuple(obstacle_from_field(o) for o in obs_f.items(max_len=10_000)) \
         if obs_f.present else ()
