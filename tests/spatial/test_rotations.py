@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
@@ -257,3 +257,20 @@ def test_wrap_angle_interval() -> None:
     w = wrap_angle([-np.pi, np.pi, 3 * np.pi, 0.5, -7.0])
     assert np.allclose(w, [np.pi, np.pi, np.pi, 0.5, -7.0 + 2 * np.pi])
     assert np.all((w > -np.pi) & (w <= np.pi))
+
+
+@settings(max_examples=60, deadline=None)
+@given(v=st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3))
+def test_perpendicular_is_a_unit_normal(v):
+    """perpendicular(e) is a unit vector with e · v = 0, for one vector and for a batch."""
+    from serialkin.spatial import perpendicular
+
+    e = np.array(v)
+    assume(np.linalg.norm(e) > 1e-3)
+    e = e / np.linalg.norm(e)
+    p = perpendicular(e)
+    assert p.shape == (3,)
+    assert abs(np.linalg.norm(p) - 1.0) < 1e-14 and abs(p @ e) < 1e-14
+    batch = perpendicular(np.stack([e, -e, np.eye(3)[1]]))
+    assert batch.shape == (3, 3) and np.allclose(batch[0], p, rtol=0, atol=0)
+    assert np.allclose(np.einsum("ij,ij->i", batch, [e, -e, np.eye(3)[1]]), 0.0, atol=1e-14)

@@ -23,6 +23,7 @@ from serialkin.spatial.rotations import (
     matrix_to_quaternion,
     matrix_to_rpy,
     matrix_to_zyz,
+    perpendicular,
     quaternion_multiply,
     quaternion_to_matrix,
     rpy_to_matrix,
@@ -71,6 +72,7 @@ __all__ = [
     "troty",
     "trotz",
     "unskew",
+    "perpendicular",
     "wrap_angle",
     "zyz_to_matrix",
 ]

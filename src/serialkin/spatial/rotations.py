@@ -57,6 +57,18 @@ def wrap_angle(angle: object) -> np.ndarray:
     return np.where(w == -np.pi, np.pi, w)
 
 
+def perpendicular(e: np.ndarray) -> np.ndarray:
+    """A unit vector perpendicular to each unit vector ``e`` (..., 3); deterministic.
+
+    ``v = t − (t·e) e``, normalised, with ``t`` the world axis along which ``e`` has its
+    smallest absolute component (so ``|v| ≥ √(2/3)``: never ill-conditioned). Trusted
+    input: finite unit vectors. Returns (..., 3).
+    """
+    t = np.eye(3)[np.argmin(np.abs(e), axis=-1)]
+    v = t - np.sum(t * e, axis=-1, keepdims=True) * e
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
 def _angles3(x: object, name: str) -> np.ndarray:
     return check_last_dims(as_float_array(x, name), name, (3,))
 

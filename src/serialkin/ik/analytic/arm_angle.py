@@ -43,7 +43,7 @@ from serialkin._memo import PerObject
 from serialkin.errors import InputError, NoClosedFormError
 from serialkin.model.robot import Robot, robot_scale
 from serialkin.spatial.pose import pose_error
-from serialkin.spatial.rotations import wrap_angle
+from serialkin.spatial.rotations import perpendicular, wrap_angle
 
 __all__ = ["ArmAngleIntervals", "ArmAngleSolutions", "SRSArm", "arm_angle",
            "arm_angle_intervals", "ik_arm_angle", "ik_arm_angle_path", "srs_structure"]
@@ -271,13 +271,6 @@ def _reference(reference: object) -> np.ndarray:
     return r / np.linalg.norm(r)
 
 
-def _any_perpendicular(e: np.ndarray) -> np.ndarray:
-    """A unit vector perpendicular to each unit vector e (..., 3) (from its smallest axis)."""
-    k = np.argmin(np.abs(e), axis=-1)
-    t = np.eye(3)[k]
-    return _unit(t - np.sum(t * e, axis=-1, keepdims=True) * e)
-
-
 # ------------------------------------------------------------------ arm angle of q
 
 def arm_angle(robot: Robot, q: object, reference: object = None) -> np.ndarray:
@@ -336,7 +329,7 @@ def _solve(arm: SRSArm, T: np.ndarray, psi: np.ndarray, r: np.ndarray):
     rp = r - (e @ r)[:, None] * e
     nr = np.linalg.norm(rp, axis=1)
     er = np.where((nr > 0.0)[:, None], rp / np.maximum(nr, 1e-300)[:, None],
-                  _any_perpendicular(e))
+                  perpendicular(e))
     # 2. E − S at ψ: its part along e is b's along a (a rotation keeps a·b); its part
     # across e points at ψ in the plane (e_r, e × e_r) of eq (1)
     c_dir = np.cos(psi)[:, None] * er + np.sin(psi)[:, None] * _cross(e, er)
@@ -347,7 +340,7 @@ def _solve(arm: SRSArm, T: np.ndarray, psi: np.ndarray, r: np.ndarray):
     h4, p4 = H[3], P[3]
     u = arm.W0 - p4
     b = arm.E0 - S
-    x3, x7 = _any_perpendicular(H[2]), _any_perpendicular(H[6])
+    x3, x7 = perpendicular(H[2]), perpendicular(H[6])
     for i4 in range(2):
         R4 = _rot(h4, q4s[:, i4])                                       # (N, 3, 3)
         a = p4 + R4 @ u - S                                             # W0(q4) − S, |a| = L
@@ -356,7 +349,7 @@ def _solve(arm: SRSArm, T: np.ndarray, psi: np.ndarray, r: np.ndarray):
         nb = np.linalg.norm(b_perp, axis=1)
         line = nb < tiny          # the elbow on the line S–W: ψ undefined, any plane
         cd = np.where(line[:, None], er, c_dir)
-        bp = np.where(line[:, None], _any_perpendicular(a_hat),
+        bp = np.where(line[:, None], perpendicular(a_hat),
                       b_perp / np.maximum(nb, 1e-300)[:, None])
         # the shoulder rotation maps the frame (a, b⊥) onto (e, c⊥): R123 = F2·F1ᵀ
         F1 = np.stack([a_hat, bp, _cross(a_hat, bp)], axis=2)           # (N, 3, 3)

@@ -44,6 +44,7 @@ import numpy as np
 
 from serialkin.errors import NoClosedFormError
 from serialkin.model.robot import Robot
+from serialkin.spatial.rotations import perpendicular
 
 #: Two axes are parallel when |w_i × w_j| is below this [rad].
 ANGLE_TOL = 1e-9
@@ -166,15 +167,6 @@ def _point_line_distance(x, p, w) -> float:
     return float(np.linalg.norm(np.cross(x - p, w)))
 
 
-def _unit_perp(w: np.ndarray) -> np.ndarray:
-    """A unit vector perpendicular to w (deterministic)."""
-    k = int(np.argmin(np.abs(w)))
-    e = np.zeros(3)
-    e[k] = 1.0
-    v = e - (e @ w) * w
-    return v / np.linalg.norm(v)
-
-
 def _fail(robot: Robot, why: str) -> NoClosedFormError:
     types = "".join(robot.joint_types)
     return NoClosedFormError(
@@ -241,7 +233,7 @@ def _parallel_family(robot, W, P, M, rev, scale, ltol, atol) -> Structure:
         raise _fail(robot, f"{what} lies on the axis of joint {ir[1] + 1}")
     kind = {(2, 0): "planar_2r", (3, 0): "planar_3r", (3, 1): "scara", (2, 1): "scara_rrp"}[
         (nr, np_)]
-    e1 = _unit_perp(w)
+    e1 = perpendicular(w)
     aux = np.array([w, e1])
     order = np.array(ir + [ip[0] if ip else -1], dtype=np.int64)
     planar_z = abs(abs(w[2]) - 1.0) < atol
@@ -251,7 +243,7 @@ def _parallel_family(robot, W, P, M, rev, scale, ltol, atol) -> Structure:
 def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons,
                atol=ANGLE_TOL) -> Structure | None:
     """The arm class in front of a spherical wrist, or None (a reason is appended)."""
-    v = _unit_perp(W[5])
+    v = perpendicular(W[5])
     none = np.zeros(0, np.int64)
     if types[:3] not in ("RRR", "RRP"):
         reasons.append(f"the arm joints are {types[:3]}; closed forms need RRR or RRP")
@@ -278,7 +270,7 @@ def _wrist_arm(W, P, M, rev, scale, ltol, types, wrist, reasons,
             elif _point_line_distance(P[2], P[1], W[1]) < ltol:
                 reasons.append("axes 2 and 3 coincide")
             else:
-                aux = np.array([wrist, W[1], _unit_perp(W[1]), v])
+                aux = np.array([wrist, W[1], perpendicular(W[1]), v])
                 return Structure("puma", W, P, M, rev, aux, none, False, scale)
             return None
     d12 = _line_distance(P[0], W[0], P[1], W[1], atol)
@@ -383,7 +375,7 @@ def _six_dof_lines(W, P, M, rev, types, scale, ltol, atol, reasons) -> Structure
                 reasons.append("two of the parallel axes 2, 3, 4 coincide")
             else:
                 p56 = _closest_point(P[4], W[4], P[5], W[5])
-                aux = np.array([p56, w, _unit_perp(w)])
+                aux = np.array([p56, w, perpendicular(w)])
                 return Structure("ur", W, P, M, rev, aux, np.zeros(0, np.int64), False, scale)
         else:
             reasons.append("axes 2, 3, 4 are not parallel")
@@ -438,7 +430,7 @@ def general_structure(robot: Robot) -> Structure:
                 # conditioning: Pieper's quartic divides by the common normal a1 of axes 1, 2
                 score = 1.0 if arm.kind != "pieper_general" else \
                     min(1.0, 10.0 * float(np.linalg.norm(arm.aux[2] - arm.aux[1])) / scale)
-                aux = np.vstack([arm.aux[:-1], _unit_perp(Wc[3])])
+                aux = np.vstack([arm.aux[:-1], perpendicular(Wc[3])])
                 found.append((score, -reversed_, Structure(
                     "general_6r", np.ascontiguousarray(Wc), np.ascontiguousarray(Pc),
                     np.ascontiguousarray(Mc), rev, aux,
