@@ -11,7 +11,7 @@ Beyond :func:`~serialkin.collision.acm.default_acm`'s same-frame and adjacent-fr
   with ``samples=20000, seed=0, margin=0, never=True`` (pairs in contact in every
   sample, "always", or in none, "never").
 
-Regenerate: ``PYTHONPATH=src python -m serialkin.collision.allowed_pairs``.
+Regenerate: ``python benchmarks/generate_allowed_pairs.py`` (prints the tables below).
 """
 
 from __future__ import annotations
@@ -69,33 +69,3 @@ ALLOWED: dict[str, tuple[tuple[str, str], ...]] = {
         ("link4", "link7"),
     ),
 }
-
-
-def _generate() -> None:  # pragma: no cover - a maintenance script
-    """Print the pairs of every robot by the method of :data:`METHOD`."""
-    from serialkin import models
-    from serialkin.collision import acm_from_srdf, default_acm, sampled_acm
-    from serialkin.collision.reference import vendor_files
-
-    for name in METHOD:
-        r = models.get(name)
-        bare = r.with_collision(_without_allowed(r.collision)).collision
-        files = vendor_files(name)
-        if name in ("panda", "ur5") and not isinstance(files, str):
-            acm = acm_from_srdf(bare, files[1])
-        else:
-            acm = sampled_acm(r, bare, samples=20000, seed=0, never=True)
-        base = default_acm(bare)
-        names = bare.body_names
-        print(name, [(a, b) for i, a in enumerate(names) for b in names[i + 1:]
-                     if acm.is_allowed(a, b) and not base.is_allowed(a, b)])
-
-
-def _without_allowed(model):
-    import dataclasses
-
-    return dataclasses.replace(model, allowed=())
-
-
-if __name__ == "__main__":  # pragma: no cover
-    _generate()
