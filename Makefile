@@ -9,7 +9,7 @@ PY     := $(VENV)/bin/python
 STAMP_RUN  := $(VENV)/.stamp-run
 STAMP_TEST := $(VENV)/.stamp-test
 
-.PHONY: run test lint bench docs browser-deps clean
+.PHONY: run test test-autograd lint bench docs browser-deps clean
 
 # The kernels the chapter report uses (`serialkin warmup --list` lists every feature).
 RUN_FEATURES := kinematics ik ik-all ik-all-general ik-methods collision workspace tracking
@@ -64,7 +64,33 @@ test: $(STAMP_RUN)
 	  $(MAKE) --no-print-directory browser-deps & browser=$$!; \
 	  $(VENV)/bin/serialkin warmup --all; \
 	  wait $$extras; wait $$browser
-	$(PY) -m pytest -n 2 --dist loadfile
+	$(PY) -m pytest -n 2 --dist loadfile --ignore=tests/autograd
+
+# The differentiable kinematics of serialkin.torch and serialkin.jax (issue 35): their
+# extras (torch, jax) and the benchmark's peer (pytorch-kinematics) install into the same
+# venv, constrained to what is already installed, and tests/autograd runs. `make test`
+# leaves that folder to this target and .ci/run calls both; here a missing extra fails the
+# run (SERIALKIN_AUTOGRAD_REQUIRED) instead of skipping it. TORCH_INDEX offers PyTorch's
+# CPU wheels beside PyPI, whose default Linux torch pulls gigabytes of CUDA libraries.
+# TORCH_PIN keeps pip on a CPU build where PyPI's newer CUDA build is also offered (a
+# local +cpu wheel in pip's find-links sorts above PyPI's build of the same version).
+TORCH_INDEX ?= https://download.pytorch.org/whl/cpu
+TORCH_PIN ?= torch==2.13.*
+AUTOGRAD_EXTRAS := torch jax autograd-bench
+STAMP_AUTOGRAD := $(VENV)/.stamp-autograd
+
+$(STAMP_AUTOGRAD): $(STAMP_TEST)
+	$(PY) -c "import tomllib; o = tomllib.load(open('pyproject.toml', 'rb'))['project']\
+	['optional-dependencies']; print('\n'.join(r for e in '$(AUTOGRAD_EXTRAS)'.split() for r in o[e]))" \
+	  > $(VENV)/autograd-extras.txt
+	$(PY) -m pip freeze --exclude-editable > $(VENV)/installed-autograd.txt
+	$(PY) -m pip install --quiet --extra-index-url $(TORCH_INDEX) \
+	  -r $(VENV)/autograd-extras.txt "$(TORCH_PIN)" -c $(VENV)/installed-autograd.txt
+	touch $@
+
+test-autograd: $(STAMP_AUTOGRAD)
+	$(VENV)/bin/serialkin warmup kinematics ik ik-methods
+	SERIALKIN_AUTOGRAD_REQUIRED=1 $(PY) -m pytest -n 2 --dist loadfile tests/autograd
 
 lint: $(STAMP_TEST)
 	$(VENV)/bin/ruff check src tests benchmarks examples

@@ -43,6 +43,9 @@ GOALS = {
     "31.b": "joint path of 1,000 samples: UR5 <= 20 ms, Panda <= 50 ms; timing <= 50 ms",
     "33.b": "calibration to the noise floor (UR5, joint errors + 8 cm marker, 50 um noise): "
             "80 positions <= 1 s, 1,000 positions <= 5 s",
+    "35.1": "serialkin.torch FK + backward, 4,096 Panda: >= 5x faster than pytorch_kinematics",
+    "35.2": "serialkin.torch Jacobian + backward, 4,096 Panda: >= 5x pytorch_kinematics",
+    "35.3": "serialkin.jax jit FK + grad, 4,096 Panda: at least as fast as a pure-JAX chain",
 }
 
 
