@@ -83,6 +83,7 @@ from serialkin.ik.analytic.structure import (
     general_structure,
 )
 from serialkin.ik.analytic.subproblems import rigid_error
+from serialkin.ik.turns import nearest_turn
 from serialkin.model.robot import Robot, check_robot
 from serialkin.spatial.rotations import wrap_angle
 
@@ -90,8 +91,8 @@ from serialkin.spatial.rotations import wrap_angle
 _WRIST_ARMS = {"puma": (0, False), "pieper_intersecting": (1, False), "stanford": (1, True),
                "pieper_general": (2, False), "stanford_general": (2, True)}
 
-__all__ = ["CLASSES", "AllSolutions", "classify", "ik_all", "shift_toward",
-           "sort_by_reference", "structure_of"]
+__all__ = ["CLASSES", "AllSolutions", "classify", "ik_all", "sort_by_reference",
+           "structure_of"]
 
 _STRUCTURES: PerObject[Structure | NoClosedFormError] = PerObject()
 
@@ -547,35 +548,13 @@ def _insert_locked(sols: np.ndarray, idx: np.ndarray, vals: np.ndarray, n: int) 
     return out
 
 
-def shift_toward(robot: Robot, q: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    """``q`` with each revolute joint moved by the multiple of 2π nearest ``reference``.
+def _toward(robot: Robot, q: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """``q`` (..., n), revolute joints moved by whole turns nearest ``reference``.
 
-    Per joint ``j`` and row, ``q_j + 2π·t`` with ``t = round((r_j − q_j) / 2π)``, stepped
-    back towards ``t = 0`` (up to three turns) while the shifted value leaves the joint
-    limits (tolerance 1e-12); a row whose every candidate leaves them keeps its value.
-    Prismatic joints are unchanged. A joint whose range is wider than 2π has several
-    representatives: the one nearest the reference is taken.
-
-    Args:
-        robot: the robot (joint kinds and limits).
-        q: (..., n) configurations [rad / m] (trusted finite float64).
-        reference: (..., n) reference configurations, broadcastable against ``q``.
-
-    Returns:
-        (..., n) a new array, the shifted configurations.
+    Inside the limits; ``reference`` broadcasts against ``q``
+    (:func:`~serialkin.ik.turns.nearest_turn`).
     """
-    q = np.array(q, dtype=np.float64)
-    ref = np.broadcast_to(reference, q.shape)
-    lo, hi = robot.qlim[:, 0] - 1e-12, robot.qlim[:, 1] + 1e-12
-    turns = np.where(robot.revolute, np.round((ref - q) / (2 * np.pi)), 0.0)
-    for _ in range(3):  # step back towards the original value while outside the limits
-        shifted = q + 2 * np.pi * turns
-        bad = (shifted < lo) | (shifted > hi)
-        if not bad.any():
-            return shifted
-        turns = np.where(bad, turns - np.sign(turns), turns)
-    shifted = q + 2 * np.pi * turns
-    return np.where((shifted >= lo) & (shifted <= hi), shifted, q)
+    return nearest_turn(q, robot.qlim[:, 0], robot.qlim[:, 1], robot.revolute, reference)
 
 
 def _distance_args(robot: Robot, reference: object, weights: object,
@@ -606,7 +585,8 @@ def sort_by_reference(robot: Robot, sols: np.ndarray, reference: object, *,
     """Solutions ordered by distance to a reference configuration, nearest first.
 
     Each revolute joint of each row is first moved by the multiple of 2π that brings it
-    nearest the reference while staying inside its limits (:func:`shift_toward`). The
+    nearest the reference while staying inside its limits
+    (:func:`serialkin.ik.turns.nearest_turn`). The
     distance is ``sqrt(Σ w_j d_j²)`` (``norm='l2'``) or ``max_j w_j |d_j|``
     (``norm='linf'``), ``d = q − reference`` after that shift.
 
@@ -626,7 +606,7 @@ def sort_by_reference(robot: Robot, sols: np.ndarray, reference: object, *,
     q = np.array(sols, dtype=float).reshape(-1, robot.n)
     if q.shape[0] == 0:
         return (q, np.zeros(0, dtype=np.int64)) if return_order else q
-    q = shift_toward(robot, q, ref)
+    q = _toward(robot, q, ref)
     order = np.argsort(reference_distance(q - ref, w, norm), kind="stable")
     if return_order:
         return q[order], order
@@ -700,7 +680,7 @@ def _sort_batch(robot: Robot, res: AllSolutions, reference: object, weights: obj
     k_max, n = res.q.shape[-2], res.q.shape[-1]
     q = res.q.reshape(-1, k_max, n)
     valid = np.arange(k_max) < np.asarray(res.count).reshape(-1, 1)  # (N, k_max)
-    shifted = np.where(valid[..., None], shift_toward(robot, q, ref), 0.0)
+    shifted = np.where(valid[..., None], _toward(robot, q, ref), 0.0)
     dist = np.where(valid, reference_distance(shifted - ref, w, norm), np.inf)
     order = np.argsort(dist, axis=1, kind="stable")
     q = np.take_along_axis(shifted, order[..., None], axis=1)

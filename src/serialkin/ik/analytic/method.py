@@ -4,7 +4,7 @@ The closed-form family registers and implements its own method here, at import
 (:mod:`serialkin.ik` imports this module): ``robot.ik(target,
 method="analytic", q0=...)`` solves with :func:`serialkin.ik.analytic.ik_all` and
 returns the solution nearest ``q0`` (revolute joints moved by 2π towards ``q0`` inside
-their limits, :func:`serialkin.ik.analytic.shift_toward`; weighted L2 or L∞ distance),
+their limits, :func:`serialkin.ik.turns.nearest_turn`; weighted L2 or L∞ distance),
 or nearest the middle of the joint ranges without ``q0``; a batch of targets is one
 ``ik_all`` batch.
 """
@@ -19,9 +19,9 @@ import numpy as np
 from serialkin.ik.analytic import (
     NEAR_TOL,
     _distance_args,
+    _toward,
     ik_all,
     reference_distance,
-    shift_toward,
 )
 from serialkin.ik.registry import MethodSpec, register_method
 from serialkin.model.robot import Robot
@@ -39,17 +39,19 @@ def _every_solution(robot: Robot, T: np.ndarray, kind: str,
                     options: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
     """Every solution of each target: rows (N, k_max, n), zero padded, and counts (N,).
 
-    Pose targets go to ``ik_all`` as one batch (every core); the other kinds, whose
-    target is a vector, one by one.
+    Several pose targets go to ``ik_all`` as one batch (every core); one pose, and the
+    other kinds, whose target is a vector, one by one (``ik_all``'s single-target path).
     """
     opts = {"near_tol": options["near_tol"], "grid": options["grid"]}
-    if kind == "pose":
+    if kind == "pose" and T.shape[0] > 1:
         res = ik_all(robot, T, **opts)
         return np.asarray(res.q, dtype=np.float64), np.asarray(res.count).reshape(-1)
     rows = []
     for Tk in T:
-        if kind == "position":
-            target: object = Tk[:3, 3].copy()
+        if kind == "pose":
+            target: object = Tk
+        elif kind == "position":
+            target = Tk[:3, 3].copy()
         elif kind == "planar":
             target = Tk[:2, 3].copy()
         else:
@@ -68,7 +70,7 @@ def analytic_solve(robot: Robot, T: np.ndarray, kind: str, q0: np.ndarray | None
     """Solve the targets ``T`` (N, 4, 4) by ``ik_all``, each answer the nearest ``q0``.
 
     The reference ``r`` is ``q0`` (N, n) or the middle of the joint ranges; each target's
-    solutions are shifted by 2π towards it (:func:`~serialkin.ik.analytic.shift_toward`)
+    solutions are shifted by 2π towards it (:func:`~serialkin.ik.turns.nearest_turn`)
     and the nearest in the ``weights``/``norm`` distance
     (:func:`~serialkin.ik.analytic.reference_distance`) is returned. All targets at once:
     one ``ik_all`` batch and array operations, no loop per target for pose targets.
@@ -82,7 +84,7 @@ def analytic_solve(robot: Robot, T: np.ndarray, kind: str, q0: np.ndarray | None
     _, w = _distance_args(robot, mid, options["weights"], options["norm"])
     Q, counts = _every_solution(robot, T, kind, options)
     valid = np.arange(Q.shape[1]) < counts[:, None]  # (N, k_max)
-    shifted = shift_toward(robot, Q, ref[:, None, :])
+    shifted = _toward(robot, Q, ref[:, None, :])
     dist = np.where(valid, reference_distance(shifted - ref[:, None, :], w, options["norm"]),
                     np.inf)
     best = np.take_along_axis(shifted, dist.argmin(axis=1)[:, None, None], axis=1)[:, 0]
