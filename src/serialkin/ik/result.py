@@ -75,6 +75,18 @@ class IKResult:
             "clearance": clearance, "closest_pair": closest_pair})
         return r
 
+    @classmethod
+    def of_rows(cls, batch: bool, method: str, **rows: np.ndarray) -> IKResult:
+        """The result of N solves from per-solve arrays, the one way solvers build it.
+
+        ``rows`` holds every field but ``method`` as an array with leading dimension N
+        (``q`` (N, n), ``success`` (N,), ..., ``closest_pair`` (N, 2) when given).
+        With ``batch`` False (a single target, N = 1) the result is that solve's, with
+        scalar fields (:meth:`__getitem__`).
+        """
+        res = cls(method=method, **rows)
+        return res if batch else res[0]
+
     @property
     def batch(self) -> bool:
         """True when this result holds a batch of solves (``q`` has two dimensions)."""

@@ -930,16 +930,12 @@ def _from_info(robot: Robot, tgt: Target, spec: MethodSpec, Q: np.ndarray, info:
     said = [reason(int(k)) for k in failed]  # a sentence for each failure only
     extra = {} if coll is None else {"clearance": rec[:, K.I_CLEARANCE].copy(),
                                      "closest_pair": np.array(pairs, dtype=str).reshape(-1, 2)}
-    if single:
-        if coll is not None:
-            extra = {"clearance": float(extra["clearance"][0]), "closest_pair": pairs[0]}
-        return IKResult.make(Q, bool(ok[0]), int(its[0]), float(pe[0]), float(oe[0]),
-                             said[0] if said else "", int(used[0]), spec.name, **extra)
     # the str array np.array(list of N str) makes, without building it from N objects
     reasons = np.zeros(Qs.shape[0], dtype=f"<U{max(map(len, said), default=1) or 1}")
     reasons[failed] = said
-    return IKResult(q=Q, success=ok, iterations=its, position_error=pe, orientation_error=oe,
-                    reason=reasons, restarts=used, method=spec.name, **extra)
+    return IKResult.of_rows(not single, spec.name, q=Qs, success=ok, iterations=its,
+                            position_error=pe, orientation_error=oe, reason=reasons,
+                            restarts=used, **extra)
 
 
 def _problem(robot: Robot, T: np.ndarray, tgt: Target, tol: float, respect: bool) -> IKProblem:
@@ -969,20 +965,12 @@ def _solve_python(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | 
         problem = _problem(robot, Ts[k], tgt, tol, respect)
         qk = None if q0 is None else (q0 if q0.ndim == 1 else q0[k])
         rows.append(run_attempts(spec, problem, qk, max_iter, restarts, seed, opts))
-    if not tgt.batch:
-        q, ok, its, pe, oe, reason, used = rows[0]
-        return IKResult(q=q, success=ok, iterations=its, position_error=pe,
-                        orientation_error=oe, reason=reason, restarts=used, method=spec.name)
-    return IKResult(
-        q=np.array([r[0] for r in rows]),
-        success=np.array([r[1] for r in rows], dtype=bool),
-        iterations=np.array([r[2] for r in rows], dtype=np.int64),
-        position_error=np.array([r[3] for r in rows]),
-        orientation_error=np.array([r[4] for r in rows]),
-        reason=np.array([r[5] for r in rows], dtype=object).astype(str),
-        restarts=np.array([r[6] for r in rows], dtype=np.int64),
-        method=spec.name,
-    )
+    q, ok, its, pe, oe, reason, used = zip(*rows, strict=True)
+    return IKResult.of_rows(
+        tgt.batch, spec.name, q=np.array(q), success=np.array(ok, dtype=bool),
+        iterations=np.array(its, dtype=np.int64), position_error=np.array(pe),
+        orientation_error=np.array(oe), reason=np.array(reason, dtype=object).astype(str),
+        restarts=np.array(used, dtype=np.int64))
 
 
 #: Why a closed-form answer that does not reproduce its target failed.
@@ -1015,10 +1003,7 @@ def _solve_whole(robot: Robot, tgt: Target, spec: MethodSpec, Ts: np.ndarray,
         reasons = np.where(found & ~inside, _OUTSIDE, reasons)
         ok &= inside
     reasons = np.where(ok, "", reasons)
-    if not tgt.batch:
-        return IKResult(q=Q[0], success=bool(ok[0]), iterations=int(found[0]),
-                        position_error=float(pe[0]), orientation_error=float(oe[0]),
-                        reason=str(reasons[0]), restarts=0, method=spec.name)
-    return IKResult(q=Q, success=ok, iterations=found.astype(np.int64), position_error=pe,
-                    orientation_error=oe, reason=reasons.astype(str),
-                    restarts=np.zeros(N, dtype=np.int64), method=spec.name)
+    return IKResult.of_rows(tgt.batch, spec.name, q=Q, success=ok,
+                            iterations=found.astype(np.int64), position_error=pe,
+                            orientation_error=oe, reason=reasons.astype(str),
+                            restarts=np.zeros(N, dtype=np.int64))
