@@ -21,12 +21,12 @@ configurations (the link frames of one chunk are held in memory).
 from __future__ import annotations
 
 import math
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
 
 from serialkin._checks import as_generator, check_int, check_real
+from serialkin._memo import PerObject
 from serialkin.collision.acm import AllowedCollisionMatrix, default_acm
 from serialkin.collision.kernels import _box_sd, _segment_box_t, segment_distance
 from serialkin.collision.shapes import encode_scene
@@ -335,8 +335,9 @@ def check_model_fits(robot, model: CollisionModel) -> None:
                          f"0..{robot.n}")
 
 
-#: (id(model), id(acm) or None) -> (weak refs to both, pa, pb); both objects are immutable.
-_PAIR_CACHE: dict[tuple[int, int | None], tuple] = {}
+#: Per model (immutable): the pairs of its default matrix (key None) and, per matrix
+#: given (immutable too), that matrix's pairs.
+_PAIRS: PerObject[tuple[dict, PerObject]] = PerObject()
 
 
 def checked_shape_pairs(model: CollisionModel,
@@ -347,10 +348,10 @@ def checked_shape_pairs(model: CollisionModel,
         Two (P,) int arrays (read-only; cached per model and matrix, both immutable).
         ``acm`` defaults to :func:`default_acm`.
     """
-    key = (id(model), None if acm is None else id(acm))
-    hit = _PAIR_CACHE.get(key)
-    if hit is not None and hit[0]() is model and (acm is None or hit[1]() is acm):
-        return hit[2], hit[3]
+    default, given = _PAIRS.setdefault(model, lambda: ({}, PerObject()))
+    hit = default.get(None) if acm is None else given.get(acm)
+    if hit is not None:
+        return hit
     full = default_acm(model) if acm is None else acm
     if not isinstance(full, AllowedCollisionMatrix) or full.body_names != model.body_names:
         raise InputError("acm must be an AllowedCollisionMatrix over the model's bodies "
@@ -361,9 +362,10 @@ def checked_shape_pairs(model: CollisionModel,
     pa, pb = np.ascontiguousarray(s[keep]), np.ascontiguousarray(t[keep])
     pa.setflags(write=False)
     pb.setflags(write=False)
-    if len(_PAIR_CACHE) >= 64:
-        _PAIR_CACHE.clear()
-    _PAIR_CACHE[key] = (weakref.ref(model), weakref.ref(full), pa, pb)
+    if acm is None:
+        default[None] = (pa, pb)
+    else:
+        given.set(acm, (pa, pb))
     return pa, pb
 
 

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from serialkin._checks import as_float_array, check_positive
+from serialkin._memo import PerObject
 from serialkin.errors import InputError
 from serialkin.kinematics import kernels as K
 from serialkin.redundancy.obstacles import (
@@ -258,7 +259,7 @@ class CollisionAvoidance(Constraint):
     influence: float | None = None
     gain: float = 0.5
     self_pairs: object = ()
-    _geo: dict = field(default_factory=dict, init=False, repr=False)
+    _geo: PerObject = field(default_factory=PerObject, init=False, repr=False)
 
     is_box = False
 
@@ -280,9 +281,8 @@ class CollisionAvoidance(Constraint):
                                 else float(self.influence))
 
     def _state(self, robot):
-        key = id(robot)
-        st = self._geo.get(key)
-        if st is None or st[0] is not robot:
+        st = self._geo.get(robot)
+        if st is None:
             g = ObstacleGeometry(robot, self.obstacles, self.link_radius)
             s = g.P0.shape[0]
             k = len(self.obstacles)
@@ -301,7 +301,8 @@ class CollisionAvoidance(Constraint):
             rows = s * k + pa.shape[0]
             st = (robot, g, pa, np.empty((rows, robot.n)), np.empty(rows),
                   np.empty((s * k, 2), dtype=np.int64), np.empty(pa.shape[0]))
-            self._geo = {key: st}
+            self._geo = PerObject()  # the latest robot's state only
+            self._geo.set(robot, st)
         return st
 
     def distances(self, robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
