@@ -95,3 +95,27 @@ def test_scenario_pose_path_units_are_explicit(tmp_path):
                    "angle_deg: 60}\n")
     path = load_scenario(arc).path
     assert path.task == "pose" and len(path) > 10
+
+
+def test_timing_takes_the_robots_own_limits_and_a_jerk_limit(tmp_path):
+    """--timing on a Panda: its data-sheet limits hold; --jerk gives the ruckig timing."""
+    sc = tmp_path / "panda.yaml"
+    sc.write_text("robot: {model: panda}\nq0: [0.2, -0.3, 0.1, -2.0, 0.1, 1.8, 0.6]\n"
+                  "path:\n  type: line\n  start: q0\n  end: {position: [0.45, 0.1, 0.45], "
+                  "rpy_deg: [180, 0, 0]}\n  max_step: 0.005\n")
+    panda = models.get("panda")
+    data = json.loads(run("path", sc, "--out", tmp_path / "o", "--timing", "--no-figures",
+                          "--json").stdout)
+    assert data["success"] and data["timing"] == "toppra"
+    traj = json.loads((tmp_path / "o" / "panda_trajectory.json").read_text())
+    assert traj["velocity_limits"] == panda.velocity_limits.tolist()
+    assert np.all(np.abs(traj["qd"]) <= panda.velocity_limits * (1 + 1e-6))
+    data = json.loads(run("path", sc, "--out", tmp_path / "j", "--jerk", 500, "--no-figures",
+                          "--json").stdout)
+    assert data["timing"] == "ruckig" and data["duration_s"] > 0
+    traj = json.loads((tmp_path / "j" / "panda_trajectory.json").read_text())
+    assert traj["jerk_limits"] == [500.0] * 7
+    ur5 = tmp_path / "seam.yaml"
+    ur5.write_text(LINE % "0.2, 0.3, 0.3")
+    res = run("path", ur5, "--out", tmp_path / "u", "--timing", code=2)
+    assert "acceleration limits" in res.stderr and "--acceleration" in res.stderr

@@ -18,6 +18,7 @@ from serialkin.cli.io import (
     write_bytes_atomic,
     write_text_atomic,
 )
+from serialkin.errors import InputError
 
 _HELP = command_help(
     "Follow the pose path of a scenario file with one joint configuration per sample, "
@@ -26,15 +27,19 @@ _HELP = command_help(
     "'waypoints' of poses (or a shipped scenario's name). The configuration of each sample "
     "is chosen over all IK solutions by dynamic programming (least joint motion, no step "
     "above --max-joint-step). Writes <name>_joints.csv (the joint path with its pose "
-    "errors), <name>_path.json (the summary) and, with --velocity and --acceleration, "
-    "the time-optimal trajectory <name>_trajectory.csv and .json (t, q, q̇, q̈; toppra, "
-    "the 'paths' extra) and <name>_timing.png. Every angle option says its unit: "
+    "errors), <name>_path.json (the summary) and, with --timing or any joint-rate "
+    "limit, the time-optimal trajectory <name>_trajectory.csv and .json (t, q, q̇, q̈; "
+    "toppra, the 'paths' extra) and <name>_timing.png; with --jerk the jerk-limited one "
+    "(ruckig). A velocity or acceleration limit not given is the robot's own (a URDF's "
+    "<limit velocity>, the zoo's data sheets); URDF has no acceleration limits. Every "
+    "angle option says its unit: "
     "--max-joint-step in radians or --max-joint-step-deg in degrees, and so on. Exit 1 "
     "when the path cannot be followed (stderr says at which sample and why; the files "
     "hold the path up to there).",
     ["serialkin path weld.yaml --max-joint-step-deg 10",
      "serialkin path weld.yaml --velocity-deg 90 --acceleration-deg 180 "
-     "--cartesian-speed 0.1"],
+     "--cartesian-speed 0.1",
+     "serialkin path panda_seam.yaml --timing --jerk 500"],
 )
 
 
@@ -64,6 +69,11 @@ def _angle(rad: float | None, deg: float | None, name: str) -> float | None:
               help="Joint acceleration limit [rad/s²].")
 @click.option("--acceleration-deg", type=float, default=None,
               help="Joint acceleration limit [deg/s²].")
+@click.option("--jerk", type=float, default=None,
+              help="Joint jerk limit [rad/s³]: a jerk-limited timing (ruckig).")
+@click.option("--jerk-deg", type=float, default=None, help="Joint jerk limit [deg/s³].")
+@click.option("--timing", is_flag=True,
+              help="Time the path with the robot's own joint limits where none is given.")
 @click.option("--cartesian-speed", type=float, default=None,
               help="Largest tool speed [m/s] (with the joint limits).")
 @click.option("--dt", type=float, default=0.01, show_default=True,
@@ -75,21 +85,24 @@ def _angle(rad: float | None, deg: float | None, name: str) -> float | None:
 def path_cmd(scenario: str, out: str, max_joint_step: float | None,
              max_joint_step_deg: float | None, velocity: float | None,
              velocity_deg: float | None, acceleration: float | None,
-             acceleration_deg: float | None, cartesian_speed: float | None, dt: float,
+             acceleration_deg: float | None, jerk: float | None, jerk_deg: float | None,
+             timing: bool, cartesian_speed: float | None, dt: float,
              no_figures: bool, as_json: bool, quiet: bool) -> None:
     """Follow a scenario's pose path: joint path, timing, figure, summary."""
-    from serialkin.paths import joint_path, time_optimal
+    from serialkin.paths import jerk_limited, joint_path, time_optimal
     from serialkin.tracking import load_scenario
 
     step = _angle(max_joint_step, max_joint_step_deg, "max-joint-step") or 0.5
     v = _angle(velocity, velocity_deg, "velocity")
     a = _angle(acceleration, acceleration_deg, "acceleration")
-    if (v is None) != (a is None):
-        raise CLIError("timing needs both a velocity and an acceleration limit (--velocity "
-                       "or --velocity-deg, and --acceleration or --acceleration-deg)")
-    if cartesian_speed is not None and v is None:
-        raise CLIError("--cartesian-speed needs the joint limits too (--velocity, "
-                       "--acceleration)")
+    j = _angle(jerk, jerk_deg, "jerk")
+    timed_too = timing or v is not None or a is not None or j is not None
+    if cartesian_speed is not None and not timed_too:
+        raise CLIError("--cartesian-speed needs a timing: --timing (the robot's limits) or "
+                       "--velocity and --acceleration")
+    if cartesian_speed is not None and j is not None:
+        raise CLIError("--cartesian-speed and --jerk cannot go together: the jerk-limited "
+                       "timing (ruckig) has no Cartesian speed limit")
     if not (dt > 0.0 and math.isfinite(dt)):
         raise CLIError(f"--dt must be a positive time step in seconds, got {dt!r}")
     check_out_folder(out)
@@ -110,11 +123,18 @@ def path_cmd(scenario: str, out: str, max_joint_step: float | None,
                "max_position_error_m": float(jp.position_error.max()) if len(jp) else None,
                "max_orientation_error_rad": (float(jp.orientation_error.max()) if len(jp)
                                              else None)}
-    if v is not None and jp.success:
-        timed = time_optimal(jp.q, v, a, robot=robot, cartesian_speed=cartesian_speed, dt=dt)
+    if timed_too and jp.success:
+        try:
+            timed = (jerk_limited(jp.q, j, v, a, robot=robot, dt=dt) if j is not None else
+                     time_optimal(jp.q, v, a, robot=robot, cartesian_speed=cartesian_speed,
+                                  dt=dt))
+        except InputError as exc:
+            raise CLIError(f"{exc} (options --velocity, --acceleration, in rad or with "
+                           "-deg)") from None
         files["trajectory_csv"] = str(timed.to_csv(folder / f"{stem}_trajectory.csv"))
         files["trajectory_json"] = str(timed.to_json(folder / f"{stem}_trajectory.json"))
         summary["duration_s"] = timed.duration
+        summary["timing"] = timed.method
         if not no_figures:
             files["figure"] = str(_figure(folder / f"{stem}_timing.png", timed, robot))
     summary["files"] = files
@@ -132,7 +152,8 @@ def path_cmd(scenario: str, out: str, max_joint_step: float | None,
             click.echo(f"pose error: max {jp.position_error.max() * 1e3:.3g} mm, "
                        f"{math.degrees(jp.orientation_error.max()):.3g} deg")
         if "duration_s" in summary:
-            click.echo(f"time-optimal duration {summary['duration_s']:.4g} s")
+            kind = "jerk-limited" if timed.method == "ruckig" else "time-optimal"
+            click.echo(f"{kind} duration {summary['duration_s']:.4g} s")
         for f in files.values():
             click.echo(f"  wrote {f}")
     if not jp.success:

@@ -67,6 +67,7 @@ class _UJoint:
     lower: float
     upper: float
     unsupported: str = ""
+    velocity: float = np.inf
 
 
 def rpy_to_matrix(rpy: np.ndarray) -> np.ndarray:
@@ -125,8 +126,17 @@ def _parse_joint(el: ET.Element, source: str) -> _UJoint:
             raise RobotDefinitionError(
                 f"{where}: <limit> lower {lower:g} is greater than upper {upper:g}"
             )
+    velocity = np.inf
+    if jtype in _MOVING and lim is not None and lim.get("velocity") is not None:
+        v = float(parse_floats(lim.get("velocity"), 1, (np.inf,),
+                               f"{where} <limit velocity>")[0])
+        # URDF requires the attribute, so files without a known limit write a
+        # placeholder 0 (serialkin's own export did, before it kept the limits): zero or
+        # a negative value states no limit.
+        velocity = v if v > 0.0 else np.inf
     return _UJoint(name, jtype, parent.get("link"), child.get("link"),
-                   _origin(el.find("origin"), where), axis, lower, upper, unsupported)
+                   _origin(el.find("origin"), where), axis, lower, upper, unsupported,
+                   velocity)
 
 
 def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | None = None,
@@ -157,7 +167,10 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
 
     Returns:
         Robot with one joint per moving (revolute, continuous, prismatic) URDF joint,
-        limits read (continuous: unlimited), joint names kept, ``link_names`` set, and
+        limits read (continuous: unlimited), ``velocity_limits`` from ``<limit
+        velocity>`` [rad/s or m/s] (``inf`` for a joint whose value is 0 or missing; None
+        when no joint states one; URDF has no acceleration limits, so
+        ``acceleration_limits`` is None), joint names kept, ``link_names`` set, and
         ``geometry``: one :class:`~serialkin.model.geometry.LinkGeometry` per link of the
         chain or fixed to it through fixed joints, with ``<visual>``/``<collision>``
         shapes posed in the chain frame the link is merged into.
@@ -174,6 +187,7 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
     base, tip = choice.base, choice.tip
     chain = _chain_between(tree, base, tip, source)
     out, link_names, fixed = _moving_joints(chain, base, tip, source)
+    speeds = [j.velocity for j in chain if j.type != "fixed"]
     folder = None if source == "<string>" else Path(source).resolve().parent
     places = _link_frames(base, chain, tree.children, tree.by_child, whole_tree)
     resolver = MeshResolver(folder, package_map or {}, search_path, resolve_meshes)
@@ -184,7 +198,8 @@ def robot_from_urdf(path_or_string: str | os.PathLike[str], base_link: str | Non
     return Robot(out, tool=fixed, name=root.get("name") or "urdf_robot",
                  source=f"URDF {source} ({base} -> {tip}{how})",
                  link_names=tuple(link_names) + ((tip,) if link_names[-1] != tip else ()),
-                 geometry=geometry)
+                 geometry=geometry,
+                 velocity_limits=speeds if np.isfinite(speeds).any() else None)
 
 
 @dataclass(frozen=True, eq=False)
@@ -738,7 +753,9 @@ def robot_to_urdf(robot: Robot) -> str:
     frame's link, so its own name is not kept), with origin
     ``L[frame] @ origin`` since the exported link frame is the compiled frame (its joint
     axis turned onto z): world poses are kept. Infinite revolute limits export as
-    ``continuous`` joints. The document is built with :mod:`xml.etree.ElementTree`,
+    ``continuous`` joints. ``robot.velocity_limits`` become ``<limit velocity>`` (0,
+    URDF's placeholder, where none is stated); URDF has no element for acceleration
+    limits, so they are not written. The document is built with :mod:`xml.etree.ElementTree`,
     which escapes every name (``&``, ``<``, quotes, newlines): no name can add markup.
 
     Raises:
@@ -749,6 +766,7 @@ def robot_to_urdf(robot: Robot) -> str:
     from scipy.spatial.transform import Rotation
 
     F, meta = robot.chain.F, robot.chain.meta
+    vel = robot.velocity_limits
     names = robot.link_names
     if names is None or len(names) < robot.n + 1:
         names = ["base_link"] + [f"link{i + 1}" for i in range(robot.n)]
@@ -777,10 +795,13 @@ def robot_to_urdf(robot: Robot) -> str:
         ET.SubElement(el, "child", link=names[i + 1])
         _origin_el(el, F[i] @ M)
         ET.SubElement(el, "axis", xyz=" ".join(_fmt(v) for v in meta[i, :3]))
+        speed = "0" if vel is None or not np.isfinite(vel[i]) else _fmt(vel[i])
         if not continuous:
             ET.SubElement(el, "limit", lower=_fmt(lo if np.isfinite(lo) else -1e9),
                           upper=_fmt(hi if np.isfinite(hi) else 1e9), effort="0",
-                          velocity="0")
+                          velocity=speed)
+        elif speed != "0":
+            ET.SubElement(el, "limit", effort="0", velocity=speed)
     el = ET.SubElement(root, "joint", name=tool_joint, type="fixed")
     ET.SubElement(el, "parent", link=names[robot.n])
     ET.SubElement(el, "child", link=tool_link)

@@ -133,6 +133,36 @@ def limits_table(qlim: object, n: int, where: str = "qlim") -> np.ndarray:
     return np.array(rows, dtype=float).reshape(n, 2)
 
 
+def rate_limits(value: object, n: int, where: str) -> np.ndarray | None:
+    """Per-joint limits on a rate (velocity, acceleration) as a read-only (n,) array, or None.
+
+    Accepted: None (no limit stated), one number for every joint, or ``n`` numbers; each
+    positive, ``inf`` for a joint whose limit is not stated. Units: rad/s or m/s
+    (velocity), rad/s² or m/s² (acceleration), per joint type.
+
+    Raises:
+        RobotDefinitionError: another shape, NaN, zero or a negative value (naming
+            ``where`` and showing what came).
+    """
+    if value is None:
+        return None
+    expected = f"{where} must be one positive number or {n} of them (inf where not stated)"
+    if isinstance(value, (str, bytes)):
+        raise RobotDefinitionError(f"{expected}, got {short_repr(value)}")
+    try:
+        a = np.array(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise RobotDefinitionError(f"{expected}, got {short_repr(value)}") from None
+    if a.ndim == 0:
+        a = np.full(n, float(a))
+    if a.shape != (n,):
+        raise RobotDefinitionError(f"{expected}, got shape {a.shape}")
+    if np.isnan(a).any() or (a <= 0.0).any():
+        raise RobotDefinitionError(f"{expected}, got {short_repr(a.tolist())}")
+    a.setflags(write=False)
+    return a
+
+
 @njit(cache=True)
 def inside(x, lo, hi, tol):
     """True when ``x`` is finite and ``lo − tol <= x <= hi + tol`` (ends may be infinite)."""

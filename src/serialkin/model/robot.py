@@ -37,7 +37,13 @@ from serialkin.kinematics.dls import manipulability_batch
 from serialkin.model.chain import compile_chain
 from serialkin.model.dh import CONVENTIONS, DHLink, dh_to_joints, parse_dh_rows
 from serialkin.model.joint import Joint, check_fixed_transform
-from serialkin.model.limits import DEFAULT_HALF_RANGE, inside_mask, limits_table, sampling_box
+from serialkin.model.limits import (
+    DEFAULT_HALF_RANGE,
+    inside_mask,
+    limits_table,
+    rate_limits,
+    sampling_box,
+)
 from serialkin.model.tasks import TASKS, task_rows
 
 if TYPE_CHECKING:
@@ -175,6 +181,13 @@ class Robot:
         base: (4, 4) world-from-base transform.
         tool: (4, 4) last-link-from-tool transform.
         qlim: (n, 2) joint limits [rad or m], ±inf where unlimited.
+        velocity_limits: (n,) read-only largest joint speeds [rad/s or m/s] (``inf`` for a
+            joint whose limit is not stated), or None when the description states none.
+            URDF ``<limit velocity>`` fills it; set with :meth:`with_rate_limits`.
+        acceleration_limits: (n,) largest joint accelerations [rad/s² or m/s²] likewise,
+            or None. URDF and MJCF have no standard place for them (MoveIt keeps them in
+            ``joint_limits.yaml``): they come from the zoo's data sheets or
+            :meth:`with_rate_limits`.
         revolute: (n,) read-only bool array, True for a revolute joint, False for a
             prismatic one (``joint_types`` holds the same as 'R'/'P').
         chain: the compiled chain arrays (:class:`~serialkin.model.chain.Chain`: ``F``,
@@ -196,6 +209,8 @@ class Robot:
         link_names: Sequence[str] | None = None,
         geometry: Sequence[LinkGeometry] = (),
         collision: object = None,
+        velocity_limits: object = None,
+        acceleration_limits: object = None,
     ) -> None:
         if isinstance(joints, (str, bytes, Mapping)) or not isinstance(joints, Sequence):
             raise RobotDefinitionError(
@@ -228,6 +243,9 @@ class Robot:
         #: capsule/sphere collision model (:mod:`serialkin.collision`), or None
         self.collision: Any = None if collision is None else self._checked_collision(collision)
         self.qlim = np.array([j.qlim for j in joints], dtype=float)
+        self.velocity_limits = rate_limits(velocity_limits, self.n, "velocity_limits")
+        self.acceleration_limits = rate_limits(acceleration_limits, self.n,
+                                               "acceleration_limits")
         self.joint_types = tuple(j.type for j in joints)
         self.revolute = np.array([t == "R" for t in self.joint_types], dtype=bool)
         self.joint_names = tuple(j.name or f"joint{i + 1}" for i, j in enumerate(joints))
@@ -247,7 +265,8 @@ class Robot:
 
         Everything is given to the constructor (``link_names``, ``geometry``,
         ``collision`` included) or changed by a copy (:meth:`with_tool`,
-        :meth:`with_base`, :meth:`with_limits`, :meth:`with_collision`).
+        :meth:`with_base`, :meth:`with_limits`, :meth:`with_rate_limits`,
+        :meth:`with_collision`).
         """
         if getattr(self, "_frozen", False):
             raise AttributeError(_immutable(name, "set"))
@@ -266,7 +285,10 @@ class Robot:
         for one argument type (the chain's arrays are restored by ``Chain``).
         """
         self.__dict__.update(state)
-        for key in ("base", "tool", "qlim", "revolute"):
+        state.setdefault("velocity_limits", None)      # pickled before the rate limits
+        state.setdefault("acceleration_limits", None)
+        for key in ("base", "tool", "qlim", "revolute", "velocity_limits",
+                    "acceleration_limits"):
             a = state.get(key)
             if isinstance(a, np.ndarray):
                 a.setflags(write=False)
@@ -369,7 +391,8 @@ class Robot:
                                     name=self.name, dh=self.dh, convention=self.convention,
                                     source=self.source)
         args.update(link_names=self.link_names, geometry=self.geometry,
-                    collision=self.collision)
+                    collision=self.collision, velocity_limits=self.velocity_limits,
+                    acceleration_limits=self.acceleration_limits)
         args.update(changes)
         return Robot(args.pop("joints"), **args)
 
@@ -465,6 +488,21 @@ class Robot:
         dh = None if self.dh is None else [
             dataclasses.replace(r, qlim=rows[i]) for i, r in enumerate(self.dh)]
         return self._copy(joints=joints, dh=dh)
+
+    def with_rate_limits(self, velocity: object = None,
+                         acceleration: object = None) -> Robot:
+        """A copy of this robot with joint velocity and acceleration limits.
+
+        Args:
+            velocity: (n,) or one largest joint speed [rad/s or m/s], ``inf`` where not
+                stated; None removes them.
+            acceleration: (n,) or one largest joint acceleration [rad/s² or m/s²]
+                likewise; None removes them.
+
+        Raises:
+            RobotDefinitionError: a limit that is not positive, or the wrong count.
+        """
+        return self._copy(velocity_limits=velocity, acceleration_limits=acceleration)
 
     # ------------------------------------------------------------------ validation
     def check_q(self, q: object, name: str = "q", *, finite: bool = True) -> np.ndarray:

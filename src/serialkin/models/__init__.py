@@ -129,7 +129,8 @@ def vendor(name: str, **kwargs: Any) -> Robot:
                         tool=robot.tool @ v.T_flange_vtip, name=key + VENDOR_SUFFIX,
                         source=f"{robot.source}; in the frames {v.base_link} -> "
                                f"{v.tip_link} of {v.description}")
-    return out.with_collision(robot.collision)
+    return out.with_collision(robot.collision).with_rate_limits(
+        robot.velocity_limits, robot.acceleration_limits)
 
 
 def get(name: str, **kwargs: Any) -> Robot:

@@ -40,6 +40,19 @@ STANFORD_SOURCE = (
 # parameters for calculations of kinematics and dynamics"; limits ±360° (UR5 data sheet).
 UR5_SOURCE = "Universal Robots, 'DH parameters for calculations of kinematics and dynamics' (UR5)"
 
+# UR5 (CB3) joint speed limit: 180°/s on every joint, UR5 User Manual (CB3, version 3.13),
+# as in ros-industrial/universal_robot ur_description/config/ur5/joint_limits.yaml
+# (`max_velocity: !degrees 180.0`; older ur5.urdf.xacro files wrote 3.15 rad/s). Universal
+# Robots publish no acceleration limits ("not publicly available", same file).
+UR5_VELOCITY = math.pi
+
+# Franka Emika Panda joint limits, Franka Control Interface docs, "Robot and interface
+# specifications" (limits in the joint space): q̇max [rad/s], q̈max [rad/s²]; the jerk
+# limits there (7500, 3750, 5000, 6250, 7500, 10000, 10000 rad/s³) are not kept on the
+# Robot (serialkin.paths.jerk_limited takes them as an argument).
+PANDA_VELOCITY = (2.1750, 2.1750, 2.1750, 2.1750, 2.6100, 2.6100, 2.6100)
+PANDA_ACCELERATION = (15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0)
+
 # Franka Emika Panda, modified (Craig) DH exactly as published by Franka in the FCI
 # documentation ("Robot and interface specifications": DH table and joint limits); the
 # flange row (a = 0, d = 0.107, α = 0, θ = 0) is the tool transform.
@@ -125,7 +138,8 @@ def ur5() -> Robot:
     """Build the Universal Robots UR5, 6R, standard DH as published by Universal Robots.
 
     a = (0, -0.425, -0.39225, 0, 0, 0) m, d = (0.089159, 0, 0, 0.10915, 0.09465, 0.0823) m,
-    α = (π/2, 0, 0, π/2, -π/2, 0); every joint ±360°.
+    α = (π/2, 0, 0, π/2, -π/2, 0); every joint ±360°, at most 180°/s (π rad/s; no
+    acceleration limits are published).
     """
     h = math.pi / 2
     lim = [(-2 * math.pi, 2 * math.pi)] * 6
@@ -136,7 +150,7 @@ def ur5() -> Robot:
     from serialkin.collision.robots import ur5_collision_model
 
     robot = Robot.from_dh(rows, "standard", name="UR5", source=UR5_SOURCE)
-    return robot.with_collision(ur5_collision_model())
+    return robot.with_collision(ur5_collision_model()).with_rate_limits(velocity=UR5_VELOCITY)
 
 
 def panda() -> Robot:
@@ -154,6 +168,9 @@ def panda() -> Robot:
     7       0.088      0      π/2     ±2.8973
     flange  0          0.107  0       (tool transform)
     ======  =========  =====  ======  =================
+
+    Velocity limits 2.175 rad/s (joints 1-4) and 2.61 rad/s (5-7); acceleration limits
+    15, 7.5, 10, 12.5, 15, 20, 20 rad/s² (Franka's specifications).
     """
     h = math.pi / 2
     lim = [(-2.8973, 2.8973), (-1.7628, 1.7628), (-2.8973, 2.8973), (-3.0718, -0.0698),
@@ -166,7 +183,8 @@ def panda() -> Robot:
     from serialkin.collision.robots import panda_collision_model
 
     robot = Robot.from_dh(rows, "modified", tool=flange, name="panda", source=PANDA_SOURCE)
-    return robot.with_collision(panda_collision_model())
+    return robot.with_collision(panda_collision_model()).with_rate_limits(
+        velocity=PANDA_VELOCITY, acceleration=PANDA_ACCELERATION)
 
 
 def iiwa7() -> Robot:

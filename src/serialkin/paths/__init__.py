@@ -7,12 +7,13 @@
   solutions by dynamic programming (no branch flips, no 2π jumps, a bounded joint step),
   or a clear refusal saying where and why;
 * :mod:`~serialkin.paths.timing` — the time-optimal timing under joint velocity and
-  acceleration limits (and a Cartesian speed limit) by toppra (the ``paths`` extra).
+  acceleration limits (and a Cartesian speed limit) by toppra, and a jerk-limited timing
+  by ruckig (both the ``paths`` extra).
 """
 
 from serialkin.paths.joint_path import JointPath, joint_path
-from serialkin.paths.timing import TimedPath, time_optimal
+from serialkin.paths.timing import TimedPath, jerk_limited, time_optimal
 from serialkin.tracking.poses import arc, line, slerp, waypoints
 
-__all__ = ["JointPath", "TimedPath", "arc", "joint_path", "line", "slerp", "time_optimal",
-           "waypoints"]
+__all__ = ["JointPath", "TimedPath", "arc", "jerk_limited", "joint_path", "line", "slerp",
+           "time_optimal", "waypoints"]

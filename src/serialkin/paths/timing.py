@@ -1,4 +1,4 @@
-"""Time-optimal timing of a joint path under velocity and acceleration limits (toppra).
+"""Timing of a joint path under velocity, acceleration (toppra) and jerk limits (ruckig).
 
 A joint path q₀ … q_{m−1} is interpolated by a cubic spline q(s) in a path parameter s
 (chord length in joint space), and the fastest ``s(t)`` that keeps every joint inside
@@ -8,6 +8,21 @@ analysis", IEEE T-RO 2018), with the ``toppra`` library (the ``paths`` extra), n
 code of our own. An optional Cartesian speed limit v_c on the tool's position becomes
 the velocity limits ``|q̇_j| ≤ |q_j'(s)|·v_c / |p'(s)|`` that vary along the path (so
 that ṡ ≤ v_c / |p'(s)|).
+
+Jerk limits (:func:`jerk_limited`, the ``ruckig`` library of the same extra): along the
+same path ``q̇ = q′ṡ``, ``q̈ = q″ṡ² + q′s̈`` and ``q⃛ = q‴ṡ³ + 3q″ṡs̈ + q′s⃛``, so bounds
+``ṡ ≤ V``, ``|s̈| ≤ A``, ``|s⃛| ≤ J`` chosen from the path's largest ``|q_j′|``,
+``|q_j″|``, ``|q_j‴|`` keep every joint within its limits, and Ruckig (Berscheid &
+Kröger, "Jerk-limited real-time trajectory generation with arbitrary target states", RSS
+2021) gives the time-optimal jerk-limited s(t) from rest to rest under them. That is not
+time-optimal for the joints: one set of bounds holds for the whole path, so its most
+curved part sets the pace everywhere (Ruckig's own waypoint following, which would do
+better, needs Ruckig Pro or its cloud service; Ruckig Community plans to one target
+state).
+
+When the caller gives no limits, the robot's own are used
+(:attr:`~serialkin.model.robot.Robot.velocity_limits`, ``acceleration_limits``: read from
+a URDF's ``<limit velocity>``, or the zoo's data sheets).
 
 Units: seconds, radians (or metres for prismatic joints) and their rates.
 """
@@ -26,7 +41,7 @@ from serialkin._io import write_text_atomic
 from serialkin.errors import InputError, SerialkinError
 from serialkin.model.robot import Robot
 
-__all__ = ["TimedPath", "time_optimal"]
+__all__ = ["TimedPath", "jerk_limited", "time_optimal"]
 
 
 def _toppra():
@@ -41,9 +56,18 @@ def _toppra():
     return toppra
 
 
+def _ruckig():
+    try:
+        import ruckig
+    except ImportError as exc:  # pragma: no cover - the extra is installed in the tests
+        raise SerialkinError(
+            "jerk_limited needs the ruckig library: pip install 'serialkin[paths]'") from exc
+    return ruckig
+
+
 @dataclass(frozen=True, eq=False)
 class TimedPath:
-    """A timed joint trajectory (what :func:`time_optimal` returns).
+    """A timed joint trajectory (what :func:`time_optimal` and :func:`jerk_limited` return).
 
     Attributes:
         t: (k,) times [s], from 0 to ``duration``.
@@ -53,6 +77,8 @@ class TimedPath:
         duration: the trajectory's length in time [s].
         velocity: (n,) the velocity limits used; acceleration: (n,) the acceleration limits.
         joint_names: the joints' names (column labels of the CSV file).
+        jerk: (n,) the jerk limits used [rad/s³ or m/s³] (:func:`jerk_limited`), else None.
+        method: 'toppra' (time-optimal) or 'ruckig' (jerk-limited).
     """
 
     t: np.ndarray
@@ -63,6 +89,8 @@ class TimedPath:
     velocity: np.ndarray
     acceleration: np.ndarray
     joint_names: tuple[str, ...] = ()
+    jerk: np.ndarray | None = None
+    method: str = "toppra"
 
     def names(self) -> list[str]:
         """The column labels: the joints' names, or q1 … qn."""
@@ -83,13 +111,58 @@ class TimedPath:
     def to_json(self, path: str | FsPath) -> FsPath:
         """Write the trajectory as JSON (atomically): units, names, limits and arrays."""
         data = {"units": {"t": "s", "q": "rad (m for prismatic)", "qd": "per s",
-                          "qdd": "per s^2"},
+                          "qdd": "per s^2", "jerk_limits": "per s^3"},
                 "joint_names": self.names(), "duration": self.duration,
                 "velocity_limits": self.velocity.tolist(),
                 "acceleration_limits": self.acceleration.tolist(),
+                "jerk_limits": None if self.jerk is None else self.jerk.tolist(),
+                "method": self.method,
                 "t": self.t.tolist(), "q": self.q.tolist(), "qd": self.qd.tolist(),
                 "qdd": self.qdd.tolist()}
         return write_text_atomic(path, json.dumps(data))
+
+
+def _robot_limits(robot: Robot | None, value: object, n: int, name: str,
+                  caller: str) -> object:
+    """``value``, or the robot's own limits of that kind when ``value`` is None."""
+    if value is not None:
+        return value
+    attr = f"{name}_limits"
+    if robot is None:
+        raise InputError(f"{caller} needs {name} limits: pass {name}=... (one per joint or "
+                         f"one for all), or robot=... whose {attr} are stated")
+    if robot.n != n:
+        raise InputError(f"q has {n} joints but robot {robot.name!r} has {robot.n}")
+    own = getattr(robot, attr)
+    if own is None:
+        where = (" (URDF and MJCF have no acceleration limits: give them, or set them with "
+                 "robot.with_rate_limits)" if name == "acceleration" else
+                 " (a URDF's <limit velocity>, or robot.with_rate_limits)")
+        raise InputError(f"{caller} needs {name} limits: pass {name}=...; robot "
+                         f"{robot.name!r} states none{where}")
+    missing = [robot.joint_names[j] for j in np.flatnonzero(~np.isfinite(own))]
+    if missing:
+        raise InputError(f"{caller} needs {name} limits: robot {robot.name!r} states none "
+                         f"for joint(s) {', '.join(missing)}; pass {name}=...")
+    return own
+
+
+def _joint_path(q: object) -> tuple[np.ndarray, np.ndarray]:
+    """The path (m, n) without consecutive duplicates, and its chord length s (m,) [rad or m]."""
+    Q = as_float_array(q, "q", ndim=2)
+    if Q.shape[0] < 2:
+        raise InputError(f"q must hold at least 2 configurations, got shape {Q.shape}")
+    keep = np.concatenate([[True], np.abs(np.diff(Q, axis=0)).max(axis=1) > 1e-12])
+    Q = Q[keep]
+    if len(Q) < 2:
+        raise InputError("q does not move: every configuration is the same")
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(Q, axis=0), axis=1))])
+    return Q, s
+
+
+def _check_dt(dt: float) -> None:
+    if not (dt > 0.0 and math.isfinite(dt)):
+        raise InputError(f"dt must be a positive time step in seconds, got {dt!r}")
 
 
 def _limits(value: object, n: int, name: str) -> np.ndarray:
@@ -101,7 +174,7 @@ def _limits(value: object, n: int, name: str) -> np.ndarray:
     return np.array(a, dtype=float)
 
 
-def time_optimal(q: object, velocity: object, acceleration: object, *,
+def time_optimal(q: object, velocity: object = None, acceleration: object = None, *,
                  robot: Robot | None = None, cartesian_speed: float | None = None,
                  dt: float = 0.01, gridpoints: int | None = None) -> TimedPath:
     """The time-optimal timing of joint path ``q`` under velocity and acceleration limits.
@@ -109,9 +182,12 @@ def time_optimal(q: object, velocity: object, acceleration: object, *,
     Args:
         q: (m, n) joint path (m ≥ 2), e.g. :attr:`JointPath.q`; consecutive duplicate
             rows are dropped.
-        velocity: (n,) or one velocity limit v_j > 0 [rad/s or m/s].
-        acceleration: (n,) or one acceleration limit a_j > 0 [rad/s² or m/s²].
-        robot: the arm (needed for ``cartesian_speed``; gives the joint names).
+        velocity: (n,) or one velocity limit v_j > 0 [rad/s or m/s]; None: the robot's
+            ``velocity_limits``.
+        acceleration: (n,) or one acceleration limit a_j > 0 [rad/s² or m/s²]; None: the
+            robot's ``acceleration_limits``.
+        robot: the arm (needed for ``cartesian_speed`` and for limits not given; gives
+            the joint names).
         cartesian_speed: the tool position's largest speed [m/s], or None.
         dt: the output's time step [s] (the last sample is at ``duration``).
         gridpoints: toppra's discretisation of the path (default: its own choice from
@@ -124,25 +200,19 @@ def time_optimal(q: object, velocity: object, acceleration: object, *,
         limit holds on a fine sampling of the result.
 
     Raises:
-        InputError: bad shapes or limits.
+        InputError: bad shapes or limits; a limit neither given nor stated by the robot
+            (the message names which, and the joints without one).
         SerialkinError: toppra missing (install the ``paths`` extra), or no timing found
             (toppra's reachability analysis failed: the path cannot be followed with these
             limits, e.g. a cusp where the path reverses).
     """
     ta = _toppra()
-    Q = as_float_array(q, "q", ndim=2)
-    if Q.shape[0] < 2:
-        raise InputError(f"q must hold at least 2 configurations, got shape {Q.shape}")
-    keep = np.concatenate([[True], np.abs(np.diff(Q, axis=0)).max(axis=1) > 1e-12])
-    Q = Q[keep]
-    if len(Q) < 2:
-        raise InputError("q does not move: every configuration is the same")
+    Q, s = _joint_path(q)
     n = Q.shape[1]
-    v = _limits(velocity, n, "velocity")
-    a = _limits(acceleration, n, "acceleration")
-    if not (dt > 0.0 and math.isfinite(dt)):
-        raise InputError(f"dt must be a positive time step in seconds, got {dt!r}")
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(Q, axis=0), axis=1))])
+    v = _limits(_robot_limits(robot, velocity, n, "velocity", "time_optimal"), n, "velocity")
+    a = _limits(_robot_limits(robot, acceleration, n, "acceleration", "time_optimal"), n,
+                "acceleration")
+    _check_dt(dt)
     path = ta.SplineInterpolator(s, Q)
     constraints = [ta.constraint.JointVelocityConstraint(np.column_stack([-v, v])),
                    ta.constraint.JointAccelerationConstraint(np.column_stack([-a, a]))]
@@ -174,6 +244,98 @@ def time_optimal(q: object, velocity: object, acceleration: object, *,
         x.setflags(write=False)
     return TimedPath(t=t, q=out[0], qd=out[1], qdd=out[2], duration=duration, velocity=v,
                      acceleration=a, joint_names=names)
+
+
+def jerk_limited(q: object, jerk: object, velocity: object = None,
+                 acceleration: object = None, *, robot: Robot | None = None,
+                 dt: float = 0.01) -> TimedPath:
+    """A timing of joint path ``q`` under velocity, acceleration and jerk limits (Ruckig).
+
+    The path is a cubic spline q(s) through ``q`` (chord length s in joint space, as in
+    :func:`time_optimal`), followed exactly; s(t) is Ruckig's time-optimal rest-to-rest
+    profile under constant bounds V, A, J on ṡ, |s̈|, |s⃛| (module docstring):
+
+        V = min_j min(v_j / D1_j, √(a_j / (2·D2_j)), ∛(j_j / (3·D3_j))),
+        A = min_j min((a_j − D2_j·V²) / D1_j, j_j / (9·D2_j·V)),
+        J = min_j (j_j − 3·D2_j·V·A − D3_j·V³) / D1_j,
+
+    where D1_j, D2_j, D3_j are the largest |q_j′|, |q_j″|, |q_j‴| along the spline; then
+    |q̇_j| ≤ v_j, |q̈_j| ≤ a_j and |q⃛_j| ≤ j_j everywhere. The bounds are conservative:
+    the duration is longer than :func:`time_optimal`'s (which has no jerk limit), the
+    more so the less uniform the path's curvature. As in :func:`time_optimal`, a fine
+    sampling of the result is checked (jerk by differences of q̈) and time is slowed by
+    the smallest factor that keeps every limit.
+
+    Args:
+        q: (m, n) joint path (m ≥ 2); consecutive duplicate rows are dropped.
+        jerk: (n,) or one jerk limit j_j > 0 [rad/s³ or m/s³].
+        velocity: (n,) or one velocity limit [rad/s or m/s]; None: the robot's.
+        acceleration: (n,) or one acceleration limit [rad/s² or m/s²]; None: the robot's.
+        robot: the arm (for limits not given; gives the joint names).
+        dt: the output's time step [s] (the last sample is at ``duration``).
+
+    Returns:
+        :class:`TimedPath` with ``method='ruckig'`` and ``jerk`` set, sampled every ``dt``.
+
+    Raises:
+        InputError: bad shapes or limits; a limit neither given nor stated by the robot.
+        SerialkinError: ruckig missing (install the ``paths`` extra) or its calculation
+            failed.
+    """
+    from scipy.interpolate import CubicSpline
+
+    rk = _ruckig()
+    Q, s = _joint_path(q)
+    n = Q.shape[1]
+    v = _limits(_robot_limits(robot, velocity, n, "velocity", "jerk_limited"), n, "velocity")
+    a = _limits(_robot_limits(robot, acceleration, n, "acceleration", "jerk_limited"), n,
+                "acceleration")
+    jk = _limits(jerk, n, "jerk")
+    _check_dt(dt)
+    spline = CubicSpline(s, Q)
+    # q′ and q″ are polynomials of degree 2 and 1 on each knot interval, q‴ a constant:
+    # their largest values from 8 points an interval (the final check covers the rest).
+    grid = (s[:-1, None] + np.diff(s)[:, None] * np.linspace(0.0, 1.0, 8)).ravel()
+    D1, D2, D3 = (np.abs(spline(grid, k)).max(axis=0) for k in (1, 2, 3))
+    V = min(_ratio(v, D1), _ratio(a, 2.0 * D2, 0.5), _ratio(jk, 3.0 * D3, 1.0 / 3.0))
+    A = min(_ratio(a - D2 * V * V, D1), _ratio(jk, 9.0 * D2 * V))
+    J = _ratio(jk - 3.0 * D2 * V * A - D3 * V ** 3, D1)
+    inp = rk.InputParameter(1)
+    inp.current_position, inp.target_position = [0.0], [float(s[-1])]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [V], [A], [J]
+    traj = rk.Trajectory(1)
+    result = rk.Ruckig(1).calculate(inp, traj)
+    if result not in (rk.Result.Working, rk.Result.Finished):
+        raise SerialkinError(f"ruckig found no trajectory ({result}) along a path of length "
+                             f"{s[-1]:.4g} with bounds ṡ ≤ {V:.4g}, |s̈| ≤ {A:.4g}, "
+                             f"|s⃛| ≤ {J:.4g}")
+    base = float(traj.duration)
+
+    def states(times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        x = np.array([traj.at_time(float(t)) for t in times])[:, :, 0]   # (k, 3): s, ṡ, s̈
+        d1 = spline(np.clip(x[:, 0], 0.0, s[-1]), 1)
+        return (spline(np.clip(x[:, 0], 0.0, s[-1])), d1 * x[:, 1:2],
+                spline(np.clip(x[:, 0], 0.0, s[-1]), 2) * x[:, 1:2] ** 2 + d1 * x[:, 2:3])
+
+    fine = np.linspace(0.0, base, max(4000, int(base / dt) + 1))
+    _, fqd, fqdd = states(fine)
+    fjerk = np.diff(fqdd, axis=0) / np.diff(fine)[:, None]
+    k = max(1.0, float((np.abs(fqd) / v).max()), math.sqrt(float((np.abs(fqdd) / a).max())),
+            float((np.abs(fjerk) / jk).max()) ** (1.0 / 3.0))
+    t = np.append(np.arange(0.0, base * k, dt), base * k)
+    qs, qd, qdd = states(t / k)
+    out = (t, qs, qd / k, qdd / (k * k))
+    for x in out:
+        x.setflags(write=False)
+    names = tuple(robot.joint_names) if robot is not None else ()
+    return TimedPath(t=out[0], q=out[1], qd=out[2], qdd=out[3], duration=base * k,
+                     velocity=v, acceleration=a, joint_names=names, jerk=jk, method="ruckig")
+
+
+def _ratio(num: np.ndarray, den: np.ndarray, power: float = 1.0) -> float:
+    """min_j (num_j / den_j)^power over the joints with den_j > 0 (inf when none)."""
+    ok = den > 0.0
+    return float(np.min((num[ok] / den[ok]) ** power)) if ok.any() else math.inf
 
 
 def _cartesian(ta, path, s, robot, speed, v):
