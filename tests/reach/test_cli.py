@@ -68,3 +68,63 @@ def test_help_has_examples():
     for name in ("reach", "base-placement"):
         out = _run(name, "--help").output
         assert "Usage: " in out and f"serialkin {name} ur5" in out.split("Example")[1]
+
+
+def _tasks_file(tmp_path):
+    tasks = tmp_path / "tasks.yaml"
+    tasks.write_text("tasks:\n  - [0.4, 0.2, 0.3, 3.14159, 0, 0]\n"
+                     "  - [0.3, -0.3, 0.2, 3.14159, 0, 0]\n")
+    return str(tasks)
+
+
+def test_base_placement_saves_its_map_and_reuses_it_with_map(tmp_path):
+    """The computed map is saved; --map with it gives the same best base and margins."""
+    args = ["base-placement", "ur5", "--tasks", _tasks_file(tmp_path), "-r", "0.3",
+            "--yaws", "2", "--no-plot", "--json"]
+    res = _run(*args, "--out", str(tmp_path / "a"))
+    assert res.exit_code == 0, res.output
+    first = json.loads(res.stdout)
+    assert first["self_collision"] is True and first["best"]["margin_min"] > 0
+    saved = first["files"]["reach_map"]
+    res = _run(*args, "--out", str(tmp_path / "b"), "--map", saved)
+    assert res.exit_code == 0, res.output
+    again = json.loads(res.stdout)
+    assert again["best"] == first["best"] and "reach_map" not in again["files"]
+    with np.load(tmp_path / "b" / "base_placement.npz") as z:
+        assert z["margin"].shape == z["reached"].shape + (2,)
+
+
+def test_base_placement_refuses_a_map_of_other_collision_settings(tmp_path):
+    """A `reach` map without --self-collision is refused naming the difference; with it: used."""
+    tasks = _tasks_file(tmp_path)
+    for flag, name in (((), "plain"), (("--self-collision",), "sc")):
+        res = _run("reach", "ur5", "-r", "0.4", "-n", "2", "--no-plot", "-q",
+                   "--out", str(tmp_path / name), *flag)
+        assert res.exit_code == 0, res.output
+    args = ["base-placement", "ur5", "--tasks", tasks, "-r", "0.4", "--yaws", "1",
+            "--no-plot", "-q", "--out", str(tmp_path / "b")]
+    res = _run(*args, "--map", str(tmp_path / "plain"))
+    assert res.exit_code != 0 and "collision: null in the map" in res.output
+    assert _run(*args, "--map", str(tmp_path / "plain"), "--no-self-collision").exit_code == 0
+    assert _run(*args, "--map", str(tmp_path / "sc")).exit_code == 0
+
+
+def test_srdf_options_on_reach_and_base_placement(tmp_path):
+    """--srdf joins the self-collision check; it is refused where self-collision is off."""
+    srdf = tmp_path / "ur5.srdf"
+    srdf.write_text('<robot name="ur5"><disable_collisions link1="base_link" '
+                    'link2="wrist_3_link" reason="Never"/></robot>')
+    res = _run("reach", "ur5", "-r", "0.4", "-n", "2", "--no-plot", "-q", "--srdf", str(srdf),
+               "--out", str(tmp_path / "m"))
+    assert res.exit_code != 0 and "--self-collision" in res.output
+    res = _run("reach", "ur5", "-r", "0.4", "-n", "2", "--no-plot", "-q", "--srdf", str(srdf),
+               "--self-collision", "--out", str(tmp_path / "m"))
+    assert res.exit_code == 0, res.output
+    acm_hash = load_map(tmp_path / "m").settings["collision"]["acm_hash"]
+    base = ["base-placement", "ur5", "--tasks", _tasks_file(tmp_path), "-r", "0.4",
+            "--yaws", "1", "--no-plot", "-q", "--out", str(tmp_path / "b")]
+    res = _run(*base, "--srdf", str(srdf), "--no-self-collision")
+    assert res.exit_code != 0 and "--no-self-collision" in res.output
+    res = _run(*base, "--map", str(tmp_path / "m"))  # the map's SRDF pairs differ
+    assert res.exit_code != 0 and acm_hash in res.output
+    assert _run(*base, "--map", str(tmp_path / "m"), "--srdf", str(srdf)).exit_code == 0

@@ -1,7 +1,8 @@
 """The ``collide`` subcommand: the closest pairs of a configuration, by name and distance.
 
-Also the ``--srdf`` / ``--skip-links`` options shared by every command that checks
-collisions (:data:`srdf_options`, read by :func:`srdf_acm`).
+Also what every command that checks collisions shares: the ``--srdf`` / ``--skip-links``
+options (:data:`srdf_options`, read by :func:`srdf_acm`) and the ``--scene`` file reader
+(:func:`read_scene`).
 """
 
 from __future__ import annotations
@@ -37,6 +38,30 @@ _COLLIDE_HELP = command_help(
      "serialkin collide panda --srdf panda.srdf --skip-links panda_hand_tcp --q 0,0,0,-3,0,0.5,0",
      "serialkin collide ur5 --q 0,-1.2,1.4,0,0.5,0 --scene table.yaml --json"],
 )
+
+
+def read_scene(path: str | None) -> list[Any] | None:
+    """Obstacles of a YAML/JSON scene file (world frame [m]).
+
+    The file holds a list, or ``{obstacles: [...]}``, of mappings
+    ``{type: sphere|capsule|circle|cylinder, ...}`` (as in scenario files).
+    """
+    if path is None:
+        return None
+    from serialkin._files import load_document
+    from serialkin.redundancy.obstacles import obstacle_from_dict
+
+    doc = load_document(path, what="scene file")
+    items = doc.get("obstacles") if isinstance(doc, dict) else doc
+    if not isinstance(items, list) or not items:
+        raise CLIError(f"scene file {path}: expected a list of obstacles (or a mapping with "
+                       "'obstacles: [...]'), each {type: sphere, center: [x, y, z], radius: r}")
+    return [obstacle_from_dict(d, f"{path}: obstacles[{i}]") if isinstance(d, dict) else
+            _not_a_mapping(path, i, d) for i, d in enumerate(items)]
+
+
+def _not_a_mapping(path: str, i: int, d: object) -> Any:
+    raise CLIError(f"scene file {path}: obstacles[{i}] must be a mapping, got {short_repr(d)}")
 
 
 def srdf_options(fn: Callable[..., Any]) -> Callable[..., Any]:
@@ -88,7 +113,6 @@ def collide_cmd(robot: str, q_text: str | None, degrees: bool, scene: str | None
                 srdf: str | None, skip_links: str | None, count: int, margin: float,
                 params: tuple[str, ...], as_json: bool, quiet: bool) -> None:
     """Print the closest pairs of one configuration."""
-    from serialkin.cli.reach_cmd import read_scene
     from serialkin.collision import closest_pairs
 
     r = resolve_robot(robot, params)

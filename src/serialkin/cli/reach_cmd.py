@@ -10,6 +10,7 @@ import click
 import numpy as np
 
 from serialkin._checks import short_repr
+from serialkin.cli.collide_cmd import read_scene, srdf_acm, srdf_options
 from serialkin.cli.commands import (
     check_out_folder,
     handle_errors,
@@ -21,30 +22,6 @@ from serialkin.cli.commands import (
 from serialkin.cli.io import CLIError, command_help, dumps_json, ensure_dir, parse_numbers
 from serialkin.cli.robots import ROBOT_HELP, param_option, resolve_robot, robot_argument
 from serialkin.cli.workspace_cmd import _parse_slice, save_figure
-
-
-def read_scene(path: str | None) -> list[Any] | None:
-    """Obstacles of a YAML/JSON scene file (world frame [m]).
-
-    The file holds a list, or ``{obstacles: [...]}``, of mappings
-    ``{type: sphere|capsule|circle|cylinder, ...}`` (as in scenario files).
-    """
-    if path is None:
-        return None
-    from serialkin._files import load_document
-    from serialkin.redundancy.obstacles import obstacle_from_dict
-
-    doc = load_document(path, what="scene file")
-    items = doc.get("obstacles") if isinstance(doc, dict) else doc
-    if not isinstance(items, list) or not items:
-        raise CLIError(f"scene file {path}: expected a list of obstacles (or a mapping with "
-                       "'obstacles: [...]'), each {type: sphere, center: [x, y, z], radius: r}")
-    return [obstacle_from_dict(d, f"{path}: obstacles[{i}]") if isinstance(d, dict) else
-            _not_a_mapping(path, i, d) for i, d in enumerate(items)]
-
-
-def _not_a_mapping(path: str, i: int, d: object) -> Any:
-    raise CLIError(f"scene file {path}: obstacles[{i}] must be a mapping, got {short_repr(d)}")
 
 
 def _executor(scheduler: str | None, cluster: str | None, quiet: bool) -> Any:
@@ -76,6 +53,7 @@ _REACH_HELP = command_help(
     + ROBOT_HELP + ".",
     ["serialkin reach ur5 --resolution 0.05 --orientations 50 --out maps/ur5",
      "serialkin reach ur5 --resolution 0.05 --out maps/ur5 --resume",
+     "serialkin reach panda --resolution 0.1 --self-collision --srdf panda.srdf --out maps/p",
      "serialkin reach ur5 --resolution 0.1 --cluster local:2 --out maps/ur5_coarse",
      "serialkin reach panda --resolution 0.1 --scheduler tcp://10.0.0.5:8786 --out maps/p",
      "serialkin reach three_link --resolution 0.02 --orientations 36 --out maps/3link"],
@@ -104,6 +82,12 @@ _REACH_HELP = command_help(
 @click.option("--seed", type=int, default=0, show_default=True, help="Root seed (>= 0).")
 @click.option("--scene", default=None, type=click.Path(dir_okay=False),
               help="Obstacle file (YAML/JSON) for the collision-aware numerical IK.")
+@click.option("--self-collision", is_flag=True,
+              help="A target counts only with a solution free of self-collision (the "
+                   "robot's collision model; --srdf adds the vendor's allowed pairs).")
+@srdf_options
+@click.option("--clearance", type=float, default=0.0, show_default=True,
+              help="Distance [m] a solution keeps from collisions (self and --scene).")
 @click.option("--chunk-voxels", type=int, default=512, show_default=True,
               help="Voxels per chunk (the unit of work, streaming and resume).")
 @click.option("--out", "-o", "out", type=click.Path(file_okay=False), required=True,
@@ -123,7 +107,9 @@ _REACH_HELP = command_help(
 @handle_errors
 def reach_cmd(robot: str, resolution: float, orientations: int, sampling: str, rolls: int,
               bounds: str | None, task: str | None, solver: str, restarts: int, seed: int,
-              scene: str | None, chunk_voxels: int, out: str, resume: bool,
+              scene: str | None, self_collision: bool, srdf: str | None,
+              skip_links: str | None, clearance: float, chunk_voxels: int, out: str,
+              resume: bool,
               scheduler: str | None, cluster: str | None, slices: tuple[str, ...],
               no_plot: bool, params: tuple[str, ...], as_json: bool, quiet: bool) -> None:
     """Compute a reachability map."""
@@ -133,10 +119,15 @@ def reach_cmd(robot: str, resolution: float, orientations: int, sampling: str, r
     box = None if bounds is None else parse_numbers(bounds, "--bounds", 6).reshape(3, 2)
     parsed_slices = [_parse_slice(s) for s in slices]
     obstacles = read_scene(scene)
+    acm = srdf_acm(r, srdf, skip_links)
+    if acm is not None and not self_collision:
+        raise CLIError("--srdf lists the pairs a self-collision check skips: add "
+                       "--self-collision")
     check_out_folder(out)
     job = make_job(r, resolution, orientations, sampling=sampling, rolls=rolls, bounds=box,
                    task=task, solver=solver, restarts=restarts, seed=seed, scene=obstacles,
-                   chunk_voxels=chunk_voxels)
+                   chunk_voxels=chunk_voxels, self_collision=self_collision, acm=acm,
+                   clearance=clearance)
     client = _executor(scheduler, cluster, quiet)
     try:
         m = run_job(job, out=out, resume=resume, client=client,
@@ -232,12 +223,21 @@ def read_tasks(path: str, degrees: bool = False) -> np.ndarray:
 
 _BASE_HELP = command_help(
     "Base placement (inverse reachability): the base poses on a floor plane, on a grid of "
-    "--resolution with --yaws headings, from which the robot reaches every task pose, and "
-    "the best one: most task poses reached, then the largest worst-case manipulability. "
-    "Writes OUT/base_placement.npz, OUT/base_placement.json and OUT/base_placement.png. "
-    "ROBOT is " + ROBOT_HELP + ".",
+    "--resolution with --yaws headings, from which the robot reaches every task pose with "
+    "a collision-free solution (self-collision when the robot has a collision model, "
+    "--scene obstacles in the tasks' frame), and the best one: most task poses reached, "
+    "then the largest margin (each task's distance from the edge of the reachable set, "
+    "read on a reachability map: the smallest over the tasks, then the median), then the "
+    "largest worst-case manipulability.\n\n"
+    "The map is computed at --map-resolution and saved as OUT/reach_map.npz, or a saved "
+    "one is reused with --map (a folder written by `serialkin reach` or a .npz; it must be "
+    "of the same robot and self-collision settings, and is refused otherwise, naming each "
+    "difference). Writes OUT/base_placement.npz, OUT/base_placement.json and "
+    "OUT/base_placement.png. ROBOT is " + ROBOT_HELP + ".",
     ["serialkin base-placement ur5 --tasks tasks.yaml --out out/base",
-     "serialkin base-placement ur5 --tasks tasks.npy --resolution 0.05 --yaws 16"],
+     "serialkin base-placement ur5 --tasks tasks.npy --resolution 0.05 --yaws 16",
+     "serialkin base-placement ur5 --tasks tasks.yaml --map out/base/reach_map.npz",
+     "serialkin base-placement panda --tasks tasks.yaml --srdf panda.srdf --scene table.yaml"],
 )
 
 
@@ -258,7 +258,21 @@ _BASE_HELP = command_help(
               default="auto", show_default=True, help="IK used for every target.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Root seed (>= 0).")
 @click.option("--scene", default=None, type=click.Path(dir_okay=False),
-              help="Obstacle file (YAML/JSON) for the collision-aware numerical IK.")
+              help="Obstacle file (YAML/JSON, the tasks' frame [m]): solutions must be "
+                   "clear of it.")
+@click.option("--self-collision/--no-self-collision", default=None,
+              help="Solutions must be free of self-collision [default: when the robot "
+                   "has a collision model].")
+@srdf_options
+@click.option("--clearance", type=float, default=0.0, show_default=True,
+              help="Distance [m] a solution keeps from collisions.")
+@click.option("--map", "map_path", default=None, type=click.Path(exists=True),
+              help="Reuse a saved reachability map (folder of `serialkin reach`, or .npz) "
+                   "for the margins instead of computing one.")
+@click.option("--map-resolution", type=float, default=None,
+              help="Voxel edge [m] of the computed map [default: --resolution].")
+@click.option("--map-orientations", type=int, default=12, show_default=True,
+              help="Orientations per voxel of the computed map.")
 @click.option("--out", "-o", "out", type=click.Path(file_okay=False), default="out/base",
               show_default=True, help="Output folder.")
 @click.option("--no-plot", is_flag=True, help="Do not draw the figure.")
@@ -272,8 +286,11 @@ _BASE_HELP = command_help(
 @handle_errors
 def base_placement_cmd(robot: str, tasks_file: str, resolution: float, yaws: int,
                        region: str | None, floor_z: float, solver: str, seed: int,
-                       scene: str | None, out: str, no_plot: bool, degrees: bool,
-                       params: tuple[str, ...], as_json: bool, quiet: bool) -> None:
+                       scene: str | None, self_collision: bool | None, srdf: str | None,
+                       skip_links: str | None, clearance: float, map_path: str | None,
+                       map_resolution: float | None, map_orientations: int, out: str,
+                       no_plot: bool, degrees: bool, params: tuple[str, ...], as_json: bool,
+                       quiet: bool) -> None:
     """Find base poses that reach every task pose."""
     import io
     import json
@@ -285,15 +302,26 @@ def base_placement_cmd(robot: str, tasks_file: str, resolution: float, yaws: int
     T = read_tasks(tasks_file, degrees)
     reg = None if region is None else parse_numbers(region, "--region", 4).reshape(2, 2)
     obstacles = read_scene(scene)
+    acm = srdf_acm(r, srdf, skip_links)
+    if acm is not None and self_collision is False:
+        raise CLIError("--srdf lists the pairs a self-collision check skips; it cannot go "
+                       "with --no-self-collision")
     check_out_folder(out)
     bp = base_placement(r, T, resolution=resolution, yaws=yaws, region=reg, floor_z=floor_z,
-                        solver=solver, seed=seed, scene=obstacles)
+                        solver=solver, seed=seed, scene=obstacles,
+                        self_collision=True if acm is not None else self_collision, acm=acm,
+                        clearance=clearance, reach_map=map_path, map_resolution=map_resolution,
+                        map_orientations=map_orientations,
+                        progress=False if quiet or as_json else None)
     folder = ensure_dir(out)
     buf = io.BytesIO()
     np.savez_compressed(buf, xs=bp.xs, ys=bp.ys, yaws=bp.yaws, reached=bp.reached,
-                        dexterity=bp.dexterity, best=bp.best, tasks=T)
+                        dexterity=bp.dexterity, margin=bp.margin, best=bp.best, tasks=T)
     files = {"data": str(write_bytes_atomic(folder / "base_placement.npz", buf.getvalue()))}
-    summary = dict(bp.summary(), robot=r.name, files=files)
+    if map_path is None and bp.reach_map is not None:
+        files["reach_map"] = str(bp.reach_map.save(folder / "reach_map.npz"))
+    summary = dict(bp.summary(), robot=r.name, files=files,
+                   map=str(map_path) if map_path else None)
     if not no_plot:
         import matplotlib
 
@@ -310,4 +338,8 @@ def base_placement_cmd(robot: str, tasks_file: str, resolution: float, yaws: int
         click.echo(f"{r.name}: {summary['feasible_candidates']} of {summary['candidates']} "
                    f"base poses reach all {bp.tasks} tasks; best x={b['x']:.3f} m "
                    f"y={b['y']:.3f} m yaw={np.degrees(b['yaw']):.1f}° (reaches {b['reached']}, "
+                   f"margin {b['margin_min'] * 1e3:.0f} mm smallest, "
+                   f"{b['margin_median'] * 1e3:.0f} mm median, "
                    f"worst-case manipulability {b['dexterity']:.4g})")
+        if "reach_map" in files:
+            click.echo(f"reach map: {files['reach_map']} (reuse it with --map)")

@@ -33,7 +33,13 @@ from typing import Any
 import numpy as np
 
 from serialkin.reach.grid import VoxelGrid
-from serialkin.reach.solve import NumericalOptions, make_targets, oriented, solve_targets
+from serialkin.reach.solve import (
+    CollisionOptions,
+    NumericalOptions,
+    make_targets,
+    oriented,
+    solve_targets,
+)
 
 #: Per-voxel arrays of a chunk and of a map, with their dtypes.
 FIELDS = {"reached": np.int32, "solutions": np.int32, "manipulability_mean": np.float64,
@@ -82,7 +88,9 @@ class ReachJob:
         seed: root seed (see the module docstring).
         numerical: options of the numerical solver.
         chunk_voxels: voxels per chunk.
-        scene: collision scene passed to the numerical IK, or None.
+        scene: collision scene (the robot's world frame), or None.
+        collision: self-collision and clearance of a solution (see
+            :mod:`serialkin.reach.solve`).
     """
 
     robot: Any
@@ -96,6 +104,7 @@ class ReachJob:
     numerical: NumericalOptions
     chunk_voxels: int
     scene: Any = field(default=None)
+    collision: CollisionOptions = field(default=CollisionOptions())
 
     @property
     def orientations(self) -> int:
@@ -117,9 +126,14 @@ class ReachJob:
         return start, min(start + self.chunk_voxels, self.grid.size)
 
     def settings(self) -> dict[str, Any]:
-        """The settings that decide the map's values, JSON-ready (the manifest's record)."""
+        """The settings that decide the map's values, JSON-ready (the manifest's record).
+
+        ``collision`` (self-collision flag, ACM hash, clearance [m]) is recorded only when
+        a self-collision check or a clearance is asked for, so that maps written before
+        it existed still resume.
+        """
         ori = self.rotations if self.rotations is not None else self.headings
-        return {
+        out = {
             "robot": self.robot.name,
             "robot_hash": robot_digest(self.robot),
             "resolution": self.grid.resolution,
@@ -137,6 +151,10 @@ class ReachJob:
             "scene_hash": scene_digest(self.scene),
             "chunk_voxels": self.chunk_voxels,
         }
+        collision = self.collision.settings(self.robot)
+        if collision is not None:
+            out["collision"] = collision
+        return out
 
 
 def voxel_starts(robot: Any, seed: int, start: int, stop: int, count: int) -> np.ndarray:
@@ -175,7 +193,7 @@ def compute_chunk(job: ReachJob, c: int) -> dict[str, Any]:
         else None
     ok, nsol, w = solve_targets(job.robot, job.task, targets, job.solver, q0=q0,
                                 seed=restart_seed(job.seed), numerical=job.numerical,
-                                scene=job.scene)
+                                scene=job.scene, collision=job.collision)
     ok, nsol, w = ok.reshape(B, N), nsol.reshape(B, N), w.reshape(B, N)
     reached = ok.sum(axis=1).astype(np.int32)
     out: dict[str, Any] = {"chunk": c, "start": start, "stop": stop,

@@ -34,7 +34,13 @@ from serialkin.reach.chunk import FIELDS, ReachJob, compute_chunk
 from serialkin.reach.grid import check_map_size, make_grid
 from serialkin.reach.orientations import SAMPLINGS, orientation_set, planar_headings
 from serialkin.reach.reachmap import ReachMap
-from serialkin.reach.solve import TASKS, NumericalOptions, default_task, resolve_solver
+from serialkin.reach.solve import (
+    TASKS,
+    NumericalOptions,
+    check_collision_options,
+    default_task,
+    resolve_solver,
+)
 
 #: Default voxels per chunk (about a second of UR5 closed-form IK at 50 orientations).
 CHUNK_VOXELS = 512
@@ -142,7 +148,9 @@ def make_job(robot: Robot, resolution: float, orientations: int = 50, *,
              sampling: str = "uniform", rolls: int = 1, bounds: object = None,
              task: str | None = None, solver: str = "auto", restarts: int = 5,
              tol: float = 1e-6, max_iter: int | None = None, seed: int = 0,
-             scene: Any = None, chunk_voxels: int = CHUNK_VOXELS) -> ReachJob:
+             scene: Any = None, chunk_voxels: int = CHUNK_VOXELS,
+             self_collision: bool = False, acm: Any = None,
+             clearance: float = 0.0) -> ReachJob:
     """Validate a map's settings and build its :class:`ReachJob` (see :func:`reachability_map`)."""
     check_robot(robot)
     task = default_task(robot) if task is None else check_choice(task, "task", TASKS)
@@ -174,11 +182,12 @@ def make_job(robot: Robot, resolution: float, orientations: int = 50, *,
     check_allocation("one chunk's IK targets", (min(chunk_voxels, grid.size), n_ori, 16), 8,
                      setting="chunk_voxels (--chunk-voxels)")
     solver = resolve_solver(robot, task, solver, scene)
+    collision = check_collision_options(robot, self_collision, acm, clearance, scene)
     if scene is not None:  # refuse a scene the IK does not take before anything is written
         robot.ik(robot.fk(np.zeros(robot.n)), method="lm", scene=scene, max_iter=1,
                  restarts=0, seed=0)
     return ReachJob(robot, grid, task, solver, rotations, headings, sampling, seed, numerical,
-                    chunk_voxels, scene)
+                    chunk_voxels, scene, collision)
 
 
 def _progress(total: int, progress: bool | None) -> Any:
@@ -254,7 +263,8 @@ def reachability_map(robot: Robot, resolution: float, orientations: int = 50, *,
                      tol: float = 1e-6, max_iter: int | None = None, seed: int = 0,
                      scene: Any = None, chunk_voxels: int = CHUNK_VOXELS,
                      out: str | Path | None = None, resume: bool = False, client: Any = None,
-                     progress: bool | None = None) -> ReachMap:
+                     progress: bool | None = None, self_collision: bool = False,
+                     acm: Any = None, clearance: float = 0.0) -> ReachMap:
     """Reachability map: per voxel, the fraction of N tool orientations the robot reaches.
 
     For every voxel centre p and orientation R_k the target ``T = [R_k p; 0 1]`` is
@@ -279,13 +289,19 @@ def reachability_map(robot: Robot, resolution: float, orientations: int = 50, *,
         tol: its position [m] / orientation [rad] tolerance.
         max_iter: its iterations per attempt (None: the method's default).
         seed: root seed, an int >= 0 (see :mod:`serialkin.reach.chunk`).
-        scene: collision scene for the constraint-aware numerical IK (passed through).
+        scene: collision scene (the robot's world frame): a target counts only with a
+            solution clear of it (:mod:`serialkin.reach.solve`).
         chunk_voxels: voxels per chunk (the unit of work, of streaming and of resuming).
         out: folder to stream chunks to (see :mod:`serialkin.reach.store`); None keeps
             everything in memory.
         resume: continue the run in ``out``, recomputing only missing chunks.
         client: a ``dask.distributed.Client`` to run the chunks on; None runs embedded.
         progress: tqdm bar over chunks (None: only on a terminal).
+        self_collision: a target counts only with a solution free of self-collision
+            (the robot's collision model, pairs not allowed by ``acm``).
+        acm: :class:`~serialkin.collision.acm.AllowedCollisionMatrix` (e.g. from a vendor
+            SRDF, :func:`~serialkin.collision.acm_from_srdf`); None: the model's default.
+        clearance: smallest signed distance a solution keeps from collisions [m], >= 0.
 
     Returns:
         :class:`ReachMap`.
@@ -298,7 +314,8 @@ def reachability_map(robot: Robot, resolution: float, orientations: int = 50, *,
     """
     job = make_job(robot, resolution, orientations, sampling=sampling, rolls=rolls,
                    bounds=bounds, task=task, solver=solver, restarts=restarts, tol=tol,
-                   max_iter=max_iter, seed=seed, scene=scene, chunk_voxels=chunk_voxels)
+                   max_iter=max_iter, seed=seed, scene=scene, chunk_voxels=chunk_voxels,
+                   self_collision=self_collision, acm=acm, clearance=clearance)
     if client is not None and not callable(getattr(client, "submit", None)):
         raise InputTypeError(f"client must be a dask.distributed.Client, got "
                              f"{type(client).__name__}")

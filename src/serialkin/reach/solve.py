@@ -12,12 +12,17 @@ so the solver can be switched in one place:
   counts one solution (a numerical solver finds one per start);
 * ``"auto"`` — closed form when the robot has one for the task, else numerical.
 
-A collision scene (``scene=``) is passed to ``robot.ik`` only when given (the
-constraint-aware IK); the closed-form path cannot honour it, so a scene selects the
-numerical solver under ``"auto"``.
+**Collisions** (:class:`CollisionOptions`, and a ``scene=``): a target counts as
+reached only with a collision-free solution, one whose clearance (smallest signed
+distance of the robot's collision model to itself, over the pairs the allowed-collision
+matrix checks, and to the scene) is at least ``clearance`` [m]. The closed-form path
+keeps, of every solution, those that are free (:func:`collision_free`, exact: a target
+with no free closed-form solution has none); the numerical path asks ``robot.ik`` for a
+collision-free solution (``scene=``, ``self_collision=``, ``acm=``, ``margin=``), which
+can miss one. The robot needs a collision model (``robot.collision``).
 
 The manipulability of a reached target is the largest ``sqrt(det(J Jᵀ))`` (eq 43, the
-task rows of J) over its solutions; 0 when not reached.
+task rows of J) over its (collision-free) solutions; 0 when not reached.
 """
 
 from __future__ import annotations
@@ -27,8 +32,8 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import check_choice
-from serialkin.errors import InputError, NoClosedFormError
+from serialkin._checks import check_choice, check_real, short_repr
+from serialkin.errors import InputError, InputTypeError, NoClosedFormError
 
 #: Solver names of :func:`solve_targets`.
 SOLVERS = ("auto", "closed_form", "numerical")
@@ -85,6 +90,9 @@ def make_targets(task: str, positions: np.ndarray, rotations: np.ndarray | None,
 def resolve_solver(robot: Any, task: str, solver: str, scene: Any = None) -> str:
     """'closed_form' or 'numerical' for ``solver`` ('auto' picks; see the module docstring).
 
+    ``scene`` is accepted for compatibility and does not change the choice: both paths
+    honour collisions (the closed form by filtering its solutions).
+
     Raises:
         InputError: an unknown solver; 'closed_form' for a robot or task without one.
     """
@@ -104,11 +112,8 @@ def resolve_solver(robot: Any, task: str, solver: str, scene: Any = None) -> str
         if not ok:
             raise InputError(f"solver 'closed_form' is not available for robot "
                              f"{robot.name!r}: {why}")
-        if scene is not None:
-            raise InputError("solver 'closed_form' cannot take a collision scene; use "
-                             "'numerical' (or 'auto')")
         return solver
-    return "closed_form" if ok and scene is None else "numerical"
+    return "closed_form" if ok else "numerical"
 
 
 @dataclass(frozen=True)
@@ -126,6 +131,113 @@ class NumericalOptions:
     max_iter: int | None = None
 
 
+@dataclass(frozen=True)
+class CollisionOptions:
+    """Which collisions make a solution unusable (besides a scene's obstacles).
+
+    Attributes:
+        self_collision: check the robot's own body pairs (those ``acm`` does not allow).
+        acm: :class:`~serialkin.collision.acm.AllowedCollisionMatrix` of the robot's model,
+            or None for the model's default (:func:`~serialkin.collision.acm.default_acm`).
+        clearance: smallest signed distance a solution must keep [m], >= 0 (0: touching
+            is allowed, overlapping is not).
+    """
+
+    self_collision: bool = False
+    acm: Any = None
+    clearance: float = 0.0
+
+    @property
+    def active(self) -> bool:
+        """True when anything beyond a scene is checked or a clearance is asked for."""
+        return self.self_collision or self.clearance != 0.0
+
+    def settings(self, robot: Any) -> dict[str, Any] | None:
+        """JSON-ready record (None when inactive): flag, ACM hash and clearance [m]."""
+        if not self.active:
+            return None
+        return {"self_collision": self.self_collision, "clearance": self.clearance,
+                "acm_hash": acm_digest(self.effective_acm(robot))
+                if self.self_collision else None}
+
+    def effective_acm(self, robot: Any) -> Any:
+        """The matrix checked: ``acm``, or the default of ``robot.collision``."""
+        if self.acm is not None:
+            return self.acm
+        from serialkin.collision.acm import default_acm
+
+        return default_acm(robot.collision)
+
+
+def acm_digest(acm: Any) -> str:
+    """SHA-256 (16 hex digits) of an allowed-collision matrix: its body names and pairs."""
+    import hashlib
+
+    h = hashlib.sha256("\n".join(acm.body_names).encode("utf-8"))
+    h.update(np.packbits(np.asarray(acm.allowed, dtype=bool)).tobytes())
+    return h.hexdigest()[:16]
+
+
+def check_collision_options(robot: Any, self_collision: object, acm: object,
+                            clearance: object, scene: object = None) -> CollisionOptions:
+    """Validate collision settings at the boundary; the :class:`CollisionOptions`.
+
+    Raises:
+        InputTypeError: ``self_collision`` not a bool; ``acm`` not an
+            AllowedCollisionMatrix.
+        InputError: a negative or non-finite clearance; ``acm`` without self-collision; an
+            ACM of other bodies; a collision check on a robot without a collision model.
+    """
+    from serialkin.collision.acm import AllowedCollisionMatrix
+
+    if not isinstance(self_collision, (bool, np.bool_)):
+        raise InputTypeError(f"self_collision must be True or False, got "
+                             f"{short_repr(self_collision)}")
+    clearance = check_real(clearance, "clearance", unit="m")
+    if clearance < 0.0:
+        raise InputError(f"clearance must be >= 0 m (the distance a solution keeps from "
+                         f"collisions), got {clearance!r}")
+    if acm is not None:
+        if not isinstance(acm, AllowedCollisionMatrix):
+            raise InputTypeError(f"acm must be an AllowedCollisionMatrix or None, got "
+                                 f"{type(acm).__name__}")
+        if not self_collision:
+            raise InputError("acm lists the body pairs a self-collision check skips; it "
+                             "needs self_collision=True")
+    opts = CollisionOptions(bool(self_collision), acm, float(clearance))
+    if (opts.self_collision or scene is not None) and getattr(robot, "collision", None) is None:
+        raise InputError(f"robot {short_repr(robot.name)} has no collision model, so "
+                         "self_collision / scene cannot be checked; attach one with "
+                         "robot.with_collision(model) or robot.fit_collision()")
+    if acm is not None and tuple(acm.body_names) != tuple(robot.collision.body_names):
+        raise InputError(f"acm is over the bodies {list(acm.body_names)[:6]}..., expected "
+                         f"those of robot {short_repr(robot.name)}'s collision model "
+                         f"{list(robot.collision.body_names)[:6]}...")
+    return opts
+
+
+def collision_free(robot: Any, Q: np.ndarray, scene: Any = None,
+                   collision: CollisionOptions = CollisionOptions()) -> np.ndarray:
+    """(K,) bool: configurations Q (K, n) whose clearance is >= ``collision.clearance``.
+
+    The clearance is the smallest signed distance [m] of the robot's collision model to
+    itself (pairs not allowed by the ACM; only with ``collision.self_collision``) and to
+    ``scene`` (world frame of the robot; only when given). Nothing to check: all True.
+    """
+    free = np.ones(Q.shape[0], dtype=bool)
+    if Q.shape[0] == 0 or not (collision.self_collision or scene is not None):
+        return free
+    from serialkin.collision.queries import scene_clearance, self_clearance
+
+    model = robot.collision
+    if collision.self_collision:
+        free &= self_clearance(robot, model, Q, collision.acm).distance >= collision.clearance
+    if scene is not None and free.any():
+        d = scene_clearance(robot, model, Q[free], scene).distance
+        free[np.flatnonzero(free)] = d >= collision.clearance
+    return free
+
+
 def _manipulability_task(task: str) -> str:
     return {"pose": "full", "position": "position", "planar": "planar",
             "planar_pose": "planar_pose"}[task]
@@ -134,7 +246,8 @@ def _manipulability_task(task: str) -> str:
 def solve_targets(robot: Any, task: str, targets: np.ndarray, solver: str, *,
                   q0: np.ndarray | None = None, seed: int = 0,
                   numerical: NumericalOptions = NumericalOptions(),
-                  scene: Any = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                  scene: Any = None, collision: CollisionOptions = CollisionOptions()
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Solve every target; (reached (M,) bool, solutions (M,) int32, manipulability (M,)).
 
     Args:
@@ -145,7 +258,11 @@ def solve_targets(robot: Any, task: str, targets: np.ndarray, solver: str, *,
         q0: (M, n) first guesses of the numerical solver.
         seed: stream seed of its restarts (the same for every target).
         numerical: its options.
-        scene: collision scene passed to ``robot.ik`` when not None.
+        scene: collision scene (the robot's world frame) when not None.
+        collision: self-collision and clearance (see the module docstring).
+
+    A solution in collision does not count: ``solutions`` counts the free ones, and a
+    target with none is not reached.
     """
     M = targets.shape[0]
     reached = np.zeros(M, dtype=bool)
@@ -162,7 +279,12 @@ def solve_targets(robot: Any, task: str, targets: np.ndarray, solver: str, *,
             count[:] = res.count
             sols = [res.q[i, : count[i]] for i in range(M)]
         else:  # planar targets: one call per target (ik_all batches poses only)
-            sols = [ik_all(robot, t) for t in targets]
+            sols = [np.asarray(ik_all(robot, t)).reshape(-1, robot.n) for t in targets]
+            count[:] = [len(s) for s in sols]
+        if scene is not None or collision.self_collision:  # keep the free solutions
+            flat = np.concatenate(sols, axis=0) if count.sum() else np.zeros((0, robot.n))
+            keep = np.split(collision_free(robot, flat, scene, collision), np.cumsum(count)[:-1])
+            sols = [s[k] for s, k in zip(sols, keep, strict=True)]
             count[:] = [len(s) for s in sols]
         reached[:] = count > 0
         if reached.any():
@@ -177,6 +299,12 @@ def solve_targets(robot: Any, task: str, targets: np.ndarray, solver: str, *,
         opts["max_iter"] = numerical.max_iter
     if scene is not None:
         opts["scene"] = scene
+    if collision.self_collision:
+        opts["self_collision"] = True
+        if collision.acm is not None:
+            opts["acm"] = collision.acm
+    if collision.clearance and (scene is not None or collision.self_collision):
+        opts["margin"] = collision.clearance
     res = robot.ik(targets, method="lm", **opts)
     reached[:] = np.asarray(res.success, dtype=bool).reshape(-1)
     count[:] = reached

@@ -46,12 +46,14 @@ def settings_hash(settings: dict[str, Any]) -> str:
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
 
 
-def _differences(old: dict[str, Any], new: dict[str, Any]) -> list[str]:
+def differences(old: dict[str, Any], new: dict[str, Any], where: str = "in the folder"
+                ) -> list[str]:
+    """``'key: <old> <where>, <new> now'`` for every key whose values differ (JSON text)."""
     out = []
     for key in sorted(set(old) | set(new)):
         a, b = old.get(key), new.get(key)
         if a != b:
-            out.append(f"{key}: {json.dumps(a)} in the folder, {json.dumps(b)} now")
+            out.append(f"{key}: {json.dumps(a)} {where}, {json.dumps(b)} now")
     return out
 
 
@@ -86,7 +88,7 @@ def open_folder(folder: str | Path, settings: dict[str, Any], resume: bool) -> P
             raise InputError(f"cannot resume {str(path)!r}: {MANIFEST} is not a map manifest "
                              f"({str(exc)[:160]}); remove the folder or choose another") \
                 from None
-        diff = _differences(old_settings, json.loads(json.dumps(settings)))
+        diff = differences(old_settings, json.loads(json.dumps(settings)))
         if diff:
             raise InputError(f"cannot resume {str(path)!r}: it was written with other "
                              "settings (" + "; ".join(diff) + ")")
