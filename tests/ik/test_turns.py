@@ -76,3 +76,14 @@ def test_ordinary_and_fast_paths_agree():
     b = sk.ik.solve(r, T, seed=3, tol=sk.ik.DEFAULT_TOL)
     np.testing.assert_allclose(a.q, b.q, atol=1e-9)
     assert np.all(np.abs(a.q) <= math.pi + 1e-9)
+
+
+def test_far_values_keep_their_turns():
+    """A value over MAX_TURNS turns from its representative is kept (rounding moves the pose)."""
+    from serialkin.ik.turns import MAX_TURNS, nearest_turn
+
+    lower, upper, wide = np.array([-np.inf]), np.array([np.inf]), np.array([True])
+    near = 3.0 + 2 * np.pi * MAX_TURNS
+    assert abs(nearest_turn(np.array([near]), lower, upper, wide)[0] - 3.0) < 1e-12
+    far = np.array([8.9e9])
+    assert nearest_turn(far, lower, upper, wide)[0] == far[0]

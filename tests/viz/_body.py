@@ -48,13 +48,20 @@ SHAPES = [("base", "box"), ("LINK1", "cylinder"), ("LINK1", "mesh"), ("link2", "
           ("link2", "sphere")]
 
 
-def write_package(folder: Path, link1: str = "LINK1") -> Path:
-    """Write the URDF and its mesh package under ``folder``; return the URDF path."""
+def write_package(folder: Path, link1: str = "LINK1", *, inside: bool = True) -> Path:
+    """Write the URDF and its mesh package ``folder/bodypkg``; return the URDF path.
+
+    ``inside``: the URDF in the package folder (its ``package://bodypkg/`` URIs then
+    resolve by themselves, from the file's ancestor of that name), else in
+    ``folder/elsewhere`` (they resolve only when told where the package is).
+    """
     trimesh = pytest.importorskip("trimesh", reason='needs the mesh extra (serialkin[mesh])')
     pkg = folder / "bodypkg"
     (pkg / "meshes").mkdir(parents=True, exist_ok=True)
     trimesh.creation.icosphere(subdivisions=2).export(str(pkg / "meshes" / "ball.stl"))
-    urdf = pkg / "body3.urdf"
+    home = pkg if inside else folder / "elsewhere"
+    home.mkdir(parents=True, exist_ok=True)
+    urdf = home / "body3.urdf"
     name = escape(link1, {'"': "&quot;"})
     urdf.write_text(URDF.replace('"LINK1"', f'"{name}"'), encoding="utf-8")
     return urdf

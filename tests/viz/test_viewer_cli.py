@@ -38,11 +38,11 @@ def test_help_default_budget_is_the_viewers():
 
 def test_urdf_meshes_through_package_and_budget(tmp_path):
     """--package resolves package:// meshes, --mesh-budget bounds them, --no-meshes drops them."""
-    urdf = write_package(tmp_path)
+    urdf = write_package(tmp_path, inside=False)
     out = tmp_path / "v.html"
     res = run("view", urdf, "--param", "tip_link=tcp", code=2)
     assert "LINK1" in res.output and "--package NAME=FOLDER" in res.output
-    run("view", urdf, "--param", "tip_link=tcp", "--package", f"bodypkg={urdf.parent}",
+    run("view", urdf, "--param", "tip_link=tcp", "--package", f"bodypkg={tmp_path / 'bodypkg'}",
         "--mesh-budget", 50, "--out", out)
     data = _page_data(out)
     assert [s["kind"] for s in data["shapes"]].count("mesh") == 1

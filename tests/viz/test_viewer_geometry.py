@@ -129,7 +129,7 @@ def test_unresolved_mesh_names_link_and_path(tmp_path):
     from serialkin import Robot
     from tests.viz._body import write_package
 
-    urdf = write_package(tmp_path)
+    urdf = write_package(tmp_path, inside=False)
     robot = Robot.from_urdf(str(urdf), tip_link="tcp")
     with pytest.raises(RobotDefinitionError,
                        match=r"link 'LINK1' visual mesh: package://bodypkg/meshes/ball\.stl"

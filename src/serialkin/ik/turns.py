@@ -9,9 +9,12 @@ limits:
     q_j ← q_j + 2π·k,  k = clip(round((r_j − q_j) / 2π), k_min, k_max)
 
 where ``[k_min, k_max]`` are the turns that keep ``q_j`` inside ``[lower_j, upper_j]``
-(tolerance :data:`TOL` rad). Joints whose range is at most 2π, prismatic joints, and a
-value no turn brings inside its limits are left as they are. The pose is unchanged (to
-rounding, ~1e-15 m).
+(tolerance :data:`TOL` rad). Joints whose range is at most 2π, prismatic joints, a
+value no turn brings inside its limits, and a value more than :data:`MAX_TURNS` turns
+from its representative (e.g. 9e9 rad after a hostile start) are left as they are: ``2π``
+is not a float, so moving by ``k`` turns also moves the angle by ``k·(2π − fl(2π))``
+(2.4e-16 rad per turn) plus the rounding of ``q`` itself, which for a few turns leaves
+the pose unchanged to ~1e-14 m and for a billion turns would not.
 """
 
 from __future__ import annotations
@@ -23,6 +26,8 @@ import numpy as np
 #: Tolerance on the limits when choosing a turn [rad]: a solver's answer may sit on a
 #: limit to rounding.
 TOL = 1e-12
+#: Most whole turns a value is moved by (see the module docstring).
+MAX_TURNS = 16
 _TWO_PI = 2.0 * math.pi
 
 
@@ -63,5 +68,6 @@ def nearest_turn(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, wide: np.n
         k_min = np.ceil((lower - TOL - q) / _TWO_PI)
         k_max = np.floor((upper + TOL - q) / _TWO_PI)
     k = np.clip(k, k_min, k_max)
-    ok = wide & (k_min <= k_max)  # a value outside its limits with no turn inside: kept
+    # a value outside its limits with no turn inside, or too many turns away: kept
+    ok = wide & (k_min <= k_max) & (np.abs(k) <= MAX_TURNS)
     return np.where(ok, q + _TWO_PI * np.where(ok, k, 0.0), q)
