@@ -103,4 +103,32 @@ def test_every_timing_is_warm(built_report):
     _, html = built_report
     timings = re.findall(r"median of \d+ ([^,]*), spread", html)
     assert timings
-    assert set(timings) == {"warm runs"}, set(timings)
+    ratios = {t for t in timings if t.startswith("interleaved pairs")}
+    assert set(timings) - ratios == {"warm runs"}, set(timings)
+    assert ratios and all("of warm runs" in t for t in ratios), ratios  # eq 48/QP, (c)/(b)
+
+
+def test_bold_symbols_are_unicode_bold(built_report):
+    """No MathML relies on mathvariant="bold…" (MathML Core ignores it): bold is Unicode bold."""
+    _, html = built_report
+    assert "\\boldsymbol" not in html
+    assert not re.search(r'mathvariant="bold', html)
+    assert "\U0001d74e" in html or "\U0001d7ce" in html  # bold-italic ω or bold 0
+
+
+def test_equation_numbers_follow_the_chapter(built_report):
+    """Numbered equations appear in the chapter's order, each number at most once (eq 2 too)."""
+    _, html = built_report
+    numbers = re.findall(r'<span class="eqno">\((\d+)(?:[^)]*)\)</span>', html)
+    values = [int(n) for n in numbers]
+    assert 2 in values and values == sorted(values), values
+    assert len(set(values)) == len(values), values
+
+
+def test_angles_in_the_half_open_interval(built_report):
+    """Angles printed in degrees in the IK tables lie in (−180°, 180°]."""
+    _, html = built_report
+    section = re.search(r'<section id="inverse">(.*?)</section>', html, re.S).group(1)
+    cells = re.findall(r'<td class="num">(-?\d+\.\d)</td>', section)
+    assert cells
+    assert all(-180.0 < float(c) <= 180.0 for c in cells)

@@ -196,3 +196,46 @@ def test_format_vector_has_no_negative_zero():
     assert format_vector([-0.0, 0.5, -2.0]) == "(0, 0.5, -2)"
     assert format_vector([-1e-12, 0.25], "{:.3f}") == "(0.000, 0.250)"
     assert format_vector(np.array([[-0.0, 1.23456]]), "{:.2f}") == "(0.00, 1.23)"
+
+
+def test_interleaved_alternates_and_gives_the_ratio(tmp_path):
+    """interleaved: warm-ups untimed, pairs in alternating order, ratio second/first per pair."""
+    clock = _FakeClock()
+    order = []
+
+    def make(name, seconds):
+        def fn():
+            order.append(name)
+            clock.now += seconds
+        return fn
+
+    ctx = ReportContext(outdir=tmp_path, clock=clock)
+    ta, tb, ratio = ctx.interleaved(make("a", 0.002), make("b", 0.006), warmup=1, repeat=4)
+    assert order == ["a", "b", "a", "b", "b", "a", "a", "b", "b", "a"]
+    assert ta.median == pytest.approx(0.002) and tb.median == pytest.approx(0.006)
+    assert ratio.median == pytest.approx(3.0) and ratio.n == 4
+    assert ctx.timings == [ta, tb]
+
+
+def test_reproduce_box_carries_the_expected_numbers():
+    """A Reproduce box stores the page's numbers as JSON (unicode minus as ASCII)."""
+    import html
+    import json
+
+    box = ReportContext.reproduce("print(1)", expect=["−0.25", "3"])
+    data = re.search(r'data-expect="([^"]*)"', box).group(1)
+    assert json.loads(html.unescape(data)) == ["-0.25", "3"]
+    assert 'data-kind="python"' in box and "Reproduce (Python)" in box
+
+
+def test_bold_mathml_becomes_unicode_bold():
+    r"""\boldsymbol and bold digits come out as Unicode bold letters, with no mathvariant."""
+    out = ReportContext.imath(r"\boldsymbol{\omega} + \mathbf{0} + \boldsymbol{x}")
+    assert "mathvariant" not in out
+    assert "\U0001d74e" in out and "\U0001d7ce" in out and "\U0001d499" in out
+
+
+def test_algorithm_box_numbers_its_steps():
+    """An algorithm box is an ordered list: one numbered item per step, indented by level."""
+    box = ReportContext.algorithm("demo", [(0, "first"), (1, "second")])
+    assert box.count("<li") == 2 and "<ol" in box and "margin-left:1.6em" in box

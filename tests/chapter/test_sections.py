@@ -13,13 +13,13 @@ def ctx(tmp_path):
 
 
 def test_default_solver_timings_are_warm(ctx):
-    """Section 5.3's solver timings come from ctx.timing: warm-up first, 7 timed runs each."""
+    """Section 5.3's solver timings come from ctx.timing: warm-up first, 21 timed runs each."""
     from serialkin.chapter.sections import numerical
 
     rows = numerical._default_solver_timings(ctx)
     assert len(rows) == len(ctx.timings) == 3
     for row, t in zip(rows, ctx.timings):
-        assert t.warm and t.n == 7 and 0 < t.low <= t.median <= t.high
+        assert t.warm and t.n == 21 and 0 < t.low <= t.median <= t.high
         assert row[-1] == t.text and "warm runs" in t.text
 
 

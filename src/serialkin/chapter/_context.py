@@ -157,10 +157,55 @@ def _is_blank(value: object) -> bool:
     return isinstance(value, str) and not hasattr(value, "__html__") and not value.strip()
 
 
+#: First code point of the Unicode mathematical alphanumerics per style, for A, a, Α, α, 0.
+_MATH_ALPHA = {
+    "bold": (0x1D400, 0x1D41A, 0x1D6A8, 0x1D6C2, 0x1D7CE),
+    "bold-italic": (0x1D468, 0x1D482, 0x1D71C, 0x1D736, 0x1D7CE),
+}
+#: Greek letters after ω in the mathematical alphabets: ∂ ϵ ϑ ϰ ϕ ϱ ϖ.
+_GREEK_TAIL = "\u2202\u03f5\u03d1\u03f0\u03d5\u03f1\u03d6"
+_VARIANT = re.compile(r'<(mi|mn|mo|mtext)( [^>]*?)? mathvariant="(bold|bold-italic)"([^>]*)>'
+                      r"([^<]*)</\1>")
+
+
+def _styled(char: str, style: str) -> str:
+    """``char`` as the Unicode mathematical alphanumeric of ``style`` (unchanged if none)."""
+    upper, lower, greek_upper, greek_lower, digit = _MATH_ALPHA[style]
+    c = ord(char)
+    if 0x41 <= c <= 0x5A:
+        return chr(upper + c - 0x41)
+    if 0x61 <= c <= 0x7A:
+        return chr(lower + c - 0x61)
+    if 0x30 <= c <= 0x39:
+        return chr(digit + c - 0x30)
+    if 0x391 <= c <= 0x3A9:
+        return chr(greek_upper + c - 0x391)
+    if 0x3B1 <= c <= 0x3C9:
+        return chr(greek_lower + c - 0x3B1)
+    if char in _GREEK_TAIL:
+        return chr(greek_lower + 25 + _GREEK_TAIL.index(char))
+    return char
+
+
+def _bold_as_unicode(mathml: str) -> str:
+    r"""Replace ``mathvariant="bold…"`` by Unicode bold letters, which MathML Core renders.
+
+    Chromium implements MathML Core, which ignores ``mathvariant`` other than "normal";
+    latex2mathml writes ``\mathbf`` letters as Unicode bold already but ``\boldsymbol``
+    and bold digits as a ``mathvariant`` attribute, shown upright and thin.
+    """
+    def sub(m: re.Match[str]) -> str:
+        tag, before, style, after, text = m.groups()
+        styled = "".join(_styled(ch, style) for ch in html.unescape(text))
+        return f"<{tag}{before or ''}{after}>{html.escape(styled, quote=False)}</{tag}>"
+
+    return _VARIANT.sub(sub, mathml)
+
+
 def _latex_to_mathml(latex: str, display: str) -> str:
     from latex2mathml.converter import convert
 
-    return convert(latex, display=display)
+    return _bold_as_unicode(convert(latex, display=display))
 
 
 @dataclass
@@ -228,12 +273,72 @@ class ReportContext:
         self.timings.append(t)
         return t
 
+    def interleaved(self, first: Callable[[], object], second: Callable[[], object], *,
+                    warmup: int = 1, repeat: int = 9) -> tuple[Timing, Timing, Timing]:
+        """Time two functions in alternation, for a ratio that one machine state affects alike.
+
+        ``warmup`` untimed calls of each, then ``repeat`` pairs, the order inside a pair
+        alternating (first-second, second-first, …) so that neither always runs on a
+        cache or clock warmed by the other.
+
+        Returns:
+            (timing of ``first``, timing of ``second``, the ratio second / first of each pair
+            as a :class:`Timing` whose numbers are ratios, not seconds). The two timings
+            are added to :attr:`timings`.
+        """
+        if repeat < 1:
+            raise InputError(f"repeat must be at least 1, got {repeat}")
+        for _ in range(max(0, warmup)):
+            first()
+            second()
+        clock = self.clock
+        a_runs, b_runs = [], []
+        for k in range(repeat):
+            pair = (first, second) if k % 2 == 0 else (second, first)
+            times = []
+            for fn in pair:
+                t0 = clock()
+                fn()
+                times.append(clock() - t0)
+            ta, tb = times if k % 2 == 0 else times[::-1]
+            a_runs.append(ta)
+            b_runs.append(tb)
+
+        def summary(runs: list[float]) -> Timing:
+            return Timing(median=float(np.median(runs)), low=float(min(runs)),
+                          high=float(max(runs)), n=repeat, warm=warmup >= 1)
+
+        ratios = [b / a for a, b in zip(a_runs, b_runs)]
+        ta, tb = summary(a_runs), summary(b_runs)
+        self.timings.extend([ta, tb])
+        return ta, tb, summary(ratios)
+
     # --- reproduction --------------------------------------------------------------------------
     @staticmethod
-    def reproduce(code: str, shell: bool = False) -> str:
-        """A "Reproduce" box with the Python snippet or ``serialkin ...`` command."""
+    def reproduce(code: str, shell: bool = False, expect: Sequence[object] = ()) -> str:
+        """A "Reproduce" box with the Python snippet or ``serialkin ...`` command.
+
+        Args:
+            code: the exact text a reader copies: Python run by ``python -c`` in a fresh
+                interpreter, or shell lines with the installed ``serialkin`` on PATH.
+            shell: True for shell lines.
+            expect: the numbers the box prints, in the order it prints them, each formatted
+                exactly as the page shows it (pass the page's own formatted strings, so the
+                box and the page come from one computation in the same units).
+                tests/chapter/test_reproduce.py runs every box and checks that its output
+                contains these numbers, in order, to their printed precision, and that the
+                page shows each of them in the box's section.
+
+        Returns:
+            HTML: the box, with the expected numbers in its ``data-expect`` attribute (JSON).
+        """
+        import json
+
         kind = "shell" if shell else "Python"
-        return (f'<div class="repro"><span class="repro-label">Reproduce ({kind})</span>'
+        tokens = [str(e).replace("\u2212", "-") for e in expect]
+        data = html.escape(json.dumps(tokens), quote=True)
+        return (f'<div class="repro" data-kind="{kind.lower()}" data-expect="{data}">'
+                f'<span class="repro-label">Reproduce ({kind})</span>'
                 f'<pre><code>{html.escape(code.strip())}</code></pre></div>')
 
     # --- figures -------------------------------------------------------------------------------
@@ -297,7 +402,7 @@ class ReportContext:
             ) + "</tr></thead>"
         body = "".join("<tr>" + "".join(f'<td class="{cls[j]}">{cell(v)}</td>'
                                         for j, v in enumerate(r)) + "</tr>" for r in rows)
-        return f"<table>{head}<tbody>{body}</tbody></table>"
+        return f'<div class="tablewrap"><table>{head}<tbody>{body}</tbody></table></div>'
 
     @staticmethod
     def matrix(M: object, fmt: str = "{:.4f}") -> str:
@@ -309,6 +414,20 @@ class ReportContext:
                 for v in r) + "</tr>" for r in a
         )
         return Html(f'<table class="matrix">{body}</table>')
+
+    @staticmethod
+    def algorithm(title: str, steps: Sequence[tuple[int, str]], note: str = "") -> str:
+        """An algorithm box of the chapter as numbered steps.
+
+        Args:
+            title: the algorithm's name, as the chapter prints it.
+            steps: (indent level, step HTML) in order; numbered 1, 2, … as in the chapter.
+            note: HTML after the steps (e.g. which steps the ERRATA corrects).
+        """
+        items = "".join(f'<li style="margin-left:{1.6 * level:g}em">{text}</li>'
+                        for level, text in steps)
+        return (f'<div class="algobox"><p><b>Algorithm:</b> {html.escape(title)}</p>'
+                f'<ol class="algorithm">{items}</ol>{note}</div>')
 
     @staticmethod
     def code(text: str) -> str:

@@ -85,6 +85,10 @@ padding:0.3em 0.8em}.repro pre{background:none;margin:0.3em 0;padding:0}
 nav ul{list-style:none;padding-left:0}nav li.sub{padding-left:2em}
 nav li.part{padding-left:4em}
 .err{color:#a00}
+td.num,th.num,table.matrix td,.nowrap{white-space:nowrap}
+.tablewrap{max-width:100%;overflow-x:auto}
+mtd[columnalign=left]{text-align:left}mtd[columnalign=right]{text-align:right}
+ol.algorithm{background:#fafafa;border:1px solid #ccc;padding:0.5em 0.8em 0.5em 2.5em}
 """
 
 
@@ -133,8 +137,23 @@ def _sections_of(result: Section | Sequence[Section]) -> list[Section]:
     return [result] if isinstance(result, Section) else list(result)
 
 
+def _load_text(load: tuple[float, float, float] | None) -> str:
+    """"1.2, 0.9, 0.7 (1, 5, 15 min)" or "not available"."""
+    if load is None:
+        return "not available on this system"
+    return ", ".join(f"{v:.2f}" for v in load) + " (1, 5, 15 min)"
+
+
+def _loadavg() -> tuple[float, float, float] | None:
+    try:
+        return os.getloadavg()
+    except (OSError, AttributeError):
+        return None
+
+
 def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
-            workers: str) -> str:
+            workers: str, load: tuple[tuple[float, float, float] | None, ...] = (None, None),
+            timings: Sequence[Timing] = ()) -> str:
     """The whole page: header with build metadata, contents, sections."""
     toc: list[str] = []
     body: list[str] = []
@@ -166,9 +185,19 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
                        f'</a> <span class="eq">({eqs})</span></li>')
         body.append(f'<section id="{anchor}"><h2>{html.escape(label)}</h2>{part}'
                     f'<p class="eq">Demonstrates: {eqs}</p>{sec.html}</section>')
+    repeats = sorted({t.n for t in timings})
     meta = build_metadata() + [
         ("build time", f"{seconds:.1f} s wall clock ({workers}); the sections took "
-                       f"{cpu:.1f} s CPU in all")]
+                       f"{cpu:.1f} s CPU in all"),
+        ("load average", f"at the start {_load_text(load[0])}; at the end "
+                         f"{_load_text(load[-1])} on {os.cpu_count()} CPUs: with a load "
+                         "above the CPU count other processes shared the cores and the "
+                         "times below are slower and more spread than on a quiet machine"),
+        ("timings", f"{len(timings)} measurements, each the median of "
+                    + (f"{repeats[0]}–{repeats[-1]}" if len(repeats) > 1 else
+                       f"{repeats[0] if repeats else 0}")
+                    + " warm runs after an untimed warm-up, with their full range; ratios "
+                    "between methods from runs interleaved in one process")]
     meta_html = ('<table class="meta">' + "".join(
         f"<tr><th>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>" for k, v in meta)
         + "</table>")
@@ -180,7 +209,13 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
         "<p>Every number and figure below is computed by serialkin when this report is "
         "built (<code>serialkin chapter</code>); equations carry the chapter's numbers and "
         "the corrected forms of the ERRATA are used. Times are wall-clock medians of warm "
-        "runs (after an untimed warm-up call) with their full range (min–max).</p>"
+        "runs (after an untimed warm-up call) with their full range (min–max), measured "
+        "while the report was built: they depend on the machine and its load, stated "
+        "below. Each Reproduce box prints the numbers its section shows; run "
+        "<code>serialkin warmup</code> once first (or set <code>SERIALKIN_COMPILE=wait</code>"
+        "): until the compiled kernels are ready the first calls run as Python, whose "
+        "rounding differs in the last digits, and a long tracking run (the 20-link arm) then "
+        "takes a slightly different path.</p>"
         f"{meta_html}<nav><h2 id='contents'>Contents</h2><ul>{''.join(toc)}</ul></nav>"
         f"{''.join(body)}</body></html>"
     )
@@ -238,6 +273,7 @@ def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
     from tqdm import tqdm
 
     start = time.perf_counter()
+    load_start = _loadavg()
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
     names = list(SECTION_MODULES) if not sections else sorted(
@@ -272,7 +308,9 @@ def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
     cpu = sum(results[name][4] for name in names)
     workers = (f"{n_jobs} worker processes, one compute thread each" if n_jobs > 1
                else "one process")
-    page = _render(parts, time.perf_counter() - start, cpu, workers)
+    timings = [t for name in names for t in results[name][2]]
+    page = _render(parts, time.perf_counter() - start, cpu, workers,
+                   (load_start, _loadavg()), timings)
     path = out / "report.html"
     write_text_atomic(path, page)
     return path

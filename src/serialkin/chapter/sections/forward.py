@@ -105,6 +105,32 @@ def _figure_frames(ctx: ReportContext, robot: Robot, q: np.ndarray) -> str:
                       "frame 3 flips z downwards (α3 = π).")
 
 
+def _figure_dh_frames(ctx: ReportContext, robot: Robot, q: np.ndarray) -> str:
+    """The chapter's Figure 3 on a real arm: the DH frames of the PUMA 560, from its model."""
+    import matplotlib.pyplot as plt
+
+    from serialkin.viz.plot import plot_robot
+
+    frames = robot.fk_all(q)
+    fig = plt.figure(figsize=(10, 5.2))
+    ax = fig.add_subplot(1, 1, 1, projection="3d")
+    plot_robot(robot, q, ax=ax, frames=True, mechanism=True, linewidth=3, frame_scale=0.12)
+    seen: dict[tuple[float, float, float], list[int]] = {}
+    for i, T in enumerate(frames):
+        seen.setdefault(tuple(np.round(T[:3, 3], 4)), []).append(i)
+    for (x, y, z), idx in seen.items():
+        ax.text(x, y, z + 0.04, "O" + ",".join(map(str, idx)), fontsize=9, color="0.1")
+    ax.set_title("DH frames 0-6 of the PUMA 560 at q = 0, drawn from its DH table: z_i on "
+                 "joint axis i+1,\nx_i along the common normal of z_(i-1) and z_i "
+                 "(x red, y green, z blue)", fontsize=9)
+    ax.view_init(elev=20, azim=-50)
+    ax.set_box_aspect((1, 1, 1))
+    return ctx.figure(fig, "forward_dh_frames_puma560",
+                      "The chapter's Figure 3 (the Denavit-Hartenberg approach) on the PUMA "
+                      "560: every link frame computed by robot.fk_all(q) from the DH table "
+                      "below, origins O_i labelled (frames that coincide share a label).")
+
+
 def _section_3_1(ctx: ReportContext) -> Section:
     """Section 3.1: eqs 10-12 on the PUMA 560."""
     puma = models.puma560()
@@ -152,8 +178,8 @@ def _section_3_1(ctx: ReportContext) -> Section:
         + ctx.reproduce(
             "import numpy as np, serialkin as sk\n"
             "robot = sk.models.puma560()\n"
-            f"print(robot.fk(np.array([{qtxt}])))          # eq 11\n"
-            "print(robot.fk_all(np.zeros(6))[:, :3, 3])     # frame origins 0..6")
+            f"print(np.round(robot.fk(np.array([{qtxt}])), 4))   # eq 11",
+            expect=[format_number(v, "{:.4f}") for v in H[:3].ravel()])
     )
     return Section(title="3.1 Open kinematic chain", equations="eqs 10-12", html=html_)
 
@@ -183,18 +209,25 @@ def _section_3_2(ctx: ReportContext) -> Section:
         f"1,000 random configurations (seed 7) = {diff:.1e}.</p>",
     ]
     rows_m = []
+    p_zero: dict[str, list[str]] = {}
     for info in models.catalog():
         r = info.build(6) if info.name == "planar" else info.build()
         pz = r.fk(np.zeros(r.n))[:3, 3]
+        p_zero[info.name] = [format_number(v, "{:.4f}") for v in pz]
         rows_m.append((info.name, r.n, "".join(r.joint_types), r.convention or "joints",
                        f"({format_number(pz[0], '{:.4f}')}, {format_number(pz[1], '{:.4f}')},"
                        f" {format_number(pz[2], '{:.4f}')})", r.source))
+    parts.append(_figure_dh_frames(ctx, puma, np.zeros(puma.n)))
+    parts.append(ctx.table([(i + 1, r.a, r.alpha, r.d, r.theta, r.type)
+                            for i, r in enumerate(puma.dh)],
+                           ["link", "a [m]", "α [rad]", "d [m]", "θ offset [rad]", "type"]))
     parts.append("<h3>Built-in models</h3><p><code>serialkin.models</code>; tool position at "
                  "q = 0 (planar shown with 6 unit links).</p>" + ctx.table(
                      rows_m, ["name", "n", "joints", "DH", "p(q = 0) [m]", "source"]))
     parts.append(ctx.reproduce(
-        'serialkin models\nserialkin fk puma560 --q "0.3, -0.6, 0.9, 0.4, -0.7, 1.1" --frames',
-        shell=True))
+        'serialkin fk puma560 --q "0, 0, 0, 0, 0, 0"     # p(q = 0) of the table\n'
+        "serialkin models                               # the list of built-in models",
+        shell=True, expect=p_zero["puma560"]))
     return Section(title="3.2 Denavit-Hartenberg convention",
                    equations="eq 12 in DH form, eqs 4 and 6", html="".join(parts))
 
@@ -225,11 +258,14 @@ def _table1_part(ctx: ReportContext, robot: Robot) -> str:
 
 def _symbolic_part(ctx: ReportContext, kin: SymbolicKinematics) -> str:
     """Eqs 13-16 (the link matrices) and eqs 17-18 (their product), derived by sympy."""
-    labels = ("13", "14-15", "16", "16")
+    # the chapter's numbers: 13 is 0A1, 14 the factors of 1A2 (garbled in print), 15 is
+    # 1A2, 16 is 2A3; 3A4 is printed with 16 but carries no number of its own
+    labels = ("13", "15", "16", None)
     return (
         "<h3>Link matrices, symbolic (eqs 13-16)</h3><p>Derived by "
         "<code>serialkin.kinematics.symbolic.derive(scara, params='lengths')</code> from the "
-        "DH matrix of section 3.2 and simplified:</p>"
+        "DH matrix of section 3.2 and simplified (the chapter's eq 14, the factors of "
+        "1A2, is garbled in print and not repeated; 3A4 has no number there):</p>"
         + "".join(ctx.eq(rf"{{}}^{{{i}}}\mathbf{{A}}_{{{i + 1}}} = {sp.latex(M)}", labels[i])
                   for i, M in enumerate(kin.A))
         + "<h3>End-effector transform (eqs 17-18)</h3><p>Eq 17 is printed as "
@@ -294,7 +330,10 @@ def _section_3_2_1(ctx: ReportContext) -> Section:
         "from serialkin.kinematics.symbolic import derive\n"
         "robot = sk.models.scara(d1=0.4, d2=0.1, l1=0.35, l2=0.30)\n"
         "print(derive(robot, params='lengths').T)                        # eq 18\n"
-        "print(robot.fk(np.array([np.radians(30), np.radians(-45), -0.05, np.radians(60)])))"))
+        "print(np.round(robot.fk(np.array([np.radians(30), np.radians(-45), -0.05, "
+        "np.radians(60)])), 4))",
+        expect=[format_number(0.0 if abs(v) < 5e-13 else v, "{:.4f}")
+                for v in robot.fk(q)[:3].ravel()]))
     return Section(title="3.2.1 Example: the SCARA", equations="Table 1, eqs 13-18 (17 "
                    "corrected), eq 7", html="".join(parts))
 

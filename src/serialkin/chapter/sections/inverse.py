@@ -17,11 +17,13 @@ from __future__ import annotations
 
 import html
 import math
+import re
 
 import numpy as np
 
 from serialkin import models
-from serialkin.chapter._context import Html, ReportContext, Section
+from serialkin.chapter._context import Html, ReportContext, Section, format_number
+from serialkin.spatial import wrap_angle
 
 #: A general 6R arm (standard DH: a [m], α [rad], d [m]) and a configuration whose pose
 #: has 16 real solutions, the most a 6R arm can have (Raghavan & Roth 1993); found by a
@@ -121,14 +123,17 @@ def _section_4(ctx: ReportContext) -> Section:
     q_ur = np.array([0.4, -1.1, 1.3, -0.6, 0.9, 0.2])
     T = ur5.fk(q_ur)
     sols = ur5.ik_all(T)
-    rows_ur = [(k + 1, *(np.round(np.degrees(qk), 1)), float(np.abs(ur5.fk(qk) - T).max()))
+    sols_deg = [[format_number(v, "{:.1f}") for v in np.degrees(wrap_angle(qk))]
+                for qk in sols]
+    rows_ur = [(k + 1, *sols_deg[k], f"{np.abs(ur5.fk(qk) - T).max():.3g}")
                for k, qk in enumerate(sols)]
     three = models.three_link(1.0, 0.8, 0.5)
     target = three.fk(np.array([0.3, 0.6, -0.4]))[:2, 3]
     rows_3 = []
     for seed in range(4):
         res = three.ik(target, seed=seed, q0=three.random_q(seed=seed))
-        rows_3.append((seed, *(np.round(np.degrees(res.q), 2)),
+        rows_3.append((seed, *(format_number(v, "{:.2f}")
+                               for v in np.degrees(wrap_angle(res.q))),
                        float(np.linalg.norm(three.fk(res.q)[:2, 3] - target)),
                        "yes" if res.success else "no"))
     from serialkin.model.dh import DHLink
@@ -152,7 +157,7 @@ def _section_4(ctx: ReportContext) -> Section:
         "computed:</p>"
         f"<p><b>Several.</b> The UR5 at q = ({', '.join(f'{v:g}' for v in q_ur)}) rad; "
         f"its closed-form solver <code>robot.ik_all(T)</code> returns {len(sols)} "
-        "configurations with the same tool pose (angles in degrees):</p>"
+        "configurations with the same tool pose (angles in degrees, in (−180°, 180°]):</p>"
         + ctx.table(rows_ur, ["#", "q1", "q2", "q3", "q4", "q5", "q6", "max |f(q) − T|"],
                     fmt="{:.3g}")
         + "<p>How many can there be? For a 6R arm, eliminating five joint angles leaves "
@@ -174,14 +179,18 @@ def _section_4(ctx: ReportContext) -> Section:
         + f"<p><b>None.</b> The two-link arm (L1 = {L1} m, L2 = {L2} m) cannot reach "
         f"x = ({far[0]}, {far[1]}) m (|x| = {np.linalg.norm(far):.3f} m &gt; L1 + L2): "
         f"<code>ik_all</code> returns {len(two.ik_all(far))} solutions and "
-        f"<code>robot.ik</code> reports success = {res_far.success}, reason: "
+        "<code>robot.ik(x, seed=0)</code> (random restarts drawn from seed 0) reports "
+        f"success = {res_far.success}, reason: "
         f"“{html.escape(res_far.reason)}”.</p>"
         + ctx.reproduce(
             "import numpy as np, serialkin as sk\n"
             "ur5 = sk.models.ur5()\n"
             f"T = ur5.fk(np.array([{', '.join(f'{v:g}' for v in q_ur)}]))\n"
-            "print(ur5.ik_all(T))                          # eq 20: several solutions\n"
-            "print(sk.models.two_link(1.0, 0.7).ik([2.0, 0.5]).reason)   # none")
+            "print(np.round(np.degrees(sk.spatial.wrap_angle(ur5.ik_all(T))), 1))  # eq 20, in °\n"
+            f"print(sk.models.two_link({L1}, {L2}).ik([{far[0]}, {far[1]}], seed=0).reason)"
+            "  # none",
+            expect=[v for row in sols_deg for v in row]
+            + re.findall(r"\d+(?:\.\d+)?(?:e-?\d+)?", res_far.reason))
     )
     return Section(title="4. Inverse kinematics", equations="eqs 19-20", html=html_)
 
@@ -263,6 +272,7 @@ def _section_4_1(ctx: ReportContext) -> Section:
 
     parts.append(ctx.reproduce(
         "import serialkin as sk\n"
-        f"print(sk.models.two_link({L1}, {L2}).ik_all([{x}, {y}]))   # both elbows, eqs 23-27"))
+        f"print(sk.models.two_link({L1}, {L2}).ik_all([{x}, {y}]))   # both elbows, eqs 23-27",
+        expect=[format_number(v) for v in mine.ravel()]))
     return Section(title="4.1 Closed-form solution of inverse kinematics",
                    equations="eqs 21-27 (23, 26, 27 corrected), Figure 5", html="".join(parts))

@@ -14,7 +14,7 @@ import numpy as np
 import sympy as sp
 
 from serialkin import models
-from serialkin.chapter._context import ReportContext, Section
+from serialkin.chapter._context import ReportContext, Section, format_number
 from serialkin.kinematics.symbolic import derive
 from serialkin.model.robot import Robot
 
@@ -24,6 +24,7 @@ TWO_LINK = (1.0, 0.7)
 TWO_LINK_Q = np.array([30 * DEG, 60 * DEG])
 THREE_LINK = (1.0, 0.8, 0.5)
 THREE_LINK_Q = np.array([20 * DEG, 40 * DEG, -30 * DEG])
+PUMA_Q = np.array([0.3, -0.6, 0.9, 0.4, -0.7, 1.1])
 
 
 def _renamed(robot: Robot, simplify: bool = True):
@@ -57,8 +58,8 @@ def _figure_mechanisms(ctx: ReportContext, two: Robot, three: Robot) -> str:
     from serialkin.viz.plot import plot_robot
 
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.4))
-    for ax, robot, q, title in ((axes[0], two, TWO_LINK_Q, "Figure 7: two-link arm"),
-                                (axes[1], three, THREE_LINK_Q, "Figure 6: three-link arm")):
+    for ax, robot, q, title in ((axes[0], three, THREE_LINK_Q, "Figure 6: three-link arm"),
+                                (axes[1], two, TWO_LINK_Q, "Figure 7: two-link arm")):
         plot_robot(robot, q, ax=ax, frames=True, planar=True)
         p = robot.fk(q)[:2, 3]
         J = robot.jacobian_planar(q)
@@ -66,8 +67,9 @@ def _figure_mechanisms(ctx: ReportContext, two: Robot, three: Robot) -> str:
         w = robot.manipulability(q, task="planar")
         ax.set_title(f"{title}, w = {w:.3f} m² (eq 43)", fontsize=9)
         ax.legend(fontsize=7, loc="lower right")
-    return ctx.figure(fig, "jacobian_mechanisms", "Figures 6 and 7 regenerated: the 3- and "
-                      "2-link arms at the sample configurations with their link frames and "
+    return ctx.figure(fig, "jacobian_mechanisms", "Figures 6 and 7 regenerated: the 3-link "
+                      "(left) and 2-link (right) arms at the sample configurations with "
+                      "their link frames and "
                       "velocity ellipses (singular values of the planar Jacobian).")
 
 
@@ -94,6 +96,12 @@ def _figure_manipulability(ctx: ReportContext, two: Robot) -> str:
     ax.set_title("Two-link arm: manipulability and condition number vs q2")
     return ctx.figure(fig, "jacobian_manipulability", "Manipulability (eq 43) of the two-link "
                       "arm vanishes at the stretched and folded singularities q2 = 0, ±180°.")
+
+
+def _matrix_tokens(M: object) -> list[str]:
+    """The entries of a matrix as :meth:`ReportContext.matrix` prints them, row by row."""
+    return [format_number(0.0 if abs(v) < 5e-13 else float(v), "{:.4f}")
+            for v in np.asarray(M, dtype=float).ravel()]
 
 
 def _fd_columns(f, q: np.ndarray, h: float = 1e-6) -> np.ndarray:
@@ -163,7 +171,8 @@ def _section_5_1(ctx: ReportContext, three: Robot) -> Section:
             "from serialkin.kinematics.symbolic import derive\n"
             "arm = sk.models.three_link(1.0, 0.8, 0.5)\n"
             "print(derive(arm, params='lengths').jacobian('planar'))      # eq 32\n"
-            "print(arm.jacobian_planar(np.radians([20, 40, -30])))")
+            "print(arm.jacobian_planar(np.radians([20, 40, -30])))",
+            expect=_matrix_tokens(f_a(THREE_LINK_Q)))
     )
     return Section(title="5.1 Analytical Jacobian", equations="eqs 28-32, Figure 6",
                    html="".join(parts))
@@ -199,7 +208,7 @@ def _analytic_vs_geometric(ctx: ReportContext) -> str:
     from serialkin.kinematics.analytic import rate_matrix, rotation_coordinates
 
     puma = models.puma560()
-    q = np.array([0.3, -0.6, 0.9, 0.4, -0.7, 1.1])
+    q = PUMA_Q
     J = puma.jacobian(q)
     JA = puma.jacobian_analytic(q, "rpy")
     phi = rotation_coordinates(puma.fk(q)[:3, :3], "rpy")
@@ -309,7 +318,7 @@ def _manipulability_part(ctx: ReportContext, two: Robot, three: Robot) -> str:
         "<h3>Rank, singularities and manipulability</h3><p>Where J loses rank the arm is "
         "singular. The manipulability of section 5.3,</p>"
         + ctx.eq(r"H(\mathbf{q}) = \sqrt{\det\left(\mathbf{J}(\mathbf{q})\mathbf{J}^T"
-                 r"(\mathbf{q})\right)}", "43")
+                 r"(\mathbf{q})\right)}\qquad\text{(eq 43, numbered in section 5.3)}")
         + "<p>and the condition number σ<sub>max</sub>/σ<sub>min</sub> of the task "
         "Jacobian measure the distance from singularities; for the two-link arm "
         + ctx.imath(r"H = L_1L_2|\sin q_2|")
@@ -322,8 +331,8 @@ def _section_5_2(ctx: ReportContext, two: Robot, three: Robot) -> Section:
     """Section 5.2: the geometric Jacobian (eqs 33-38), J_A against J, eq 43, two figures."""
     parts = [
         _columns_part(ctx),
-        _two_link_part(ctx, two),
         _prismatic_column(ctx),
+        _two_link_part(ctx, two),
         _analytic_vs_geometric(ctx),
         _manipulability_part(ctx, two, three),
         _figure_mechanisms(ctx, two, three),
@@ -332,7 +341,9 @@ def _section_5_2(ctx: ReportContext, two: Robot, three: Robot) -> Section:
             'serialkin jacobian two_link --q "30, 60" --degrees --param l1=1.0 --param l2=0.7\n'
             'serialkin jacobian scara --q "30, -45, -0.05, 60" --degrees '
             '--param d1=0.4 --param d2=0.1 --param l1=0.35 --param l2=0.30\n'
-            'serialkin jacobian puma560 --q "0.3, -0.6, 0.9, 0.4, -0.7, 1.1"', shell=True),
+            f'serialkin jacobian puma560 --q "{", ".join(f"{v:g}" for v in PUMA_Q)}"',
+            shell=True, expect=_matrix_tokens(two.jacobian(TWO_LINK_Q))
+            + _matrix_tokens(models.puma560().jacobian(PUMA_Q))),
     ]
     return Section(title="5.2 Geometric Jacobian",
                    equations="eqs 33-38 (36 on the SCARA), J_A vs J on the PUMA 560, eq 43",

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from serialkin.chapter._context import ReportContext, Section, format_vector
+from serialkin.chapter._context import ReportContext, Section, format_number, format_vector
 from serialkin.spatial import (
     inv_transform,
     make_transform,
@@ -145,8 +145,18 @@ def _change_of_frame_part(ctx: ReportContext, R: np.ndarray, R_other: np.ndarray
         "reference frame and of frame 1,</p>"
         + ctx.eq(r"\mathbf{p} = p_{xr}\mathbf{i}_r + p_{yr}\mathbf{j}_r + p_{zr}\mathbf{k}_r"
                  r" = p_{x1}\mathbf{i}_1 + p_{y1}\mathbf{j}_1 + p_{z1}\mathbf{k}_1", "1")
-        + "<p>has reference coordinates given by the scalar products of the unit vectors "
-        "(eq 2), in matrix form</p>"
+        + "<p>has reference coordinates given by the scalar products of the unit vectors</p>"
+        + ctx.eq(r"\begin{array}{rcl}"
+                 r"p_{xr} & = & \mathbf{i}_r\cdot\mathbf{p} = \mathbf{i}_r\cdot p_{x1}"
+                 r"\mathbf{i}_1 + \mathbf{i}_r\cdot p_{y1}\mathbf{j}_1 + \mathbf{i}_r\cdot"
+                 r" p_{z1}\mathbf{k}_1\\ "
+                 r"p_{yr} & = & \mathbf{j}_r\cdot\mathbf{p} = \mathbf{j}_r\cdot p_{x1}"
+                 r"\mathbf{i}_1 + \mathbf{j}_r\cdot p_{y1}\mathbf{j}_1 + \mathbf{j}_r\cdot"
+                 r" p_{z1}\mathbf{k}_1\\ "
+                 r"p_{zr} & = & \mathbf{k}_r\cdot\mathbf{p} = \mathbf{k}_r\cdot p_{x1}"
+                 r"\mathbf{i}_1 + \mathbf{k}_r\cdot p_{y1}\mathbf{j}_1 + \mathbf{k}_r\cdot"
+                 r" p_{z1}\mathbf{k}_1\end{array}", "2")
+        + "<p>in matrix form</p>"
         + ctx.eq(r"\begin{bmatrix}p_{xr}\\ p_{yr}\\ p_{zr}\end{bmatrix} = \begin{bmatrix}"
                  r"\mathbf{i}_r\cdot\mathbf{i}_1 & \mathbf{i}_r\cdot\mathbf{j}_1 & "
                  r"\mathbf{i}_r\cdot\mathbf{k}_1\\ \mathbf{j}_r\cdot\mathbf{i}_1 & "
@@ -185,8 +195,8 @@ def _homogeneous_part(ctx: ReportContext, T: np.ndarray, p1: np.ndarray) -> str:
         + ctx.eq(r"\begin{bmatrix}x_r\\ y_r\\ z_r\\ 1\end{bmatrix} = \begin{bmatrix}"
                  r"\mathbf{R} & \mathbf{p}\\ \mathbf{0}^T & 1\end{bmatrix}\begin{bmatrix}"
                  r"x_1\\ y_1\\ z_1\\ 1\end{bmatrix}", "9")
-        + f"<p>With the rotation above and origin p = {format_vector(o)} m, the homogeneous "
-        "transform of eq 9 (<code>make_transform(R, p)</code>) is</p>"
+        + f"<p>With the rotation R of eq 3 above and origin p = {format_vector(o)} m, the "
+        "homogeneous transform of eq 9 (<code>make_transform(R, p)</code>) is</p>"
         + ctx.matrix(T)
         + f"<p>The point with frame-1 coordinates {format_vector(p1)} m has reference coordinates "
         f"{format_vector(pr_eq8)} by eq 8 and {format_vector(pr_eq9)} by eq 9; "
@@ -201,11 +211,11 @@ def _homogeneous_part(ctx: ReportContext, T: np.ndarray, p1: np.ndarray) -> str:
 
 def _orthonormality_part(ctx: ReportContext, elem: dict[str, np.ndarray], R: np.ndarray,
                          T: np.ndarray) -> str:
-    """Eq 7 checked on every matrix above and on 10,000 random compositions."""
+    """Eq 7 checked on every matrix of the section and on 10,000 random compositions."""
     rng = np.random.default_rng(2024)
     many = rpy_to_matrix(rng.uniform(-np.pi, np.pi, size=(10000, 3)))
     checks = [("Rx(30°)", elem["x"]), ("Ry(45°)", elem["y"]), ("Rz(60°)", elem["z"]),
-              ("Rz Ry Rx", R), ("rotation block of T", T[:3, :3]),
+              ("Rz Ry Rx", R), ("rotation block of T (eq 9 below)", T[:3, :3]),
               ("10,000 random rpy compositions (seed 2024)", many)]
     return (
         "<h3>Orthonormality (eq 7)</h3>"
@@ -281,7 +291,12 @@ def _frames_part(ctx: ReportContext, T: np.ndarray, p1: np.ndarray) -> str:
             "from serialkin.spatial import rotx, roty, rotz, make_transform, inv_transform\n"
             "R = rotz(np.radians(60)) @ roty(np.radians(45)) @ rotx(np.radians(30))\n"
             "T = make_transform(R, [0.5, 0.4, 0.3])                      # eq 9\n"
-            "print(T @ [0.3, 0.2, 0.1, 1.0], inv_transform(T) @ T)          # eq 8, T⁻¹T = I")
+            "print(np.round(T, 4))\n"
+            "print(T @ [0.3, 0.2, 0.1, 1.0])                             # eq 9 on a point\n"
+            "print(np.round(inv_transform(T) @ T, 12))                   # T⁻¹T = I",
+            expect=[format_number(0.0 if abs(v) < 5e-13 else v, "{:.4f}")
+                    for v in T[:3].ravel()]
+            + [format_number(v) for v in (T @ np.append(p1, 1.0))[:3]])
     )
 
 
@@ -292,11 +307,11 @@ def build(ctx: ReportContext) -> Section:
     R = rotz(gamma) @ roty(beta) @ rotx(alpha)
     p1 = np.array([0.3, 0.2, 0.1])
     T = make_transform(R, np.array([0.5, 0.4, 0.3]))
-    parts = [
-        _elementary_part(ctx, elem, (alpha, beta, gamma)),
+    parts = [  # in the chapter's order of equations: 1-3, 4-6, 7, 8-9
         _change_of_frame_part(ctx, R, rotx(alpha) @ roty(beta) @ rotz(gamma), p1),
-        _homogeneous_part(ctx, T, p1),
+        _elementary_part(ctx, elem, (alpha, beta, gamma)),
         _orthonormality_part(ctx, elem, R, T),
+        _homogeneous_part(ctx, T, p1),
         _representations_part(ctx, R),
         _twist_part(ctx, T),
         _frames_part(ctx, T, p1),

@@ -78,7 +78,8 @@ def _limits_text(robot: object) -> str:
     return " × ".join(parts)
 
 
-def _dof_table(ctx: ReportContext) -> str:
+def _dof_table(ctx: ReportContext) -> tuple[str, dict[str, tuple[int, int]]]:
+    """The table of every built-in robot, and {name: (n, m)}."""
     rows = []
     for info in models.catalog():
         r = info.build() if info.dof is not None else info.build(6, 0.1)
@@ -90,11 +91,13 @@ def _dof_table(ctx: ReportContext) -> str:
                      "planar (x, y, φ)" if planar else "spatial (x, y, z, 3 rotations)", m,
                      r.n - m))
     return ctx.table(rows, ["robot", "DOF n", "joints", "joint space Q",
-                            "task space", "m = rank J", "redundancy n − m"])
+                            "task space", "m = rank J", "redundancy n − m"]), {
+        row[0]: (row[1], row[5]) for row in rows}
 
 
 def _dof_part(ctx: ReportContext) -> str:
     """DOF, joint space and task space of every built-in robot (table and reproduction)."""
+    table, nm = _dof_table(ctx)
     return (
         "<h3>Degrees of freedom, joint space and task space</h3>"
         "<p>The number of DOF is the dimension of the joint space Q (one coordinate per "
@@ -102,12 +105,13 @@ def _dof_part(ctx: ReportContext) -> str:
         "spatial arm m = 6; the table gives the generic rank of the Jacobian, the number "
         "of task coordinates the tool can actually move in (2 for the 2-link arm, 4 for "
         "the SCARA: x, y, z and the yaw). A robot with n &gt; m is kinematically redundant "
-        "(section 5.3). S¹ is an unlimited revolute joint.</p>" + _dof_table(ctx)
+        "(section 5.3). S¹ is an unlimited revolute joint.</p>" + table
         + ctx.reproduce(
             "import numpy as np\n"
             "from serialkin import models\n"
             "r = models.scara(); J = r.jacobian(r.random_q(8, seed=2024))\n"
-            "print(r.n, max(np.linalg.matrix_rank(Jk, tol=1e-9) for Jk in J))  # n, m")
+            "print(r.n, max(np.linalg.matrix_rank(Jk, tol=1e-9) for Jk in J))  # n, m",
+            expect=[str(v) for v in nm["scara"]])
     )
 
 
@@ -146,8 +150,12 @@ def _two_link_map_part(ctx: ReportContext, progress: bool | None) -> str:
     plot_workspace(ws2, axes[0], robot=two, q=[0.6, 1.1])
     plot_manipulability_map(ws2, axes[1])
     fig.tight_layout()
+    e = ws2.estimate
+    area, err = f"{e.value:.6g}", f"{e.error:.2g}"
     return (
-        "<p>The manipulability of eq 43 of the 2-link arm is "
+        f"<p>The figure's workspace, {ws2.samples:,} samples (seed {SEED}): Â = {area} ± "
+        f"{err} m² (closed form {_annulus(1.0, 0.6):.6g} m²). "
+        "The manipulability of eq 43 of the 2-link arm is "
         + ctx.imath(r"w = \sqrt{\det\left(\mathbf{J}\mathbf{J}^T\right)}"
                     r" = L_1 L_2 \left|\sin q_2\right|")
         + ": zero on both boundary circles, the singular configurations "
@@ -155,7 +163,9 @@ def _two_link_map_part(ctx: ReportContext, progress: bool | None) -> str:
         + ctx.figure(fig, "workspace_two_link",
                      "2-link arm (L1 = 1 m, L2 = 0.6 m): maximal workspace with its "
                      "boundary (left) and the manipulability per cell (right, eq 43).")
-        + ctx.reproduce("serialkin workspace two_link --out out/ws -w", shell=True)
+        + ctx.reproduce(f"serialkin workspace two_link --param l1=1.0 --param l2=0.6 "
+                        f"--samples {ws2.samples} --seed {SEED} -w --out out/ws", shell=True,
+                        expect=[area, err])
     )
 
 
@@ -257,7 +267,11 @@ def _three_link_figure(ctx: ReportContext, kinds: list[_Kind]) -> str:
             "from serialkin.workspace.kinds import total_and_dexterous_workspaces\n"
             "arm = models.three_link(1.0, 0.8, 0.3)\n"
             "tot, dex = total_and_dexterous_workspaces(arm, 12, 20_000, seed=2024,"
-            " singularity_margin=0.05)")
+            " singularity_margin=0.05)\n"
+            "print(f'total {tot.estimate.value:.4f} ± {tot.estimate.error:.2g} m², '\n"
+            "      f'dexterous {dex.estimate.value:.4f} ± {dex.estimate.error:.2g} m²')",
+            expect=[f"{kinds[3][1].estimate.value:.4f}", f"{kinds[3][1].estimate.error:.2g}",
+                    f"{kinds[4][1].estimate.value:.4f}", f"{kinds[4][1].estimate.error:.2g}"])
     )
 
 
@@ -281,14 +295,16 @@ def _puma_table(ctx: ReportContext, ws3: Workspace, wsc: Workspace, wsi: Workspa
         "millions of samples per orientation (<code>serialkin workspace puma560 --kind "
         "dexterous --samples ...</code>).</p>"
         + ctx.table(
-            [("maximal", ws3.estimate.value, ws3.estimate.error, ws3.points.shape[0]),
-             ("constant orientation (tool down)", wsc.estimate.value, wsc.estimate.error,
-              wsc.points.shape[0]),
+            [("maximal", ws3.estimate.value, f"{ws3.estimate.error:.2g}", ws3.samples,
+              ws3.points.shape[0]),
+             ("constant orientation (tool down)", wsc.estimate.value,
+              f"{wsc.estimate.error:.2g}", wsc.samples, wsc.points.shape[0]),
              ("inclusive orientation (tool within 30° of down)", wsi.estimate.value,
-              wsi.estimate.error, wsi.points.shape[0])]
-            + [(f"slice z = {s.value:.2f} m (area, m²)", s.estimate.value, s.estimate.error,
-                s.points.shape[0]) for s in slices],
-            ["set", "volume [m³] / area [m²]", "error bound", "samples"])
+              f"{wsi.estimate.error:.2g}", wsi.samples, wsi.points.shape[0])]
+            + [(f"slice z = {s.value:.2f} m of the maximal (area, m²)", s.estimate.value,
+                f"{s.estimate.error:.2g}", "", s.points.shape[0]) for s in slices],
+            ["set", "volume [m³] / area [m²]", "error bound", "samples (seed 2024)",
+             "points kept"])
     )
 
 
@@ -331,8 +347,11 @@ def _puma_part(ctx: ReportContext, progress: bool | None) -> str:
                                           progress=progress)
     slices = [workspace_slice(ws3, "z", z) for z in (0.2, 0.67, 1.1)]
     return (_puma_table(ctx, ws3, wsc, wsi, slices) + _puma_figures(ctx, ws3, wsc, slices)
-            + ctx.reproduce("serialkin workspace puma560 --samples 400000 --slice z=0.67 "
-                            "--out out/ws", shell=True))
+            + ctx.reproduce(f"serialkin workspace puma560 --samples {ws3.samples} --seed {SEED} "
+                            "--slice z=0.67 --out out/ws", shell=True,
+                            expect=[f"{ws3.estimate.value:.6g}", f"{ws3.estimate.error:.2g}",
+                                    f"{slices[1].estimate.value:.6g}",
+                                    f"{slices[1].estimate.error:.2g}"]))
 
 
 def build(ctx: ReportContext) -> Section:

@@ -34,14 +34,14 @@ def build(ctx: ReportContext) -> list[Section]:
     """Run the redundancy examples of section 5.3 and return the report's parts."""
     sb = load_scenario("twenty_link_free")
     sc = load_scenario("twenty_link_obstacles")
-    tb, time_b = timed_run(ctx, sb, repeat=5)
-    tc, time_c = timed_run(ctx, sc, repeat=3)
+    tb, tc = sb.run(), sc.run()  # the trajectories (every run gives the same)
+    time_b, time_c, ratio = ctx.interleaved(sb.run, sc.run, warmup=1, repeat=15)
     runs = ablation(sc, tc)
     return [
         _nullspace_part(ctx),
         _six_link_part(ctx),
         _weights_part(ctx, sc, tc),
         _figure10_part(ctx, sc, tc),
-        _twenty_link_part(ctx, sb, sc, tb, tc, time_b, time_c, runs),
-        _qp_part(ctx, sc, side_by_side(ctx, sc, tc, time_c)),
+        _twenty_link_part(ctx, sb, sc, tb, tc, time_b, time_c, runs, ratio),
+        _qp_part(ctx, sc, side_by_side(ctx, sc, tc)),
     ]

@@ -7,11 +7,6 @@ from typing import Any
 import numpy as np
 
 from serialkin.chapter._context import ReportContext, Timing
-from serialkin.redundancy import (
-    joint_limit_weights,
-    obstacle_jacobian,
-)
-from serialkin.redundancy.multitask import smoothstep
 from serialkin.tracking.scenario import Scenario
 
 DEG = 180.0 / np.pi
@@ -66,29 +61,88 @@ def timed_run(ctx: ReportContext, scenario: Any, repeat: int = 5) -> tuple[Any, 
     return runs[0], timing
 
 
+def _smoothstep(s: np.ndarray) -> np.ndarray:
+    """σ(s) = 3s² − 2s³ with s clipped to [0, 1] (the designed eq 49's ramp)."""
+    s = np.clip(s, 0.0, 1.0)
+    return 3.0 * s**2 - 2.0 * s**3
+
+
+def _planar_joint_points(robot: Any, q: np.ndarray) -> np.ndarray:
+    """Joint positions s_0 … s_n of a planar revolute chain, (n + 1, 2), by eq 21's pattern.
+
+    s_k = s_(k−1) + L_k (cos θ_k, sin θ_k), θ_k = q_1 + … + q_k, from the DH lengths a_k
+    and the base's origin (no library kinematics).
+    """
+    L = np.array([row.a for row in robot.dh], dtype=float)
+    theta = np.cumsum(q + np.array([row.theta for row in robot.dh], dtype=float))
+    steps = L[:, None] * np.c_[np.cos(theta), np.sin(theta)]
+    return np.vstack([np.zeros((1, 2)), np.cumsum(steps, axis=0)]) + robot.base[:2, 3]
+
+
+def _cross_z(points: np.ndarray, about: np.ndarray) -> np.ndarray:
+    """Columns ẑ × (p − s_j) of a planar revolute chain: shape (2, len(about))."""
+    d = points[None, :] - about
+    return np.vstack([-d[:, 1], d[:, 0]])
+
+
 def eq48_by_hand(scenario: Scenario, q: np.ndarray, xdot: np.ndarray) -> dict[str, Any]:
-    """Assemble eq 48 from its parts (eqs 49-50, 55, the W_s of the resolver) with numpy.
+    """Eq 48 assembled with numpy from the chapter's formulas, without serialkin's kinematics.
+
+    For a planar revolute chain between circular obstacles: joint positions from the link
+    lengths (eq 21's pattern), the task Jacobian by eq 35 (ẑ × (p_E − s_j)), eq 49's
+    weights with σ(s) = 3s² − 2s³ (eq 50's diagonal), per link and obstacle eqs 51-54
+    (clamped projection, closest point, distance, unit vector) and eq 55's row
+    −u_iᵀ J_sci with eq 56's J_sci by eq 35 again, kept within the distance of influence
+    and weighted W_c σ((d_infl − c)/d_infl); W_s = (λ² + λ_s²) I with the singularity
+    damping of the resolver. Only the resolver's settings (weights, buffer, damping) and
+    the obstacles' geometry are read from the library's objects.
 
     Returns:
         dict with ``qdot`` (n,), ``W_L`` (n,) diagonal of eq 50, ``J_c`` (r, n), ``W_c``
-        (r,), ``lambda_s`` and ``w``.
+        (r,), ``clearance`` (r,), ``lambda_s``, ``w`` and ``points`` (n + 1, 2).
     """
     res = scenario.solver
     robot = scenario.robot
-    J = robot.jacobian(q)[:2]
+    q = np.asarray(q, dtype=float)
+    n = q.shape[0]
+    S = _planar_joint_points(robot, q)
+    J = _cross_z(S[-1], S[:-1])  # eq 35, (2, n)
     lim = np.asarray(robot.qlim, dtype=float)
-    WL = joint_limit_weights(q, lim, buffer=res.limit_buffer, max_weight=res.joint_limit_weight)
-    Jc, clear, pairs = obstacle_jacobian(robot, q, scenario.obstacles)
-    infl = np.array([scenario.obstacles[j].influence for _, j in pairs])
-    Wc = (res.obstacle_weight * smoothstep((infl - clear) / infl) if len(pairs)
-          else np.zeros(0))
-    w = float(np.sqrt(max(np.linalg.det(J @ J.T), 0.0)))
+    b = res.limit_buffer * (lim[:, 1] - lim[:, 0])
+    low = _smoothstep((lim[:, 0] + b - q) / b)
+    high = _smoothstep((q - lim[:, 1] + b) / b)
+    WL = res.joint_limit_weight * np.maximum(low, high)  # eq 49
+    rows, clear, weights = [], [], []
+    for obs in scenario.obstacles:
+        s0 = np.asarray(obs.center, dtype=float)[:2]
+        for i in range(n):  # link i + 1 runs from S[i] to S[i + 1]
+            ell = float(np.linalg.norm(S[i + 1] - S[i]))
+            if ell == 0.0:
+                continue
+            e = (S[i + 1] - S[i]) / ell
+            p = min(max(float(e @ (s0 - S[i])), 0.0), ell)  # eq 51 (clamped)
+            s_c = S[i] + p * e  # eq 52
+            d = float(np.linalg.norm(s_c - s0))  # eq 53
+            c = d - obs.radius - res.link_radius
+            if c >= obs.influence:
+                continue
+            u = (s_c - s0) / d  # eq 54
+            J_sc = np.zeros((2, n))
+            J_sc[:, :i + 1] = _cross_z(s_c, S[:i + 1])  # eq 56: joints 1 … i + 1 move it
+            rows.append(-u @ J_sc)  # eq 55
+            clear.append(c)
+            weights.append(res.obstacle_weight
+                           * float(_smoothstep((obs.influence - c) / obs.influence)))
+    Jc = np.array(rows).reshape(-1, n)
+    Wc = np.array(weights)
+    w = float(np.sqrt(max(np.linalg.det(J @ J.T), 0.0)))  # eq 43
     w0 = res.manipulability_threshold
     lam_s = res.singularity_damping * max(0.0, 1.0 - w / w0) if w0 > 0 else 0.0
     A = (res.weight * J.T @ J + Jc.T @ (Wc[:, None] * Jc) + np.diag(WL)
-         + (res.damping ** 2 + lam_s ** 2) * np.eye(robot.n))
-    qdot = np.linalg.solve(A, res.weight * J.T @ xdot)
-    return {"qdot": qdot, "W_L": WL, "J_c": Jc, "W_c": Wc, "lambda_s": lam_s, "w": w}
+         + (res.damping ** 2 + lam_s ** 2) * np.eye(n))
+    qdot = np.linalg.solve(A, res.weight * J.T @ xdot)  # eq 48
+    return {"qdot": qdot, "W_L": WL, "J_c": Jc, "W_c": Wc, "clearance": np.array(clear),
+            "lambda_s": lam_s, "w": w, "points": S}
 
 
 def _phase_marks(scenario: Scenario) -> list[int]:

@@ -114,26 +114,40 @@ def _eq48_by_hand_part(ctx: ReportContext, sc: Scenario, tc: Any) -> str:
         "<p>Eqs 48-50 at path points " + " and ".join(str(k) for k in picks)
         + " of the constrained run (Figure 12; the joint-limit task acts at both, with the "
         "singularity task at the first and the obstacle task at the second), with ẋ towards "
-        "the next path point: eq 48 assembled by hand with numpy from "
-        "<code>joint_limit_weights</code> (eq 49), the diagonal of eq 50, the obstacle rows of "
-        "eq 55 and the resolver's " + ctx.imath(r"\mathbf{W}_s") + ", against the library's "
-        "compiled <code>MultiTaskResolver.velocity</code>:</p>"
+        "the next path point. Eq 48 is assembled here by hand: plain numpy on the chapter's "
+        "formulas, calling no serialkin kinematics or weight function "
+        "(<code>eq48_by_hand</code> in this report's source): the joint positions from the "
+        "link lengths, the Jacobian columns of eq 35, the weights of eq 49 (eq 50's "
+        "diagonal), eqs 51-56 for every link and obstacle within the distance of influence, "
+        "and " + ctx.imath(r"\mathbf{W}_s") + " from the resolver's damping settings; only "
+        "the settings and the obstacles' centres and radii are read from the library's "
+        "objects. It is compared with the library's compiled "
+        "<code>MultiTaskResolver.velocity</code>:</p>"
         + ctx.table([(lab, *[c[i] for c in cols]) for i, lab in enumerate(labels)],
                     ["quantity", *[f"path point {k}" for k in picks]]))
 
 
 def _weights_part(ctx: ReportContext, sc: Scenario, tc: Any) -> Section:
     """Weighted multi-task resolution: eqs 47-50, the eq 49 figure, eq 48 by hand."""
+    res = sc.solver
+    q_deg = (0.0, 85.0, 95.0, 101.0)
+    W = joint_limit_weights(np.radians(q_deg), np.radians([[-100.0, 100.0]] * len(q_deg)),
+                            buffer=res.limit_buffer, max_weight=res.joint_limit_weight)
+    w_txt = [f"{v:.4g}" for v in W]
     parts = [
         _eq47_50_text(ctx, sc),
         _eq49_figure(ctx, sc),
+        "<p>For example, with limits ±100°: W<sub>L</sub> = "
+        + ", ".join(f"{w} at {q:g}°" for w, q in zip(w_txt, q_deg)) + ".</p>",
         _eq48_by_hand_part(ctx, sc, tc),
         ctx.reproduce(
             "import numpy as np\n"
             "from serialkin.redundancy import joint_limit_weights\n"
-            "lim = np.radians([[-100.0, 100.0]] * 3)\n"
-            "joint_limit_weights(np.radians([0.0, 85.0, 101.0]), lim, buffer=0.1, "
-            "max_weight=100.0)"),
+            f"lim = np.radians([[-100.0, 100.0]] * {len(q_deg)})\n"
+            f"W = joint_limit_weights(np.radians({list(q_deg)}), lim, "
+            f"buffer={res.limit_buffer:g}, max_weight={res.joint_limit_weight:g})\n"
+            "print(', '.join(f'{w:.4g}' for w in W))   # eq 49",
+            expect=w_txt),
     ]
     return Section(title="5.3 Kinematically redundant manipulators",
                    part="Weighted multi-task resolution (eqs 47-50)",
@@ -334,7 +348,11 @@ def _figure10_part(ctx: ReportContext, sc: Scenario, tc: Any) -> Section:
             "sc = load_scenario('twenty_link_obstacles'); tr = sc.run()\n"
             f"p = min(closest_pairs(sc.robot, tr.q[{g.k}], sc.obstacles, with_jacobian=True),"
             " key=lambda p: p.clearance)\n"
-            "print(p.point, p.distance, p.u, p.jacobian_row)"),
+            "print('s_ci', p.point[:2], 'd_ci [mm]', p.distance * 1e3, 'u_i', p.u[:2])\n"
+            f"print('J_ci', p.jacobian_row[:{g.link}])",
+            expect=[f"{v:.4f}" for v in g.s_ci] + [f"{g.d_ci * 1e3:.3f}"]
+            + [f"{v:.4f}" for v in g.u_i]
+            + [f"{g.pair.jacobian_row[a]:.6f}" for a in range(g.link)]),
     ]
     return Section(title="5.3 Kinematically redundant manipulators",
                    part="Figure 10: a link and an obstacle (eqs 51-56)",
