@@ -84,7 +84,11 @@ $(STAMP_AUTOGRAD): $(STAMP_TEST)
 	['optional-dependencies']; print('\n'.join(r for e in '$(AUTOGRAD_EXTRAS)'.split() for r in o[e]))" \
 	  > $(VENV)/autograd-extras.txt
 	$(PY) -m pip freeze --exclude-editable > $(VENV)/installed-autograd.txt
-	$(PY) -m pip install --quiet --extra-index-url $(TORCH_INDEX) \
+	@# PyTorch's index only when its host resolves (else pip retries it for every package)
+	index=$$($(PY) -c "import socket, urllib.parse as u; \
+	  socket.getaddrinfo(u.urlsplit('$(TORCH_INDEX)').hostname, 443)" 2>/dev/null \
+	  && echo "--extra-index-url $(TORCH_INDEX)"); \
+	$(PY) -m pip install --quiet $$index \
 	  -r $(VENV)/autograd-extras.txt "$(TORCH_PIN)" -c $(VENV)/installed-autograd.txt
 	touch $@
 
