@@ -99,6 +99,35 @@ def test_imports_are_found_statically():
     assert "ik/analytic/ur.py" in deps("ik/analytic/dispatch.py")
 
 
+def test_a_submodule_import_does_not_stamp_the_package():
+    """``from serialkin import _background`` depends on _background, not serialkin/__init__.
+
+    The package's __init__ imports nearly everything; counting it would make every
+    kernel's cache stale after any edit anywhere. A kernel's whole closure stays inside
+    what it imports: the IK kernels' stamps do not include the CLI or the report.
+    """
+    pkg = _jit._PACKAGE_DIR
+
+    def deps(rel):
+        return {os.path.relpath(p, pkg) for p in _jit._imports(os.path.join(pkg, rel))}
+
+    assert "_background.py" in deps("_jit.py") and "__init__.py" not in deps("_jit.py")
+    closure = {os.path.relpath(p, pkg) for p in _closure(os.path.join(pkg, "ik/_kernels.py"))}
+    assert not any(p.startswith(("cli/", "chapter/", "viz/", "reach/")) for p in closure)
+    assert "ik/solver.py" not in _closure(os.path.join(pkg, "kinematics/kernels.py"))
+
+
+def _closure(path):
+    """Every file in the import closure of ``path`` (as the stamp walks it)."""
+    seen, todo = {path}, [path]
+    while todo:
+        for dep in _jit._imports_of(todo.pop()):
+            if dep not in seen:
+                seen.add(dep)
+                todo.append(dep)
+    return seen
+
+
 def test_an_edit_changes_the_stamps_of_its_importers_only(tmp_path, monkeypatch):
     """Editing a module changes its own stamp and its importers', never the others'."""
     pkg = tmp_path / "serialkin"

@@ -489,7 +489,8 @@ def _imports(path: str) -> set[str]:
     """The files of the serialkin modules that the source file ``path`` imports.
 
     A static scan of its ``import`` and ``from ... import`` lines (also inside functions:
-    more than needed rather than less), relative imports resolved.
+    more than needed rather than less), relative imports resolved. ``from A import b``
+    counts the module ``A.b`` when it exists, else ``A`` (``b`` is then defined in A).
     """
     rel = os.path.relpath(path, _PACKAGE_DIR)[:-3].split(os.sep)
     package = ["serialkin", *rel[:-1]]
@@ -507,8 +508,14 @@ def _imports(path: str) -> set[str]:
                 module = ".".join(base + ([name] if name else []))
             else:
                 module = name
-            candidates = [module] + [f"{module}.{n.split()[0]}" for n in names.split(",")
-                                     if n.split()]
+            # ``from A import b``: the module A.b when there is one, else A itself (b is
+            # a name defined in A). Not A's __init__ for a submodule: the package
+            # serialkin's own __init__ imports nearly everything, and would make every
+            # kernel's stamp change with any edit anywhere.
+            subs = [f"{module}.{n.split()[0]}" for n in names.split(",") if n.split()]
+            candidates = [m for m in subs if _module_file(m) is not None]
+            if len(candidates) < len(subs) or not subs:
+                candidates.append(module)
         for m in candidates:
             file = _module_file(m)
             if file is not None and file != path:
