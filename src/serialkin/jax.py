@@ -248,6 +248,19 @@ def ik(robot: Robot, T: object, q0: object, *, method: str = "lm",
     """
     robot = check_robot(robot)
     d = core.check_damping(damping)
+    Ta, q0a = _check_ik_arrays(robot, T, q0)
+    solve = _ik_function(robot, method, seed, dict(options), d, Ta.dtype)
+    q, ok = solve(Ta, q0a)
+    return IKSolution(q, ok)
+
+
+def _check_ik_arrays(robot: Robot, T: object, q0: object) -> tuple[jax.Array, jax.Array]:
+    """The targets (..., 4, 4) and the starts (..., n) of :func:`ik`, in T's dtype.
+
+    Raises:
+        InputTypeError: T not a floating-point array.
+        InputError: T not (..., 4, 4), q0 not (..., n) or not broadcast against T.
+    """
     Ta = _check_array(T, "T")
     if Ta.ndim < 2 or Ta.shape[-2:] != (4, 4):
         raise InputError(f"T must have shape (..., 4, 4), got {Ta.shape}")
@@ -260,8 +273,28 @@ def ik(robot: Robot, T: object, q0: object, *, method: str = "lm",
     except ValueError:
         raise InputError(f"q0's leading shape {q0a.shape[:-1]} does not broadcast against "
                          f"T's {Ta.shape[:-2]}") from None
-    options = dict(options)
-    dtype = Ta.dtype
+    return Ta, q0a
+
+
+def _sum_to_shape(G: jax.Array, T: jax.Array) -> jax.Array:
+    """``G`` summed over the dimensions that broadcasting added to ``T`` or stretched in it.
+
+    The cotangent of a broadcast input: leading extra axes summed away, axes where T has
+    length 1 summed with ``keepdims``.
+    """
+    extra = G.ndim - T.ndim
+    G = G.sum(axis=tuple(range(extra))) if extra else G
+    ones = tuple(i for i, (m, k) in enumerate(zip(G.shape, T.shape)) if k == 1 and m != 1)
+    return G.sum(axis=ones, keepdims=True) if ones else G
+
+
+def _ik_function(robot: Robot, method: str, seed: Any, options: dict[str, Any], d: float,
+                 dtype: Any) -> Callable[[jax.Array, jax.Array], tuple[jax.Array, jax.Array]]:
+    """The custom_vjp ``solve(T, q0) -> (q, success)`` of :func:`ik`, results in ``dtype``.
+
+    Forward: ``core.solve_ik`` in a callback; reverse: the target cotangent of
+    ``core.ik_target_cotangent`` with damping ``d``, zero for q0.
+    """
 
     def solve_host(T: Any, q0: Any) -> tuple[np.ndarray, np.ndarray]:
         q, ok = core.solve_ik(robot, core.as_float64(T), core.as_float64(q0), method, seed,
@@ -291,12 +324,7 @@ def ik(robot: Robot, T: object, q0: object, *, method: str = "lm",
         gq = cotangents[0]
         G = _callback(cotangent_host, jax.ShapeDtypeStruct(q.shape[:-1] + (4, 4), dtype),
                       T, q, gq, vmap_method="broadcast_all")
-        extra = G.ndim - T.ndim
-        G = G.sum(axis=tuple(range(extra))) if extra else G
-        ones = tuple(i for i, (m, k) in enumerate(zip(G.shape, T.shape)) if k == 1 and m != 1)
-        G = G.sum(axis=ones, keepdims=True) if ones else G
-        return G, jnp.zeros_like(q0)
+        return _sum_to_shape(G, T), jnp.zeros_like(q0)
 
     solve.defvjp(solve_fwd, solve_bwd)
-    q, ok = solve(Ta, q0a)
-    return IKSolution(q, ok)
+    return solve

@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from serialkin.errors import InputError, InputTypeError
 from serialkin.model.geometry import Capsule, Cylinder, Sphere
 from serialkin.viz.plot import (
+    Obstacle,
     as_obstacle,
     is_3d_axes,
     joint_positions,
@@ -195,6 +196,36 @@ def test_redundancy_obstacle_classes():
         ob = as_obstacle(src)
         assert ob.kind == "capsule"
         np.testing.assert_allclose(ob.b, [0.2, 0, 0.1])
+
+
+def test_obstacle_holds_the_geometry_shape():
+    """as_obstacle turns every accepted form into an Obstacle holding the geometry shape."""
+    cases = [
+        (dict(center=[0.5, 0.5], radius=0.1, name="A"),
+         Cylinder(0.1, math.inf, center=[0.5, 0.5, 0.0], influence=0.0, name="A")),
+        (dict(center=[0, 0, 1], radius=0.2, height=0.5, influence=0.03),
+         Cylinder(0.2, 0.5, center=[0, 0, 1], influence=0.03)),
+        (dict(p0=[0, 0, 0], p1=[0, 0, 1], radius=0.1),
+         Capsule(0.1, a=[0, 0, 0], b=[0, 0, 1], influence=0.0)),
+        (dict(a=[1, 0, 0], b=[1, 0, 0], radius=0.1), Sphere(0.1, center=[1, 0, 0], influence=0.0)),
+        (Sphere(0.07, center=[0.1, 0.2, 0.3]), Sphere(0.07, center=[0.1, 0.2, 0.3])),
+        (Cylinder(0.1, 0.4, center=[0, 0, 0.2]), Cylinder(0.1, 0.4, center=[0, 0, 0.2])),
+    ]
+    for src, shape in cases:
+        ob = as_obstacle(src)
+        assert ob.shape == shape, src
+        assert ob.radius == shape.radius and ob.name == shape.name
+        assert ob.influence == shape.influence
+    assert as_obstacle(cases[1][1]).height == 0.5  # a finite Cylinder keeps its length
+
+
+def test_old_obstacle_constructor_warns():
+    """The field-by-field Obstacle(kind, center, radius, ...) builds the shape and warns."""
+    with pytest.warns(DeprecationWarning, match="Obstacle"):
+        ob = Obstacle("capsule", np.zeros(3), 0.1, None, [0, 0, 0], [0, 0, 1], 0.02, "c")
+    assert ob.shape == Capsule(0.1, a=[0, 0, 0], b=[0, 0, 1], influence=0.02, name="c")
+    with pytest.raises(InputTypeError, match="Sphere, Cylinder or Capsule"):
+        Obstacle(dict(center=[0, 0, 0], radius=0.1))
 
 
 def test_influence_rings(planar3):

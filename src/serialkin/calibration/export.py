@@ -210,6 +210,138 @@ def _chain(root: Any, base: str, tip: str) -> list[dict[str, Any]]:
     return out[::-1]
 
 
+def _result_notes(result: Any, tool: bool | None) -> tuple[bool, list[str]]:
+    """Whether to write the tool change of a calibration ``result``, and what is not written.
+
+    ``tool`` None: write it when the result identified all six tool errors. The notes name
+    the encoder scales, marker offsets and tool change that the URDF will not hold.
+    """
+    params = result.model.parameters
+    tool_params = [k for k, p in enumerate(params) if p.group == "tool"]
+    identified = len(tool_params) == 6 and all(
+        result.identifiability.identifiable[k] for k in tool_params)
+    if tool is None:
+        tool = identified
+    notes: list[str] = []
+    scale = result.encoder_scale
+    if np.any(scale != 1.0):
+        notes.append("encoder scales are not part of a URDF: drive the robot with the "
+                     "joint values times " + ", ".join(f"{s:.8g}" for s in scale))
+    if result.model.markers > 1:
+        notes.append("the marker offsets are not written (they are no part of the "
+                     "robot)")
+    if not tool and tool_params:
+        notes.append("the identified tool change is not written (the tool translation "
+                     "of position measurements is the marker)" if not identified else
+                     "the identified tool change is not written (tool=False)")
+    return tool, notes
+
+
+def _calibrated_robot(calibrated: Any, tool: bool | None) -> tuple[Robot, bool, list[str]]:
+    """The calibrated robot of ``calibrated``, whether to write its tool, and the notes.
+
+    Raises:
+        InputError: ``calibrated`` is neither a CalibrationResult nor a Robot.
+    """
+    from serialkin.calibration.fit import CalibrationResult
+
+    if isinstance(calibrated, CalibrationResult):
+        tool, notes = _result_notes(calibrated, tool)
+        return calibrated.robot, tool, notes
+    if isinstance(calibrated, Robot):
+        return calibrated, bool(tool), []
+    raise InputError(f"calibrated must be a CalibrationResult or a Robot, got "
+                     f"{type(calibrated).__name__}")
+
+
+def _check_same_joints(robot: Robot, nominal: Robot, src: Path) -> None:
+    """Refuse a calibrated robot whose joints (count, types, local axes) are not the file's.
+
+    Raises:
+        InputError: naming the first difference.
+    """
+    if robot.n != nominal.n or [j.type for j in robot.joints] != \
+            [j.type for j in nominal.joints]:
+        raise InputError(f"the calibrated robot's joints ({robot.n}: "
+                         f"{''.join(j.type for j in robot.joints)}) are not those of {src} "
+                         f"({nominal.n}: {''.join(j.type for j in nominal.joints)})")
+    for i, (a, b) in enumerate(zip(robot.joints, nominal.joints)):
+        if not np.allclose(a.axis, b.axis, atol=1e-9):
+            raise InputError(f"joint {i + 1} of the calibrated robot turns about "
+                             f"{a.axis.round(6).tolist()} in its frame, the URDF's about "
+                             f"{b.axis.round(6).tolist()}: calibrate with the 'joints' error "
+                             "model of this URDF")
+
+
+def _joint_edits(chain: list[dict[str, Any]], robot: Robot,
+                 ) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """The new origins (4, 4) of the moving joints whose origin changed, by joint name.
+
+    A moving joint's new origin absorbs the fixed joints before it (their origins stay)
+    and the calibrated joint's pre-transform and offset; also returns the last moving
+    joint's post-transform (4, 4), which the tool change starts from.
+    """
+    from serialkin.calibration.models import _motion
+
+    edits: dict[str, np.ndarray] = {}
+    fixed = np.eye(4)
+    prev_post = np.eye(4)
+    i = 0
+    for j in chain:
+        if j["type"] == "fixed":
+            fixed = fixed @ j["origin"]
+            continue
+        cj = robot.joints[i]
+        new = np.linalg.inv(fixed) @ prev_post @ cj.origin @ _motion(cj, cj.offset)
+        if not np.allclose(new, j["origin"], rtol=0.0, atol=1e-13):
+            edits[j["name"]] = new
+        prev_post, fixed, i = cj.post, np.eye(4), i + 1
+    return edits, prev_post
+
+
+def _tool_edit(chain: list[dict[str, Any]], robot: Robot, prev_post: np.ndarray,
+               src: Path) -> tuple[str, np.ndarray | None]:
+    """The last fixed joint before the tip and its new origin (None: unchanged).
+
+    The fixed joints after the last moving one keep their origins but the last, which
+    takes the tool change.
+
+    Raises:
+        RobotDefinitionError: no fixed joint after the last moving one.
+    """
+    tail = []
+    for j in reversed(chain):
+        if j["type"] != "fixed":
+            break
+        tail.append(j)
+    if not tail:
+        raise RobotDefinitionError(
+            f"{src}: no fixed joint after the last moving one to take the tool change "
+            "(pass tool=False)")
+    last = tail[0]
+    rest = np.eye(4)
+    for j in reversed(tail[1:]):
+        rest = rest @ j["origin"]
+    new = np.linalg.inv(rest) @ prev_post @ robot.tool
+    if np.allclose(new, last["origin"], rtol=0.0, atol=1e-13):
+        return last["name"], None
+    return last["name"], new
+
+
+def _rewrite_origins(data: bytes, spans: dict[str, Any], edits: dict[str, np.ndarray],
+                     ) -> bytes:
+    """``data`` with each edited joint's origin set to its new (4, 4) transform."""
+    from serialkin.spatial import matrix_to_rpy
+
+    # rewrite from the end of the file backwards: earlier offsets stay valid
+    for name in sorted(edits, key=lambda n: spans[n]["start"], reverse=True):
+        T = edits[name]
+        xyz = " ".join(_fmt(v) for v in T[:3, 3])
+        rpy = " ".join(_fmt(v) for v in matrix_to_rpy(T[:3, :3], check=False))
+        data = _set_origin(data, spans[name], xyz, rpy)
+    return data
+
+
 def patch_urdf(original: str | os.PathLike[str], calibrated: Any,
                path: str | os.PathLike[str], *, base_link: str | None = None,
                tip_link: str | None = None, tool: bool | None = None) -> UrdfPatch:
@@ -238,52 +370,15 @@ def patch_urdf(original: str | os.PathLike[str], calibrated: Any,
     """
     from serialkin._files import parse_xml, read_bytes
     from serialkin._io import write_bytes_atomic
-    from serialkin.calibration.fit import CalibrationResult
-    from serialkin.calibration.models import _motion
     from serialkin.formats.urdf import robot_from_urdf
-    from serialkin.spatial import matrix_to_rpy
 
     src, out = Path(original), Path(path)
     if out.exists() and src.exists() and os.path.samefile(src, out):
         raise InputError(f"patch_urdf: path {str(out)!r} is the original URDF; writing it "
                          "would replace the input; choose another path")
-    notes: list[str] = []
-    if isinstance(calibrated, CalibrationResult):
-        result, robot = calibrated, calibrated.robot
-        params = result.model.parameters
-        tool_params = [k for k, p in enumerate(params) if p.group == "tool"]
-        identified = len(tool_params) == 6 and all(
-            result.identifiability.identifiable[k] for k in tool_params)
-        if tool is None:
-            tool = identified
-        scale = result.encoder_scale
-        if np.any(scale != 1.0):
-            notes.append("encoder scales are not part of a URDF: drive the robot with the "
-                         "joint values times " + ", ".join(f"{s:.8g}" for s in scale))
-        if result.model.markers > 1:
-            notes.append("the marker offsets are not written (they are no part of the "
-                         "robot)")
-        if not tool and tool_params:
-            notes.append("the identified tool change is not written (the tool translation "
-                         "of position measurements is the marker)" if not identified else
-                         "the identified tool change is not written (tool=False)")
-    elif isinstance(calibrated, Robot):
-        robot, tool = calibrated, bool(tool)
-    else:
-        raise InputError(f"calibrated must be a CalibrationResult or a Robot, got "
-                         f"{type(calibrated).__name__}")
+    robot, tool, notes = _calibrated_robot(calibrated, tool)
     nominal = robot_from_urdf(str(src), base_link, tip_link)
-    if robot.n != nominal.n or [j.type for j in robot.joints] != \
-            [j.type for j in nominal.joints]:
-        raise InputError(f"the calibrated robot's joints ({robot.n}: "
-                         f"{''.join(j.type for j in robot.joints)}) are not those of {src} "
-                         f"({nominal.n}: {''.join(j.type for j in nominal.joints)})")
-    for i, (a, b) in enumerate(zip(robot.joints, nominal.joints)):
-        if not np.allclose(a.axis, b.axis, atol=1e-9):
-            raise InputError(f"joint {i + 1} of the calibrated robot turns about "
-                             f"{a.axis.round(6).tolist()} in its frame, the URDF's about "
-                             f"{b.axis.round(6).tolist()}: calibrate with the 'joints' error "
-                             "model of this URDF")
+    _check_same_joints(robot, nominal, src)
     if not np.allclose(robot.base, nominal.base, atol=1e-12):
         notes.append("the identified base pose (the robot in the measuring device's frame) "
                      "is not written: the URDF stays in its root link's frame")
@@ -292,44 +387,12 @@ def patch_urdf(original: str | os.PathLike[str], calibrated: Any,
     names = nominal.link_names
     chain = _chain(root, names[0], names[-1])
     spans = _joint_spans(data)
-    edits: dict[str, np.ndarray] = {}
-    fixed = np.eye(4)
-    prev_post = np.eye(4)
-    i = 0
-    for j in chain:
-        if j["type"] == "fixed":
-            fixed = fixed @ j["origin"]
-            continue
-        cj = robot.joints[i]
-        new = np.linalg.inv(fixed) @ prev_post @ cj.origin @ _motion(cj, cj.offset)
-        if not np.allclose(new, j["origin"], rtol=0.0, atol=1e-13):
-            edits[j["name"]] = new
-        prev_post, fixed, i = cj.post, np.eye(4), i + 1
-    tool_written = False
+    edits, prev_post = _joint_edits(chain, robot)
     if tool:
-        tail = []
-        for j in reversed(chain):
-            if j["type"] != "fixed":
-                break
-            tail.append(j)
-        if not tail:
-            raise RobotDefinitionError(
-                f"{src}: no fixed joint after the last moving one to take the tool change "
-                "(pass tool=False)")
-        last = tail[0]
-        rest = np.eye(4)
-        for j in reversed(tail[1:]):
-            rest = rest @ j["origin"]
-        new = np.linalg.inv(rest) @ prev_post @ robot.tool
-        if not np.allclose(new, last["origin"], rtol=0.0, atol=1e-13):
-            edits[last["name"]] = new
-        tool_written = True
-    # rewrite from the end of the file backwards: earlier offsets stay valid
-    for name in sorted(edits, key=lambda n: spans[n]["start"], reverse=True):
-        T = edits[name]
-        xyz = " ".join(_fmt(v) for v in T[:3, 3])
-        rpy = " ".join(_fmt(v) for v in matrix_to_rpy(T[:3, :3], check=False))
-        data = _set_origin(data, spans[name], xyz, rpy)
+        name, new = _tool_edit(chain, robot, prev_post, src)
+        if new is not None:
+            edits[name] = new
+    data = _rewrite_origins(data, spans, edits)
     written = write_bytes_atomic(out, data)
     changed = tuple(j["name"] for j in chain if j["name"] in edits)
-    return UrdfPatch(Path(written), changed, tool_written, tuple(notes))
+    return UrdfPatch(Path(written), changed, bool(tool), tuple(notes))

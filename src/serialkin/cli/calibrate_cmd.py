@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -119,7 +120,8 @@ def calibrate_cmd(robot: str, measurements: str, out: str | None, urdf: str | No
     if simulate is not None:
         model = error_model(r, kind, hayati=hayati, base=not no_base, tool=not no_tool,
                             scale=encoder_scale)
-        _simulate(model, simulate, measurements, say, as_json, **opts)
+        _simulate(model, _Simulation(simulate, kind=opts.pop("sim_kind"), **opts),
+                  measurements, say, as_json)
         return
     meas = read_measurements(measurements, r, sigma_position=sigma_position,
                              sigma_rotation=sigma_rotation)
@@ -257,9 +259,35 @@ def _parameter_lines(res: Any) -> str:
     return "\n".join(lines)
 
 
-def _simulate(model: Any, count: int, path: str, say: Any, as_json: bool, *, sim_kind: str,
-              noise_position: float, noise_rotation: float, perturb_length: float,
-              perturb_angle: float, select: int | None, truth: str | None, seed: int) -> None:
+@dataclass(frozen=True)
+class _Simulation:
+    """The simulation options of ``serialkin calibrate --simulate N`` (see their help).
+
+    Attributes:
+        count: poses to measure (``--simulate``).
+        kind: 'position' or 'pose' (``--kind``).
+        noise_position: noise of each coordinate [m].
+        noise_rotation: noise of each rotation [rad].
+        perturb_length: largest length error [m].
+        perturb_angle: largest angle error [deg].
+        select: candidates the poses are picked from by O1 (None: random poses).
+        truth: file to write the perturbed robot to, or None.
+        seed: random seed.
+    """
+
+    count: int
+    kind: str
+    noise_position: float
+    noise_rotation: float
+    perturb_length: float
+    perturb_angle: float
+    select: int | None
+    truth: str | None
+    seed: int
+
+
+def _simulate(model: Any, sim: _Simulation, path: str, say: Any, as_json: bool) -> None:
+    """Perturb ``model``'s robot, measure it as ``sim`` says and write the measurements."""
     from serialkin._checks import check_int
     from serialkin.calibration import (
         perturb,
@@ -269,24 +297,25 @@ def _simulate(model: Any, count: int, path: str, say: Any, as_json: bool, *, sim
         write_measurements,
     )
 
-    kind = sim_kind
-    count = check_int(count, "--simulate", minimum=1)
-    rng = np.random.default_rng(seed)
-    params = perturb(model, length=perturb_length, angle=math.radians(perturb_angle), seed=rng)
+    kind = sim.kind
+    count = check_int(sim.count, "--simulate", minimum=1)
+    rng = np.random.default_rng(sim.seed)
+    params = perturb(model, length=sim.perturb_length, angle=math.radians(sim.perturb_angle),
+                     seed=rng)
     real = model.calibrated_robot(params, name=f"{model.robot.name} (simulated real)")
-    if select is not None:
-        cand = model.robot.random_q(check_int(select, "--select", minimum=1), seed=rng)
+    if sim.select is not None:
+        cand = model.robot.random_q(check_int(sim.select, "--select", minimum=1), seed=rng)
         if count > len(cand):
             raise CLIError(f"--simulate {count} poses cannot be picked out of --select "
                            f"{len(cand)} candidates")
         q: Any = cand[select_poses(model, cand, count, kind=kind, seed=rng)]
     else:
         q = count
-    meas = simulate_measurements(real, q, kind=kind, noise_position=noise_position,
-                                 noise_rotation=noise_rotation, seed=rng)
+    meas = simulate_measurements(real, q, kind=kind, noise_position=sim.noise_position,
+                                 noise_rotation=sim.noise_rotation, seed=rng)
     written = [write_measurements(path, meas)]
-    if truth:
-        written.append(save_robot(real, truth))
+    if sim.truth:
+        written.append(save_robot(real, sim.truth))
     if as_json:
         click.echo(dumps_json({"measurements": len(meas), "kind": kind,
                                "written": [str(w) for w in written],

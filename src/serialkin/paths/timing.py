@@ -33,6 +33,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path as FsPath
+from typing import Any
 
 import numpy as np
 
@@ -293,29 +294,12 @@ def jerk_limited(q: object, jerk: object, velocity: object = None,
     jk = _limits(jerk, n, "jerk")
     _check_dt(dt)
     spline = CubicSpline(s, Q)
-    # q′ and q″ are polynomials of degree 2 and 1 on each knot interval, q‴ a constant:
-    # their largest values from 8 points an interval (the final check covers the rest).
-    grid = (s[:-1, None] + np.diff(s)[:, None] * np.linspace(0.0, 1.0, 8)).ravel()
-    D1, D2, D3 = (np.abs(spline(grid, k)).max(axis=0) for k in (1, 2, 3))
-    V = min(_ratio(v, D1), _ratio(a, 2.0 * D2, 0.5), _ratio(jk, 3.0 * D3, 1.0 / 3.0))
-    A = min(_ratio(a - D2 * V * V, D1), _ratio(jk, 9.0 * D2 * V))
-    J = _ratio(jk - 3.0 * D2 * V * A - D3 * V ** 3, D1)
-    inp = rk.InputParameter(1)
-    inp.current_position, inp.target_position = [0.0], [float(s[-1])]
-    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [V], [A], [J]
-    traj = rk.Trajectory(1)
-    result = rk.Ruckig(1).calculate(inp, traj)
-    if result not in (rk.Result.Working, rk.Result.Finished):
-        raise SerialkinError(f"ruckig found no trajectory ({result}) along a path of length "
-                             f"{s[-1]:.4g} with bounds ṡ ≤ {V:.4g}, |s̈| ≤ {A:.4g}, "
-                             f"|s⃛| ≤ {J:.4g}")
+    V, A, J = _path_bounds(spline, s, v, a, jk)
+    traj = _ruckig_profile(rk, float(s[-1]), V, A, J)
     base = float(traj.duration)
 
     def states(times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        x = np.array([traj.at_time(float(t)) for t in times])[:, :, 0]   # (k, 3): s, ṡ, s̈
-        d1 = spline(np.clip(x[:, 0], 0.0, s[-1]), 1)
-        return (spline(np.clip(x[:, 0], 0.0, s[-1])), d1 * x[:, 1:2],
-                spline(np.clip(x[:, 0], 0.0, s[-1]), 2) * x[:, 1:2] ** 2 + d1 * x[:, 2:3])
+        return _joint_states(traj, spline, float(s[-1]), times)
 
     fine = np.linspace(0.0, base, max(4000, int(base / dt) + 1))
     _, fqd, fqdd = states(fine)
@@ -330,6 +314,53 @@ def jerk_limited(q: object, jerk: object, velocity: object = None,
     names = tuple(robot.joint_names) if robot is not None else ()
     return TimedPath(t=out[0], q=out[1], qd=out[2], qdd=out[3], duration=base * k,
                      velocity=v, acceleration=a, joint_names=names, jerk=jk, method="ruckig")
+
+
+def _path_bounds(spline: Any, s: np.ndarray, v: np.ndarray, a: np.ndarray,
+                 jk: np.ndarray) -> tuple[float, float, float]:
+    """The bounds V, A, J on ṡ, |s̈|, |s⃛| that keep every joint inside v, a, jk.
+
+    The formulas of :func:`jerk_limited` with D1, D2, D3 the largest |q′|, |q″|, |q‴| of
+    ``spline`` (a cubic spline over the knots ``s`` (m,)): q′ and q″ are polynomials of
+    degree 2 and 1 on each knot interval, q‴ a constant, so their largest values are
+    taken from 8 points an interval (the final check of the timing covers the rest).
+    """
+    grid = (s[:-1, None] + np.diff(s)[:, None] * np.linspace(0.0, 1.0, 8)).ravel()
+    D1, D2, D3 = (np.abs(spline(grid, k)).max(axis=0) for k in (1, 2, 3))
+    V = min(_ratio(v, D1), _ratio(a, 2.0 * D2, 0.5), _ratio(jk, 3.0 * D3, 1.0 / 3.0))
+    A = min(_ratio(a - D2 * V * V, D1), _ratio(jk, 9.0 * D2 * V))
+    J = _ratio(jk - 3.0 * D2 * V * A - D3 * V ** 3, D1)
+    return V, A, J
+
+
+def _ruckig_profile(rk: Any, length: float, V: float, A: float, J: float) -> Any:
+    """Ruckig's time-optimal rest-to-rest trajectory of s from 0 to ``length``.
+
+    Raises:
+        SerialkinError: ruckig found none.
+    """
+    inp = rk.InputParameter(1)
+    inp.current_position, inp.target_position = [0.0], [length]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [V], [A], [J]
+    traj = rk.Trajectory(1)
+    result = rk.Ruckig(1).calculate(inp, traj)
+    if result not in (rk.Result.Working, rk.Result.Finished):
+        raise SerialkinError(f"ruckig found no trajectory ({result}) along a path of length "
+                             f"{length:.4g} with bounds ṡ ≤ {V:.4g}, |s̈| ≤ {A:.4g}, "
+                             f"|s⃛| ≤ {J:.4g}")
+    return traj
+
+
+def _joint_states(traj: Any, spline: Any, length: float, times: np.ndarray,
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """q, q̇, q̈ (k, n) at ``times`` (k,) [s] of the profile s(t) ``traj`` along ``spline``.
+
+    ``q̇ = q′ ṡ`` and ``q̈ = q″ ṡ² + q′ s̈``, s clipped to [0, ``length``].
+    """
+    x = np.array([traj.at_time(float(t)) for t in times])[:, :, 0]   # (k, 3): s, ṡ, s̈
+    d1 = spline(np.clip(x[:, 0], 0.0, length), 1)
+    return (spline(np.clip(x[:, 0], 0.0, length)), d1 * x[:, 1:2],
+            spline(np.clip(x[:, 0], 0.0, length), 2) * x[:, 1:2] ** 2 + d1 * x[:, 2:3])
 
 
 def _ratio(num: np.ndarray, den: np.ndarray, power: float = 1.0) -> float:

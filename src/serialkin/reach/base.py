@@ -168,6 +168,78 @@ def _task_poses(tasks: object) -> np.ndarray:
     return a
 
 
+def _check_spatial(robot: Robot) -> None:
+    """Refuse what is not a spatial robot (base placement is on a floor plane).
+
+    Raises:
+        InputTypeError: not a Robot.
+        InputError: a planar robot.
+    """
+    check_robot(robot)
+    if robot.is_planar:
+        raise InputError("base_placement places a spatial robot on a floor plane; "
+                         f"{robot.name!r} is planar")
+
+
+def _candidate_grid(robot: Robot, T: np.ndarray, region: object, res: float, yaws: int,
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The candidates' floor coordinates xs (nx,), ys (ny,) [m] and headings (yaws,) [rad].
+
+    The grid of spacing ``res`` covering the floor box (:func:`_floor_box`), headings
+    ``2πj/yaws``.
+
+    Raises:
+        BudgetError: too many candidates × tasks for the memory budget.
+    """
+    box = _floor_box(robot, T, region)
+    ix = (math.floor(box[0, 0] / res), math.ceil(box[0, 1] / res) + 1)
+    iy = (math.floor(box[1, 0] / res), math.ceil(box[1, 1] / res) + 1)
+    K = (ix[1] - ix[0]) * (iy[1] - iy[0]) * yaws
+    check_allocation("the base-placement targets", (K, T.shape[0], 16), 8,
+                     setting="resolution / region")
+    return np.arange(*ix) * res, np.arange(*iy) * res, 2.0 * math.pi * np.arange(yaws) / yaws
+
+
+def _reach_candidates(robot: Robot, task: str, rel: np.ndarray, sol: str,
+                      q0: np.ndarray | None, opts: dict[str, Any], shapes: Any,
+                      binv: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """Which relative targets are reached (K·M,) bool, and the manipulability there (K·M,).
+
+    ``rel`` (K·M, 4, 4) holds the task poses in each candidate's frame (candidates
+    slowest); ``opts`` the keywords of :func:`solve_targets`. With a scene (``shapes``
+    not None), ``binv`` (K, 4, 4) holds each candidate's ``B⁻¹``.
+    """
+    targets = rel if task == "pose" else np.ascontiguousarray(rel[:, :3, 3])
+    ok, _, w = solve_targets(robot, task, targets, sol, q0=q0, **opts)
+    if shapes is not None:
+        # The scene stands still in the world: moved into each candidate's frame, it is
+        # checked candidate by candidate, on the targets reached without it (a scene only
+        # removes solutions of the closed form; the numerical IK solves them again).
+        K = binv.shape[0]
+        M = ok.size // K
+        for c in np.flatnonzero(ok.reshape(K, M).any(axis=1)):
+            rows = c * M + np.flatnonzero(ok[c * M:(c + 1) * M])
+            ok[rows], _, w[rows] = solve_targets(
+                robot, task, targets[rows], sol, q0=None if q0 is None else q0[rows],
+                scene=scene_in_frame(shapes, binv[c]), **opts)
+    return ok, w
+
+
+def _rank_candidates(ok: np.ndarray, w: np.ndarray, margin: np.ndarray,
+                     ) -> tuple[np.ndarray, np.ndarray, int]:
+    """Reached counts (K,), dexterity (K,) and the index of the best candidate.
+
+    ``ok``, ``w`` and ``margin`` are (K, M). The best reaches the most task poses, then
+    has the largest smallest margin, then the largest median margin, then the largest
+    dexterity (the smallest manipulability over the reached poses).
+    """
+    reached = ok.sum(axis=1)
+    dex = np.where(ok, w, 0.0).min(axis=1)
+    best = int(np.lexsort((-dex, -np.median(margin, axis=1), -margin.min(axis=1),
+                           -reached))[0])
+    return reached, dex, best
+
+
 def base_placement(robot: Robot, tasks: object, *, resolution: float = 0.1, yaws: int = 8,
                    region: object = None, floor_z: float = 0.0, solver: str = "auto",
                    restarts: int = 5, tol: float = 1e-6, seed: int = 0,
@@ -215,10 +287,7 @@ def base_placement(robot: Robot, tasks: object, *, resolution: float = 0.1, yaws
             ``reach_map`` (each difference named).
         BudgetError: too many candidates × tasks for the memory budget.
     """
-    check_robot(robot)
-    if robot.is_planar:
-        raise InputError("base_placement places a spatial robot on a floor plane; "
-                         f"{robot.name!r} is planar")
+    _check_spatial(robot)
     T = _task_poses(tasks)
     floor_z = check_real(floor_z, "floor_z", max_abs=1e6, unit="m")
     res = check_positive(resolution, "resolution")
@@ -229,41 +298,21 @@ def base_placement(robot: Robot, tasks: object, *, resolution: float = 0.1, yaws
     shapes = _scene_list(scene)
     collision = check_collision_options(robot, self_collision, acm, clearance, shapes)
     task = "pose" if robot.n >= 6 else "position"
-    box = _floor_box(robot, T, region)
-    ix = (math.floor(box[0, 0] / res), math.ceil(box[0, 1] / res) + 1)
-    iy = (math.floor(box[1, 0] / res), math.ceil(box[1, 1] / res) + 1)
-    M = T.shape[0]
-    K = (ix[1] - ix[0]) * (iy[1] - iy[0]) * yaws
-    check_allocation("the base-placement targets", (K, M, 16), 8, setting="resolution / region")
-    xs = np.arange(*ix) * res
-    ys = np.arange(*iy) * res
-    psi = 2.0 * math.pi * np.arange(yaws) / yaws
+    xs, ys, psi = _candidate_grid(robot, T, region, res, yaws)
+    M, K = T.shape[0], xs.size * ys.size * yaws
     sol = resolve_solver(robot, task, solver)
     numerical = NumericalOptions(check_int(restarts, "restarts", minimum=0),
                                  check_positive(tol, "tol"))
     rmap = _margin_map(robot, task, collision, reach_map, map_resolution or res,
                        map_orientations, sol, numerical, seed, progress)
     rel = _relative_targets(T, xs, ys, psi, float(floor_z))
-    targets = rel if task == "pose" else np.ascontiguousarray(rel[:, :3, 3])
     q0 = voxel_starts(robot, seed, 0, K, M) if sol == "numerical" else None
     opts = {"seed": restart_seed(seed), "numerical": numerical, "collision": collision}
-    ok, _, w = solve_targets(robot, task, targets, sol, q0=q0, **opts)
-    if shapes is not None:
-        # The scene stands still in the world: moved into each candidate's frame, it is
-        # checked candidate by candidate, on the targets reached without it (a scene only
-        # removes solutions of the closed form; the numerical IK solves them again).
-        binv = _base_inverses(xs, ys, psi, float(floor_z))
-        for c in np.flatnonzero(ok.reshape(K, M).any(axis=1)):
-            rows = c * M + np.flatnonzero(ok[c * M:(c + 1) * M])
-            ok[rows], _, w[rows] = solve_targets(
-                robot, task, targets[rows], sol, q0=None if q0 is None else q0[rows],
-                scene=scene_in_frame(shapes, binv[c]), **opts)
+    binv = None if shapes is None else _base_inverses(xs, ys, psi, float(floor_z))
+    ok, w = _reach_candidates(robot, task, rel, sol, q0, opts, shapes, binv)
     ok, w = ok.reshape(K, M), w.reshape(K, M)
     margin = np.where(ok, edge_margin(rmap, rel[:, :3, 3]).reshape(K, M), 0.0)
-    reached = ok.sum(axis=1)
-    dex = np.where(ok, w, 0.0).min(axis=1)
-    best = int(np.lexsort((-dex, -np.median(margin, axis=1), -margin.min(axis=1),
-                           -reached))[0])
+    reached, dex, best = _rank_candidates(ok, w, margin)
     shape = (xs.size, ys.size, yaws)
     i, j, k = (int(v) for v in np.unravel_index(best, shape))
     return BasePlacement(xs, ys, psi, float(floor_z), reached.reshape(shape),

@@ -7,11 +7,13 @@ link frames as RGB triads (x red, y green, z blue). Planar robots
 (:attr:`~serialkin.Robot.is_planar`) are drawn in the world xy plane on ordinary 2D axes,
 every other robot on 3D axes.
 
-Obstacles are duck-typed so that the shapes of :mod:`serialkin.model.geometry` and
-plain dicts both work: anything with a ``center`` (or ``centre``) and a ``radius`` is a
-circle (2D) or a sphere (3D); with a ``height`` too it is a vertical cylinder (the chapter's
-Figure 10 model, drawn as a circle in 2D); with two end points (``a``/``b``, ``p0``/``p1``
-or ``start``/``end``) and a ``radius`` it is a capsule.
+Obstacles are the shapes of :mod:`serialkin.model.geometry` (a sphere, a vertical
+cylinder, a capsule), each drawn through an :class:`Obstacle` that holds it.
+:func:`as_obstacle` is the boundary: it also reads plain dicts and duck-typed objects, where
+anything with a ``center`` (or ``centre``) and a ``radius`` is a circle (2D) or a sphere
+(3D); with a ``height`` too it is a vertical cylinder (the chapter's Figure 10 model, drawn
+as a circle in 2D); with two end points (``a``/``b``, ``p0``/``p1`` or ``start``/``end``)
+and a ``radius`` it is a capsule.
 
 Lengths are in metres, angles in radians. matplotlib is imported lazily inside the
 functions, so importing :mod:`serialkin` never requires it.
@@ -19,6 +21,8 @@ functions, so importing :mod:`serialkin` never requires it.
 
 from __future__ import annotations
 
+import math
+import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -27,6 +31,7 @@ import numpy as np
 
 from serialkin._checks import as_float_array, check_positive
 from serialkin.errors import InputError, InputTypeError
+from serialkin.model.geometry import Capsule, Cylinder, Sphere
 from serialkin.model.robot import robot_scale  # noqa: F401  (public here too)
 
 if TYPE_CHECKING:
@@ -289,30 +294,88 @@ def _draw_triad(ax: Any, T: np.ndarray, size: float, two_d: bool, alpha: float, 
 
 
 # ---------------------------------------------------------------------- obstacles and paths
-@dataclass(frozen=True)
+#: The shapes of :mod:`serialkin.model.geometry` the figures and the viewer draw.
+Drawable = Sphere | Cylinder | Capsule
+
+
+@dataclass(frozen=True, init=False)
 class Obstacle:
-    """A normalised obstacle shape for drawing.
+    """A shape of :mod:`serialkin.model.geometry` as the figures and the viewer draw it.
+
+    It holds the shape and describes nothing again: every attribute below is read from
+    ``shape``. A cylinder is drawn vertical (its axis along the world z) about its
+    ``center``.
+
+    ``Obstacle(shape)`` wraps a :class:`~serialkin.model.geometry.Sphere`,
+    :class:`~serialkin.model.geometry.Cylinder` or :class:`~serialkin.model.geometry.Capsule`;
+    :func:`as_obstacle` builds one from any accepted form. The old form
+    ``Obstacle(kind, center, radius, height, a, b, influence, name)`` still builds the
+    shape for one release, with a ``DeprecationWarning``.
 
     Attributes:
-        kind: 'sphere', 'cylinder' (vertical, axis along world z, centred at ``center``;
-            a circle in 2D) or 'capsule' (segment a-b swept by ``radius``).
-        center: (3,) centre [m] (capsule: midpoint of a-b).
-        radius: radius [m].
-        height: cylinder height [m] (None: infinite, drawn as tall as the scene needs).
-        a: (3,) capsule start point [m] or None.
-        b: (3,) capsule end point [m] or None.
-        influence: distance of influence beyond the surface [m] (Figure 10), 0 if none.
-        name: label.
+        shape: the geometry shape drawn.
+
+    Raises:
+        InputTypeError: ``shape`` is not a Sphere, Cylinder or Capsule.
     """
 
-    kind: str
-    center: np.ndarray
-    radius: float
-    height: float | None = None
-    a: np.ndarray | None = None
-    b: np.ndarray | None = None
-    influence: float = 0.0
-    name: str = ""
+    shape: Drawable
+
+    def __init__(self, shape: Drawable | str, *old: Any, **old_keywords: Any) -> None:
+        """Wrap ``shape`` (or build it from the deprecated field-by-field form)."""
+        if isinstance(shape, str):
+            warnings.warn("Obstacle(kind, center, radius, ...) is deprecated: pass the shape, "
+                          "Obstacle(Sphere(radius, center=...)), or call as_obstacle(...)",
+                          DeprecationWarning, stacklevel=2)
+            shape = _old_shape(shape, *old, **old_keywords)
+        elif old or old_keywords:
+            raise InputTypeError("Obstacle takes one geometry shape, got more arguments")
+        if not isinstance(shape, Sphere | Cylinder | Capsule):
+            raise InputTypeError(f"Obstacle: expected a Sphere, Cylinder or Capsule of "
+                                 f"serialkin.model.geometry, got {type(shape).__name__}")
+        object.__setattr__(self, "shape", shape)
+
+    @property
+    def kind(self) -> str:
+        """'sphere', 'cylinder' (vertical; a circle in 2D) or 'capsule'."""
+        return self.shape.kind
+
+    @property
+    def center(self) -> np.ndarray:
+        """(3,) centre [m] (a capsule: the midpoint of a-b)."""
+        return self.shape.center
+
+    @property
+    def radius(self) -> float:
+        """Radius [m]."""
+        return self.shape.radius
+
+    @property
+    def height(self) -> float | None:
+        """A cylinder's height [m]; None when infinite (drawn as tall as the scene needs)."""
+        if isinstance(self.shape, Cylinder) and math.isfinite(self.shape.length):
+            return self.shape.length
+        return None
+
+    @property
+    def a(self) -> np.ndarray | None:
+        """(3,) a capsule's start point [m], else None."""
+        return self.shape.a if isinstance(self.shape, Capsule) else None
+
+    @property
+    def b(self) -> np.ndarray | None:
+        """(3,) a capsule's end point [m], else None."""
+        return self.shape.b if isinstance(self.shape, Capsule) else None
+
+    @property
+    def influence(self) -> float:
+        """Distance of influence beyond the surface [m] (Figure 10)."""
+        return self.shape.influence
+
+    @property
+    def name(self) -> str:
+        """Label."""
+        return self.shape.name
 
     def extent_points(self) -> np.ndarray:
         """Points whose bounding box holds the obstacle's cross-section, for axis limits.
@@ -323,6 +386,21 @@ class Obstacle:
         ends = [self.center] if self.a is None else [self.a, self.b]
         offsets = self.radius * np.vstack([np.eye(3), -np.eye(3)])
         return np.vstack([c[None] + offsets for c in ends])
+
+
+def _old_shape(kind: str, center: object, radius: float, height: float | None = None,
+               a: object = None, b: object = None, influence: float = 0.0,
+               name: str = "") -> Drawable:
+    """The shape of the deprecated ``Obstacle(kind, center, radius, ...)`` fields."""
+    label = {"influence": influence, "name": name}
+    if kind == "capsule":
+        return Capsule(radius, a=a, b=b, **label)
+    if kind == "cylinder":
+        return Cylinder(radius, math.inf if height is None else height, center=center,
+                        **label)
+    if kind == "sphere":
+        return Sphere(radius, center=center, **label)
+    raise InputError(f"Obstacle kind must be one of sphere, cylinder, capsule, got {kind!r}")
 
 
 _ENDPOINT_NAMES = (("a", "b"), ("p0", "p1"), ("start", "end"), ("p1", "p2"))
@@ -370,22 +448,55 @@ def _kind_of(obj: object, name: str) -> str | None:
     return kind
 
 
-def as_obstacle(obj: object, name: str = "obstacle") -> Obstacle:
-    """Normalise an obstacle object or dict to :class:`Obstacle`.
+def _capsule_of(obj: object, r: float, label: dict[str, Any], name: str) -> Drawable | None:
+    """The capsule (a sphere when its ends meet) of an object with end points, else None."""
+    for na, nb in _ENDPOINT_NAMES:
+        pa, pb = _field(obj, (na,)), _field(obj, (nb,))
+        if pa is not None and pb is not None and not isinstance(pa, (int, float, str)):
+            a = _point3(pa, f"{name}.{na}")
+            b = _point3(pb, f"{name}.{nb}")
+            if np.allclose(a, b, rtol=0.0, atol=1e-12):
+                return Sphere(r, center=a, **label)
+            return Capsule(r, a=a, b=b, **label)
+    return None
 
-    Works with the shapes of :mod:`serialkin.model.geometry` (``Cylinder`` of infinite
-    length: a vertical cylinder; ``Sphere``; ``Capsule``), their scenario-file form
-    (:func:`serialkin.redundancy.obstacles.obstacle_to_dict`) and plain dicts.
+
+def _height_of(obj: object, name: str) -> float | None:
+    """A vertical cylinder's height [m] (inf: infinite), None when ``obj`` names none.
+
+    A :class:`~serialkin.model.geometry.Cylinder` gives its ``length``; other objects a
+    ``height``/``h`` field (a non-finite one: infinite).
+    """
+    if isinstance(obj, Cylinder):
+        return obj.length
+    height = _field(obj, ("height", "h"))
+    if height is None:
+        return None
+    h = float(height)
+    if not np.isfinite(h):
+        return math.inf
+    return check_positive(h, f"{name}.height", allow_zero=True)
+
+
+def as_obstacle(obj: object, name: str = "obstacle") -> Obstacle:
+    """Normalise an obstacle object or dict to an :class:`Obstacle` (a geometry shape).
+
+    Works with the shapes of :mod:`serialkin.model.geometry` (``Cylinder``: a vertical
+    cylinder of its length, ``math.inf`` for an infinite one; ``Sphere``; ``Capsule``),
+    their scenario-file form (:func:`serialkin.redundancy.obstacles.obstacle_to_dict`) and
+    plain dicts.
     Accepted fields (attributes or mapping keys): ``center``/``centre``/``position`` (2 or 3
     coordinates; z = 0 when 2), ``radius`` (> 0), optional ``height`` (a vertical cylinder
     of that height), capsule end points ``a``/``b`` (or ``p0``/``p1``, ``start``/``end``),
     ``kind``/``type``/``shape`` ('circle' = 'cylinder', 'sphere', 'capsule', or the integer
-    codes 0, 1, 2), ``influence`` [m] and ``name``. Without a kind, a 2-coordinate centre
-    is a circle (infinite cylinder along z) and a 3-coordinate centre a sphere.
+    codes 0, 1, 2), ``influence`` [m] (default 0, a geometry shape's own) and ``name``.
+    Without a kind, a 2-coordinate centre is a circle (infinite cylinder along z) and a
+    3-coordinate centre a sphere.
 
     Raises:
         InputTypeError: ``obj`` has no radius or no centre.
-        InputError: bad coordinates, a non-positive radius or an unknown kind.
+        InputError: bad coordinates, a non-positive radius, a negative height or an
+            unknown kind.
     """
     if isinstance(obj, Obstacle):
         return obj
@@ -398,17 +509,12 @@ def as_obstacle(obj: object, name: str = "obstacle") -> Obstacle:
     r = check_positive(radius, f"{name}.radius")
     kind = _kind_of(obj, name)
     infl = _field(obj, ("influence",))
-    influence = 0.0 if infl is None else check_positive(infl, f"{name}.influence",
-                                                         allow_zero=True)
-    label = str(_field(obj, ("name",)) or "")
-    for na, nb in _ENDPOINT_NAMES:
-        pa, pb = _field(obj, (na,)), _field(obj, (nb,))
-        if pa is not None and pb is not None and not isinstance(pa, (int, float, str)):
-            a = _point3(pa, f"{name}.{na}")
-            b = _point3(pb, f"{name}.{nb}")
-            if np.allclose(a, b, rtol=0.0, atol=1e-12):
-                return Obstacle("sphere", a, r, influence=influence, name=label)
-            return Obstacle("capsule", (a + b) / 2, r, None, a, b, influence, label)
+    label = {"influence": 0.0 if infl is None else check_positive(
+                 infl, f"{name}.influence", allow_zero=True),
+             "name": str(_field(obj, ("name",)) or "")}
+    capsule = _capsule_of(obj, r, label, name)
+    if capsule is not None:
+        return Obstacle(capsule)
     if kind == "capsule":
         raise InputTypeError(f"{name} is a capsule but has no end points 'a' and 'b'")
     centre = _field(obj, ("center", "centre", "position", "c"))
@@ -416,14 +522,13 @@ def as_obstacle(obj: object, name: str = "obstacle") -> Obstacle:
         raise InputTypeError(f"{name} has a radius but no 'center': {obj!r}"[:200])
     c_raw = as_float_array(centre, f"{name}.center")
     c = _point3(c_raw, f"{name}.center")
-    height = _field(obj, ("height", "h"))
-    if height is not None:
-        h = float(height)
-        return Obstacle("cylinder", c, r, h if np.isfinite(h) else None, influence=influence,
-                        name=label)
-    if kind is None:
+    height = _height_of(obj, name)
+    if height is None and kind is None:
         kind = "cylinder" if c_raw.shape == (2,) else "sphere"
-    return Obstacle(kind, c, r, influence=influence, name=label)
+    if height is not None or kind == "cylinder":
+        return Obstacle(Cylinder(r, math.inf if height is None else height, center=c,
+                                 **label))
+    return Obstacle(Sphere(r, center=c, **label))
 
 
 def plot_obstacles(

@@ -178,7 +178,8 @@ class Scene:
             points get z = 0 in the page).
         obstacles: obstacle objects or dicts (see :func:`serialkin.viz.plot.as_obstacle`):
             spheres, vertical cylinders, capsules; stored as a tuple of
-            :class:`~serialkin.viz.plot.Obstacle`.
+            :class:`~serialkin.viz.plot.Obstacle`, each holding its
+            :mod:`~serialkin.model.geometry` shape (``.shape``).
         collision: the capsule model checked and drawn: None = :attr:`Robot.collision`
             (if any), a :class:`~serialkin.model.collision_model.CollisionModel`, or False
             for none (True requires the robot's own).

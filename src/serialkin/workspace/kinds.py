@@ -169,21 +169,50 @@ def _seed_value(seed: Any) -> int | None:
     return int(seed) if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) else None
 
 
-def _finish(robot: Any, kind: str, planar: bool, Q: np.ndarray, P: np.ndarray,
-            w: np.ndarray | None, samples: int, seed: Any, cell: float | None,
-            resolution: int | None, params: dict[str, Any],
+@dataclass(frozen=True)
+class _Sampling:
+    """The keyword options every workspace kind shares (see :func:`reachable_workspace`).
+
+    Attributes:
+        samples: joint-space samples (None: the kind's default).
+        seed: ``None | int | Generator``.
+        cell: grid cell edge [m] (None: automatic).
+        resolution: cells along the largest extent (None: the default).
+        manipulability: also compute each sample's manipulability (eq 43).
+        planar: force 2D/3D (None: ``robot.is_planar``).
+        progress: progress bar (None: only on a terminal).
+    """
+
+    samples: int | None = None
+    seed: Any = 0
+    cell: float | None = None
+    resolution: int | None = None
+    manipulability: bool = False
+    planar: bool | None = None
+    progress: bool | None = None
+
+
+def _finish(robot: Any, kind: str, planar: bool,
+            kept: tuple[np.ndarray, np.ndarray, np.ndarray | None], drawn: int,
+            how: _Sampling, params: dict[str, Any],
             grid: OccupancyGrid | None = None) -> Workspace:
+    """The :class:`Workspace` of the samples ``kept`` = (q (N, n), points (N, 3), w or None).
+
+    ``drawn`` joint-space samples were drawn with ``how.seed``; the grid is ``grid`` or
+    one of ``how.cell`` / ``how.resolution`` over the points (xy only when ``planar``).
+    """
+    Q, P, w = kept
     pts = P[:, :2] if planar else P
     if grid is None:
-        h = _cell_size(pts, cell, resolution, planar)
+        h = _cell_size(pts, how.cell, how.resolution, planar)
         if pts.shape[0]:
             grid = occupancy_grid(pts, h)
         else:
             grid = OccupancyGrid(lower=np.zeros(pts.shape[1]), cell=h,
                                  counts=np.zeros((1,) * pts.shape[1], dtype=np.int64))
     return Workspace(kind=kind, robot_name=robot.name, planar=planar, points=pts, q=Q,
-                     manipulability=w, grid=grid, estimate=grid.measure(), samples=samples,
-                     seed=_seed_value(seed), params=params)
+                     manipulability=w, grid=grid, estimate=grid.measure(), samples=drawn,
+                     seed=_seed_value(how.seed), params=params)
 
 
 def _default_samples(samples: int | None, planar: bool) -> int:
@@ -227,8 +256,9 @@ def reachable_workspace(robot: Any, samples: int | None = None, *, seed: Any = 0
     Q = sample_configurations(robot, N, as_generator(seed) if seed is not None else None)
     task = manipulability_task(robot, pl) if manipulability else None
     S = evaluate(robot, Q, manipulability=task, progress=progress, desc="workspace")
-    return _finish(robot, "reachable", pl, Q, S.position, S.manipulability, N, seed, cell,
-                   resolution, {"manipulability_task": task})
+    return _finish(robot, "reachable", pl, (Q, S.position, S.manipulability), N,
+                   _Sampling(seed=seed, cell=cell, resolution=resolution),
+                   {"manipulability_task": task})
 
 
 def _oriented_samples(robot: Any, R_t: np.ndarray, max_angle: float, N: int, rng: Any,
@@ -265,8 +295,9 @@ def constant_orientation_workspace(robot: Any, orientation: object, samples: int
         planar: force 2D/3D (default: ``robot.is_planar``).
         progress: progress bar (None: only on a terminal).
     """
-    return _orientation_range_workspace(robot, "constant", orientation, None, samples, seed,
-                                        cell, resolution, manipulability, planar, progress)
+    return _orientation_range_workspace(
+        robot, "constant", orientation, None,
+        _Sampling(samples, seed, cell, resolution, manipulability, planar, progress))
 
 
 def inclusive_orientation_workspace(robot: Any, orientation: object, max_angle: float,
@@ -295,21 +326,18 @@ def inclusive_orientation_workspace(robot: Any, orientation: object, max_angle: 
         planar: force 2D/3D (default: ``robot.is_planar``).
         progress: progress bar (None: only on a terminal).
     """
-    return _orientation_range_workspace(robot, "inclusive", orientation, max_angle, samples,
-                                        seed, cell, resolution, manipulability, planar,
-                                        progress)
+    return _orientation_range_workspace(
+        robot, "inclusive", orientation, max_angle,
+        _Sampling(samples, seed, cell, resolution, manipulability, planar, progress))
 
 
 def _orientation_range_workspace(robot: Any, kind: str, orientation: object,
-                                 max_angle: float | None, samples: int | None, seed: Any,
-                                 cell: float | None, resolution: int | None,
-                                 manipulability: bool, planar: bool | None,
-                                 progress: bool | None) -> Workspace:
+                                 max_angle: float | None, how: _Sampling) -> Workspace:
     """Body of the constant- (``max_angle`` None, i.e. 0) and inclusive-orientation kinds.
 
     Keeps the samples projected onto ``{q : angle(R_target R(q)ᵀ) ≤ max_angle}``.
     """
-    pl = _is_planar(robot, planar)
+    pl = _is_planar(robot, how.planar)
     R_t = _target_rotation(orientation, pl)
     params: dict[str, Any] = {"orientation": R_t}
     ma = 0.0
@@ -318,14 +346,14 @@ def _orientation_range_workspace(robot: Any, kind: str, orientation: object,
         if ma > np.pi:
             raise InputError(f"max_angle must be in [0, π] rad, got {max_angle!r}")
         params["max_angle"] = ma
-    N = _default_samples(samples, pl)
-    task = manipulability_task(robot, pl) if manipulability else None
-    Q, P, w = _oriented_samples(robot, R_t, ma, N, as_generator(seed), pl, task, progress,
-                                f"{kind} orientation")
+    N = _default_samples(how.samples, pl)
+    task = manipulability_task(robot, pl) if how.manipulability else None
+    kept = _oriented_samples(robot, R_t, ma, N, as_generator(how.seed), pl, task,
+                             how.progress, f"{kind} orientation")
     params["manipulability_task"] = task
     if pl:
         params["phi"] = float(np.arctan2(R_t[1, 0], R_t[0, 0]))
-    return _finish(robot, kind, pl, Q, P, w, N, seed, cell, resolution, params)
+    return _finish(robot, kind, pl, kept, N, how, params)
 
 
 def _orientation_set(orientations: int | Sequence[object], planar: bool, rng: Any
@@ -436,9 +464,10 @@ def _intersect_orientations(robot: Any, sampled: dict[str, Any], margin: float,
     params = {"orientations": np.array(Rs), "min_manipulability": w_min,
               "singularity_margin": margin if min_manipulability is None else None,
               "samples_per_orientation": per, "manipulability_task": task}
+    how = _Sampling(seed=seed, cell=cell, resolution=resolution)
     if all_pts.shape[0] == 0:
-        return _finish(robot, kind, pl, np.zeros((0, robot.n)), np.zeros((0, 3)), np.zeros(0),
-                       per * K, seed, cell, resolution, params)
+        return _finish(robot, kind, pl, (np.zeros((0, robot.n)), np.zeros((0, 3)), np.zeros(0)),
+                       per * K, how, params)
     if grid is not None:
         if grid.dim != dim:
             raise InputError(f"grid must be {dim}-dimensional for this robot, got {grid.dim}D")
@@ -460,8 +489,8 @@ def _intersect_orientations(robot: Any, sampled: dict[str, Any], margin: float,
     idx, inside = grid.index(Pa[:, :dim])
     keep = inside.copy()
     keep[inside] = grid.occupied[tuple(idx[inside].T)]
-    ws = _finish(robot, kind, pl, Qa[keep], Pa[keep], wa[keep], per * K, seed, cell,
-                 resolution, params, grid=grid)
+    ws = _finish(robot, kind, pl, (Qa[keep], Pa[keep], wa[keep]), per * K, how, params,
+                 grid=grid)
     # the intersection's own Chao1 count does not see misses of single orientations
     est = ws.estimate
     vol = h ** dim

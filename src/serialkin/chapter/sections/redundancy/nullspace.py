@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from serialkin.chapter._context import Html, ReportContext, Section
@@ -125,27 +127,9 @@ def _nullspace_part(ctx: ReportContext) -> Section:
                    part="Null-space methods", equations="eqs 42-45 (44 corrected)", html=body)
 
 
-def _six_link_part(ctx: ReportContext) -> Section:
-    import dataclasses
-    import inspect
-
-    import matplotlib.pyplot as plt
-
-    from serialkin.tracking.tracker import track
-    from serialkin.viz import plot_joint_trajectories, plot_motion
-
-    sa = load_scenario("six_link_circle")
-    ta, t_a = timed_run(ctx, sa, repeat=15)
-    cap = float(sa.options.get("max_step", inspect.signature(track).parameters["max_step"]
-                               .default))
-    # the same run with the cap doubled and with no effective cap: does the branch change?
-    other = {c: dataclasses.replace(sa, options={**sa.options, "max_step": c}).run()
-             for c in (2 * cap, 100.0)}
-    branch = {c: float(np.abs(tr.q - ta.q).max()) * DEG for c, tr in other.items()}
-    reached = f"{int(ta.reached.sum())} / {len(sa.path)}"
-    max_err = f"{ta.max_error * 1e3:.4g}"
-    total_it = str(int(ta.iterations.sum()))
-    parts = [
+def _six_link_algorithm(ctx: ReportContext, sa: Any) -> str:
+    """The DLS step (eq 46, corrected) and the chapter's 6-link algorithm, steps corrected."""
+    return (
         "<p>Damped least squares (the Levenberg-Marquardt step); <b>eq 46 and the 6-link "
         "algorithm are corrected</b> (ERRATA): the chapter prints "
         + ctx.imath(r"\mathbf{J}^{T}(\mathbf{J}^{T} + \lambda^2\mathbf{I})^{-1}")
@@ -170,7 +154,15 @@ def _six_link_part(ctx: ReportContext) -> Section:
             (1, "END WHILE"),
             (0, "END FOR"),
         ], "<p>The chapter prints step 7 as Δq = q + Jᵀ(JJᵀ + λ²I)⁻¹Δx and step 8 as "
-           "q = Δq (ERRATA).</p>"),
+           "q = Δq (ERRATA).</p>"))
+
+
+def _six_link_setup(sa: Any, cap: float, branch: dict[float, float]) -> str:
+    """The scenario's parameters and what the step cap ``cap`` [rad] decides.
+
+    ``branch`` maps another cap [rad] to the largest joint difference [deg] it makes.
+    """
+    return (
         "<p>Scenario <code>six_link_circle</code>: six links of L = 100 mm, circle of centre "
         "(−2.5L, 0) and radius L, φ from 0 to 2π in steps of 0.2 (32 points), q0 = 0 (the "
         f"stretched arm, drawn dashed in Figure 8), λ = {sa.options.get('damping', 0.02):g} m "
@@ -184,21 +176,21 @@ def _six_link_part(ctx: ReportContext) -> Section:
         "way the arm folds, and with it which branch the joint curves of Figure 9 follow: "
         f"with the cap at {2 * cap:g} rad the joint trajectory differs from the one shown by "
         f"up to {branch[2 * cap]:.1f}°, without an effective cap (100 rad) by up to "
-        f"{branch[100.0]:.1f}°.</p>",
-        ctx.table([
-            ("path points reached within ±5 mm", reached),
-            ("largest tracking error", f"{max_err} mm"),
-            ("iterations (first point / median of the others / in all)",
-             f"{ta.iterations[0]} / {int(np.median(ta.iterations[1:]))} / {total_it}"),
-            ("time for the whole path (compiled loop)", t_a.text),
-        ], ["quantity", "value"]),
-    ]
+        f"{branch[100.0]:.1f}°.</p>")
+
+
+def _six_link_figures(ctx: ReportContext, sa: Any, ta: Any, cap: float) -> list[str]:
+    """Figures 8 (the motion) and 9 (the joint angles) of the run ``ta``, and its GIF."""
+    import matplotlib.pyplot as plt
+
+    from serialkin.viz import plot_joint_trajectories, plot_motion
+
     fig, ax = plt.subplots(figsize=(7.5, 4.6))
     plot_motion(sa.robot, ta.q, ax, path_points=sa.path.points, every=2, q0=sa.q0,
                 title="Figure 8: six-link arm tracking the circle (DLS)")
-    parts.append(ctx.figure(fig, "fig08_six_link_motion",
-                            "Figure 8 — motion of the six-link arm from the stretched start "
-                            "pose q0 = 0 (dashed); the circle in green."))
+    parts = [ctx.figure(fig, "fig08_six_link_motion",
+                        "Figure 8 — motion of the six-link arm from the stretched start "
+                        "pose q0 = 0 (dashed); the circle in green.")]
     fig, ax = plt.subplots(figsize=(7.5, 4.0))
     plot_joint_trajectories(ta.q, sa.path.parameter, ax, robot=sa.robot, xlabel="φ [rad]",
                             title="Figure 9: variations of the joint angles")
@@ -208,6 +200,39 @@ def _six_link_part(ctx: ReportContext) -> Section:
                             "singular start (see the step cap above)."))
     parts.append(_gif(ctx, sa.robot, ta, "fig08_six_link", "Six-link arm tracking the circle",
                       frames=32))
+    return parts
+
+
+def _six_link_part(ctx: ReportContext) -> Section:
+    """The six-link example: the DLS algorithm, the run, its table and Figures 8 and 9."""
+    import dataclasses
+    import inspect
+
+    from serialkin.tracking.tracker import track
+
+    sa = load_scenario("six_link_circle")
+    ta, t_a = timed_run(ctx, sa, repeat=15)
+    cap = float(sa.options.get("max_step", inspect.signature(track).parameters["max_step"]
+                               .default))
+    # the same run with the cap doubled and with no effective cap: does the branch change?
+    other = {c: dataclasses.replace(sa, options={**sa.options, "max_step": c}).run()
+             for c in (2 * cap, 100.0)}
+    branch = {c: float(np.abs(tr.q - ta.q).max()) * DEG for c, tr in other.items()}
+    reached = f"{int(ta.reached.sum())} / {len(sa.path)}"
+    max_err = f"{ta.max_error * 1e3:.4g}"
+    total_it = str(int(ta.iterations.sum()))
+    parts = [
+        _six_link_algorithm(ctx, sa),
+        _six_link_setup(sa, cap, branch),
+        ctx.table([
+            ("path points reached within ±5 mm", reached),
+            ("largest tracking error", f"{max_err} mm"),
+            ("iterations (first point / median of the others / in all)",
+             f"{ta.iterations[0]} / {int(np.median(ta.iterations[1:]))} / {total_it}"),
+            ("time for the whole path (compiled loop)", t_a.text),
+        ], ["quantity", "value"]),
+        *_six_link_figures(ctx, sa, ta, cap),
+    ]
     parts.append(ctx.reproduce("serialkin track six_link_circle --out out/track", shell=True,
                                expect=reached.split(" / ") + [max_err, total_it]))
     return Section(title="5.3 Kinematically redundant manipulators",
