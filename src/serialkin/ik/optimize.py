@@ -168,68 +168,89 @@ def minimize_attempt(
     from scipy.optimize import minimize
 
     scipy_method = SCIPY_METHODS[method]
-    n = q_start.shape[0]
-    J = np.empty((6, n))
-    T = np.empty((4, 4))
-    e = np.empty(6)
-    g = np.empty(n)
-    Tt = np.ascontiguousarray(T_target, dtype=np.float64)
-    wv = np.ascontiguousarray(w, dtype=np.float64)
-    best = {"cost": math.inf, "q": np.array(q_start, dtype=np.float64)}
-
-    def remember(x: np.ndarray, cost: float) -> None:
-        if cost < best["cost"] and math.isfinite(cost):
-            best["cost"] = cost
-            best["q"] = x.copy()
-
-    def check(x: np.ndarray) -> None:
-        ep, eo = selected_errors(x, F, meta, Tt, wv, T, e)
-        if ep <= tol and eo <= tol:
-            best["q"] = x.copy()
-            raise _Converged
-
-    if scipy_method == "L-BFGS-B":
-
-        def fun(x: np.ndarray) -> tuple[float, np.ndarray]:
-            x = np.ascontiguousarray(x, dtype=np.float64)
-            c = cost_and_gradient(x, F, meta, Tt, wv, J, T, e, g)
-            remember(x, c)
-            return c, g.copy()
-
-        options = {"maxiter": int(max_iter), "maxfun": 20 * int(max_iter) + 20,
-                   "maxcor": max(10, n), "ftol": 1e-30, "gtol": 1e-30}
-        jac = True
-    else:
-
-        def fun(x: np.ndarray) -> float:  # type: ignore[misc]
-            x = np.ascontiguousarray(x, dtype=np.float64)
-            c = cost_only(x, F, meta, Tt, wv, T, e)
-            remember(x, c)
-            return c
-
-        options = {"maxiter": int(max_iter), "maxfev": 20 * n * int(max_iter) + 20,
-                   "xtol": float(xtol), "ftol": 1e-30}
-        jac = False
-
+    run = _Attempt(F, meta, T_target, w, q_start, tol)
+    bfgs = scipy_method == "L-BFGS-B"
     iterations = 0
 
     def callback(intermediate_result: object) -> None:
         nonlocal iterations
         iterations += 1
-        check(np.ascontiguousarray(intermediate_result.x, dtype=np.float64))  # type: ignore[attr-defined]
+        run.check(np.ascontiguousarray(intermediate_result.x, dtype=np.float64))  # type: ignore[attr-defined]
 
-    bounds = _bounds(lo, hi) if bounded else None
     x0 = np.array(q_start, dtype=np.float64)
     try:
-        check(x0)
+        run.check(x0)
         with single_threaded_blas():
-            res = minimize(fun, x0, method=scipy_method, jac=jac, bounds=bounds,
-                           options=options, callback=callback)
+            res = minimize(run.cost_and_gradient if bfgs else run.cost, x0,
+                           method=scipy_method, jac=bfgs,
+                           bounds=_bounds(lo, hi) if bounded else None,
+                           options=_scipy_options(bfgs, q_start.shape[0], max_iter, xtol),
+                           callback=callback)
         iterations = max(iterations, int(getattr(res, "nit", iterations)))
-        remember(np.ascontiguousarray(res.x, dtype=np.float64), float(res.fun))
+        run.remember(np.ascontiguousarray(res.x, dtype=np.float64), float(res.fun))
     except _Converged:
         pass
-    q = best["q"]
+    q = run.best_q
     if project is not None:
         q = project(q)
     return q, iterations
+
+
+def _scipy_options(bfgs: bool, n: int, max_iter: int, xtol: float) -> dict[str, object]:
+    """The options scipy gets for L-BFGS-B (``bfgs``) or Powell.
+
+    The budgets of :func:`minimize_attempt`, and tolerances that never stop it first
+    (ours do: :meth:`_Attempt.check`).
+    """
+    if bfgs:
+        return {"maxiter": int(max_iter), "maxfun": 20 * int(max_iter) + 20,
+                "maxcor": max(10, n), "ftol": 1e-30, "gtol": 1e-30}
+    return {"maxiter": int(max_iter), "maxfev": 20 * n * int(max_iter) + 20,
+            "xtol": float(xtol), "ftol": 1e-30}
+
+
+class _Attempt:
+    """The cost functions scipy calls, the best configuration seen and the tolerance test.
+
+    Holds the workspace of the compiled cost kernels (``J`` (6, n), ``T`` (4, 4), ``e``
+    (6,), ``g`` (n,)) so that no evaluation allocates.
+    """
+
+    def __init__(self, F: np.ndarray, meta: np.ndarray, T_target: np.ndarray,
+                 w: np.ndarray, q_start: np.ndarray, tol: float) -> None:
+        n = q_start.shape[0]
+        self.F, self.meta, self.tol = F, meta, tol
+        self.Tt = np.ascontiguousarray(T_target, dtype=np.float64)
+        self.w = np.ascontiguousarray(w, dtype=np.float64)
+        self.J, self.T, self.e, self.g = np.empty((6, n)), np.empty((4, 4)), np.empty(6), \
+            np.empty(n)
+        self.best_cost = math.inf
+        self.best_q = np.array(q_start, dtype=np.float64)
+
+    def remember(self, x: np.ndarray, cost: float) -> None:
+        """Keep ``x`` when its cost is the lowest (finite) so far."""
+        if cost < self.best_cost and math.isfinite(cost):
+            self.best_cost = cost
+            self.best_q = x.copy()
+
+    def check(self, x: np.ndarray) -> None:
+        """Raise :class:`_Converged` (keeping ``x``) when ``x`` meets the tolerance."""
+        ep, eo = selected_errors(x, self.F, self.meta, self.Tt, self.w, self.T, self.e)
+        if ep <= self.tol and eo <= self.tol:
+            self.best_q = x.copy()
+            raise _Converged
+
+    def cost_and_gradient(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """``(E, ∇E)`` at ``x`` for L-BFGS-B (``E = ½ Σ w_i e_i²``)."""
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        c = cost_and_gradient(x, self.F, self.meta, self.Tt, self.w, self.J, self.T, self.e,
+                              self.g)
+        self.remember(x, c)
+        return c, self.g.copy()
+
+    def cost(self, x: np.ndarray) -> float:
+        """``E`` at ``x`` for Powell."""
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        c = cost_only(x, self.F, self.meta, self.Tt, self.w, self.T, self.e)
+        self.remember(x, c)
+        return c
