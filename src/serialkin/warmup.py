@@ -93,12 +93,18 @@ def _ik() -> None:
 
 def _ik_all() -> None:
     import serialkin as sk
+    from serialkin.ik.analytic.arm_angle import ik_arm_angle_path
 
     for name in ("ur5", "puma560", "stanford", "scara", "three_link"):
         r = sk.models.get(name)
         T = r.fk(r.random_q(4, seed=0))
         r.ik_all(T[0])
         r.ik_all(T)
+    iiwa = sk.models.get("iiwa7")  # S-R-S arms by the arm angle: one pose, a path, ψ intervals
+    T = iiwa.fk(iiwa.random_q(4, seed=0))
+    iiwa.ik_arm_angle(T[0], 0.3)
+    ik_arm_angle_path(iiwa, T, 0.3)
+    iiwa.arm_angle_intervals(T[0])
 
 
 def _ik_methods() -> None:

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from serialkin import Robot, models
 from serialkin.errors import InputError, NoClosedFormError
+from serialkin.ik.analytic.arm_angle import _solve as compiled_solve
 from serialkin.ik.analytic.arm_angle import (
     arm_angle,
     arm_angle_intervals,
@@ -19,6 +20,8 @@ from serialkin.ik.analytic.arm_angle import (
 )
 from serialkin.ik.sweep import joint_sweep
 from serialkin.model.dh import DHLink
+
+from . import _arm_angle_reference as reference_closed_form
 
 
 def _wrapped(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -277,3 +280,51 @@ def test_robot_methods_are_the_module_functions():
     assert psi == arm_angle(robot, q)
     assert np.array_equal(robot.ik_arm_angle(T, psi).q, ik_arm_angle(robot, T, psi).q)
     assert robot.arm_angle_intervals(T).feasible == arm_angle_intervals(robot, T).feasible
+
+
+@pytest.mark.parametrize("seed", [None, 3, 8, 21])
+def test_compiled_closed_form_equals_the_numpy_reference(seed):
+    """The compiled kernel gives the numpy closed form's flags and angles to 1e-12.
+
+    iiwa7 (with limits) and random S-R-S arms (no limits), random poses and arm angles.
+    """
+    robot = models.get("iiwa7") if seed is None else _random_srs(seed)
+    arm = srs_structure(robot)
+    rng = np.random.default_rng(0 if seed is None else seed)
+    r = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
+    for T in robot.fk(robot.random_q(20, seed=1)):
+        psi = rng.uniform(-math.pi, math.pi, 16)
+        Q_ref, ok_ref = reference_closed_form.solve(arm, T, psi, r)
+        Q, ok = compiled_solve(arm, T, psi, r)
+        assert np.array_equal(ok, ok_ref)
+        assert ok.any()
+        assert np.abs(Q - Q_ref)[ok].max() < 1e-12
+
+
+def test_one_pose_fast_path_equals_the_checked_path():
+    """A C-ordered float64 pose (compiled checks) and a Fortran-ordered one give the same rows."""
+    robot = models.get("iiwa7")
+    rng = np.random.default_rng(4)
+    for T in robot.fk(robot.random_q(30, seed=2)):
+        psi = float(rng.uniform(-math.pi, math.pi))
+        fast = ik_arm_angle(robot, T, psi)
+        checked = ik_arm_angle(robot, np.asfortranarray(T), psi)
+        assert np.array_equal(fast.branch, checked.branch)
+        assert fast.branch.dtype == checked.branch.dtype == np.int64
+        assert np.abs(fast.q - checked.q).max(initial=0.0) < 1e-12
+        if len(fast):
+            assert _reaches(robot, fast.q, T) < 1e-10
+
+
+def test_sweep_of_the_last_joint_has_the_locked_solves_rows():
+    """A sweep of joint 7 (one batch solve) has, at each value, the rows of ik_all(free=...)."""
+    robot = models.get("panda")
+    T = robot.fk(np.array([0.2, -0.3, 0.1, -2.0, 0.1, 1.8, 0.6]))
+    sw = joint_sweep(robot, T, 6, resolution=math.radians(5.0))
+    assert sw.valid.any()
+    for i, v in enumerate(sw.values):
+        rows = np.asarray(robot.ik_all(T, free={6: float(v)}).q)
+        got = sw.q[i, sw.valid[i]]
+        assert got.shape == rows.shape
+        for row in rows:
+            assert np.abs(got - row).max(axis=1).min() < 1e-9

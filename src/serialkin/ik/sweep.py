@@ -26,6 +26,7 @@ from serialkin.errors import InputError
 from serialkin.ik.analytic import ik_all
 from serialkin.model.robot import Robot
 from serialkin.spatial.rotations import wrap_angle
+from serialkin.spatial.transforms import inv_transform
 
 __all__ = ["JointSweep", "joint_sweep"]
 
@@ -101,15 +102,45 @@ def joint_sweep(robot: Robot, T: object, joint: int, values: object = None, *,
     if not (max_jump > 0.0 and math.isfinite(max_jump)):
         raise InputError(f"max_jump must be a positive length or angle, got {max_jump!r}")
     v = _values(robot, j, values, resolution)
-    rows = [np.asarray(ik_all(robot, Tt, free={j: float(x)}).q) for x in v]
+    rows = _rows(robot, Tt, j, v)
     q, valid = _connect(rows, n, max_jump)
 
-    def exists(x: float) -> bool:
-        return len(ik_all(robot, Tt, free={j: float(x)})) > 0
+    def exists(x: np.ndarray) -> np.ndarray:
+        return np.array([len(r) > 0 for r in _rows(robot, Tt, j, x)], dtype=bool)
 
+    ways = _BATCH_WAYS if j in (0, n - 1) else 2  # a batch solve costs about one solve
     return JointSweep(joint=j, values=v, q=q, valid=valid,
-                      feasible=_intervals(v, [len(r) > 0 for r in rows], exists),
+                      feasible=_intervals(v, [len(r) > 0 for r in rows], exists, ways),
                       max_jump=float(max_jump))
+
+
+def _rows(robot: Robot, T: np.ndarray, j: int, v: np.ndarray) -> list[np.ndarray]:
+    """``ik_all(robot, T, free={j: x}).q`` for every value x of v (m,): m arrays (k, n).
+
+    The first or the last joint moves the base or the tool end of the others rigidly:
+    ``fk(q) = fk(q with q_j = 0)·D(q_j)`` for the last joint, with ``D(x) =
+    fk(0)⁻¹·fk(x·e_j)``, and ``fk(q) = G(q_j)·fk(q with q_j = 0)`` for the first, with
+    ``G(x) = fk(x·e_j)·fk(0)⁻¹``. Locking it at 0 then leaves one reduced arm for every
+    value, whose targets ``T·D(x)⁻¹`` (or ``G(x)⁻¹·T``) are solved as one batch (one
+    reduced robot, one compiled call); the locked column is then set to x. A joint in
+    between changes the reduced arm's geometry: one locked solve per value.
+    """
+    n = robot.n
+    if j not in (0, n - 1):
+        return [np.asarray(ik_all(robot, T, free={j: float(x)}).q) for x in v]
+    Q = np.zeros((len(v), n))
+    Q[:, j] = v
+    F = robot.fk(Q)                                       # (m, 4, 4)
+    inv0 = inv_transform(robot.fk(np.zeros(n)), check=False)
+    moved = inv_transform(inv0 @ F if j == n - 1 else F @ inv0, check=False)
+    targets = T @ moved if j == n - 1 else moved @ T
+    res = ik_all(robot, targets, free={j: 0.0})
+    out = []
+    for i, k in enumerate(np.asarray(res.count).tolist()):
+        r = res.q[i, :k].copy()
+        r[:, j] = v[i]
+        out.append(r)
+    return out
 
 
 def _values(robot: Robot, j: int, values: object, resolution: float) -> np.ndarray:
@@ -159,9 +190,17 @@ def _connect(rows: list[np.ndarray], n: int, max_jump: float) -> tuple[np.ndarra
     return q, valid
 
 
-def _intervals(v: np.ndarray, some: list[bool], exists) -> list[tuple[float, float]]:
-    """Closed runs of values with a solution; inner ends bisected to 1e-9."""
-    out = []
+#: Parts each bracket of an interval end is cut into per round when the values are solved
+#: as one batch (the first or last joint swept): 16 parts, 4 bits a round instead of 1.
+_BATCH_WAYS = 16
+
+
+def _intervals(v: np.ndarray, some: list[bool], exists, ways: int) -> list[tuple[float, float]]:
+    """Closed runs of values with a solution; inner ends refined to 1e-9 (:func:`_refine`).
+
+    ``exists(x)`` says for each value of x (k,) whether a solution exists there.
+    """
+    runs, ends = [], []
     i, m = 0, len(v)
     while i < m:
         if not some[i]:
@@ -170,18 +209,41 @@ def _intervals(v: np.ndarray, some: list[bool], exists) -> list[tuple[float, flo
         k = i
         while k + 1 < m and some[k + 1]:
             k += 1
-        lo = v[i] if i == 0 else _bisect(v[i - 1], v[i], exists)
-        hi = v[k] if k == m - 1 else _bisect(v[k + 1], v[k], exists)
-        out.append((float(lo), float(hi)))
+        runs.append((i, k))
+        if i > 0:
+            ends.append((v[i - 1], v[i]))
+        if k < m - 1:
+            ends.append((v[k + 1], v[k]))
         i = k + 1
-    return out
+    refined = iter(_refine(ends, exists, ways))
+    return [(float(v[i] if i == 0 else next(refined)),
+             float(v[k] if k == m - 1 else next(refined))) for i, k in runs]
 
 
-def _bisect(bad: float, good: float, exists) -> float:
-    while abs(good - bad) > 1e-9:
-        mid = 0.5 * (bad + good)
-        if exists(mid):
-            good = mid
-        else:
-            bad = mid
-    return good
+def _refine(ends: list[tuple[float, float]], exists, ways: int) -> list[float]:
+    """The feasible end of each (infeasible value, feasible value) bracket, to 1e-9.
+
+    Every round cuts each bracket wider than 1e-9 into ``ways`` equal parts and keeps the
+    part where, walking from the infeasible end, the first feasible point is met; all
+    brackets' points are solved in one ``exists`` call. With ``ways = 2``: bisection.
+    """
+    if not ends:
+        return []
+    bad = np.array([e[0] for e in ends], dtype=float)
+    good = np.array([e[1] for e in ends], dtype=float)
+    t = np.arange(1, ways) / ways
+    while True:
+        open_ = np.flatnonzero(np.abs(good - bad) > 1e-9)
+        if not len(open_):
+            return good.tolist()
+        b, g = bad[open_], good[open_]
+        pts = b[:, None] + (g - b)[:, None] * t                  # (e, ways − 1)
+        if ways == 2:
+            pts = 0.5 * (b + g)[:, None]                         # bisection's midpoint
+        ok = exists(pts.reshape(-1)).reshape(pts.shape)
+        first = np.where(ok.any(axis=1), ok.argmax(axis=1), pts.shape[1])
+        rows = np.arange(len(open_))
+        new_bad = np.where(first > 0, pts[rows, np.maximum(first - 1, 0)], b)
+        new_good = np.where(first < pts.shape[1], pts[rows, np.minimum(first, pts.shape[1] - 1)],
+                            g)
+        bad[open_], good[open_] = new_bad, new_good

@@ -27,8 +27,12 @@ A solution's *branch* ``4·i₄ + 2·i_s + i_w`` (i₄ the elbow's, i_s the shou
 i_w the wrist's choice of sign, 0 or 1) is continuous in ψ away from singular
 configurations, so a branch can be followed along ψ (:func:`arm_angle_intervals`).
 
-Units: angles in radians, lengths in metres. Everything is computed with numpy on
-batches of arm angles (no compiled kernel: nothing to compile at a first call).
+Units: angles in radians, lengths in metres. Steps 1–4 run compiled, one pose at one ψ
+per call of :func:`_srs_one` (3-vectors as tuples: nothing allocated per ψ), batched over
+poses and ψ by :func:`_srs_solve` and over interval ends by :func:`_srs_bisect`; the
+arm's constants are packed once per robot. One pose at one ψ with the defaults takes one
+compiled call (the rigidity check, the solve, a forward-kinematics check of each row).
+The kernels belong to the ``ik-all`` compile feature (``serialkin warmup``).
 """
 
 from __future__ import annotations
@@ -38,7 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from serialkin._checks import as_float_array, check_transform
+from serialkin._checks import as_float_array, check_transform, readonly
+from serialkin._jit import entry_point, njit
 from serialkin._memo import PerObject
 from serialkin.errors import InputError, NoClosedFormError
 from serialkin.model.robot import Robot, robot_scale
@@ -225,41 +230,12 @@ def _rot(h: np.ndarray, t: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
-def _sp1(w: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Subproblem 1 on directions: θ (...,) with Rot(w, θ)·u pointing like v in the plane ⟂ w."""
-    up = u - (u @ w)[..., None] * w
-    vp = v - (v @ w)[..., None] * w
-    return np.arctan2(_cross(up, vp) @ w, np.sum(up * vp, axis=-1))
-
-
-def _sp2(w1: np.ndarray, w2: np.ndarray, u: np.ndarray, v: np.ndarray):
-    """Subproblem 2: (θ1, θ2) with Rot(w1, θ1)·Rot(w2, θ2)·u = v, both signs of the root.
-
-    u (3,) and v (..., 3) are unit vectors from the axes' common point; returns θ1, θ2
-    of shape (..., 2) (second index: the sign of γ in z = α w1 + β w2 ± γ (w1 × w2)) and
-    ``ok`` (...,): False where no solution exists beyond rounding (then γ = 0 is used).
-    """
-    c12 = float(w1 @ w2)
-    den = c12 * c12 - 1.0
-    a2u = float(w2 @ u)
-    a1v = v @ w1
-    alpha = (c12 * a2u - a1v) / den
-    beta = (c12 * a1v - a2u) / den
-    x = _cross(w1, w2)
-    g2 = (1.0 - alpha**2 - beta**2 - 2.0 * alpha * beta * c12) / float(x @ x)
-    ok = g2 > -1e-9
-    g = np.sqrt(np.maximum(g2, 0.0))
-    sign = np.array([1.0, -1.0])
-    z = (alpha[..., None, None] * w1 + beta[..., None, None] * w2
-         + (g[..., None] * sign)[..., None] * x)                       # (..., 2, 3)
-    t2 = _sp1(w2, np.broadcast_to(u, z.shape), z)
-    t1 = _sp1(w1, z, np.broadcast_to(v[..., None, :], z.shape))
-    return t1, t2, ok
-
-
 def _unit(v: np.ndarray) -> np.ndarray:
     n = np.linalg.norm(v, axis=-1, keepdims=True)
     return v / np.where(n > 0.0, n, 1.0)
+
+
+_Z_REF = readonly(np.array([0.0, 0.0, 1.0]))
 
 
 def _reference(reference: object) -> np.ndarray:
@@ -309,68 +285,398 @@ def _psi_of(arm: SRSArm, E: np.ndarray, Wt: np.ndarray, r: np.ndarray) -> np.nda
     return np.where(undefined, 0.0, np.arctan2(y, x))
 
 
+# ------------------------------------------------------------------- the compiled form
+# One pose at one ψ in compiled code (:func:`_srs_one`, the same steps as the module
+# docstring), called by :func:`_srs_solve` (poses × ψ) and :func:`_srs_bisect` (the
+# interval ends). 3-vectors are tuples and rotations tuples of three rows, so nothing is
+# allocated per ψ. The arm's constants are packed once per robot (:func:`_packed`):
+#
+# * ``H``, ``P``: (7, 3) joint directions and points, ``M``: (4, 4) the pose at q = 0;
+# * ``V``: (_NV,) S (0:3), W0 (3:6), E0 (6:9), lo (9:16), hi (16:23), mid (23:30), then
+#   scale, the wrist point in the tool frame (31:34), x3 = perpendicular(h3) (34:37),
+#   x7 = perpendicular(h7) (37:40) and the elbow's constants A, B, atan2(B, A), |(A, B)|,
+#   |u|² + |v|², v·u∥ (40:46) of :func:`_elbow_angles`.
+_NV = 46
+
+
+@njit(cache=True)
+def _dot(a, b):
+    """The dot product a · b of two 3-tuples."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True)
+def _crs(a, b):
+    """The cross product a × b of two 3-tuples."""
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@njit(cache=True)
+def _lin(s, a, t, b):
+    """s·a + t·b of two 3-tuples."""
+    return (s * a[0] + t * b[0], s * a[1] + t * b[1], s * a[2] + t * b[2])
+
+
+@njit(cache=True)
+def _perp(e):
+    """:func:`~serialkin.spatial.rotations.perpendicular` of one unit 3-tuple."""
+    k = 0
+    if abs(e[1]) < abs(e[0]):
+        k = 1
+    if abs(e[2]) < abs(e[k]):
+        k = 2
+    t = (1.0 if k == 0 else 0.0, 1.0 if k == 1 else 0.0, 1.0 if k == 2 else 0.0)
+    v = _lin(1.0, t, -e[k], e)
+    n = math.sqrt(_dot(v, v))
+    return (v[0] / n, v[1] / n, v[2] / n)
+
+
+@njit(cache=True)
+def _rot3(h, t):
+    """Rodrigues: the rotation (three row 3-tuples) by angle t about the unit 3-tuple h."""
+    s, c = math.sin(t), math.cos(t)
+    k = 1.0 - c
+    return ((1.0 + k * (h[0] * h[0] - 1.0), k * h[0] * h[1] - s * h[2],
+             k * h[0] * h[2] + s * h[1]),
+            (k * h[1] * h[0] + s * h[2], 1.0 + k * (h[1] * h[1] - 1.0),
+             k * h[1] * h[2] - s * h[0]),
+            (k * h[2] * h[0] - s * h[1], k * h[2] * h[1] + s * h[0],
+             1.0 + k * (h[2] * h[2] - 1.0)))
+
+
+@njit(cache=True)
+def _mv(R, v):
+    """R·v."""
+    return (_dot(R[0], v), _dot(R[1], v), _dot(R[2], v))
+
+
+@njit(cache=True)
+def _mtv(R, v):
+    """Rᵀ·v."""
+    return (R[0][0] * v[0] + R[1][0] * v[1] + R[2][0] * v[2],
+            R[0][1] * v[0] + R[1][1] * v[1] + R[2][1] * v[2],
+            R[0][2] * v[0] + R[1][2] * v[1] + R[2][2] * v[2])
+
+
+@njit(cache=True)
+def _mtm(A, B):
+    """Aᵀ·B, by rows."""
+    return (_mtv(B, (A[0][0], A[1][0], A[2][0])), _mtv(B, (A[0][1], A[1][1], A[2][1])),
+            _mtv(B, (A[0][2], A[1][2], A[2][2])))
+
+
+@njit(cache=True)
+def _mm(A, B):
+    """A·B, by rows."""
+    return (_mtv(B, A[0]), _mtv(B, A[1]), _mtv(B, A[2]))
+
+
+@njit(cache=True)
+def _sp1_3(w, u, v):
+    """Subproblem 1 (:func:`_sp1`) on 3-tuples."""
+    up = _lin(1.0, u, -_dot(u, w), w)
+    vp = _lin(1.0, v, -_dot(v, w), w)
+    return math.atan2(_dot(_crs(up, vp), w), _dot(up, vp))
+
+
+@njit(cache=True)
+def _sp2_3(w1, w2, u, v, sign):
+    """Subproblem 2 (:func:`_sp2`) on 3-tuples for one sign of γ: (θ1, θ2, exists)."""
+    c12 = _dot(w1, w2)
+    den = c12 * c12 - 1.0
+    a2u = _dot(w2, u)
+    a1v = _dot(v, w1)
+    alpha = (c12 * a2u - a1v) / den
+    beta = (c12 * a1v - a2u) / den
+    x = _crs(w1, w2)
+    g2 = (1.0 - alpha * alpha - beta * beta - 2.0 * alpha * beta * c12) / _dot(x, x)
+    g = sign * math.sqrt(max(g2, 0.0))
+    z = (alpha * w1[0] + beta * w2[0] + g * x[0], alpha * w1[1] + beta * w2[1] + g * x[1],
+         alpha * w1[2] + beta * w2[2] + g * x[2])
+    return _sp1_3(w1, z, v), _sp1_3(w2, u, z), g2 > -1e-9
+
+
+@njit(cache=True)
+def _row(A, i):
+    """Row i of a (k, 3) array as a 3-tuple."""
+    return (A[i, 0], A[i, 1], A[i, 2])
+
+
+@njit(cache=True)
+def _srs_one(T, psi, r, H, P, M, V, Q, ok):
+    """Every branch at one pose T (4, 4) and arm angle ψ: Q (8, 7) [rad], ok (8,) bool.
+
+    :func:`_solve` for one (pose, ψ), in the same steps; the angles are moved by whole
+    turns nearest ``mid`` (:func:`_into_limits`) and ``ok[j]`` is True when branch j
+    exists and lies inside the limits. ``r`` (3,) is the unit reference direction.
+    """
+    two_pi = 2.0 * math.pi
+    S, W0, E0 = (V[0], V[1], V[2]), (V[3], V[4], V[5]), (V[6], V[7], V[8])
+    tiny = 1e-12 * V[30]
+    rr = (r[0], r[1], r[2])
+    loc = (V[31], V[32], V[33])
+    Wt = (T[0, 3] + T[0, 0] * loc[0] + T[0, 1] * loc[1] + T[0, 2] * loc[2],
+          T[1, 3] + T[1, 0] * loc[0] + T[1, 1] * loc[1] + T[1, 2] * loc[2],
+          T[2, 3] + T[2, 0] * loc[0] + T[2, 1] * loc[1] + T[2, 2] * loc[2])
+    d = _lin(1.0, Wt, -1.0, S)
+    L = math.sqrt(_dot(d, d))
+    Lm = max(L, tiny)
+    e = (d[0] / Lm, d[1] / Lm, d[2] / Lm)
+    rp = _lin(1.0, rr, -_dot(e, rr), e)
+    nr = math.sqrt(_dot(rp, rp))
+    er = (rp[0] / nr, rp[1] / nr, rp[2] / nr) if nr > 0.0 else _perp(e)
+    c_dir = _lin(math.cos(psi), er, math.sin(psi), _crs(e, er))
+    # Rw = R_T · R_Mᵀ
+    RT = ((T[0, 0], T[0, 1], T[0, 2]), (T[1, 0], T[1, 1], T[1, 2]),
+          (T[2, 0], T[2, 1], T[2, 2]))
+    RMt = ((M[0, 0], M[1, 0], M[2, 0]), (M[0, 1], M[1, 1], M[2, 1]),
+           (M[0, 2], M[1, 2], M[2, 2]))
+    Rw = _mm(RT, RMt)
+    # 1. the elbow (subproblem 3, :func:`_elbow_angles`)
+    k = 0.5 * (V[44] - L * L) - V[45]
+    rho = V[43]
+    ratio = k / rho if rho > 0.0 else math.inf
+    ok4 = abs(ratio) <= 1.0 + 1e-12 and L > tiny
+    phi = math.acos(min(max(ratio, -1.0), 1.0))
+    h = (_row(H, 0), _row(H, 1), _row(H, 2), _row(H, 3), _row(H, 4), _row(H, 5), _row(H, 6))
+    p4 = _row(P, 3)
+    u = _lin(1.0, W0, -1.0, p4)
+    b = _lin(1.0, E0, -1.0, S)
+    x3 = (V[34], V[35], V[36])
+    x7 = (V[37], V[38], V[39])
+    for i4 in range(2):
+        q4 = V[42] + phi if i4 == 0 else V[42] - phi
+        R4 = _rot3(h[3], q4)
+        a = _lin(1.0, _lin(1.0, p4, 1.0, _mv(R4, u)), -1.0, S)
+        a_hat = (a[0] / Lm, a[1] / Lm, a[2] / Lm)
+        b_perp = _lin(1.0, b, -_dot(a_hat, b), a_hat)
+        nb = math.sqrt(_dot(b_perp, b_perp))
+        if nb < tiny:  # the elbow on the line S–W: ψ undefined, any plane
+            cd = er
+            bp = _perp(a_hat)
+        else:
+            cd = c_dir
+            nbm = max(nb, 1e-300)
+            bp = (b_perp[0] / nbm, b_perp[1] / nbm, b_perp[2] / nbm)
+        # R123 = F2·F1ᵀ with F1 = [a, b⊥, a × b⊥], F2 = [e, c⊥, e × c⊥] (columns)
+        ab = _crs(a_hat, bp)
+        ec = _crs(e, cd)
+        R123 = (_lin(1.0, _lin(e[0], a_hat, cd[0], bp), ec[0], ab),
+                _lin(1.0, _lin(e[1], a_hat, cd[1], bp), ec[1], ab),
+                _lin(1.0, _lin(e[2], a_hat, cd[2], bp), ec[2], ab))
+        X = _mtm(_mm(R123, R4), Rw)                      # (R123·R4)ᵀ·R_T·R_Mᵀ
+        v3 = _mv(R123, h[2])
+        v7 = _mv(X, h[6])
+        for i_s in range(2):
+            t1, t2, ok_s = _sp2_3(h[0], h[1], h[2], v3, 1.0 if i_s == 0 else -1.0)
+            R3 = _mtm(_mm(_rot3(h[0], t1), _rot3(h[1], t2)), R123)
+            q3 = _sp1_3(h[2], x3, _mv(R3, x3))
+            for i_w in range(2):
+                t5, t6, ok_w = _sp2_3(h[4], h[5], h[6], v7, 1.0 if i_w == 0 else -1.0)
+                R7 = _mtm(_mm(_rot3(h[4], t5), _rot3(h[5], t6)), X)
+                q7 = _sp1_3(h[6], x7, _mv(R7, x7))
+                j = 4 * i4 + 2 * i_s + i_w
+                Q[j, 0], Q[j, 1], Q[j, 2], Q[j, 3] = t1, t2, q3, q4
+                Q[j, 4], Q[j, 5], Q[j, 6] = t5, t6, q7
+                inside = ok4 and ok_s and ok_w
+                for c in range(7):
+                    x = Q[j, c] - two_pi * np.rint((Q[j, c] - V[23 + c]) / two_pi)
+                    Q[j, c] = x
+                    if not (V[9 + c] - LIMIT_TOL <= x <= V[16 + c] + LIMIT_TOL):
+                        inside = False
+                ok[j] = inside
+
+
+@njit(cache=True)
+def _miss(T, q, H, P, M):
+    """How far the configuration q (7,) misses T: max |e| of ``pose_error`` (e = [Δp; ω]).
+
+    Forward kinematics as the product of exponentials of the joint lines at q = 0 (H, P)
+    times M; ω from the angle-axis of ``R_T·Rᵀ`` (its angle by atan2, exact near 0 and π).
+    """
+    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    t = (0.0, 0.0, 0.0)
+    for i in range(7):
+        p = _row(P, i)
+        Ri = _rot3(_row(H, i), q[i])
+        t = _lin(1.0, t, 1.0, _mv(R, _lin(1.0, p, -1.0, _mv(Ri, p))))
+        R = _mm(R, Ri)
+    t = _lin(1.0, t, 1.0, _mv(R, (M[0, 3], M[1, 3], M[2, 3])))
+    R = _mm(R, ((M[0, 0], M[0, 1], M[0, 2]), (M[1, 0], M[1, 1], M[1, 2]),
+                (M[2, 0], M[2, 1], M[2, 2])))
+    size = max(abs(T[0, 3] - t[0]), abs(T[1, 3] - t[1]), abs(T[2, 3] - t[2]))
+    E = (_mv(R, (T[0, 0], T[0, 1], T[0, 2])), _mv(R, (T[1, 0], T[1, 1], T[1, 2])),
+         _mv(R, (T[2, 0], T[2, 1], T[2, 2])))                     # R_T·Rᵀ, by rows
+    w = (0.5 * (E[2][1] - E[1][2]), 0.5 * (E[0][2] - E[2][0]), 0.5 * (E[1][0] - E[0][1]))
+    s = math.sqrt(_dot(w, w))
+    angle = math.atan2(s, 0.5 * (E[0][0] + E[1][1] + E[2][2] - 1.0))
+    if s > 0.0:
+        f = angle / s
+        size = max(size, abs(w[0]) * f, abs(w[1]) * f, abs(w[2]) * f)
+    elif angle > 1.0:  # a half turn
+        size = max(size, angle)
+    return size
+
+
+@njit(cache=True)
+def _rigid(T):
+    """T (4, 4) is rigid to 1e-13: RᵀR = I, det R = 1, last row [0, 0, 0, 1], finite."""
+    tol = 1e-13
+    good = (abs(T[3, 0]) <= tol and abs(T[3, 1]) <= tol and abs(T[3, 2]) <= tol
+            and abs(T[3, 3] - 1.0) <= tol)
+    for i in range(3):
+        good = good and math.isfinite(T[i, 3])
+        for j in range(3):
+            g = T[0, i] * T[0, j] + T[1, i] * T[1, j] + T[2, i] * T[2, j]
+            good = good and abs(g - 1.0 if i == j else g) <= tol
+    det = _dot((T[0, 0], T[1, 0], T[2, 0]),
+               _crs((T[0, 1], T[1, 1], T[2, 1]), (T[0, 2], T[1, 2], T[2, 2])))
+    return good and abs(det - 1.0) <= tol
+
+
+@njit(cache=True)
+def _srs_solve(T, psi, r, H, P, M, V, check, Q, found):
+    """Every branch at each (pose, ψ): T (1 or N, 4, 4), ψ (N,) → Q (N, 8, 7), found (N, 8).
+
+    Without ``check``: ``found[i, j]`` is 1 where branch j exists inside the limits at
+    pose i and ψ[i] (:func:`_srs_one`), else 0; returns 0.
+
+    With ``check`` (the fast path of :func:`ik_arm_angle`): the rows of each pose that
+    meet it to 1e-13 (:func:`_miss`) are moved to the front of ``Q[i]``, ``found[i, :k]``
+    their branches, −1 after them; rows missing by more than 1e-5 are dropped. Returns
+    the number of rows; −1 (nothing solved) when a pose is not rigid to 1e-13 (a
+    rotation block not orthonormal, a last row not [0, 0, 0, 1], NaN); −2 when a row
+    misses by 1e-13 to 1e-5 (:func:`_polish` would move it).
+    """
+    n_t = T.shape[0]
+    if check:
+        for i in range(n_t):
+            if not _rigid(T[i]):
+                return -1
+    ok = np.zeros(8, dtype=np.bool_)
+    total = 0
+    for i in range(psi.shape[0]):
+        Ti = T[i if n_t > 1 else 0]
+        Qi = Q[i]
+        _srs_one(Ti, psi[i], r, H, P, M, V, Qi, ok)
+        if not check:
+            for j in range(8):
+                found[i, j] = 1 if ok[j] else 0
+            continue
+        k = 0
+        for j in range(8):
+            found[i, j] = -1
+            if ok[j]:
+                size = _miss(Ti, Qi[j], H, P, M)
+                if size <= 1e-13:
+                    for c in range(7):
+                        Qi[k, c] = Qi[j, c]
+                    found[i, k] = j
+                    k += 1
+                elif size < 1e-5:
+                    return -2
+        total += k
+    return total
+
+
+@njit(cache=True)
+def _srs_bisect(T, r, H, P, M, V, branch, bad, good, steps):
+    """Bisect each (branch, infeasible ψ, feasible ψ) ``steps`` times; ``good`` (m,) updated.
+
+    The feasible end of each of the m stretches: ``good[k]`` ends feasible on branch
+    ``branch[k]`` (:func:`_srs_one`), ``bad[k]`` infeasible, |bad − good| halved per step.
+    """
+    Q = np.empty((8, 7))
+    ok = np.zeros(8, dtype=np.bool_)
+    for k in range(branch.shape[0]):
+        lo, hi = bad[k], good[k]
+        for _ in range(steps):
+            mid = 0.5 * (lo + hi)
+            _srs_one(T, mid, r, H, P, M, V, Q, ok)
+            if ok[branch[k]]:
+                hi = mid
+            else:
+                lo = mid
+        good[k] = hi
+
+
 # ------------------------------------------------------------- solving at given ψ
 
-def _solve(arm: SRSArm, T: np.ndarray, psi: np.ndarray, r: np.ndarray):
-    """Every branch for every (pose, ψ): (N, 8, 7) joint values and (N, 8) 'exists' flags.
+_PACKED: PerObject[tuple] = PerObject()
+_ENTRIES: dict[str, object] = {}
 
-    T is one (4, 4) pose or (N, 4, 4) poses, ψ (N,). Branch ``4·i4 + 2·is + iw``; rows
-    whose subproblem has no solution (beyond rounding) are flagged False. No limits here.
+
+def _packed(arm: SRSArm) -> tuple:
+    """``(H, P, M, V)``: the arm's constants for the kernels, read-only (cached per arm).
+
+    ``V`` is laid out as described above :data:`_NV`.
     """
-    H, P, S = arm.H, arm.P, arm.S
-    N = len(psi)
-    T = np.broadcast_to(T, (N, 4, 4))
-    Q = np.zeros((N, 8, 7))
-    ok = np.zeros((N, 8), dtype=bool)
-    tiny = 1e-12 * arm.scale
-    d = _wrist_target(arm, T) - S                                       # (N, 3)
-    L = np.linalg.norm(d, axis=1)
-    e = d / np.maximum(L, tiny)[:, None]
-    rp = r - (e @ r)[:, None] * e
-    nr = np.linalg.norm(rp, axis=1)
-    er = np.where((nr > 0.0)[:, None], rp / np.maximum(nr, 1e-300)[:, None],
-                  perpendicular(e))
-    # 2. E − S at ψ: its part along e is b's along a (a rotation keeps a·b); its part
-    # across e points at ψ in the plane (e_r, e × e_r) of eq (1)
-    c_dir = np.cos(psi)[:, None] * er + np.sin(psi)[:, None] * _cross(e, er)
-    Rw = T[:, :3, :3] @ arm.M[:3, :3].T
-    # 1. the elbow joint: two q4 (subproblem 3) put the wrist at distance L from S
-    q4s, ok4 = _elbow_angles(arm, L)                                    # (N, 2), (N,)
-    ok4 &= L > tiny
-    h4, p4 = H[3], P[3]
-    u = arm.W0 - p4
-    b = arm.E0 - S
-    x3, x7 = perpendicular(H[2]), perpendicular(H[6])
-    for i4 in range(2):
-        R4 = _rot(h4, q4s[:, i4])                                       # (N, 3, 3)
-        a = p4 + R4 @ u - S                                             # W0(q4) − S, |a| = L
-        a_hat = a / np.maximum(L, tiny)[:, None]
-        b_perp = b - (a_hat @ b)[:, None] * a_hat
-        nb = np.linalg.norm(b_perp, axis=1)
-        line = nb < tiny          # the elbow on the line S–W: ψ undefined, any plane
-        cd = np.where(line[:, None], er, c_dir)
-        bp = np.where(line[:, None], perpendicular(a_hat),
-                      b_perp / np.maximum(nb, 1e-300)[:, None])
-        # the shoulder rotation maps the frame (a, b⊥) onto (e, c⊥): R123 = F2·F1ᵀ
-        F1 = np.stack([a_hat, bp, _cross(a_hat, bp)], axis=2)           # (N, 3, 3)
-        F2 = np.stack([e, cd, _cross(e, cd)], axis=2)
-        R123 = F2 @ np.swapaxes(F1, -1, -2)
-        # 3. the shoulder: Rot(h1,q1) Rot(h2,q2) h3 = R123 h3, then q3
-        t1, t2, ok_s = _sp2(H[0], H[1], H[2], R123 @ H[2])
-        # 4. the wrist: Rot(h5) Rot(h6) Rot(h7) = (R123 R4)ᵀ R_T R_Mᵀ
-        X = np.swapaxes(R123 @ R4, -1, -2) @ Rw
-        t5, t6, ok_w = _sp2(H[4], H[5], H[6], X @ H[6])
-        for i_s in range(2):
-            R3 = np.swapaxes(_rot(H[0], t1[:, i_s]) @ _rot(H[1], t2[:, i_s]), -1, -2) @ R123
-            q3 = _sp1(H[2], np.broadcast_to(x3, (N, 3)), R3 @ x3)
-            for i_w in range(2):
-                R7 = np.swapaxes(_rot(H[4], t5[:, i_w]) @ _rot(H[5], t6[:, i_w]), -1, -2) @ X
-                q7 = _sp1(H[6], np.broadcast_to(x7, (N, 3)), R7 @ x7)
-                j = 4 * i4 + 2 * i_s + i_w
-                Q[:, j] = np.stack([t1[:, i_s], t2[:, i_s], q3, q4s[:, i4],
-                                    t5[:, i_w], t6[:, i_w], q7], axis=1)
-                ok[:, j] = ok4 & ok_s & ok_w
-    return Q, ok
+    got = _PACKED.get(arm)
+    if got is None:
+        h4, p4 = arm.H[3], arm.P[3]
+        u, v = arm.W0 - p4, arm.S - p4
+        u_par = (u @ h4) * h4
+        u_perp = u - u_par
+        A, B = float(v @ u_perp), float(v @ np.cross(h4, u_perp))
+        V = np.concatenate([
+            arm.S, arm.W0, arm.E0, arm.lo, arm.hi, arm.mid, [arm.scale],
+            arm.M[:3, :3].T @ (arm.W0 - arm.M[:3, 3]), perpendicular(arm.H[2]),
+            perpendicular(arm.H[6]),
+            [A, B, math.atan2(B, A), math.hypot(A, B), float(u @ u + v @ v),
+             float(v @ u_par)]])
+        got = _PACKED.set(arm, tuple(readonly(np.ascontiguousarray(x, dtype=np.float64))
+                                     for x in (arm.H, arm.P, arm.M, V)))
+    return got
+
+
+def _entry(name: str):
+    """The compiled entry point of ``_srs_solve`` or ``_srs_bisect`` (no type dispatch).
+
+    Compiled for exactly the types the callers pass: read-only C-contiguous float64
+    inputs (T (N, 4, 4), ψ (N,), r (3,), H, P, M, V), a bool, and fresh outputs
+    (Q float64 (N, 8, 7), found int64 (N, 8)); for the bisection T (4, 4), the branches
+    read-only int64, the ends float64 and an int64 step count.
+    """
+    found = _ENTRIES.get(name)
+    if found is not None:
+        return found
+
+    def sig() -> tuple:  # numba's types, imported only when the kernel is loaded
+        import numba
+
+        Array, f64 = numba.types.Array, numba.float64
+
+        def ro(ndim: int, dtype=f64):
+            return Array(dtype, ndim, "C", readonly=True)
+
+        if name == "solve":
+            return (ro(3), ro(1), ro(1), ro(2), ro(2), ro(2), ro(1), numba.boolean,
+                    Array(f64, 3, "C"), Array(numba.int64, 2, "C"))
+        return (ro(2), ro(1), ro(2), ro(2), ro(2), ro(1), ro(1, numba.int64), ro(1),
+                Array(f64, 1, "C"), numba.int64)
+
+    found, final = entry_point(_srs_solve if name == "solve" else _srs_bisect, sig)
+    if final:  # else the Python function while it compiles: ask again next call
+        _ENTRIES[name] = found
+    return found
+
+
+def _solve(arm: SRSArm, T: np.ndarray, psi: np.ndarray, r: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """Every branch for every (pose, ψ): (N, 8, 7) joint values and (N, 8) 'inside' flags.
+
+    T is one (4, 4) pose or (N, 4, 4) poses, ψ (N,), r (3,) the unit reference.
+    Branch ``4·i4 + 2·is + iw``; angles moved by whole turns nearest the middle of their
+    limits; a row is flagged True when its subproblems have a solution (beyond rounding)
+    and it lies inside the limits. Compiled: :func:`_srs_solve`.
+    """
+    H, P, M, V = _packed(arm)
+    T = readonly(np.ascontiguousarray(T, dtype=np.float64).reshape(-1, 4, 4))
+    psi = readonly(np.ascontiguousarray(psi, dtype=np.float64).reshape(-1))
+    Q = np.empty((len(psi), 8, 7))
+    found = np.empty((len(psi), 8), dtype=np.int64)
+    _entry("solve")(T, psi, readonly(r), H, P, M, V, False, Q, found)
+    return Q, found == 1
 
 
 def _elbow_angles(arm: SRSArm, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -397,14 +703,6 @@ def _elbow_angles(arm: SRSArm, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.stack([base + phi, base - phi], axis=-1), ok
 
 
-def _into_limits(arm: SRSArm, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Angles moved by whole turns nearest the middle of their limits; the inside mask (...,)."""
-    lo, hi = arm.lo, arm.hi
-    Qw = Q - _TWO_PI * np.round((Q - arm.mid) / _TWO_PI)
-    inside = np.all((Qw >= lo - LIMIT_TOL) & (Qw <= hi + LIMIT_TOL), axis=-1)
-    return Qw, inside
-
-
 def ik_arm_angle(robot: Robot, T: object, psi: float, reference: object = None, *,
                  tol: float = 1e-9) -> ArmAngleSolutions:
     """Every configuration of an S-R-S arm reaching pose T at arm angle ψ (closed form).
@@ -426,10 +724,49 @@ def ik_arm_angle(robot: Robot, T: object, psi: float, reference: object = None, 
         NoClosedFormError: the robot is not an S-R-S arm (the message says why).
         InputError: T is not a rigid transform, ψ not finite, r not a direction.
     """
+    if (type(T) is np.ndarray and reference is None and tol == _TOL and T.shape == (4, 4)
+            and T.dtype == np.float64 and T.flags.c_contiguous and isinstance(psi, (float, int))
+            and math.isfinite(psi)):
+        got = _ik_arm_angle_fast(robot, T, float(psi))
+        if got is not None:
+            return got
     Tt = check_transform(T, "T")
     if Tt.shape != (4, 4):
         raise InputError(f"T must be one (4, 4) pose, got shape {Tt.shape}")
     return ik_arm_angle_path(robot, Tt[None], psi, reference, tol=tol)[0]
+
+
+#: The default ``tol`` of :func:`ik_arm_angle` (the fast path's).
+_TOL = 1e-9
+#: Per robot: its packed constants (:func:`_packed`) and the default reference z.
+_FAST: PerObject[tuple] = PerObject()
+
+
+def _ik_arm_angle_fast(robot: Robot, T: np.ndarray, psi: float) -> ArmAngleSolutions | None:
+    """:func:`ik_arm_angle` with its defaults for one C-contiguous float64 pose T (4, 4).
+
+    One compiled call (:func:`_srs_solve` with its checks) on the robot's cached constants:
+    the rows of the ordinary path. None when T is not rigid to 1e-13 or a row would be
+    polished (:func:`_polish`): the ordinary path then checks, polishes or raises.
+    """
+    packed = _FAST.get(robot)
+    if packed is None:
+        packed = _FAST.set(robot, _packed(srs_structure(robot)) + (_Z_REF,))
+    H, P, M, V, r = packed
+    Q = _EMPTY((1, 8, 7))
+    found = _EMPTY((1, 8), _I64)
+    k = _entry("solve")(T.reshape(1, 4, 4), _ARRAY((psi,)), r, H, P, M, V, True, Q, found)
+    if k < 0:
+        return None
+    got = _NEW(ArmAngleSolutions)  # frozen: set as the dataclass's __init__ would
+    _PUT(got, "q", Q[0, :k])
+    _PUT(got, "branch", found[0, :k])
+    _PUT(got, "psi", psi)
+    return got
+
+
+_EMPTY, _ARRAY, _I64 = np.empty, np.array, np.int64
+_NEW, _PUT = object.__new__, object.__setattr__
 
 
 def ik_arm_angle_path(robot: Robot, T: object, psi: float, reference: object = None, *,
@@ -447,10 +784,9 @@ def ik_arm_angle_path(robot: Robot, T: object, psi: float, reference: object = N
     if not math.isfinite(psi_f):
         raise InputError(f"psi must be a finite angle in radians, got {psi!r}")
     p = len(Tt)
-    Q, ok = _solve(arm, Tt, np.full(p, psi_f), _reference(reference))
-    Qw, inside = _into_limits(arm, Q)
-    which, branch = np.nonzero(ok & inside)                     # (pose, branch) pairs
-    rows = Qw[which, branch]
+    Q, inside = _solve(arm, Tt, np.full(p, psi_f), _reference(reference))
+    which, branch = np.nonzero(inside)                          # (pose, branch) pairs
+    rows = Q[which, branch]
     if len(rows):
         rows = _polish(robot, rows, Tt[which])
         good = _reaches(robot, rows, Tt[which], tol, arm.scale)
@@ -541,23 +877,23 @@ def arm_angle_intervals(robot: Robot, T: object, reference: object = None, *,
 
 def _feasible(arm: SRSArm, T: np.ndarray, psi: np.ndarray, r: np.ndarray) -> np.ndarray:
     """(N, 8): branch j reaches T at ψ[i] inside the joint limits."""
-    Q, ok = _solve(arm, T, psi, r)
-    return ok & _into_limits(arm, Q)[1]
+    return _solve(arm, T, psi, r)[1]
 
 
-def _bisect(arm, T, r, ends, steps: int = 36) -> list[float]:
-    """Bisect every (branch, infeasible ψ, feasible ψ) at once: the feasible ends."""
+def _bisect(arm: SRSArm, T: np.ndarray, r: np.ndarray, ends: list, steps: int = 36
+            ) -> list[float]:
+    """Bisect every (branch, infeasible ψ, feasible ψ) ``steps`` times: the feasible ends.
+
+    36 halvings of the grid step: below 1e-10 rad. Compiled: :func:`_srs_bisect`.
+    """
     if not ends:
         return []
-    j = np.array([e[0] for e in ends])
-    bad = np.array([e[1] for e in ends], dtype=float)
-    good = np.array([e[2] for e in ends], dtype=float)
-    rows = np.arange(len(ends))
-    for _ in range(steps):  # the grid step halves 36 times: below 1e-10 rad
-        mid = 0.5 * (bad + good)
-        f = _feasible(arm, T, mid, r)[rows, j]
-        good = np.where(f, mid, good)
-        bad = np.where(f, bad, mid)
+    H, P, M, V = _packed(arm)
+    j = readonly(np.array([e[0] for e in ends], dtype=np.int64))
+    bad = readonly(np.array([e[1] for e in ends], dtype=np.float64))
+    good = np.array([e[2] for e in ends], dtype=np.float64)
+    T = readonly(np.ascontiguousarray(T, dtype=np.float64))
+    _entry("bisect")(T, readonly(r), H, P, M, V, j, bad, good, steps)
     return good.tolist()
 
 
