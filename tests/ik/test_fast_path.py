@@ -137,3 +137,118 @@ def test_robot_pickles_after_fast_solves():
     del copy
     gc.collect()
     assert len(solver._FAST_ENTRIES) == before - 1
+
+
+def _ordinary(robot, target, method, q0, seed):
+    """The ordinary path of ``robot.ik`` (every argument parsed), skipping the fast one."""
+    return solver._solve_checked(robot, target, method, solver._Request(
+        q0=q0, mask=None, tol=None, max_iter=None, restarts=None, seed=seed,
+        respect_limits=True, scene=None, self_collision=False, margin=0.0, acm=None,
+        options={}))
+
+
+def _identical(a, b):
+    """Two single results agree in every field and type, q bit for bit (zero signs too)."""
+    return (_same(a, b) and np.array_equal(np.signbit(a.q), np.signbit(b.q))
+            and a.q.shape == b.q.shape and a.q.dtype == b.q.dtype
+            and all(type(getattr(a, f)) is type(getattr(b, f))
+                    for f in ("success", "iterations", "position_error", "reason", "restarts"))
+            and a.clearance == b.clearance and a.closest_pair == b.closest_pair)
+
+
+def _analytic_robots():
+    """Arms with a closed form: UR5 (±2π), PUMA 560, UR5 with joint 1 in [-3π, π].
+
+    The last one's middle of the ranges is not zero.
+    """
+    ur5 = models.ur5()
+    lim = ur5.qlim.copy()
+    lim[0] = (-3 * np.pi, np.pi)
+    return [ur5, models.puma560(), ur5.with_limits(lim)]
+
+
+@pytest.mark.parametrize("k", range(3))
+def test_analytic_fast_path_equals_ordinary(k):
+    """method='analytic' on one pose: the fast path answers exactly as the ordinary path.
+
+    Over random reachable poses, poses out of reach and poses reachable only outside the
+    limits, with q0 None, q0 inside the limits and q0 a whole turn away (the 2π
+    representatives of with_nearest_turns), seeds None and int.
+    """
+    robot = _analytic_robots()[k]
+    rng = np.random.default_rng(10 + k)
+    Q = robot.random_q(40, seed=11 + k)
+    poses = [np.ascontiguousarray(robot.fk(q)) for q in Q]
+    far = np.eye(4)
+    far[:3, 3] = (3.0, 0.2, 0.4)
+    poses.append(far)
+    wide = solver._wide(robot)
+    taken = 0
+    for i, T in enumerate(poses):
+        q0s = [None, robot.random_q(seed=100 + i)]
+        if wide is not False:  # a q0 a turn off where that stays inside the limits
+            q, lo, hi = Q[i % len(Q)], robot.qlim[:, 0], robot.qlim[:, 1]
+            up, down = q + 2 * np.pi, q - 2 * np.pi
+            q0s.append(np.where(wide & (up <= hi), up,
+                                np.where(wide & (down >= lo), down, q)))
+        for q0 in q0s:
+            for seed in (None, int(rng.integers(1 << 40))):
+                fast = robot.ik(T, method="analytic", q0=q0, seed=seed)
+                assert solver._fast(robot, T, "analytic", q0, seed) is not None
+                taken += 1
+                assert _identical(fast, _ordinary(robot, T, "analytic", q0, seed)), (i, q0)
+    assert taken > 100
+
+
+def test_analytic_fast_path_failures_and_errors_equal_ordinary():
+    """Unreachable poses fail with the ordinary reason; bad input raises the ordinary error."""
+    ur5 = models.ur5()
+    far = np.eye(4)
+    far[:3, 3] = (3.0, 0.0, 0.5)
+    res = ur5.ik(far, method="analytic")
+    assert not res.success and res.reason
+    assert _identical(res, _ordinary(ur5, far, "analytic", None, None))
+    T = np.ascontiguousarray(ur5.fk(ur5.random_q(seed=2)))
+    bad_pose = T.copy()
+    bad_pose[0, 0] = 2.0
+    assert solver._fast(ur5, bad_pose, "analytic", None, None) is None
+    for target, q0 in ((bad_pose, None), (T, np.full(6, 7.0)), (T, np.zeros(5)),
+                       (T, [0.0, 0.0, np.nan, 0.0, 0.0, 0.0]), (bad_pose, np.full(6, 7.0))):
+        with pytest.raises(InputError) as fast:
+            ur5.ik(target, method="analytic", q0=q0)
+        with pytest.raises(InputError) as ordinary:
+            _ordinary(ur5, target, "analytic", q0, None)
+        assert str(fast.value) == str(ordinary.value)
+    panda = models.panda()  # 7 joints: no closed form, the same error either way
+    Tp = np.ascontiguousarray(panda.fk(panda.random_q(seed=1)))
+    messages = []
+    for call in (lambda: panda.ik(Tp, method="analytic"),
+                 lambda: _ordinary(panda, Tp, "analytic", None, None)):
+        with pytest.raises(Exception) as err:  # noqa: PT011 (compared below)
+            call()
+        messages.append((type(err.value), str(err.value)))
+    assert messages[0] == messages[1]
+    # a Generator seed is drawn from on the ordinary path: the fast path declines it
+    assert solver._fast(ur5, T, "analytic", None, np.random.default_rng(0)) is None
+
+
+def test_analytic_fast_path_other_layouts():
+    """Fortran-ordered, float32 and read-only poses and list q0 give the ordinary answer."""
+    ur5 = models.ur5()
+    T = np.ascontiguousarray(ur5.fk(ur5.random_q(seed=5)))
+    q0 = ur5.random_q(seed=6)
+    frozen = T.copy()
+    frozen.setflags(write=False)
+    for Tv in (np.asfortranarray(T), T.astype(np.float32), frozen):
+        for qv in (None, q0, list(q0)):
+            assert _identical(ur5.ik(Tv, method="analytic", q0=qv, seed=1),
+                              _ordinary(ur5, Tv, "analytic", qv, 1))
+
+
+def test_solve_pose_needs_solve():
+    """A method spec with ``solve_pose`` but no ``solve`` is refused (the batch path needs it)."""
+    from serialkin.ik.registry import MethodSpec
+
+    with pytest.raises(InputError, match="solve_pose goes with solve"):
+        MethodSpec(name="_x", family="analytic", summary="", limits="",
+                   attempt=lambda *a: None, solve_pose=lambda *a: None)

@@ -87,3 +87,25 @@ def test_far_values_keep_their_turns():
     assert abs(nearest_turn(np.array([near]), lower, upper, wide)[0] - 3.0) < 1e-12
     far = np.array([8.9e9])
     assert nearest_turn(far, lower, upper, wide)[0] == far[0]
+
+
+edge_angles = st.one_of(angles, st.sampled_from([0.0, -0.0, math.pi, -math.pi, TWO_PI, -TWO_PI,
+                                                 3 * math.pi, 1e6, -1e6]))
+bounds = st.sampled_from([math.inf, TWO_PI, math.pi, 10.0, 3.0, 0.0, 1e-13, 4 * math.pi])
+
+
+@settings(max_examples=400, deadline=None)
+@given(q=st.lists(edge_angles, min_size=1, max_size=7), data=st.data())
+def test_one_configuration_equals_the_array_rule(q, data):
+    """One configuration (joint by joint) gets the array rule's values, zero signs included."""
+    n = len(q)
+    lo = -np.array(data.draw(st.lists(bounds, min_size=n, max_size=n)))
+    hi = np.array(data.draw(st.lists(bounds, min_size=n, max_size=n)))
+    wide = np.array(data.draw(st.lists(st.booleans(), min_size=n, max_size=n)))
+    refs = [None, np.array(data.draw(st.lists(edge_angles, min_size=n, max_size=n)))]
+    for ref in refs:
+        one = nearest_turn(np.array(q), lo, hi, wide, ref)
+        rows = nearest_turn(np.array([q]), lo, hi, wide, None if ref is None else ref[None])[0]
+        assert one.shape == (n,)
+        assert np.array_equal(one, rows)
+        assert np.array_equal(np.signbit(one), np.signbit(rows))

@@ -9,6 +9,7 @@ import click
 import numpy as np
 
 from serialkin._checks import short_repr
+from serialkin.cli.collide_cmd import srdf_acm, srdf_options
 from serialkin.cli.commands import (
     _angle_factor,
     check_out_folder,
@@ -146,11 +147,7 @@ def _is_serialkin_csv(p: Path) -> bool:
               help="Show the collision capsules when the page opens; a robot without a "
                    "collision model gets capsules fitted to its links' collision geometry "
                    "(Robot.fit_collision).")
-@click.option("--srdf", type=click.Path(dir_okay=False), default=None,
-              help="SRDF whose <disable_collisions> pairs the in-page check skips.")
-@click.option("--skip-links", "skip_links", default=None, metavar="LINK1,LINK2",
-              help="SRDF links without a collision body (pairs naming them are skipped); "
-                   "needs --srdf.")
+@srdf_options
 @click.option("--points", "points_file", type=click.Path(dir_okay=False), default=None,
               help="CSV of x,y,z or x,y,z,r,g,b rows [m; colours in 0..1] drawn as points.")
 @click.option("--points-label", default=None, help="Name of the point layer in the page "
@@ -182,7 +179,7 @@ def view_cmd(robot: str | None, q_text: str | None, trajectory: str | None,
     check_out_folder(Path(out).parent)
     Q, path_points = _view_motion(r, sc, trajectory)
     r, fitted = _with_collision(r, show_collision)
-    acm = _srdf_acm(r, srdf, skip_links)
+    acm = srdf_acm(r, srdf, skip_links)
     points, colors, points_label = _point_layer(points_file, points_label)
     ensure_dir(Path(out).parent)
     from serialkin.viz.scene import Scene, ViewerOptions
@@ -243,13 +240,6 @@ def _with_collision(r: Any, show_collision: bool) -> tuple[Any, bool]:
                        "and no collision geometry to fit one to")
     fitted, _ = r.fit_collision()  # bounding capsules of the links' collision shapes
     return fitted, True
-
-
-def _srdf_acm(r: Any, srdf: str | None, skip_links: str | None = None) -> Any:
-    """The allowed-collision matrix of --srdf/--skip-links for the collision model, or None."""
-    from serialkin.cli.collide_cmd import srdf_acm
-
-    return srdf_acm(r, srdf, skip_links)
 
 
 def _point_layer(points_file: str | None, points_label: str | None,

@@ -69,9 +69,17 @@ class MethodSpec:
             (N, 4, 4) the targets, ``kind`` their target kind, ``q0`` (N, n) or None;
             ``q`` (N, n) the answers, ``found`` (N,) bool and ``reason`` the sentence
             of a target not found. The solver measures the errors and decides success.
+        solve_pose: with ``solve``, optionally the same solve for the common single call
+            (one (4, 4) pose, the method's default options), cheaper than ``solve`` on
+            a batch of one: ``solve_pose(robot, T, q0) -> (q, found, reason)`` with
+            ``T`` a checked C-contiguous float64 (4, 4) pose, ``q0`` a checked (n,)
+            guess or None; ``q`` (n,), ``found`` a bool. Its answer must be ``solve``'s
+            for that target, bit for bit: :func:`serialkin.ik.solver.solve` calls it
+            on its fast path in place of ``solve``.
 
     Raises:
-        InputError: not exactly one of ``kernel``, ``attempt``, ``solve`` given.
+        InputError: not exactly one of ``kernel``, ``attempt``, ``solve`` given, or
+            ``solve_pose`` without ``solve``.
     """
 
     name: str
@@ -86,12 +94,15 @@ class MethodSpec:
     attempt: AttemptFn | None = None
     solve: Callable[..., Any] | None = None
     max_joints: int | None = None
+    solve_pose: Callable[..., Any] | None = None
 
     def __post_init__(self) -> None:
         if (self.kernel is None) + (self.attempt is None) + (self.solve is None) != 2:
             raise InputError(
                 f"method {self.name!r} needs exactly one of kernel, attempt, solve"
             )
+        if self.solve_pose is not None and self.solve is None:
+            raise InputError(f"method {self.name!r}: solve_pose goes with solve")
 
 
 _REGISTRY: dict[str, MethodSpec] = {}

@@ -517,6 +517,15 @@ def _solve_checked(robot: object, target: object, method: str, req: _Request) ->
 _WIDE: PerObject[Any] = PerObject()
 
 
+def _wide(robot: Robot) -> Any:
+    """The (n,) mask of ``robot``'s joints wider than a turn, or False (cached, ``_WIDE``)."""
+    wide = _WIDE.get(robot)
+    if wide is None:
+        mask = wide_joints(robot.qlim[:, 0], robot.qlim[:, 1], robot.revolute)
+        wide = _WIDE.set(robot, mask if mask.any() else False)
+    return wide
+
+
 def with_nearest_turns(robot: Robot, res: IKResult, q0: np.ndarray | None) -> IKResult:
     """``res`` with q moved by whole turns to the representative nearest ``q0`` (or zero).
 
@@ -529,10 +538,7 @@ def with_nearest_turns(robot: Robot, res: IKResult, q0: np.ndarray | None) -> IK
         res: the solver's result (single or batch).
         q0: the initial guess, (n,) or (N, n), or None (the reference is then zero).
     """
-    wide = _WIDE.get(robot)
-    if wide is None:
-        mask = wide_joints(robot.qlim[:, 0], robot.qlim[:, 1], robot.revolute)
-        wide = _WIDE.set(robot, mask if mask.any() else False)
+    wide = _wide(robot)
     if wide is False:
         return res
     q = nearest_turn(res.q, robot.qlim[:, 0], robot.qlim[:, 1], wide, q0)
@@ -547,7 +553,7 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
     """The prepared arrays of the fast path for ``robot`` and ``method`` (None: not eligible).
 
     ``(spec, entry point of solve_fast, S, zeros (n,), the strides (8,) of a contiguous q0,
-    method name)``,
+    method name)`` (for a method with ``solve_pose``: no entry point nor ``S``, None),
     kept in ``_FAST_ENTRIES`` per robot and method: ``S`` the packed constants
     (:func:`~serialkin.ik._kernels.pack_fast`) and the compiled entry point of the
     method's ``solve_fast`` for a read-only ``S``, C (4, 4) target, C (n,) q0 and q, an
@@ -557,9 +563,18 @@ def _fast_entry(robot: object, method: str) -> tuple | None:
     """
     from serialkin._jit import entry_point
 
-    if not isinstance(robot, Robot) or method not in available_methods():
+    if not isinstance(robot, Robot) or method not in _REGISTRY:
         return None
     spec = get_method(method)
+    if (spec.solve_pose is not None and "pose" in spec.targets
+            and (spec.max_joints is None or robot.n <= spec.max_joints)):
+        # a method that solves one pose by itself: no compiled entry, and in place of S
+        # the limits _fast_pose reads (_fast_pose)
+        a = robot_arrays(robot)
+        limits = (a.lo, a.hi, robot.qlim[:, 0], robot.qlim[:, 1], _wide(robot))
+        entry = (spec, None, limits, np.zeros(robot.n), (8,), spec.name)
+        _FAST_ENTRIES.setdefault(robot, dict)[method] = entry
+        return entry
     if (spec.kernel is None or spec.kernel.solve_fast is None or "pose" not in spec.targets
             or (spec.max_joints is not None and robot.n > spec.max_joints)):
         return None
@@ -605,11 +620,12 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
     """:func:`solve` for the common call, or None when the call is not that one.
 
     The common call: one floating-point (4, 4) pose (copied to C-contiguous float64 when
-    it is not), ``q0`` None or a C-contiguous
-    float64 (n,) array, ``seed`` None or an int, every other argument at its default, a
-    compiled method. The checks of the ordinary path run inside the one compiled call
-    (``solve_fast``, :func:`~serialkin.ik._kernels.pose_and_q0_valid`); when they fail,
-    None, and the ordinary path raises its precise error. The answer is the ordinary
+    it is not), ``q0`` None or a C-contiguous float64 (n,) array, ``seed`` None or an
+    int, every other argument at its default, a compiled method (or one with
+    ``solve_pose``: :func:`_fast_pose`, which takes any q0). The checks of the ordinary
+    path run inside the one compiled call (``solve_fast``,
+    :func:`~serialkin.ik._kernels.pose_and_q0_valid`); when they fail, None, and the
+    ordinary path raises its precise error. The answer is the ordinary
     path's, bit for bit (same kernel, configuration and seed). Read-only arrays are
     fine: the call only reads them.
     """
@@ -627,6 +643,8 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
         if ent is None:
             return None
     _, solve_fast, S, zeros, strides, name = ent
+    if solve_fast is None:
+        return _fast_pose(robot, ent[0], S, target, q0, seed)
     if q0 is None:
         q0k = zeros
     elif (type(q0) is _NDARRAY and q0.dtype is _F64 and q0.nbytes == zeros.nbytes
@@ -662,6 +680,48 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
                             failure_hint(robot, q, DEFAULT_WEIGHTS["pose"], True, target))
     return with_nearest_turns(robot, IKResult.make(q, False, its, pe, oe, reason, used, name),
                               q0)
+
+
+#: The flag fk_checked_range raises for a non-finite q (never, for a solver's answer).
+_UNUSED = np.zeros(1, dtype=np.int64)
+
+
+def _fast_pose(robot: Robot, spec: MethodSpec, limits: tuple, target: np.ndarray,
+               q0: object, seed: object) -> IKResult | None:
+    """:func:`_fast` for a method with ``solve_pose``: the ordinary path's answer, in scalars.
+
+    The ordinary path's checks, in its order, for the common call: the target's compiled
+    rigidity check (failing: None, and the ordinary path names the fault), then
+    :func:`check_q0` (raising the ordinary path's errors); a seed other than None or an
+    int takes the ordinary path (which draws from a Generator). Then
+    :func:`_solve_whole`'s judgement of one answer, with the same kernels (FK of a
+    (1, n) batch, ``pose_error_batch``) and the same arithmetic (the norms of three
+    values summed left to right, as numpy's reduction sums them), and
+    :func:`with_nearest_turns`' shift. ``limits`` is ``(lo, hi, lower, upper, wide)``:
+    the kernels' read-only limits, ``robot.qlim``'s columns and :func:`_wide`.
+    """
+    if seed is not None and type(seed) is not int:
+        return None
+    T1 = readonly(target.reshape(1, 4, 4))
+    if not SK.transforms_valid(T1, ROTATION_TOL):
+        return None
+    q0a = None if q0 is None else check_q0(robot, q0, None, True)
+    q, found, why = spec.solve_pose(robot, target, q0a)
+    # robot.fk of the (1, n) batch, its kernel called directly (q is finite)
+    Tq, E = np.empty((1, 4, 4)), np.empty((1, 6))
+    FK.fk_checked_range(q.reshape(1, -1), robot.chain.F, robot.chain.meta, Tq, _UNUSED, 0, 1)
+    Tq.flags.writeable = False  # pose_error's read-only input
+    SK.pose_error_batch(Tq, T1, E)
+    e0, e1, e2, e3, e4, e5 = E[0].tolist()
+    pe = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    oe = math.sqrt(e3 * e3 + e4 * e4 + e5 * e5)
+    lo, hi, lower, upper, wide = limits
+    inside = K.inside_limits(readonly(q), lo, hi, LIMIT_TOL)
+    ok = found and pe <= DEFAULT_TOL and oe <= DEFAULT_TOL and inside
+    reason = ("" if ok else why if not found else _NOT_REPRODUCED if inside else _OUTSIDE)
+    if wide is not False:
+        q = nearest_turn(q, lower, upper, wide, q0a)
+    return IKResult.make(q, bool(ok), int(found), pe, oe, reason, 0, spec.name)
 
 
 def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray | None,

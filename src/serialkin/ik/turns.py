@@ -59,15 +59,58 @@ def nearest_turn(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, wide: np.n
     Returns:
         (..., n) float64 array.
     """
-    q = np.array(q, dtype=np.float64)
-    if not np.any(wide):
-        return q
+    q = np.asarray(q, dtype=np.float64)
+    wide = np.asarray(wide, dtype=bool)
+    if not wide.any():
+        return q.copy()
     ref = 0.0 if reference is None else np.asarray(reference, dtype=np.float64)
+    n = q.shape[-1] if q.ndim else -1
+    if (q.ndim == 1 and (np.ndim(ref) == 0 or np.shape(ref) == (n,)) and wide.shape == (n,)
+            and isinstance(lower, np.ndarray) and isinstance(upper, np.ndarray)
+            and lower.shape == upper.shape == (n,)):
+        # one configuration: joint by joint, cheaper than a dozen numpy calls on n values
+        return _nearest_turn_row(q, lower, upper, wide, ref)
     with np.errstate(invalid="ignore"):  # ±inf limits give ±inf bounds on k: fine
-        k = np.round((ref - q) / _TWO_PI)
+        k = np.rint((ref - q) / _TWO_PI)  # np.round to 0 decimals, half to even
         k_min = np.ceil((lower - TOL - q) / _TWO_PI)
         k_max = np.floor((upper + TOL - q) / _TWO_PI)
-    k = np.clip(k, k_min, k_max)
+    k = k.clip(k_min, k_max)  # np.clip, without its wrapper
     # a value outside its limits with no turn inside, or too many turns away: kept
     ok = wide & (k_min <= k_max) & (np.abs(k) <= MAX_TURNS)
     return np.where(ok, q + _TWO_PI * np.where(ok, k, 0.0), q)
+
+
+def _nearest_turn_row(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, wide: np.ndarray,
+                      ref: np.ndarray | float) -> np.ndarray:
+    """:func:`nearest_turn` of one configuration ``q`` (n,), joint by joint in Python floats.
+
+    The same rule and the same IEEE operations in the same order as the array version
+    (whose dozen numpy calls cost more than the arithmetic on a few values), down to the
+    sign of a zero: Python's ``round`` rounds half to even as ``np.rint`` does, a zero
+    takes the sign ``np.rint``, ``np.ceil`` and ``np.floor`` give it (``copysign``), and
+    on a tie ``np.clip`` returns the bound, as here. An infinite bound stays infinite.
+    ``tests/ik/test_turns.py`` checks both versions against each other. ``ref`` is
+    (n,) or a scalar.
+    """
+    out = q.tolist()
+    refs = ref.tolist() if np.ndim(ref) == 1 else None
+    r = float(ref) if refs is None else 0.0  # a scalar reference (zero without q0)
+    lows, highs = lower.tolist(), upper.tolist()
+    for j, moves in enumerate(wide.tolist()):
+        if not moves:
+            continue
+        x = out[j]
+        t = ((r if refs is None else refs[j]) - x) / _TWO_PI
+        low, high = lows[j] - TOL, highs[j] + TOL
+        if -0.5 < t < 0.5 and low <= x <= high and x != 0.0:
+            continue  # k = ±0 inside [k_min <= 0, k_max >= 0]: x + 2π·(±0) is x
+        k = round(t) or math.copysign(0.0, t)  # np.rint: -0.0 for t in [-0.5, 0)
+        a = (low - x) / _TWO_PI
+        b = (high - x) / _TWO_PI
+        k_min = (math.ceil(a) or math.copysign(0.0, a)) if math.isfinite(a) else a
+        k_max = (math.floor(b) or math.copysign(0.0, b)) if math.isfinite(b) else b
+        k = k if k > k_min else k_min  # np.clip(k, k_min, k_max), the bound on ties
+        k = k if k < k_max else k_max
+        if k_min <= k_max and abs(k) <= MAX_TURNS:
+            out[j] = x + _TWO_PI * k
+    return np.array(out)

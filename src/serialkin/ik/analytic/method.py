@@ -6,16 +6,19 @@ method="analytic", q0=...)`` solves with :func:`serialkin.ik.analytic.ik_all` an
 returns the solution nearest ``q0`` (revolute joints moved by 2π towards ``q0`` inside
 their limits, :func:`serialkin.ik.turns.nearest_turn`; weighted L2 or L∞ distance),
 or nearest the middle of the joint ranges without ``q0``; a batch of targets is one
-``ik_all`` batch.
+``ik_all`` batch. The common single call (one pose, default options) takes
+:func:`analytic_solve_pose`: the same answer without the batch's array bookkeeping.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
+from serialkin._memo import PerObject
 from serialkin.ik.analytic import (
     NEAR_TOL,
     _distance_args,
@@ -24,6 +27,7 @@ from serialkin.ik.analytic import (
     reference_distance,
 )
 from serialkin.ik.registry import MethodSpec, register_method
+from serialkin.ik.turns import nearest_turn
 from serialkin.model.robot import Robot
 
 #: Options of the method, with their defaults (passed on to ``ik_all``).
@@ -65,6 +69,20 @@ def _every_solution(robot: Robot, T: np.ndarray, kind: str,
     return Q, counts
 
 
+#: Per robot: the middle of the joint ranges (the reference without q0), read-only.
+_MIDDLE: PerObject[np.ndarray] = PerObject()
+
+
+def _middle(robot: Robot) -> np.ndarray:
+    """The (n,) middle of ``robot``'s sampling box (computed once per robot)."""
+    mid = _MIDDLE.get(robot)
+    if mid is None:
+        mid = robot.sampling_limits().mean(axis=1)
+        mid.setflags(write=False)
+        _MIDDLE.set(robot, mid)
+    return mid
+
+
 def analytic_solve(robot: Robot, T: np.ndarray, kind: str, q0: np.ndarray | None,
                    options: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray, str]:
     """Solve the targets ``T`` (N, 4, 4) by ``ik_all``, each answer the nearest ``q0``.
@@ -79,7 +97,7 @@ def analytic_solve(robot: Robot, T: np.ndarray, kind: str, q0: np.ndarray | None
         ``(q (N, n), found (N,) bool, reason)``: a target without any solution inside
         the limits answers its reference, ``found`` False and ``reason`` says why.
     """
-    mid = robot.sampling_limits().mean(axis=1)
+    mid = _middle(robot)
     ref = np.broadcast_to(mid, (T.shape[0], robot.n)) if q0 is None else q0
     _, w = _distance_args(robot, mid, options["weights"], options["norm"])
     Q, counts = _every_solution(robot, T, kind, options)
@@ -92,6 +110,31 @@ def analytic_solve(robot: Robot, T: np.ndarray, kind: str, q0: np.ndarray | None
     return np.where(found[:, None], best, ref), found, NOT_FOUND
 
 
+def analytic_solve_pose(robot: Robot, T: np.ndarray,
+                        q0: np.ndarray | None) -> tuple[np.ndarray, bool, str]:
+    """:func:`analytic_solve` of one pose ``T`` (4, 4) with the default options.
+
+    The same operations on the ``k`` rows of the one target (no padding, no batch
+    axis; unit weights multiply by 1.0, which changes no value), so the same answer bit
+    for bit: the rows of ``ik_all``, each revolute joint shifted by 2π towards the
+    reference (``q0`` (n,) or the middle of the ranges), the nearest in the L2
+    distance (the first of equals).
+
+    Returns:
+        ``(q (n,), found, reason)``: without any solution, a copy of the reference.
+    """
+    ref = _middle(robot) if q0 is None else q0
+    rows = np.asarray(ik_all(robot, T).q, dtype=np.float64).reshape(-1, robot.n)
+    if rows.shape[0] == 0:
+        return ref.copy(), False, NOT_FOUND
+    shifted = nearest_turn(rows, robot.qlim[:, 0], robot.qlim[:, 1], robot.revolute, ref)
+    d = shifted - ref
+    # reference_distance's sqrt(Σ d²) (the sum: add.reduce, as ndarray.sum), the first
+    # of the nearest as argmin picks it (math.sqrt rounds as np.sqrt does)
+    dist = [math.sqrt(s) for s in np.add.reduce(d * d, axis=-1).tolist()]
+    return shifted[dist.index(min(dist))].copy(), True, NOT_FOUND
+
+
 def register_analytic() -> None:
     """Register the method ``'analytic'`` (done once, when this module is imported)."""
     register_method(MethodSpec(
@@ -100,6 +143,7 @@ def register_analytic() -> None:
                 "nearest q0",
         limits="only solutions inside the limits are returned by ik_all",
         max_iter=1, restarts=0, options=dict(OPTIONS), solve=analytic_solve,
+        solve_pose=analytic_solve_pose,
     ))
 
 
