@@ -2,23 +2,15 @@
 
 from __future__ import annotations
 
-import importlib.metadata
 from pathlib import Path
 
 
 def robots_dir() -> Path | None:
     """The folder ``.../share/example-robot-data/robots`` of the installed package, or None."""
-    try:
-        dist = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError:
-        return None
-    for f in dist.files or []:
-        parts = Path(str(f)).parts
-        if "robots" in parts and parts[-1].endswith(".urdf"):
-            full = Path(str(dist.locate_file(f)))
-            idx = full.parts.index("robots")
-            return Path(*full.parts[: idx + 1])
-    return None
+    from serialkin.collision.reference import example_robot_data_share
+
+    share = example_robot_data_share()
+    return None if share is None else share / "example-robot-data" / "robots"
 
 
 def urdf(relative: str) -> Path | None:

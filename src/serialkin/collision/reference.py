@@ -34,7 +34,7 @@ import numpy as np
 from serialkin._checks import as_generator
 
 __all__ = ["VENDOR", "Agreement", "CoalReference", "VendorSpec", "compare_with_coal",
-           "frame_offsets", "vendor_files"]
+           "example_robot_data_share", "frame_offsets", "vendor_files"]
 
 
 @dataclass(frozen=True)
@@ -77,7 +77,7 @@ VENDOR = {
 NO_VENDOR_MESHES = ("puma560", "stanford", "iiwa7")
 
 
-def _share() -> Path | None:
+def example_robot_data_share() -> Path | None:
     """``.../share`` holding ``example-robot-data/robots`` (the package:// root), or None."""
     try:
         dist = importlib.metadata.distribution("example-robot-data")
@@ -102,7 +102,7 @@ def vendor_files(name: str) -> tuple[Path, Path, Path] | str:
         import pinocchio  # noqa: F401
     except ImportError as exc:
         return f"Pinocchio with coal is not installed ({exc}); pip install pin"
-    share = _share()
+    share = example_robot_data_share()
     if share is None:
         return "example-robot-data is not installed; pip install example-robot-data"
     root = share / "example-robot-data" / "robots"
