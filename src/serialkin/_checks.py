@@ -14,10 +14,11 @@ import itertools
 import math
 import reprlib
 from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
-from serialkin.errors import InputError, InputTypeError
+from serialkin.errors import InputError, InputTypeError, NotSupportedError
 
 #: Tolerance used to decide whether a matrix is a rotation (max |RᵀR − I| and |det R − 1|).
 ROTATION_TOL = 1e-6
@@ -353,3 +354,19 @@ def as_generator(seed: None | int | np.random.Generator) -> np.random.Generator:
             raise InputError(f"seed must be >= 0, got {short_repr(seed)}")
         return np.random.default_rng(int(seed))
     raise InputTypeError(f"seed must be None, an int or a numpy Generator, got {_describe(seed)}")
+
+
+def require(module: str, extra: str, needed_for: str) -> Any:
+    """Import the optional dependency ``module`` (dotted name) or say which extra brings it.
+
+    Raises:
+        NotSupportedError: ``module`` is not installed; the message names what needs it
+            and the command ``pip install "serialkin[<extra>]"``.
+    """
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise NotSupportedError(f'{needed_for} needs {module.split(".")[0]}: '
+                                f'pip install "serialkin[{extra}]"') from None

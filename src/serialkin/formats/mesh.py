@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import check_choice, check_int, short_repr
+from serialkin._checks import check_choice, check_int, require, short_repr
 from serialkin.errors import InputTypeError, NotSupportedError, RobotDefinitionError
 from serialkin.model.geometry import Box, Capsule, Cylinder, Mesh, Sphere
 
@@ -54,12 +54,7 @@ _cache_lock = threading.Lock()
 
 def _trimesh() -> Any:
     """Import trimesh, or raise naming the extra to install."""
-    try:
-        import trimesh
-    except ImportError:
-        raise NotSupportedError(
-            'loading mesh files needs trimesh: pip install "serialkin[mesh]"') from None
-    return trimesh
+    return require("trimesh", "mesh", "loading mesh files")
 
 
 @dataclass(frozen=True, eq=False)
@@ -259,11 +254,7 @@ def decimate(mesh: TriangleMesh, max_faces: int) -> TriangleMesh:
     if mesh.faces.shape[0] <= max_faces:
         return mesh
     trimesh = _trimesh()
-    try:
-        import fast_simplification  # noqa: F401
-    except ImportError:
-        raise NotSupportedError(
-            'mesh decimation needs fast-simplification: pip install "serialkin[mesh]"') from None
+    require("fast_simplification", "mesh", "mesh decimation")
     mesh = welded(mesh)
     tm = trimesh.Trimesh(mesh.vertices.copy(), mesh.faces.copy(), process=False)
     out = tm.simplify_quadric_decimation(face_count=max_faces)

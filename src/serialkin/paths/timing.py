@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin._checks import as_float_array
+from serialkin._checks import as_float_array, require
 from serialkin._io import write_text_atomic
 from serialkin.errors import InputError, SerialkinError
 from serialkin.model.robot import Robot
@@ -46,24 +46,11 @@ __all__ = ["TimedPath", "jerk_limited", "time_optimal"]
 
 
 def _toppra():
-    try:
-        import toppra
-        import toppra.algorithm
-        import toppra.constraint
-    except ImportError as exc:  # pragma: no cover - the extra is installed in the tests
-        raise SerialkinError(
-            "time_optimal needs the toppra library: pip install 'serialkin[paths]'") from exc
+    toppra = require("toppra", "paths", "time_optimal")
+    for sub in ("toppra.algorithm", "toppra.constraint"):
+        require(sub, "paths", "time_optimal")
     toppra.setup_logging("WARNING")
     return toppra
-
-
-def _ruckig():
-    try:
-        import ruckig
-    except ImportError as exc:  # pragma: no cover - the extra is installed in the tests
-        raise SerialkinError(
-            "jerk_limited needs the ruckig library: pip install 'serialkin[paths]'") from exc
-    return ruckig
 
 
 @dataclass(frozen=True, eq=False)
@@ -161,6 +148,22 @@ def _joint_path(q: object) -> tuple[np.ndarray, np.ndarray]:
     return Q, s
 
 
+def _path_and_limits(q: object, robot: Robot | None, velocity: object, acceleration: object,
+                     dt: float, caller: str) -> tuple[np.ndarray, ...]:
+    """The checked path and limits of ``caller`` (time_optimal, jerk_limited).
+
+    Returns the joint path ``Q`` (k, n), its parameter ``s`` (k,) and the velocity and
+    acceleration limits (n,) (given, else the robot's); ``dt`` is checked too.
+    """
+    Q, s = _joint_path(q)
+    n = Q.shape[1]
+    v = _limits(_robot_limits(robot, velocity, n, "velocity", caller), n, "velocity")
+    a = _limits(_robot_limits(robot, acceleration, n, "acceleration", caller), n,
+                "acceleration")
+    _check_dt(dt)
+    return Q, s, v, a
+
+
 def _check_dt(dt: float) -> None:
     if not (dt > 0.0 and math.isfinite(dt)):
         raise InputError(f"dt must be a positive time step in seconds, got {dt!r}")
@@ -208,12 +211,7 @@ def time_optimal(q: object, velocity: object = None, acceleration: object = None
             limits, e.g. a cusp where the path reverses).
     """
     ta = _toppra()
-    Q, s = _joint_path(q)
-    n = Q.shape[1]
-    v = _limits(_robot_limits(robot, velocity, n, "velocity", "time_optimal"), n, "velocity")
-    a = _limits(_robot_limits(robot, acceleration, n, "acceleration", "time_optimal"), n,
-                "acceleration")
-    _check_dt(dt)
+    Q, s, v, a = _path_and_limits(q, robot, velocity, acceleration, dt, "time_optimal")
     path = ta.SplineInterpolator(s, Q)
     constraints = [ta.constraint.JointVelocityConstraint(np.column_stack([-v, v])),
                    ta.constraint.JointAccelerationConstraint(np.column_stack([-a, a]))]
@@ -285,14 +283,10 @@ def jerk_limited(q: object, jerk: object, velocity: object = None,
     """
     from scipy.interpolate import CubicSpline
 
-    rk = _ruckig()
-    Q, s = _joint_path(q)
+    rk = require("ruckig", "paths", "jerk_limited")
+    Q, s, v, a = _path_and_limits(q, robot, velocity, acceleration, dt, "jerk_limited")
     n = Q.shape[1]
-    v = _limits(_robot_limits(robot, velocity, n, "velocity", "jerk_limited"), n, "velocity")
-    a = _limits(_robot_limits(robot, acceleration, n, "acceleration", "jerk_limited"), n,
-                "acceleration")
     jk = _limits(jerk, n, "jerk")
-    _check_dt(dt)
     spline = CubicSpline(s, Q)
     V, A, J = _path_bounds(spline, s, v, a, jk)
     traj = _ruckig_profile(rk, float(s[-1]), V, A, J)
