@@ -1,9 +1,9 @@
 """Every command that checks self-collision takes ``--srdf`` and ``--skip-links`` alike.
 
-The commands that check collision (``collide``, ``reach``, ``base-placement``, ``view``)
-declare the two options through one helper (``collide_cmd.srdf_options``), refuse
-``--skip-links`` without ``--srdf`` in the same words, and hand the SRDF's allowed pairs
-to the library call that checks.
+The commands that check collision (``collide``, ``reach``, ``base-placement``, ``view``,
+``track``) declare the two options through one helper (``collide_cmd.srdf_options``),
+refuse ``--skip-links`` without ``--srdf`` in the same words, and hand the SRDF's allowed
+pairs to the library call that checks.
 """
 
 from __future__ import annotations
@@ -28,6 +28,8 @@ CHECKING = {
     "base-placement": lambda tmp: ["base-placement", "ur5", "--tasks", str(_tasks(tmp)),
                                    "--no-plot", "-q", "--out", str(tmp / "bp")],
     "view": lambda tmp: ["view", "ur5", "--out", str(tmp / "p.html")],
+    "track": lambda tmp: ["track", str(_ur5_scenario(tmp)), "--no-figures", "--no-animation",
+                          "-q", "--out", str(tmp / "track")],
 }
 #: Options by which a command checks collision.
 COLLISION_OPTIONS = {"--scene", "--self-collision", "--collision", "--clearance"}
@@ -38,6 +40,15 @@ PAIR = ("base_link", "wrist_3_link")
 def _tasks(tmp):
     path = tmp / "tasks.yaml"
     path.write_text("tasks:\n  - [0.4, 0.1, 0.3, 3.14159, 0, 0]\n", encoding="utf-8")
+    return path
+
+
+def _ur5_scenario(tmp):
+    """A UR5 scenario tracked by the QP with self-collision (its solver checks it)."""
+    path = tmp / "ur5_path.yaml"
+    path.write_text("robot: {model: ur5}\nq0: [0, -1.2, 1.4, 0, 0.5, 0]\n"
+                    "path: {type: points, points: [[0.4, 0.1, 0.3], [0.4, 0.15, 0.3]]}\n"
+                    "solver: {method: qp, self_collision: true}\n", encoding="utf-8")
     return path
 
 
@@ -66,8 +77,8 @@ def _options(cmd: click.Command) -> set[str]:
 def test_every_collision_checking_command_takes_srdf_and_skip_links():
     """A command with a collision option (or collide itself) has --srdf and --skip-links.
 
-    The checking set is stated: a command that starts to check collision (``ik`` or
-    ``track`` with a scene, say) fails here until it takes the SRDF options too.
+    The checking set is stated: a command that starts to check collision (``ik`` with a
+    scene, say) fails here until it takes the SRDF options too.
     """
     commands = _commands(cli)
     checking = {name for name, cmd in commands.items()
@@ -101,6 +112,7 @@ def test_unknown_srdf_file_is_refused(name, tmp_path):
     ("reach", "serialkin.reach.execute.make_job"),
     ("base-placement", "serialkin.reach.base_placement"),
     ("view", "serialkin.viz.scene.Scene"),
+    ("track", "serialkin.tracking.scenario.track"),
 ])
 def test_srdf_pairs_reach_the_library_call(name, target, tmp_path, monkeypatch):
     """The SRDF's disabled pair arrives as ``acm`` in the call that checks collision."""
@@ -149,3 +161,119 @@ def test_view_srdf_drops_the_disabled_pair_from_the_page(tmp_path):
     full = pairs()
     skipped = pairs("--srdf", str(_srdf(tmp_path)))
     assert full - skipped == {tuple(sorted(PAIR))}
+
+
+# ------------------------------------------------------------------------- track
+#: A unit-link 6-link planar arm with its capsule model, folded towards its base: links 1
+#: and 6 cross unless the QP keeps them apart (tests/tracking/test_self_collision_pairs.py).
+FOLD = ("robot: {model: planar6}\nq0: 0.1\n"
+        "path: {type: polyline, waypoints: [[5.0, 1.0], [0.5, 0.0], [0.0, 0.0]], step: 0.2}\n"
+        "solver: {method: qp, self_collision: true, safety: 0.05}\n")
+
+
+def _fold(tmp, text=FOLD):
+    path = tmp / "fold.yaml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _fold_srdf(tmp, a="link1", b="link6"):
+    path = tmp / f"{a}_{b}.srdf"
+    path.write_text(f'<robot name="planar6"><disable_collisions link1="{a}" link2="{b}"/>'
+                    "</robot>", encoding="utf-8")
+    return path
+
+
+def _track_q(tmp, scenario, *extra):
+    """Joint trajectory (p, n) that `serialkin track` writes for ``scenario``."""
+    from serialkin.tracking import Trajectory
+
+    out = tmp / "out"
+    res = CliRunner().invoke(cli, ["track", str(scenario), "--out", str(out), "--format", "npz",
+                                   "--no-figures", "--no-animation", "-q", *extra])
+    assert res.exit_code in (0, 1), res.output  # 1: a point not reached
+    return Trajectory.load(out / f"{scenario.stem}.npz").q
+
+
+@pytest.mark.parametrize("extra", [(), ("link1", "link6"), ("link2", "link5")])
+def test_track_cli_and_python_api_agree(extra, tmp_path):
+    """`track --srdf` writes the trajectory of ``track(..., srdf=...)``, bit for bit."""
+    from serialkin.tracking import load_scenario, track
+
+    scenario = _fold(tmp_path)
+    srdf = {"srdf": _fold_srdf(tmp_path, *extra)} if extra else {}
+    cli_q = _track_q(tmp_path, scenario, *(("--srdf", str(srdf["srdf"])) if srdf else ()))
+    sc = load_scenario(scenario)
+    api = track(sc.robot, sc.path, sc.solver, q0=sc.q0, **srdf)
+    np.testing.assert_array_equal(cli_q, api.q)
+
+
+def test_track_srdf_lets_the_disabled_pair_cross(tmp_path):
+    """With link1–link6 disabled by --srdf the fold completes through them; not without."""
+    from serialkin import models
+
+    arm = models.get("planar6")
+    scenario = _fold(tmp_path)
+    kept = _track_q(tmp_path, scenario)
+    crossed = _track_q(tmp_path, scenario, "--srdf", str(_fold_srdf(tmp_path)))
+    assert arm.clearance(kept).distance.min() > 0.0
+    worst = arm.clearance(crossed)
+    k = int(np.argmin(worst.distance))
+    assert worst.distance[k] < 0.0 and (worst.first[k], worst.second[k]) == ("link1", "link6")
+
+
+def test_track_self_collision_flag_turns_the_qp_check_on(tmp_path):
+    """--self-collision on a QP scenario without it keeps the bodies apart; needs the QP."""
+    from serialkin import models
+
+    arm = models.get("planar6")
+    scenario = _fold(tmp_path, FOLD.replace("self_collision: true", "self_collision: false"))
+    assert arm.clearance(_track_q(tmp_path, scenario)).distance.min() < 0.0
+    kept = _track_q(tmp_path, scenario, "--self-collision")
+    np.testing.assert_array_equal(kept, _track_q(tmp_path, _fold(tmp_path)))
+    dls = _fold(tmp_path, FOLD.replace("{method: qp, self_collision: true, safety: 0.05}",
+                                       "{method: dls}"))
+    res = CliRunner().invoke(cli, ["track", str(dls), "--self-collision", "-q",
+                                   "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2
+    assert "--self-collision needs the QP solver" in res.output and "'dls'" in res.output
+
+
+@pytest.mark.parametrize(("solver", "hint"), [
+    ("{method: dls}", "add --self-collision and --solver qp"),
+    ("{method: qp}", "add --self-collision"),
+])
+def test_track_srdf_without_a_self_collision_check_is_refused(solver, hint, tmp_path):
+    """--srdf where nothing checks self-collision says what to add."""
+    scenario = _fold(tmp_path, FOLD.replace("{method: qp, self_collision: true, safety: 0.05}",
+                                            solver))
+    res = CliRunner().invoke(cli, ["track", str(scenario), "--srdf",
+                                   str(_fold_srdf(tmp_path)), "-q", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2
+    assert "--srdf lists the pairs a self-collision check skips" in res.output
+    assert hint in res.output
+
+
+@pytest.mark.parametrize(("content", "match"), [
+    ("<robot><disable_collisions link1='link1'", "malformed XML"),
+    ("<robot><disable_collisions link1='link1' link2='nope'/></robot>", "'nope'"),
+])
+def test_track_bad_srdf_content_names_the_option(content, match, tmp_path):
+    """An SRDF that cannot be read, or names a link without a body: 'Error: --srdf: ...'."""
+    bad = tmp_path / "bad.srdf"
+    bad.write_text(content, encoding="utf-8")
+    res = CliRunner().invoke(cli, ["track", str(_fold(tmp_path)), "--srdf", str(bad), "-q",
+                                   "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2
+    assert "Error: --srdf: " in res.output and match in res.output
+    assert not (tmp_path / "o").exists()  # refused before anything is written
+
+
+def test_track_srdf_on_a_robot_without_a_collision_model_is_refused(tmp_path):
+    """A scenario's planar arm has no collision model: --srdf says so."""
+    scenario = _fold(tmp_path, FOLD.replace("{model: planar6}",
+                                            "{planar: {links: 6, length: 1.0}}"))
+    res = CliRunner().invoke(cli, ["track", str(scenario), "--srdf", str(_fold_srdf(tmp_path)),
+                                   "-q", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2
+    assert "--srdf: robot" in res.output and "has no collision model" in res.output

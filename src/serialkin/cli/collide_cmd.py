@@ -69,7 +69,7 @@ def srdf_options(fn: Callable[..., Any]) -> Callable[..., Any]:
     fn = click.option("--skip-links", "skip_links", default=None, metavar="LINK1,LINK2",
                       help="SRDF links without a collision body (fingers off the chain, a "
                            "TCP frame): pairs naming them are skipped. Needs --srdf.")(fn)
-    return click.option("--srdf", type=click.Path(dir_okay=False), default=None,
+    return click.option("--srdf", type=click.Path(exists=True, dir_okay=False), default=None,
                         help="SRDF whose <disable_collisions> pairs are not checked.")(fn)
 
 
@@ -77,7 +77,9 @@ def srdf_acm(robot: Any, srdf: str | None, skip_links: str | None) -> Any:
     """The allowed-collision matrix of ``--srdf`` / ``--skip-links``, or None (the default).
 
     Raises:
-        CLIError: --skip-links without --srdf, or a robot without a collision model.
+        CLIError: --skip-links without --srdf, a robot without a collision model, or an
+            SRDF that cannot be read or names a link that is not a body (the message
+            starts with ``--srdf``).
     """
     skip = [s.strip() for s in (skip_links or "").split(",") if s.strip()]
     if srdf is None:
@@ -88,8 +90,12 @@ def srdf_acm(robot: Any, srdf: str | None, skip_links: str | None) -> Any:
         raise CLIError(f"--srdf: robot {short_repr(robot.name)} has no collision model to "
                        "apply it to")
     from serialkin.collision import acm_from_srdf
+    from serialkin.errors import RobotDefinitionError
 
-    return acm_from_srdf(robot.collision, srdf, skip_links=skip)
+    try:
+        return acm_from_srdf(robot.collision, srdf, skip_links=skip)
+    except RobotDefinitionError as exc:  # malformed XML, a link that is not a body
+        raise CLIError(f"--srdf: {exc}") from exc
 
 
 @click.command("collide", help=_COLLIDE_HELP,

@@ -11,6 +11,7 @@ import click
 import numpy as np
 
 from serialkin._checks import check_int, check_positive
+from serialkin.cli.collide_cmd import srdf_acm, srdf_options
 from serialkin.cli.commands import (
     check_out_folder,
     handle_errors,
@@ -43,11 +44,17 @@ _TRACK_HELP = command_help(
     "viewer). --solver qp replaces the scenario's solver by the differential-IK quadratic "
     "program with hard joint limits and collision constraints (serialkin.diffik); "
     "--max-joint-step reports (and with qp forbids) larger joint jumps between path points. "
+    "--self-collision makes the QP keep the robot's own bodies apart (the body pairs of "
+    "its collision model that the allowed-collision matrix checks, as in 'serialkin "
+    "collide'; a robot without a collision model: its link segments), and --srdf adds the "
+    "SRDF's <disable_collisions> pairs to the pairs it skips (a scenario whose solver has "
+    "self_collision: true needs no --self-collision). "
     "Exit code 1 when a path point is not reached within the tolerance; 2 on bad input.",
     ["serialkin track six_link_circle --out out/track",
      "serialkin track twenty_link_obstacles --format npz --viewer",
      "serialkin track my_scenario.yaml --no-animation --json",
      "serialkin track twenty_link_obstacles --solver qp --max-joint-step 0.2",
+     "serialkin track ur5_path.yaml --solver qp --self-collision --srdf ur5.srdf",
      "serialkin track --list"],
 )
 
@@ -74,6 +81,10 @@ _TRACK_HELP = command_help(
                    "with --solver qp.")
 @click.option("--max-joint-step-deg", type=float, default=None,
               help="The same in degrees.")
+@click.option("--self-collision", is_flag=True,
+              help="Keep the robot's own bodies apart (the QP solver: --solver qp or a "
+                   "scenario with method: qp).")
+@srdf_options
 @click.option("--list", "list_only", is_flag=True, help="List the shipped scenarios.")
 @click.option("--verbose", "-v", is_flag=True,
               help="List every failed point and joint jump in the summary (default: the "
@@ -85,6 +96,7 @@ _TRACK_HELP = command_help(
 def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_animation: bool,
               mp4: bool, fps: float, max_frames: int, viewer: bool, solver: str,
               max_joint_step: float | None, max_joint_step_deg: float | None,
+              self_collision: bool, srdf: str | None, skip_links: str | None,
               list_only: bool, verbose: bool, as_json: bool, quiet: bool) -> None:
     """Track a scenario's path and write trajectory, figures and animation."""
     from serialkin.tracking import list_scenarios, load_scenario
@@ -108,6 +120,7 @@ def track_cmd(scenario: str | None, out: str, fmt: str, no_figures: bool, no_ani
                            hint="use --max-joint-step-deg")
     check_out_folder(out)
     sc = _with_solver(load_scenario(scenario), solver, max_joint_step)
+    sc = _with_self_collision(sc, self_collision, srdf_acm(sc.robot, srdf, skip_links))
     stem = Path(scenario).stem if Path(scenario).suffix else scenario
     show = not quiet and not as_json and sys.stderr.isatty()
     if show:
@@ -266,6 +279,40 @@ def _with_solver(sc: Any, solver: str, max_joint_step: float | None) -> Any:
             sc = replace(sc, solver=sc.solver.with_options(max_joint_step=max_joint_step))
         sc = replace(sc, options={**sc.options, "max_joint_step": max_joint_step})
     return sc
+
+
+def _with_self_collision(sc: Any, self_collision: bool, acm: Any) -> Any:
+    """The scenario with --self-collision and the allowed pairs of --srdf (``acm``) applied.
+
+    Raises:
+        CLIError: --self-collision or --srdf when the solver is not the QP (the only one
+            that checks self-collision), --srdf when the QP checks none.
+    """
+    from dataclasses import replace
+
+    from serialkin.diffik.resolver import QPResolver
+
+    qp = isinstance(sc.solver, QPResolver)
+    if self_collision:
+        if not qp:
+            raise CLIError(f"--self-collision needs the QP solver, the one that checks it: "
+                           f"add --solver qp (the scenario's solver is {_solver_name(sc)})")
+        sc = replace(sc, solver=sc.solver.with_options(self_collision=True))
+    if acm is not None:
+        if not (qp and sc.solver.self_collision):
+            raise CLIError("--srdf lists the pairs a self-collision check skips: add "
+                           "--self-collision" + ("" if qp else " and --solver qp"))
+        sc = replace(sc, options={**sc.options, "acm": acm})
+    return sc
+
+
+def _solver_name(sc: Any) -> str:
+    """The scenario's solver as a scenario file names it ('dls', 'multitask', ...)."""
+    from serialkin.redundancy.multitask import MultiTaskResolver
+
+    if isinstance(sc.solver, MultiTaskResolver):
+        return "'multitask'"
+    return repr(sc.solver) if isinstance(sc.solver, str) else type(sc.solver).__name__
 
 
 def _summary(sc: Any, traj: Any, files: dict[str, str]) -> dict[str, Any]:

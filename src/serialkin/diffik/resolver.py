@@ -14,7 +14,13 @@ the hard constraints:
   previous point's q): the tracker then never jumps by more, and a target it cannot
   reach within that bound is reported as not reached;
 * collision avoidance against the obstacles (velocity damper with safety distance
-  ``safety`` and gain ``collision_gain``).
+  ``safety`` and gain ``collision_gain``);
+* optionally self-collision avoidance (``self_collision``): for a robot with a collision
+  model (``robot.collision``) between the body pairs of that model that its
+  allowed-collision matrix checks (``acm``; by default
+  :func:`~serialkin.collision.acm.default_acm`: same and adjacent frames and the pairs
+  the model ships as allowed), the same pairs ``robot.in_collision`` checks; for a robot
+  without one between the chain's link segments two or more apart.
 
 With ``solver='compiled'`` (the default) the iterations of one target run in one
 compiled loop (:func:`serialkin.diffik.compiled.qp_point_into`); with 'daqp' or a
@@ -42,7 +48,7 @@ from serialkin.diffik.constraints import (
 )
 from serialkin.diffik.qp import DiffIK, check_solver
 from serialkin.diffik.tasks import FrameTask, PostureTask
-from serialkin.errors import InputError
+from serialkin.errors import InputError, InputTypeError
 from serialkin.model.geometry import Capsule, Cylinder, Sphere
 from serialkin.redundancy.obstacles import check_obstacles, encode_obstacles
 
@@ -72,8 +78,15 @@ class QPResolver:
         link_radius: link capsule radius [m].
         safety: d_s, clearance kept from obstacles [m].
         collision_gain: fraction of ``d − d_s`` the clearance may lose per step, (0, 1].
-        self_collision: also keep non-adjacent links apart (segments two or more apart; with
-            ``scene`` the checked body pairs of the capsule model).
+        self_collision: also keep the robot's own bodies apart: with a collision model
+            (``robot.collision``) the body pairs of the capsule model that ``acm`` checks
+            (:class:`~serialkin.diffik.model_collision.ModelCollisionAvoidance`); without
+            one, the chain's link segments two or more apart (capsules of ``link_radius``).
+        acm: :class:`~serialkin.collision.acm.AllowedCollisionMatrix` of the capsule
+            model's body pairs never checked (e.g. an SRDF's
+            ``<disable_collisions>``: :func:`~serialkin.collision.acm.acm_from_srdf`);
+            None: the model's default (:func:`~serialkin.collision.acm.default_acm`).
+            Needs ``self_collision`` and a robot with a collision model.
         scene: scene shapes for the robot's capsule model ``robot.collision``
             (:class:`~serialkin.diffik.model_collision.ModelCollisionAvoidance`): spheres,
             capsules, z-cylinders, boxes, half-spaces of :mod:`serialkin.collision`, in the
@@ -99,6 +112,7 @@ class QPResolver:
     safety: float = 0.002
     collision_gain: float = 0.5
     self_collision: bool = False
+    acm: object = None
     posture_weight: float = 1e-4
     damping: float = 1e-6
     max_step: float = 0.1
@@ -144,6 +158,15 @@ class QPResolver:
         if not isinstance(self.self_collision, bool):
             raise InputError(f"self_collision must be true or false, got "
                              f"{short_repr(self.self_collision)}")
+        if self.acm is not None:
+            from serialkin.collision.acm import AllowedCollisionMatrix
+
+            if not isinstance(self.acm, AllowedCollisionMatrix):
+                raise InputTypeError(f"acm must be an AllowedCollisionMatrix or None, got "
+                                     f"{type(self.acm).__name__} {short_repr(self.acm)}")
+            if not self.self_collision:
+                raise InputError("acm lists the body pairs a self-collision check skips; it "
+                                 "needs self_collision=True")
 
     def with_options(self, **changes: object) -> QPResolver:
         """A copy with some settings changed (validated again)."""
@@ -178,18 +201,25 @@ class _QPState:
             cons.append(self.box)
         self.collision = None
         self.model_collision = None
-        if res.scene:
+        has_model = getattr(robot, "collision", None) is not None
+        if res.acm is not None and not has_model:
+            raise InputError(f"acm names bodies of a collision model, but robot "
+                             f"{short_repr(robot.name)} has none (its self-collision check "
+                             "keeps link segments apart); give it one with "
+                             "robot.with_collision(model)")
+        if res.scene or (res.self_collision and has_model):
             from serialkin.diffik.model_collision import ModelCollisionAvoidance
 
             self.model_collision = ModelCollisionAvoidance(
-                res.scene, self_collision=res.self_collision, safety=res.safety,
+                res.scene, acm=res.acm, self_collision=res.self_collision, safety=res.safety,
                 influence=res.safety + 0.03, gain=res.collision_gain)
             self.model_collision._state(robot)  # no model, or the scene through the base
             cons.append(self.model_collision)
-        if res.obstacles or (res.self_collision and not res.scene):
+        segments = res.self_collision and self.model_collision is None  # no body model
+        if res.obstacles or segments:
             self.collision = CollisionAvoidance(
                 res.obstacles, link_radius=res.link_radius, safety=res.safety,
-                gain=res.collision_gain, self_pairs="auto" if res.self_collision else ())
+                gain=res.collision_gain, self_pairs="auto" if segments else ())
             cons.append(self.collision)
         tasks = [self.frame] + ([self.posture] if res.posture_weight > 0 else [])
         self.ik = DiffIK(robot, tasks, cons, damping=res.damping, solver=res.solver)

@@ -19,6 +19,18 @@ A point whose final error exceeds ``tolerance`` is reported (:class:`PathFailure
 error, target); tracking continues from the best configuration found or stops there, as
 chosen with ``on_unreachable``; everything computed so far is kept in the trajectory.
 
+Self-collision: a :class:`~serialkin.diffik.resolver.QPResolver` with
+``self_collision=True`` keeps the robot's own bodies apart. On a robot with a collision
+model (``robot.collision``) these are the body pairs that the model's allowed-collision
+matrix checks, the same pairs as :meth:`Robot.in_collision <serialkin.Robot.in_collision>`,
+``serialkin collide`` and the reach maps check: by default
+:func:`~serialkin.collision.acm.default_acm` (same and adjacent frames, and the pairs of
+:mod:`serialkin.collision.allowed_pairs`), or the matrix given to :func:`track` as
+``acm``, or that default with an SRDF's ``<disable_collisions>`` pairs added (``srdf``,
+``skip_links``, as in :func:`serialkin.collision.robot_acm`). On a robot without a model
+(the scenarios' planar arms) the chain's link segments two or more apart are kept apart;
+an SRDF cannot name those segments and is refused.
+
 Joint jumps: with ``max_joint_step`` set, every pair of consecutive points where some joint
 moved by more than that (a branch flip, a wrap) is reported in ``Trajectory.jumps``
 (:class:`~serialkin.tracking.trajectory.JointJump`), never silently; the QP solver
@@ -28,8 +40,9 @@ reach within the bound as not reached instead of jumping.
 
 from __future__ import annotations
 
+import os
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -43,7 +56,7 @@ from serialkin._checks import (
     short_repr,
 )
 from serialkin.diffik.resolver import QPResolver
-from serialkin.errors import InputError, InputTypeError
+from serialkin.errors import InputError, InputTypeError, RobotDefinitionError
 from serialkin.kinematics import kernels as K
 from serialkin.kinematics.dls import dls_step_into, weigh_rows_into
 from serialkin.model.limits import project as interval_project
@@ -172,6 +185,8 @@ class _TrackSettings:
         cap: cap on the joint step per DLS iteration [rad] (``max_step``).
         jump: ``max_joint_step`` [rad or m], or None.
         stop: stop after the first point not reached (``on_unreachable='stop'``).
+        acm: the allowed-collision matrix of the QP's self-collision check (from
+            ``acm`` or ``srdf``), or None: the resolver's own.
     """
 
     q_start: np.ndarray
@@ -185,6 +200,7 @@ class _TrackSettings:
     cap: float
     jump: float | None
     stop: bool
+    acm: Any = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -227,6 +243,9 @@ def track(
     max_step: float = 0.5,
     ik_options: Mapping[str, Any] | None = None,
     max_joint_step: float | None = None,
+    acm: object = None,
+    srdf: object = None,
+    skip_links: Iterable[str] = (),
 ) -> Trajectory:
     """Track a path and record the trajectory.
 
@@ -254,19 +273,35 @@ def track(
         max_joint_step: report every point where a joint moved by more than this since
             the previous point [rad or m] (``Trajectory.jumps``); with ``'qp'`` it is also
             a hard bound of the QP. None: no check.
+        acm: :class:`~serialkin.collision.acm.AllowedCollisionMatrix` over the bodies of
+            ``robot.collision``: the pairs the solver's self-collision check skips (a
+            ``QPResolver`` with ``self_collision=True``; see the module docstring).
+            None: the resolver's own (by default the model's
+            :func:`~serialkin.collision.acm.default_acm`).
+        srdf: an SRDF (file path, XML text or :class:`~serialkin.collision.srdf.Srdf`)
+            whose ``<disable_collisions>`` pairs are added to the model's default matrix
+            (:func:`serialkin.collision.robot_acm`); not together with ``acm``.
+        skip_links: links of the SRDF without a body in the collision model (fingers off
+            the chain, a TCP frame): pairs naming them are skipped. Needs ``srdf``.
 
     Returns:
         :class:`~serialkin.tracking.trajectory.Trajectory`.
 
     Raises:
         InputError: bad q0, negative tolerances, unknown ``on_unreachable``, obstacles
-            overlapping the base.
-        InputTypeError: path is not a Path.
+            overlapping the base; ``acm`` or ``srdf`` with a solver that checks no
+            self-collision, on a robot without a collision model, or both given;
+            ``skip_links`` without ``srdf``; an ``srdf`` file that does not exist.
+        RobotDefinitionError: an unreadable SRDF, or one naming a link that is neither a
+            body of the model nor in ``skip_links`` (the message starts with ``srdf``).
+        InputTypeError: path is not a Path; ``acm`` is not an AllowedCollisionMatrix;
+            ``srdf`` is not a path, text or Srdf.
     """
     s = _track_settings(robot, path, solver, q0=q0, obstacles=obstacles,
                         link_radius=link_radius, tolerance=tolerance,
                         on_unreachable=on_unreachable, damping=damping, tol=tol,
-                        max_iter=max_iter, max_step=max_step, max_joint_step=max_joint_step)
+                        max_iter=max_iter, max_step=max_step, max_joint_step=max_joint_step,
+                        acm=acm, srdf=srdf, skip_links=skip_links)
     rec = _Record.empty(len(path), robot.n)
     targets = np.ascontiguousarray(path.targets)
     if isinstance(solver, str) and solver == "dls":
@@ -283,7 +318,8 @@ def track(
 def _track_settings(robot, path: Path, solver: object, *, q0: object, obstacles: tuple,
                     link_radius: float, tolerance: float, on_unreachable: str, damping: float,
                     tol: float, max_iter: int, max_step: float,
-                    max_joint_step: float | None) -> _TrackSettings:
+                    max_joint_step: float | None, acm: object = None, srdf: object = None,
+                    skip_links: Iterable[str] = ()) -> _TrackSettings:
     """Check the arguments of :func:`track` (same names) and gather them; raises as it does."""
     if not isinstance(path, Path):
         raise InputTypeError(f"path must be a serialkin.tracking.Path, got {type(path).__name__}")
@@ -305,8 +341,89 @@ def _track_settings(robot, path: Path, solver: object, *, q0: object, obstacles:
     obstacles = tuple(obstacles)
     encode_obstacles(obstacles)
     check_obstacles(robot, obstacles, link_radius=link_radius)
+    allowed = _self_collision_acm(robot, solver, acm, srdf, skip_links)
     return _TrackSettings(q_start, rows, obstacles, link_radius, accept, conv, lam, budget, cap,
-                          jump, on_unreachable == "stop")
+                          jump, on_unreachable == "stop", allowed)
+
+
+def _link_names(skip_links: object) -> tuple[str, ...]:
+    """``skip_links`` as a tuple of link names; InputTypeError for anything else."""
+    if isinstance(skip_links, str | bytes) or not isinstance(skip_links, Iterable):
+        raise InputTypeError(f"skip_links must be a list of link names, got "
+                             f"{type(skip_links).__name__} {short_repr(skip_links)}")
+    names = tuple(skip_links)
+    for i, x in enumerate(names):
+        if not isinstance(x, str):
+            raise InputTypeError(f"skip_links[{i}] must be a link name (str), got "
+                                 f"{type(x).__name__} {short_repr(x)}")
+    return names
+
+
+def _check_srdf_source(srdf: object) -> None:
+    """Refuse an ``srdf`` that is not an Srdf, XML text or an existing file, naming it."""
+    from serialkin.collision.srdf import Srdf
+
+    if isinstance(srdf, Srdf):
+        return
+    if not isinstance(srdf, str | os.PathLike):
+        raise InputTypeError(f"srdf must be an SRDF file path, SRDF XML text or a "
+                             f"serialkin.collision.Srdf, got {type(srdf).__name__} "
+                             f"{short_repr(srdf)}")
+    text = os.fsdecode(srdf)
+    if not text.lstrip().startswith("<") and not os.path.isfile(text):
+        raise InputError(f"srdf must be an SRDF file or SRDF XML text, got "
+                         f"{short_repr(text)}: no such file")
+
+
+def _self_collision_acm(robot, solver: object, acm: object, srdf: object,
+                        skip_links: object) -> Any:
+    """The allowed-collision matrix of :func:`track`'s ``acm`` / ``srdf`` / ``skip_links``.
+
+    None when neither ``acm`` nor ``srdf`` is given (the resolver keeps its own matrix);
+    else ``acm``, or :func:`serialkin.collision.robot_acm` of the SRDF (the model's
+    default matrix with the SRDF's disabled pairs added). Raises as :func:`track` says.
+    """
+    from serialkin.collision.acm import AllowedCollisionMatrix
+    from serialkin.collision.checks import robot_acm
+
+    skip = _link_names(skip_links)
+    if skip and srdf is None:
+        raise InputError("skip_links names links of an SRDF: give srdf too")
+    if acm is None and srdf is None:
+        return None
+    if acm is not None and srdf is not None:
+        raise InputError("give acm or srdf, not both (serialkin.collision.acm_from_srdf("
+                         "model, srdf, acm) combines them)")
+    name = "acm" if acm is not None else "srdf"
+    if not (isinstance(solver, QPResolver) and solver.self_collision):
+        what = (f"solver {solver!r}" if isinstance(solver, str)
+                else f"this {type(solver).__name__}")
+        raise InputError(f"{name} lists the body pairs a self-collision check skips, but "
+                         f"{what} checks no self-collision: use "
+                         "solver=QPResolver(task=..., self_collision=True)")
+    if solver.acm is not None:
+        raise InputError(f"{name} is given to track and the QPResolver has its own acm: "
+                         "give the allowed pairs once")
+    model = getattr(robot, "collision", None)
+    if model is None:
+        raise InputError(f"{name} names bodies of a collision model, but robot "
+                         f"{short_repr(robot.name)} has none (its self-collision check keeps "
+                         "the chain's link segments apart, which an SRDF cannot name); give "
+                         "it one with robot.with_collision(model) or robot.fit_collision()")
+    if acm is not None:
+        if not isinstance(acm, AllowedCollisionMatrix):
+            raise InputTypeError(f"acm must be an AllowedCollisionMatrix or None, got "
+                                 f"{type(acm).__name__} {short_repr(acm)}")
+        if tuple(acm.body_names) != tuple(model.body_names):
+            raise InputError(f"acm must be over the bodies of robot {short_repr(robot.name)}'s "
+                             f"collision model {short_repr(list(model.body_names))}, got "
+                             f"{short_repr(list(acm.body_names))}")
+        return acm
+    _check_srdf_source(srdf)
+    try:
+        return robot_acm(robot, srdf=srdf, skip_links=skip)
+    except RobotDefinitionError as exc:  # unreadable XML, or a link that is not a body
+        raise RobotDefinitionError(f"srdf: {exc}") from exc
 
 
 def _run_dls(robot, targets: np.ndarray, s: _TrackSettings, rec: _Record) -> tuple[str, int]:
@@ -349,6 +466,8 @@ def _solver_step(robot, path: Path, solver: object, targets: np.ndarray, s: _Tra
         _check_resolver_task(solver, path, s.rows)
         if s.jump is not None and solver.max_joint_step is None:
             solver = solver.with_options(max_joint_step=s.jump)
+        if s.acm is not None:
+            solver = solver.with_options(acm=s.acm)
         qstate = solver.prepare(robot)
         return ("differential-IK QP (hard limits and collision constraints)",
                 lambda k, q: qstate.solve(targets[k], q))
