@@ -226,6 +226,11 @@ class _Record:
         """Zeroed buffers for ``p`` points of an ``n``-joint robot."""
         return cls(np.zeros((p, n)), np.zeros(p, dtype=np.int64), np.zeros(p), np.zeros(p), {})
 
+    def first(self, count: int) -> _Record:
+        """The record of the first ``count`` points (views, same reasons)."""
+        return _Record(self.Q[:count], self.ITER[:count], self.ERR[:count],
+                       self.TIMES[:count], self.reasons)
+
 
 def track(
     robot,
@@ -310,9 +315,7 @@ def track(
         label, step = _solver_step(robot, path, solver, targets, s, ik_options)
         count = _run_steps(step, len(path), s, rec)
     stopped = s.stop and count > 0 and rec.ERR[count - 1] > s.accept
-    return _assemble(robot, path, rec.Q[:count], rec.ITER[:count], rec.ERR[:count],
-                     rec.TIMES[:count], s.obstacles, s.link_radius, s.accept, label, stopped,
-                     s.q_start, s.jump, rec.reasons)
+    return _assemble(robot, path, s, rec.first(count), label, stopped)
 
 
 def _track_settings(robot, path: Path, solver: object, *, q0: object, obstacles: tuple,
@@ -549,14 +552,21 @@ def joint_jumps(q_start: np.ndarray, Q: np.ndarray, threshold: float) -> list[Jo
     return out
 
 
-def _assemble(robot, path: Path, Q, ITER, ERR, TIMES, obstacles, link_radius, accept, label,
-              stopped, q_start=None, jump=None, reasons=None) -> Trajectory:
+def _assemble(robot, path: Path, s: _TrackSettings, rec: _Record, label: str,
+              stopped: bool) -> Trajectory:
+    """The :class:`Trajectory` of the points recorded in ``rec`` under the settings ``s``.
+
+    Poses by FK, clearances to ``s.obstacles`` (minimum over the links, [m]), joint-limit
+    margins, failures with their reasons, and the joint jumps beyond ``s.jump``.
+    """
+    Q, ITER, ERR, TIMES = rec.Q, rec.ITER, rec.ERR, rec.TIMES
+    obstacles, accept = s.obstacles, s.accept
     count = Q.shape[0]
     poses = np.empty((count, 4, 4))
     for k in range(count):  # serial: the parallel batch kernel costs ms of thread start-up
         K.fk_into(np.ascontiguousarray(Q[k]), robot.chain.F, robot.chain.meta, poses[k])
     if obstacles and count:
-        g = ObstacleGeometry(robot, obstacles, link_radius)
+        g = ObstacleGeometry(robot, obstacles, s.link_radius)
         clear = np.empty((count, len(obstacles)))
         for k in range(count):
             g.update(np.ascontiguousarray(Q[k]))
@@ -565,7 +575,7 @@ def _assemble(robot, path: Path, Q, ITER, ERR, TIMES, obstacles, link_radius, ac
         clear = np.zeros((count, len(obstacles)))
     margin = limit_margins(Q, np.asarray(robot.qlim, dtype=float))
     reached = ERR <= accept
-    reasons = reasons or {}
+    reasons = rec.reasons
     failures = [PathFailure(int(k), float(ERR[k]), tuple(float(v) for v in path.points[k]),
                             reasons.get(int(k), ""))
                 for k in np.flatnonzero(~reached)]
@@ -583,4 +593,4 @@ def _assemble(robot, path: Path, Q, ITER, ERR, TIMES, obstacles, link_radius, ac
         task=path.task, tolerance=accept, joint_names=tuple(robot.joint_names),
         obstacle_names=tuple(o.name or f"obstacle{i + 1}" for i, o in enumerate(obstacles)),
         failures=failures, stopped=bool(stopped), path_length=len(path), solver=label,
-        jumps=[] if jump is None else joint_jumps(q_start, Q, jump), notes=note_text)
+        jumps=[] if s.jump is None else joint_jumps(s.q_start, Q, s.jump), notes=note_text)
