@@ -113,15 +113,21 @@ def _trig_from_roots(roots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     np.linspace(-3.0, 3.0, 16),                                   # spread out
     np.r_[np.linspace(-3.0, 1.0, 13), 2.0, 2.0015, 2.003],         # a cluster of three
     np.r_[np.linspace(-3.0, 0.5, 14), 1.2, 1.2 + 2e-4],            # a close pair
+    # four within 3.3° across a cell boundary, as θ3 of the Manseur–Doty arm (the
+    # bracketing before derivatives were isolated first found two of them)
+    np.r_[np.linspace(-2.5, 2.5, 12), np.radians([-180.04, -179.07, -177.74, -176.72])],
+    np.r_[np.linspace(-2.0, 1.5, 11), 2.5, 2.51, 2.52, 2.53, 2.54],  # five within 0.04
 ])
 def test_eliminant_roots_separates_close_roots(roots):
     """Every real root of a degree-8 trigonometric polynomial, clusters included, to 1e-8 rad."""
     a, b = _trig_from_roots(roots)
     out = np.empty(16)
-    k = eliminant_roots(a, b, out)
+    near = np.empty(16)
+    k, kn = eliminant_roots(a, b, out, near)
     assert k == 16
     found = np.sort(out[:k])
-    np.testing.assert_allclose(found, np.sort(roots), atol=1e-8)
+    expected = np.sort((roots + np.pi) % (2 * np.pi) - np.pi)
+    np.testing.assert_allclose(found, expected, atol=1e-8)
 
 
 def test_eliminant_roots_none_and_identically_zero():
@@ -129,9 +135,69 @@ def test_eliminant_roots_none_and_identically_zero():
     a = np.zeros(DEGREE + 1)
     b = np.zeros(DEGREE + 1)
     out = np.empty(16)
-    assert eliminant_roots(a, b, out) == -1
+    near = np.empty(16)
+    assert eliminant_roots(a, b, out, near) == (-1, 0)
     a[0], a[3] = 2.0, 1.0  # 2 + cos 3θ > 0
-    assert eliminant_roots(a, b, out) == 0
+    assert eliminant_roots(a, b, out, near) == (0, 0)
+
+
+@pytest.mark.parametrize("eta, where", [(1e-4, "near"), (1e-7, "root"), (0.1, None)])
+def test_eliminant_roots_lists_near_real_pairs(eta, where):
+    """A complex root pair t0 ± iη with η ≤ NEAR_REAL gives the candidate t0.
+
+    Listed as near-real, or as a double root where |f(t0)| is rounding (η ≲ 1e-5);
+    beyond NEAR_REAL the pair is dropped.
+    """
+    t0 = 0.7
+    real = np.r_[np.linspace(-3.0, -0.5, 7), np.linspace(1.5, 3.0, 7)]
+    n = 2 * DEGREE + 1
+    t = 2 * np.pi * np.arange(n) / n
+    f = np.prod(np.sin((t[:, None] - real[None]) / 2), axis=1) * (np.cosh(eta) - np.cos(t - t0))
+    a = np.array([(1 if k == 0 else 2) * np.mean(f * np.cos(k * t)) for k in range(DEGREE + 1)])
+    b = np.array([2 * np.mean(f * np.sin(k * t)) for k in range(DEGREE + 1)])
+    out = np.empty(16)
+    near = np.empty(16)
+    k, kn = eliminant_roots(a, b, out, near)
+    assert k == 14 + (where == "root")
+    expected = np.sort(np.r_[real, [t0] if where == "root" else []])
+    np.testing.assert_allclose(np.sort(out[:k]), expected, atol=1e-6)
+    assert kn == (where == "near")
+    if kn:
+        assert abs(near[0] - t0) < 1e-6
+
+
+def test_eliminant_roots_agree_with_a_high_precision_solve():
+    """The real roots of 60 random degree-8 polynomials are mpmath's, to 1e-8 rad.
+
+    The independent count: 40-digit ``polyroots`` of z⁸·f (z = e^{iθ}; a real root lies
+    on |z| = 1); a third of the polynomials have a planted cluster of 2-4 roots within
+    0.05 rad, their coefficients then perturbed so that some pairs turn complex.
+    """
+    mpmath = pytest.importorskip("mpmath")
+    mpmath.mp.dps = 40
+    rng = np.random.default_rng(11)
+    out = np.empty(16)
+    near = np.empty(16)
+    for i in range(60):
+        if i % 3 == 0:  # a planted cluster of 2-4 roots within 0.05 rad, the rest random
+            c = rng.uniform(-np.pi, np.pi)
+            m = int(rng.integers(2, 5))
+            roots = np.r_[c + rng.uniform(0, 0.05, m), rng.uniform(-np.pi, np.pi, 16 - m)]
+            a, b = _trig_from_roots(roots)
+            a = a + rng.normal(0, 1e-3, a.shape) * np.abs(a).max()  # some pairs go complex
+        else:
+            a, b = rng.normal(size=DEGREE + 1), rng.normal(size=DEGREE + 1)
+        b[0] = 0.0
+        p = [mpmath.mpf(float(a[0]))] * (2 * DEGREE + 1)
+        for kk in range(1, DEGREE + 1):
+            p[DEGREE + kk] = mpmath.mpc(float(a[kk]), -float(b[kk])) / 2
+            p[DEGREE - kk] = mpmath.mpc(float(a[kk]), float(b[kk])) / 2
+        z = np.array([complex(r) for r in mpmath.polyroots(p[::-1], maxsteps=400,
+                                                            extraprec=200)])
+        expected = np.sort(np.angle(z[np.abs(np.log(np.abs(z))) < 1e-7]))
+        k, _ = eliminant_roots(a, b, out, near)
+        assert k == len(expected)
+        np.testing.assert_allclose(np.sort(out[:k]), expected, atol=1e-8)
 
 
 def test_elimination_agrees_with_the_search_on_random_arms():
@@ -194,9 +260,10 @@ def test_sixteen_real_solution_arm():
     """An arm and pose with 16 real solutions (the most a 6R has): all 16, Newton agrees.
 
     The DH table (``chapter.sections.inverse.ARM16``) was found by a random walk from the
-    14-solution arm of test_analytic_general (the published Manseur–Doty and
-    Raghavan–Roth tables were not at hand); 16 is confirmed independently by Newton's
-    method from 300 random starts and by the 2-D search.
+    14-solution arm of test_analytic_general; 16 is confirmed independently by Newton's
+    method from 300 random starts and by the 2-D search. The published 16-solution arm
+    (Manocha & Canny 1994, after Manseur & Doty 1989), with its published solutions, is
+    tests/ik/test_published_6r.py.
     """
     from serialkin.chapter.sections.inverse import ARM16, Q16  # the report shows it too
 

@@ -82,16 +82,29 @@ def general_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_
     fine (four times the nodes: on 96 random poses of arms with two axes 0.5–1° apart
     and 0–1e-6 m away, 18 solutions a multi-start Newton search found were missing
     before, 7 after; an unreachable pose on such an arm takes about 17 ms instead of
-    3.4). Arguments and result as for :func:`search_candidates`.
+    3.4). The solutions the elimination did converge to before it declined are kept
+    beside the search's (the union, duplicates dropped in joint space): a search that
+    misses one cannot lose it. Arguments and result as for :func:`search_candidates`.
     """
     k = rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out)
     if k >= 0 and k % 2 == 0:
         return k
     near_special = k == NEAR_SPECIAL
+    kept = 0 if near_special else (k if k >= 0 else -1 - k)  # converged rows in out
+    found = out[:kept].copy()
     k = search_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r, out)
     if near_special and k == 0:  # basins narrower than a cell?
         k = search_candidates(T, W, P, M, aux, arm, reverse, 2 * grid, F, meta, tol_p, tol_r,
                               out)
+    for i in range(kept):  # the elimination's converged solutions are kept: the union
+        new = k < out.shape[0]
+        for j in range(k):
+            if wrapped_dist(found[i], out[j], 6) < 1e-7:
+                new = False
+                break
+        if new:
+            out[k] = found[i]
+            k += 1
     return k
 
 

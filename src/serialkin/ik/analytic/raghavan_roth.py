@@ -33,10 +33,15 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
 5. **The univariate equation.** ``det K(θ3)`` is a trigonometric polynomial of degree 8
    (the eliminant of degree 16 in ``tan(θ3/2)``; the degree-24 determinant in the
    half-angle carries the spurious factor ``(1 + x3²)⁴``). Its 17 coefficients are the
-   discrete Fourier transform of 17 determinants (LU). Its real roots are bracketed on
-   a grid whose cells are cut into pieces where it is monotone (at its extrema, found
-   the same way from its derivatives), so roots closer than a cell are separated, and
-   an extremum at zero (a double root) is kept as well (:func:`eliminant_roots`).
+   discrete Fourier transform of 17 determinants (LU). Its real roots are isolated by
+   its derivatives: the zeros of its second derivative are bracketed on a grid, its
+   first derivative is monotone between them, so it has at most one extremum between
+   two of those, and each root is bracketed alone (:func:`eliminant_roots`). Roots
+   closer together than a cell are so separated (the published 16-solution arm has four
+   within 3.3°: Manocha & Canny 1994, Table III). An extremum at zero (a double root)
+   is a root; an extremum that comes within a small imaginary part of zero (a complex
+   pair t ± iη, η ≤ :data:`NEAR_REAL`: a near-double root that rounding may have moved
+   off the real line) is a candidate as well.
 6. **Back substitution.** For each root, the null vector of ``K(θ3)`` (Gaussian
    elimination with complete pivoting) gives x4, x5 as ratios of its entries (a root
    where that null space has two or more dimensions is shared by several solutions:
@@ -45,7 +50,10 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
    ``(cos θ2, sin θ2)``; θ6 follows by subproblem 1 on ``w6``.
 7. **Refinement.** Every candidate is polished by Newton's method on the robot's own
    chain (:func:`~serialkin.ik.analytic.refine.refine_new`) to the solver's
-   tolerance; duplicates are dropped.
+   tolerance; duplicates are dropped in joint space after polishing, never before (no
+   early stop near a solution already found). A near-real candidate that converges to
+   nothing new was a complex pair and is dropped; a real root that gives nothing new
+   makes the caller search instead (below).
 
 :func:`rr_candidates` reports failure (:data:`NEAR_SPECIAL`) when the elimination does not
 apply: ``Q`` of rank below 8 or a pencil singular to rounding for all six splits (an exact special
@@ -85,8 +93,15 @@ _HALF = np.array([[1.0, 0.0, 1.0], [1.0, 0.0, -1.0], [0.0, 2.0, 0.0]])
 DEGREE = 8
 #: Determinants sampled for its coefficients (2·DEGREE + 1).
 _N_DET = 2 * DEGREE + 1
-#: Grid on which the eliminant's roots are bracketed.
+#: Grid on which the zeros of the eliminant's second derivative are bracketed.
 N_GRID = 128
+#: Bracket or Newton step [rad] at which a zero of the eliminant or of a derivative is
+#: accepted (each root is then polished on the determinant and the pose anyway).
+ZERO_TOL = 1e-13
+#: Largest imaginary part [rad] of a pair of complex roots of the eliminant whose real
+#: part is tried as a candidate θ3 (:func:`eliminant_roots`): a near-double real root
+#: that rounding turned into a complex pair survives; refinement on the pose decides.
+NEAR_REAL = 1e-3
 #: Smallest singular value of Q, relative to the largest, for the elimination to apply.
 RANK_TOL = 1e-9
 #: Smallest pivot ratio (≈ 1/cond) of the best-conditioned sample of K(θ3): below it the
@@ -111,9 +126,6 @@ MULTIPLE_TOL = 1e-8
 #: tilted Puma 560s — so the search answers instead).
 RANK_DEFICIENT = -1000
 NEAR_SPECIAL = -1001
-#: Newton iterates this close to a solution already found stop [rad] (see
-#: :func:`~serialkin.ik.analytic.refine.newton_refine_known`).
-KNOWN_RADIUS = 1e-4
 
 
 @njit(cache=True)
@@ -251,27 +263,54 @@ def _null_vector(A, v):
     return abs(A[n - 2, n - 2]) / abs(A[0, 0]) if A[0, 0] != 0.0 else 0.0
 
 
-@njit(cache=True)
-def _trig(a, b, t, order):
-    """Derivative ``order`` (0, 1, 2 or 3) at t of ``f(t) = a0 + Σ_k a_k cos kt + b_k sin kt``.
+@njit(cache=True, inline="always")
+def _phase(u, v, m):
+    """``u, v, −u, −v`` for m mod 4 = 0, 1, 2, 3: an m-th derivative (:func:`_trig3`)."""
+    r = m % 4
+    if r == 0:
+        return u
+    if r == 1:
+        return v
+    if r == 2:
+        return -u
+    return -v
 
-    k = 1..DEGREE; the derivatives are exact (``d/dt cos kt = −k sin kt``).
+
+@njit(cache=True)
+def _trig3(a, b, c1, s1, order):
+    """Derivatives ``order``, ``order + 1`` and ``order + 2`` of f where (cos t, sin t) = (c1, s1).
+
+    ``f(t) = a0 + Σ_k a_k cos kt + b_k sin kt`` (k = 1..DEGREE). The m-th derivative of
+    ``a cos kt + b sin kt`` is ``k^m`` times ``u, v, −u, −v`` for m mod 4 = 0, 1, 2, 3,
+    with ``u = a cos kt + b sin kt`` and ``v = b cos kt − a sin kt``: exact, no
+    differences.
     """
-    c1 = math.cos(t)
-    s1 = math.sin(t)
     ck, sk = 1.0, 0.0
-    f = a[0] if order == 0 else 0.0
+    d0 = a[0] if order == 0 else 0.0
+    d1 = 0.0
+    d2 = 0.0
+    u0, v0 = _phase(1.0, 0.0, order), _phase(0.0, 1.0, order)  # d0 = Σ w (u0 u + v0 v)
+    u1, v1 = _phase(1.0, 0.0, order + 1), _phase(0.0, 1.0, order + 1)
+    u2, v2 = _phase(1.0, 0.0, order + 2), _phase(0.0, 1.0, order + 2)
     for k in range(1, a.shape[0]):
         ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1
-        if order == 0:
-            f += a[k] * ck + b[k] * sk
-        elif order == 1:
-            f += k * (b[k] * ck - a[k] * sk)
-        elif order == 2:
-            f -= k * k * (a[k] * ck + b[k] * sk)
-        else:
-            f -= k * k * k * (b[k] * ck - a[k] * sk)
-    return f
+        u = a[k] * ck + b[k] * sk
+        v = b[k] * ck - a[k] * sk
+        w = 1.0
+        for _ in range(order):
+            w *= k
+        d0 += w * (u0 * u + v0 * v)
+        w *= k
+        d1 += w * (u1 * u + v1 * v)
+        w *= k
+        d2 += w * (u2 * u + v2 * v)
+    return d0, d1, d2
+
+
+@njit(cache=True)
+def _trig(a, b, t, order):
+    """Derivative ``order`` (0, 1, 2, ...) of f at t (see :func:`_trig3`)."""
+    return _trig3(a, b, math.cos(t), math.sin(t), order)[0]
 
 
 @njit(cache=True)
@@ -280,12 +319,13 @@ def _zero(a, b, lo, hi, order):
 
     Newton steps on the next derivative when they stay inside the bracket, else
     bisection; 60 iterations at most, or until the bracket or a Newton step is below
-    1e-15 rad.
+    :data:`ZERO_TOL` (a derivative's value near its zero is rounding noise: smaller
+    steps only wander in it).
     """
     flo = _trig(a, b, lo, order)
     x = 0.5 * (lo + hi)
     for _ in range(60):
-        f = _trig(a, b, x, order)
+        f, fp, _unused = _trig3(a, b, math.cos(x), math.sin(x), order)
         if f == 0.0:
             return x
         if (f > 0.0) == (flo > 0.0):
@@ -293,12 +333,11 @@ def _zero(a, b, lo, hi, order):
             flo = f
         else:
             hi = x
-        if hi - lo < 1e-15:
+        if hi - lo < ZERO_TOL:
             break
-        fp = _trig(a, b, x, order + 1)
         xn = x - f / fp if fp != 0.0 else 0.5 * (lo + hi)
         if lo < xn < hi:
-            if abs(xn - x) < 1e-15:
+            if abs(xn - x) < ZERO_TOL:
                 return xn
             x = xn
         else:
@@ -327,107 +366,171 @@ def _changes(u, v):
 
 
 @njit(cache=True)
-def _trig3(a, b, c1, s1):
-    """f, f' and f'' of the trigonometric polynomial (a, b) where (cos t, sin t) = (c1, s1)."""
-    ck, sk = 1.0, 0.0
-    f = a[0]
-    f1 = 0.0
-    f2 = 0.0
+def _tiny(a, b, order):
+    """1e-10 of the size of derivative ``order`` of f (``Σ k^order (|a_k| + |b_k|)``).
+
+    Below it a value is zero to rounding: an extremum there is a double zero.
+    """
+    s = abs(a[0]) if order == 0 else 0.0
     for k in range(1, a.shape[0]):
-        ck, sk = ck * c1 - sk * s1, sk * c1 + ck * s1
-        u = a[k] * ck + b[k] * sk
-        f += u
-        f1 += k * (b[k] * ck - a[k] * sk)
-        f2 -= k * k * u
-    return f, f1, f2
+        w = 1.0
+        for _ in range(order):
+            w *= k
+        s += w * (abs(a[k]) + abs(b[k]))
+    return 1e-10 * s
 
 
 @njit(cache=True)
-def _cell_pieces(a, b, lo, hi, f_lo, g_lo, s_lo, f_hi, g_hi, s_hi, tiny, roots, k):
-    """Roots of f in the cell [lo, hi] by monotone pieces (the general case); new count.
+def _cell_pieces(a, b, lo, hi, f_lo, g_lo, s_lo, f_hi, g_hi, s_hi, tiny, order, roots, k):
+    """Zeros of g = f^(order) in a cell [lo, hi] where g'' changes sign; the new count.
 
-    The extrema of f (zeros of f') split the cell; f' is monotone between the zeros of
-    f'' (at most one is looked for). One root at most lies on each piece.
+    The zero of g'' (one is looked for) splits the cell into two pieces where g' is
+    monotone, so each holds at most one extremum of g (a zero of g'); those extrema cut
+    the cell into pieces where g is monotone, each holding at most one zero. ``f_*``,
+    ``g_*``, ``s_*`` are g, g', g'' at the ends.
     """
-    cut = np.empty(4)
-    nc = 0
-    cut[nc] = lo
-    nc += 1
-    if _changes(s_lo, s_hi):
-        x = _zero(a, b, lo, hi, 2)
-        gx = _trig(a, b, x, 1)
-        if _changes(g_lo, gx):
-            cut[nc] = _zero(a, b, lo, x, 1)
-            nc += 1
-        if _changes(gx, g_hi):
-            cut[nc] = _zero(a, b, x, hi, 1)
-            nc += 1
-    elif _changes(g_lo, g_hi):
-        cut[nc] = _zero(a, b, lo, hi, 1)
+    cut = np.empty(4)  # lo, up to two extrema, hi
+    fv = np.empty(4)
+    cut[0] = lo
+    fv[0] = f_lo
+    nc = 1
+    x = _zero(a, b, lo, hi, order + 2)
+    gx = _trig(a, b, x, order + 1)
+    if _changes(g_lo, gx):
+        cut[nc] = _zero(a, b, lo, x, order + 1)
         nc += 1
-    x0 = lo
-    f0 = f_lo
-    for i in range(1, nc + 1):
-        x1 = cut[i] if i < nc else hi
-        f1 = _trig(a, b, x1, 0) if i < nc else f_hi
-        if i < nc and abs(f1) <= tiny:
-            k = _add_root(roots, k, x1)  # an extremum at zero: a double root
-        elif _changes(f0, f1):
-            k = _add_root(roots, k, _zero(a, b, x0, x1, 0))
-        x0, f0 = x1, f1
+    if _changes(gx, g_hi):
+        cut[nc] = _zero(a, b, x, hi, order + 1)
+        nc += 1
+    for i in range(1, nc):
+        fv[i] = _trig(a, b, cut[i], order)
+    cut[nc] = hi
+    fv[nc] = f_hi
+    for i in range(nc):
+        if _changes(fv[i], fv[i + 1]):
+            k = _add_root(roots, k, _zero(a, b, cut[i], cut[i + 1], order))
+        elif i > 0 and fv[i] != 0.0 and abs(fv[i]) <= tiny and not _changes(fv[i - 1], fv[i]):
+            k = _add_root(roots, k, cut[i])  # an extremum at zero to rounding: a double zero
     return k
 
 
 @njit(cache=True)
-def eliminant_roots(a, b, roots):
-    """Real roots in [−π, π) of the trigonometric polynomial (a, b) into ``roots``; their count.
+def _scan(a, b, order, roots):
+    """Zeros in [−π, π) of g = f^(order) on a grid of :data:`N_GRID` cells; their count.
 
-    The circle is cut into :data:`N_GRID` cells, and each cell into pieces on which f is
-    monotone: the zeros of f' (its extrema) split it, and f' is itself monotone between
-    the zeros of f'' (at most one is looked for per cell). A piece where f changes sign
-    holds exactly one root (bisected with Newton steps); an extremum where |f| is below
-    1e-10 of the coefficients' size is a double root. So two or three roots closer
-    than a cell are separated; only a cell holding two inflections of this degree-8
-    polynomial could hide a pair. Cells where f and f' are monotone, or where f has one
-    extremum moving away from zero, are settled from their end values alone.
-    Returns −1 when f vanishes identically.
+    Exact while g'' has at most one zero in every cell. Then g has at most one extremum
+    in a cell unless g'' changes sign there while g' keeps its sign and first moves
+    toward zero: such a cell is cut at the zero of g'' (:func:`_cell_pieces`). In the
+    others, a cell where g changes sign holds exactly one zero (bisected with Newton
+    steps); a cell where g keeps its sign and first moves toward zero holds two, a double
+    one (an extremum where |g| is below :func:`_tiny`) or none, decided at its extremum;
+    the rest hold none, settled from their end values alone.
     """
-    size = 0.0
-    for k in range(a.shape[0]):
-        size += abs(a[k]) + abs(b[k])
-    if size == 0.0:
-        return -1
-    tiny = 1e-10 * size
+    tiny = _tiny(a, b, order)
     h = TWO_PI / N_GRID
     ch, sh = math.cos(h), math.sin(h)
     c, s = -1.0, 0.0  # cos, sin of the cell's end, advanced by the rotation of h
     k = 0
     lo = -math.pi
-    f_lo, g_lo, s_lo = _trig3(a, b, c, s)
+    f_lo, g_lo, s_lo = _trig3(a, b, c, s, order)
     for m in range(N_GRID):
         hi = -math.pi + h * (m + 1)
         if m % 16 == 15:  # re-anchor the rotation now and then (no drift)
             c, s = math.cos(hi), math.sin(hi)
         else:
             c, s = c * ch - s * sh, s * ch + c * sh
-        f_hi, g_hi, s_hi = _trig3(a, b, c, s)
+        f_hi, g_hi, s_hi = _trig3(a, b, c, s, order)
         if f_lo == 0.0:
             k = _add_root(roots, k, lo)
-        if _changes(s_lo, s_hi):  # f' may turn twice: the general case
-            k = _cell_pieces(a, b, lo, hi, f_lo, g_lo, s_lo, f_hi, g_hi, s_hi, tiny, roots, k)
-        elif _changes(f_lo, f_hi):  # at most one extremum: exactly one root
+        if (_changes(s_lo, s_hi) and not _changes(g_lo, g_hi)
+                and (g_lo > 0.0) == (s_lo < 0.0)):
+            # g' turns in the cell and moves toward zero first: g may have two extrema
+            k = _cell_pieces(a, b, lo, hi, f_lo, g_lo, s_lo, f_hi, g_hi, s_hi, tiny, order,
+                             roots, k)
+        elif _changes(f_lo, f_hi):  # at most one extremum: exactly one zero
+            k = _add_root(roots, k, _zero(a, b, lo, hi, order))
+        elif _changes(g_lo, g_hi) and (f_lo > 0.0) == (g_lo < 0.0):
+            # one extremum, and g moves toward zero first: two zeros, a double one, or none
+            x = _zero(a, b, lo, hi, order + 1)
+            fx = _trig(a, b, x, order)
+            if _changes(f_lo, fx):
+                k = _add_root(roots, k, _zero(a, b, lo, x, order))
+                k = _add_root(roots, k, _zero(a, b, x, hi, order))
+            elif abs(fx) <= tiny:
+                k = _add_root(roots, k, x)
+        lo, f_lo, g_lo, s_lo = hi, f_hi, g_hi, s_hi
+    return k
+
+
+@njit(cache=True)
+def eliminant_roots(a, b, roots, near):
+    """Real roots in [−π, π) of the trigonometric polynomial (a, b), and near-real pairs.
+
+    Root isolation by derivatives: the zeros of f'' are found on a grid of
+    :data:`N_GRID` cells (:func:`_scan`: exact while f⁗ has at most one zero in a
+    cell), and f' is monotone between consecutive ones, so f has at most one extremum
+    on each such arc. An arc where f changes sign holds exactly one root; an arc where
+    f keeps its sign and first moves toward zero holds two, a double one or none,
+    decided at its extremum. Roots of f closer together than a grid cell are so
+    separated (the 16-solution arm of Manseur & Doty has four within 3.3°); an extremum
+    where |f| is below 1e-10 of the coefficients' size, between two ends of its sign,
+    is a double root.
+
+    An extremum of f that comes close to zero without reaching it,
+    ``2|f| ≤ η² |f''|`` with η = :data:`NEAR_REAL` (near a pair of complex roots
+    t0 ± iη, f ≈ f''·((t − t0)² + η²)/2), is written to ``near``: a pair with a small
+    imaginary part, which rounding may have moved off the real line (a near-double real
+    root), is a candidate too, and refinement on the pose decides.
+
+    Args:
+        a: (DEGREE + 1,) cosine coefficients.
+        b: (DEGREE + 1,) sine coefficients (``b[0]`` unused).
+        roots: (16,) output: the real roots.
+        near: (16,) output: the centres t0 of near-real pairs.
+
+    Returns:
+        (number of real roots, number of near-real pairs); (−1, 0) when f vanishes
+        identically.
+    """
+    size = abs(a[0])
+    for k in range(1, a.shape[0]):
+        size += abs(a[k]) + abs(b[k])
+    if size == 0.0:
+        return -1, 0
+    tiny = _tiny(a, b, 0)
+    z2 = np.empty(2 * DEGREE)
+    n2 = _scan(a, b, 2, z2)
+    k = 0
+    kn = 0
+    if n2 == 0:  # f' keeps its sign on the circle: f is constant (no root unless ≡ 0)
+        return 0, 0
+    z2 = np.sort(z2[:n2])
+    fz = np.empty(n2)  # f and f' at the zeros of f''
+    gz = np.empty(n2)
+    for i in range(n2):
+        fz[i], gz[i], _unused = _trig3(a, b, math.cos(z2[i]), math.sin(z2[i]), 0)
+    for i in range(n2):
+        j = i + 1 if i + 1 < n2 else 0
+        lo = z2[i]
+        hi = z2[j] if j > 0 else z2[0] + TWO_PI
+        f_lo, g_lo, f_hi, g_hi = fz[i], gz[i], fz[j], gz[j]
+        if f_lo == 0.0:
+            k = _add_root(roots, k, lo)
+        if _changes(f_lo, f_hi):  # at most one extremum: exactly one root
             k = _add_root(roots, k, _zero(a, b, lo, hi, 0))
         elif _changes(g_lo, g_hi) and (f_lo > 0.0) == (g_lo < 0.0):
             # one extremum, and f moves toward zero first: two roots, a double one, or none
             x = _zero(a, b, lo, hi, 1)
-            fx = _trig(a, b, x, 0)
-            if abs(fx) <= tiny:
-                k = _add_root(roots, k, x)
-            elif _changes(f_lo, fx):
+            fx, _unused, f2 = _trig3(a, b, math.cos(x), math.sin(x), 0)
+            if _changes(f_lo, fx):
                 k = _add_root(roots, k, _zero(a, b, lo, x, 0))
                 k = _add_root(roots, k, _zero(a, b, x, hi, 0))
-        lo, f_lo, g_lo, s_lo = hi, f_hi, g_hi, s_hi
-    return k
+            elif abs(fx) <= tiny:
+                k = _add_root(roots, k, x)
+            elif 2.0 * abs(fx) <= NEAR_REAL * NEAR_REAL * abs(f2) and kn < near.shape[0]:
+                near[kn] = x - TWO_PI * math.floor((x + math.pi) / TWO_PI)
+                kn += 1
+    return k, kn
 
 
 @njit(cache=True)
@@ -464,12 +567,13 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
         out: (16, 6) output rows (refined, not wrapped).
 
     Returns:
-        the number of distinct converged solutions, one per real root of the eliminant;
+        the number of distinct converged solutions, one per real root of the eliminant
+        (and per near-real pair that converged to a new solution);
         :data:`NEAR_SPECIAL` when no split applies (eliminating joint 6, 5 or 4 of the
         chain or of its reversal, tried in turn while one degenerates exactly,
         :data:`EXACT_TOL`) or the pencil is nearly singular for every θ3
         (:data:`PIVOT_TOL`), and −1 − k
-        when a root gave no new solution even after polishing (a cluster of solutions
+        when a real root gave no new solution even after polishing (a cluster of solutions
         or a singular configuration) or belongs to several solutions
         (:data:`MULTIPLE_TOL`; the k solutions found so far are in ``out``): in both
         cases the caller searches instead.
@@ -626,11 +730,15 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
         cb[k] *= 2.0 / _N_DET
     cb[0] = 0.0
     roots = np.empty(2 * DEGREE)
-    nr = eliminant_roots(ca, cb, roots)
+    near = np.empty(2 * DEGREE)
+    nr, nn = eliminant_roots(ca, cb, roots, near)
     if nr < 0:
         return NEAR_SPECIAL
-    # 6-7. back substitution and refinement; a root whose candidate does not converge to
-    # a new solution is polished on the determinant itself and tried once more
+    # 6-7. back substitution and refinement of every candidate (the real roots, then the
+    # near-real pairs); duplicates are dropped only after Newton's method has converged
+    # (radius 0: no early stop near a solution already found). A real root whose candidate
+    # does not converge to a new solution is polished on the determinant itself and tried
+    # once more; a near-real pair that converges to nothing is complex, and dropped
     u6 = np.zeros(3)  # a unit vector ⟂ w_e
     ax = 0 if abs(w_e[0]) < 0.9 else 1
     u6[ax] = 1.0
@@ -643,21 +751,24 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
     q = np.empty(6)
     k = 0
     lost = False
-    for ir in range(nr):
-        t3 = roots[ir]
+    for ir in range(nr + nn):
+        real = ir < nr
+        t3 = roots[ir] if real else near[ir - nr]
         found = False
-        for attempt in range(2):
+        for attempt in range(2 if real else 1):
             if attempt == 1:
                 t3 = _polish_root(K, t3, A)
             second = _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u6, reverse, A, q)
             if second < MULTIPLE_TOL:  # K(θ3) has a null space of 2+ dimensions: this θ3
+                if not real:
+                    break
                 return -1 - k  # belongs to several solutions, one null vector gives one
-            k_new = refine_new(q, T, F, meta, tol_p, tol_r, out, k, KNOWN_RADIUS)
+            k_new = refine_new(q, T, F, meta, tol_p, tol_r, out, k, 0.0)
             if k_new > k:
                 k = k_new
                 found = True
                 break
-        lost = lost or not found
+        lost = lost or (real and not found)
     if lost:  # a root that gave no new solution: a cluster or a singular configuration
         return -1 - k
     return k
