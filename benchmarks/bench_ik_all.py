@@ -6,7 +6,9 @@ goals <= 10 us single, <= 3 us batched), a UR5 with every axis perturbed by up t
 general 6R arms (Raghavan-Roth elimination, the 2-D search as its fallback: goal
 <= 200 us, against Robotics Toolbox's Raghavan-Roth ``analytic_ik`` in the same run;
 one arm in detail, then the median over 50 random arms). IK-Geo's published native
-figures are printed beside them. Beside wall time, "CPU" columns give the calling
+figures are printed beside them. Then ``robot.ik(T, method="analytic")`` (the
+nearest solution, judged as every IK answer) against ``ik_all`` on the same poses, calls
+interleaved (goal: within 2x, issue 32). Beside wall time, "CPU" columns give the calling
 thread's CPU time per single call and the process's CPU time (all threads) per pose of
 a batch: the work done, whatever share of the cores the run got on a shared machine.
 
@@ -201,6 +203,45 @@ def bench_per_pose(n_batch: int, repeat: int) -> None:
           + ", ".join(f"{k} {v:g} us" for k, v in IKGEO_US.items()))
 
 
+def bench_analytic_method(n_targets: int, passes: int) -> None:
+    """``robot.ik(T, method="analytic")`` on one pose against ``ik_all`` on it (issue 32).
+
+    The method solves by ``ik_all`` and returns the row nearest q0 (or the middle of the
+    ranges), judged as every solver's answer is (errors, limits, the 2π representative):
+    goal within 2x of ``ik_all``. Each call timed on its own, the two (and the call with
+    a q0) interleaved target by target, ``passes`` passes over ``n_targets`` poses.
+    """
+    print(f"\nrobot.ik(T, method='analytic') against ik_all(T), one pose per call, "
+          f"{n_targets} targets x {passes} passes interleaved; median [10-90 %] us")
+    print(f"{'arm':12s} {'ik analytic':>20s} {'with q0':>20s} {'ik_all':>18s} {'ratio':>6s}")
+    clock = time.perf_counter
+    for robot in (models.ur5(), models.puma560(), models.get("stanford"), _wrist_first_arm()):
+        Ts = [np.ascontiguousarray(T) for T in robot.fk(robot.random_q(n_targets, seed=1))]
+        Q0 = robot.random_q(n_targets, seed=2)
+        for T, q0 in zip(Ts[:5], Q0):  # compile / load the kernels
+            robot.ik(T, method="analytic")
+            robot.ik(T, method="analytic", q0=q0)
+            ik_all(robot, T)
+        one, with_q0, alone = [], [], []
+        for _ in range(passes):
+            for T, q0 in zip(Ts, Q0):
+                t0 = clock()
+                robot.ik(T, method="analytic")
+                t1 = clock()
+                robot.ik(T, method="analytic", q0=q0)
+                t2 = clock()
+                ik_all(robot, T)
+                t3 = clock()
+                one.append(t1 - t0)
+                with_q0.append(t2 - t1)
+                alone.append(t3 - t2)
+        a, b, c = (Stat(np.array(v) * 1e6) for v in (one, with_q0, alone))
+        ratio = a / c
+        print(f"{robot.name:12s} {a.fmt(1):>20s} {b.fmt(1):>20s} {c.fmt(1):>18s} {ratio:6.2f}")
+        record("32", f"robot.ik(method='analytic') / ik_all, one pose, {robot.name}", ratio,
+               "x", "<= 2", ratio <= 2.0)
+
+
 def bench_general_vs_rtb(repeat: int) -> None:
     """General 6R: ours against Robotics Toolbox's Raghavan–Roth solver, same DH table."""
     try:
@@ -270,6 +311,29 @@ def bench_general_arms(n_arms: int, repeat: int) -> None:
            med <= 200.0)
 
 
+def bench_published_arm(repeat: int) -> None:
+    """General 6R: the published 16-solution arm at its published pose (issue 30.1).
+
+    D. Manocha, J. F. Canny, IEEE T-RA 10(5), 1994: Table I (standard DH; twists 90° and
+    1°), the pose ``A_hand`` of p. 655 (its rotation made orthonormal) and 16 solutions
+    (Table III); the test tests/ik/test_published_6r.py matches them one-to-one.
+    """
+    a, d, alpha = (0.3, 1.0, 0.0, 1.5, 0.0, 0.0), (0.0, 0.0, 0.2, 0.0, 0.0, 0.0), (90, 1) * 3
+    robot = Robot.from_dh([DHLink(a=ai, alpha=np.radians(al), d=di)
+                           for ai, di, al in zip(a, d, alpha, strict=True)], name="published")
+    A = np.array([[-0.7601, -0.6416, 0.1022, -1.1401], [0.1333, 0.0, 0.9910, 0.0],
+                  [-0.6359, 0.7669, 0.0855, 0.0], [0.0, 0.0, 0.0, 1.0]])
+    U, _, Vt = np.linalg.svd(A[:3, :3])
+    A[:3, :3] = U @ Vt
+    T = np.ascontiguousarray(A)
+    single = latency_us(lambda: ik_all(robot, T), 20, repeat)
+    n = len(ik_all(robot, T))
+    print(f"\npublished 16-solution arm (Manocha & Canny 1994) at its pose: single call "
+          f"{single.fmt(0)} us, {n} solutions")
+    record("14.1", f"ik_all general 6R, published 16-solution arm ({n} solutions)",
+           single.median, "us", "<= 200", single.median <= 200.0 and n == 16)
+
+
 def miss_rate(n_arms: int, starts: int, grids: tuple[int, ...]) -> None:
     """Completeness of the general solver: solutions found by Newton from random starts
     (the compiled ``newton_refine`` on the robot's chain) that ``ik_all`` does not return.
@@ -319,6 +383,8 @@ def main() -> None:
     parser.add_argument("--no-peers", action="store_true")
     parser.add_argument("--batch", type=int, default=2000)
     parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--analytic-passes", type=int, default=5,
+                        help="passes over the targets of the method='analytic' rows")
     parser.add_argument("--miss-arms", type=int, default=0,
                         help="random general arms for the completeness study (0: skip)")
     parser.add_argument("--miss-starts", type=int, default=200)
@@ -329,7 +395,9 @@ def main() -> None:
         miss_rate(args.miss_arms, args.miss_starts, tuple(args.miss_grids))
         return
     bench_per_pose(args.batch, args.repeat)
+    bench_analytic_method(200, args.analytic_passes)
     bench_general_arms(50, max(3, args.repeat // 2))
+    bench_published_arm(max(3, args.repeat // 2))
     if not args.no_peers:
         bench_general_vs_rtb(args.repeat)
 

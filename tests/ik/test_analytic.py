@@ -836,3 +836,28 @@ def test_ik_all_returns_one_type_for_one_target_and_a_batch():
         one.q = rows
     np.testing.assert_array_equal(pickle.loads(pickle.dumps(one)), rows)
     assert str(one) == str(rows) and "AllSolutions(kind='ur'" in repr(one)
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560", "stanford"])
+def test_analytic_method_picks_the_nearest_representative(name):
+    """robot.ik(method='analytic') on one pose is the nearest 2π-shift of an ik_all row."""
+    robot = models.get(name)
+    lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
+    turns = np.arange(-3, 4) * 2 * np.pi
+    for i, q in enumerate(robot.random_q(25, seed=40)):
+        T = np.ascontiguousarray(robot.fk(q))
+        rows = np.asarray(ik_all(robot, T))
+        for q0 in (None, robot.random_q(seed=41 + i)):
+            ref = robot.sampling_limits().mean(axis=1) if q0 is None else q0
+            best = np.inf  # every row, every revolute joint at every turn inside the limits
+            for row in rows:
+                c = row[None, :] + np.where(robot.revolute, 1.0, 0.0) * turns[:, None]
+                c = np.where((c >= lo - 1e-12) & (c <= hi + 1e-12), c, np.inf)
+                nearest = np.take_along_axis(c, np.abs(c - ref).argmin(axis=0)[None], 0)[0]
+                best = min(best, float(np.linalg.norm(nearest - ref)))
+            res = robot.ik(T, method="analytic", q0=q0)
+            assert res.success
+            np.testing.assert_allclose(robot.fk(res.q), T, atol=1e-9)
+            # without q0 the solver then moves joints wider than a turn nearest zero
+            if q0 is not None or not np.any(hi - lo > 2 * np.pi):
+                assert abs(np.linalg.norm(res.q - ref) - best) < 1e-9

@@ -157,17 +157,18 @@ def _identical(a, b):
 
 
 def _analytic_robots():
-    """Arms with a closed form: UR5 (±2π), PUMA 560, UR5 with joint 1 in [-3π, π].
+    """Arms with a closed form: UR5 (±2π), PUMA 560, UR5 with joint 1 in [-3π, π], Stanford.
 
-    The last one's middle of the ranges is not zero.
+    The third one's middle of the ranges is not zero; the Stanford arm's third joint
+    slides (never moved by a turn).
     """
     ur5 = models.ur5()
     lim = ur5.qlim.copy()
     lim[0] = (-3 * np.pi, np.pi)
-    return [ur5, models.puma560(), ur5.with_limits(lim)]
+    return [ur5, models.puma560(), ur5.with_limits(lim), models.get("stanford")]
 
 
-@pytest.mark.parametrize("k", range(3))
+@pytest.mark.parametrize("k", range(4))
 def test_analytic_fast_path_equals_ordinary(k):
     """method='analytic' on one pose: the fast path answers exactly as the ordinary path.
 

@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import serialkin as sk
-from serialkin.ik.turns import TOL, nearest_turn, wide_joints
+from serialkin.ik.turns import MAX_TURNS, TOL, nearest_turn, wide_joints
 
 TWO_PI = 2 * math.pi
 angles = st.floats(-20.0, 20.0, allow_nan=False)
@@ -94,18 +94,77 @@ edge_angles = st.one_of(angles, st.sampled_from([0.0, -0.0, math.pi, -math.pi, T
 bounds = st.sampled_from([math.inf, TWO_PI, math.pi, 10.0, 3.0, 0.0, 1e-13, 4 * math.pi])
 
 
+def _documented_rule(q, lower, upper, wide, reference):
+    """The module docstring's formula with numpy's array operations (the reference)."""
+    ref = 0.0 if reference is None else reference
+    with np.errstate(invalid="ignore"):
+        k = np.rint((ref - q) / TWO_PI)
+        k_min = np.ceil((lower - TOL - q) / TWO_PI)
+        k_max = np.floor((upper + TOL - q) / TWO_PI)
+    k = np.clip(k, k_min, k_max)
+    ok = wide & (k_min <= k_max) & (np.abs(k) <= MAX_TURNS)
+    return np.where(ok, q + TWO_PI * np.where(ok, k, 0.0), q)
+
+
 @settings(max_examples=400, deadline=None)
 @given(q=st.lists(edge_angles, min_size=1, max_size=7), data=st.data())
-def test_one_configuration_equals_the_array_rule(q, data):
-    """One configuration (joint by joint) gets the array rule's values, zero signs included."""
+def test_compiled_rule_equals_the_documented_formula(q, data):
+    """nearest_turn of one row, rows or strided rows is the documented formula, bit for bit."""
     n = len(q)
     lo = -np.array(data.draw(st.lists(bounds, min_size=n, max_size=n)))
     hi = np.array(data.draw(st.lists(bounds, min_size=n, max_size=n)))
     wide = np.array(data.draw(st.lists(st.booleans(), min_size=n, max_size=n)))
-    refs = [None, np.array(data.draw(st.lists(edge_angles, min_size=n, max_size=n)))]
-    for ref in refs:
-        one = nearest_turn(np.array(q), lo, hi, wide, ref)
-        rows = nearest_turn(np.array([q]), lo, hi, wide, None if ref is None else ref[None])[0]
-        assert one.shape == (n,)
-        assert np.array_equal(one, rows)
-        assert np.array_equal(np.signbit(one), np.signbit(rows))
+    ref = np.array(data.draw(st.lists(edge_angles, min_size=n, max_size=n)))
+    rows = np.array([q, ref[::-1], np.array(q)[::-1]])
+    cases = [(np.array(q), None), (np.array(q), ref), (rows, None), (rows, ref),
+             (rows, rows[::-1].copy()), (rows[:, ::-1], ref)]  # the last one strided
+    for x, r in cases:
+        got = nearest_turn(x, lo, hi, wide, r)
+        want = _documented_rule(x, lo, hi, wide, r)
+        assert got.shape == x.shape
+        assert np.array_equal(got, want)
+        assert np.array_equal(np.signbit(got), np.signbit(want))
+
+
+def test_half_turn_ties_keep_the_even_turn():
+    """Half a turn from the reference keeps the even turn, in nearest_turn and the IK loop."""
+    from serialkin.ik import _kernels as K
+
+    lo, hi = np.array([-np.inf, -4 * math.pi]), np.array([np.inf, 4 * math.pi])
+    wide = np.array([True, True])
+    for q, ref, want in ((0.0, math.pi, 0.0), (0.0, -math.pi, 0.0),
+                         (0.0, 5 * math.pi, 4 * math.pi), (0.0, -5 * math.pi, -4 * math.pi)):
+        assert (ref - q) / TWO_PI % 1.0 == 0.5  # an exact tie
+        q2, r2 = np.array([q, q]), np.array([ref, ref])
+        got = nearest_turn(q2, lo, hi, wide, r2)
+        assert got[0] == want and got[1] == want
+        loop = q2.copy()
+        box = np.array([lo, hi, [1.0, 1.0]])  # read-only rows, as the solver's limit box
+        box.setflags(write=False)
+        K.nearest_into(loop, r2, box[0], box[1], box[2], True)
+        assert np.array_equal(loop, got)
+
+
+@settings(max_examples=300, deadline=None)
+@given(q=angles, ref=st.floats(-200.0, 200.0), lo=st.floats(-15.0, 0.0),
+       width=st.sampled_from([1.0, math.pi, TWO_PI, 7.0, 12.0, 30.0, math.inf]),
+       bounded=st.booleans())
+def test_ik_loop_applies_the_same_rule(q, ref, lo, width, bounded):
+    """The IK loop's nearest_into is nearest_turn on its wide joints (all, if limits are off)."""
+    from serialkin.ik import _kernels as K
+
+    hi = lo + width
+    q = min(max(q, lo), hi) if bounded else q
+    lower, upper = np.array([lo, lo]), np.array([hi, hi])
+    box = np.array([lower, upper, [1.0, 0.0]])  # read-only rows, as the solver's limit box
+    box.setflags(write=False)
+    loop = np.array([q, q])
+    K.nearest_into(loop, np.array([ref, ref]), box[0], box[1], box[2], bounded)
+    if bounded:
+        wide = wide_joints(lower, upper, np.array([True, False]))
+        want = nearest_turn(np.array([q, q]), lower, upper, wide, np.array([ref, ref]))
+    else:
+        want = nearest_turn(np.array([q, q]), np.full(2, -np.inf), np.full(2, np.inf),
+                            np.array([True, False]), np.array([ref, ref]))
+    assert np.array_equal(loop, want)
+    assert loop[1] == q  # prismatic: never moved

@@ -92,9 +92,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from serialkin.collision.queries import PAIR_NONE, clearance_at, pair_distance_at
+from serialkin.ik.turns import turn_toward
 from serialkin.kinematics.dls import dls_step_into, spd_solve_into
 from serialkin.kinematics.kernels import fk_all_into, fk_into, jacobian_into
-from serialkin.model.limits import TIDY_MAX
 from serialkin.model.limits import inside as interval_inside
 from serialkin.model.limits import normalize as interval_normalize
 from serialkin.model.limits import project as interval_project
@@ -236,33 +236,22 @@ def normalize_into(q, lo, hi, revolute):
 
 @njit(cache=True)
 def nearest_into(q, ref, lo, hi, revolute, bounded):
-    """Move each revolute q_i (in place) to its 2π-representative nearest ``ref_i`` in range.
+    """Move each revolute q_i (in place) to its 2π-representative nearest ``ref_i``.
 
-    Among ``q_i + 2πk`` (same pose) with k such that the value stays in [lo_i, hi_i]
-    (any k when ``bounded`` is False), the one nearest ``ref_i``: since ``|q_i + 2πk −
-    ref_i|`` is convex in k, that is ``k = round((ref_i − q_i)/2π)`` clamped to
-    ``[⌈(lo_i − q_i)/2π⌉, ⌊(hi_i − q_i)/2π⌋]``. This only matters for ranges wider than 2π
-    (the UR5's ±2π) and unlimited joints. Prismatic joints are untouched; ``ref`` (n,) is
-    the initial guess q0. Neither q_i nor the moved value may exceed
-    :data:`~serialkin.model.limits.TIDY_MAX` in magnitude (rounding would change the
-    pose): else q_i stays.
+    The rule of :mod:`serialkin.ik.turns`, by its one implementation
+    (:func:`~serialkin.ik.turns.turn_toward`: half-turn ties to the even number of turns,
+    at most :data:`~serialkin.ik.turns.MAX_TURNS` turns), on every revolute joint whose
+    range [lo_i, hi_i] is wider than 2π; with ``bounded`` False (limits not kept) on
+    every revolute joint, as if unlimited. Prismatic joints are untouched; ``ref`` (n,)
+    is the initial guess q0.
     """
     for i in range(q.shape[0]):
-        if revolute[i] == 0 or not abs(ref[i]) <= TIDY_MAX or not abs(q[i]) <= TIDY_MAX:
+        if revolute[i] == 0:
             continue
-        if abs(ref[i] - q[i]) < math.pi and (not bounded or (q[i] >= lo[i] and q[i] <= hi[i])):
-            continue  # the common case: k = 0 below, with no division
-        k = math.floor((ref[i] - q[i]) / TWO_PI + 0.5)
-        if bounded:
-            if math.isfinite(lo[i]):
-                kmin = math.ceil((lo[i] - q[i]) / TWO_PI)
-                k = max(k, kmin)
-            if math.isfinite(hi[i]):
-                kmax = math.floor((hi[i] - q[i]) / TWO_PI)
-                k = min(k, kmax)
-        x = q[i] + TWO_PI * k
-        if (not bounded or (x >= lo[i] and x <= hi[i])) and abs(x) <= TIDY_MAX:
-            q[i] = x
+        if not bounded:
+            q[i] = turn_toward(q[i], ref[i], -np.inf, np.inf)
+        elif hi[i] - lo[i] > TWO_PI:
+            q[i] = turn_toward(q[i], ref[i], lo[i], hi[i])
 
 
 @njit(cache=True)

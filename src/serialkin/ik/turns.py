@@ -8,20 +8,31 @@ limits:
 
     q_j ← q_j + 2π·k,  k = clip(round((r_j − q_j) / 2π), k_min, k_max)
 
-where ``[k_min, k_max]`` are the turns that keep ``q_j`` inside ``[lower_j, upper_j]``
+where ``round`` rounds half to even (``np.rint``: a value exactly half a turn from the
+reference keeps the even number of turns, so ``q_j = 0`` stays 0 for ``r_j = π``) and
+``[k_min, k_max]`` are the turns that keep ``q_j`` inside ``[lower_j, upper_j]``
 (tolerance :data:`TOL` rad). Joints whose range is at most 2π, prismatic joints, a
 value no turn brings inside its limits, and a value more than :data:`MAX_TURNS` turns
 from its representative (e.g. 9e9 rad after a hostile start) are left as they are: ``2π``
 is not a float, so moving by ``k`` turns also moves the angle by ``k·(2π − fl(2π))``
 (2.4e-16 rad per turn) plus the rounding of ``q`` itself, which for a few turns leaves
 the pose unchanged to ~1e-14 m and for a billion turns would not.
+
+One implementation of the rule, :func:`turn_toward` (one joint, compiled), serves every
+caller: the compiled IK loop (:func:`serialkin.ik._kernels.nearest_into`), the closed-form
+method's choice among its solutions (:mod:`serialkin.ik.analytic.method`) and, through
+:func:`nearest_turn`, any array from Python. Its arithmetic is rounded operation by
+operation (no fused multiply-add), so every caller gets the same bits.
 """
 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
+
+from serialkin._jit import entry_point, njit_exact
 
 #: Tolerance on the limits when choosing a turn [rad]: a solver's answer may sit on a
 #: limit to rounding.
@@ -42,11 +53,105 @@ def wide_joints(lower: np.ndarray, upper: np.ndarray, revolute: np.ndarray) -> n
     return np.asarray(revolute, dtype=bool) & (np.asarray(upper) - np.asarray(lower) > _TWO_PI)
 
 
+@njit_exact(cache=True)
+def turn_toward(x, r, lower, upper):
+    """The rule of the module docstring for one joint that may move: ``x + 2π·k`` or ``x``.
+
+    Args:
+        x: the joint's value [rad], finite.
+        r: its reference [rad].
+        lower: its lower limit [rad], −inf when open (or when limits are not kept).
+        upper: its upper limit [rad], +inf when open.
+
+    Returns:
+        float: the representative; ``x`` itself (same bits) when no turn applies.
+    """
+    k = np.rint((r - x) / _TWO_PI)  # half to even
+    k_min = np.ceil((lower - TOL - x) / _TWO_PI)  # ±inf for an open end
+    k_max = np.floor((upper + TOL - x) / _TWO_PI)
+    k = k if k > k_min else k_min  # clip(k, k_min, k_max), the bound on ties
+    k = k if k < k_max else k_max
+    if k_min <= k_max and abs(k) <= MAX_TURNS:
+        return x + _TWO_PI * k
+    return x
+
+
+@njit_exact(cache=True)
+def nearest_turn_rows(Q, R, lower, upper, wide, out):
+    """:func:`turn_toward` on every ``wide`` joint of the rows ``Q``, into ``out``.
+
+    Args:
+        Q: (m, n) configurations [rad / m], finite.
+        R: (m, n) or (1, n) references (one for all rows), or no rows for zeros.
+        lower: (n,) lower limits, −inf when open.
+        upper: (n,) upper limits, +inf when open.
+        wide: (n,) bool, the joints that may move.
+        out: (m, n) output.
+
+    Returns:
+        int: the first row nearest its reference, ``sqrt(Σ_j (out_ij − r_ij)²)`` summed
+        left to right (numpy's sum for fewer than 8 joints); −1 without rows. What a
+        caller choosing one of several solutions needs, for the cost of ``n`` products
+        per row.
+    """
+    m, n = Q.shape
+    best, index = np.inf, -1
+    for i in range(m):
+        s = 0.0
+        for j in range(n):
+            r = 0.0 if R.shape[0] == 0 else R[i if R.shape[0] > 1 else 0, j]
+            x = Q[i, j]
+            if wide[j]:
+                x = turn_toward(x, r, lower[j], upper[j])
+            out[i, j] = x
+            d = x - r
+            s = d * d if j == 0 else s + d * d
+        dist = math.sqrt(s)
+        if dist < best or index < 0:
+            best, index = dist, i
+    return index
+
+
+def _rows_signature() -> tuple:
+    """The numba types of :func:`nearest_turn_rows` as :func:`nearest_turn` calls it."""
+    import numba
+
+    Array, f64 = numba.types.Array, numba.float64
+    rows = Array(f64, 2, "A", readonly=True)
+    joints = Array(f64, 1, "A", readonly=True)
+    return (rows, rows, joints, joints, Array(numba.boolean, 1, "A", readonly=True),
+            Array(f64, 2, "C"))
+
+
+#: [entry point of nearest_turn_rows] once compiled (see :func:`rows_entry`).
+_ROWS: list[Any] = []
+#: The reference "zeros" of :func:`nearest_turn_rows` (no rows).
+NO_REFERENCE = np.zeros((0, 0))
+NO_REFERENCE.setflags(write=False)
+
+
+def rows_entry() -> Any:
+    """The compiled entry point of :func:`nearest_turn_rows` (its Python while it compiles).
+
+    Compiled for one set of types, whatever layout or writeability the caller's arrays
+    have: float64 rows and limits of any strides (read only), a bool mask, a fresh
+    C-contiguous output. Calling it skips numba's type dispatch and checks nothing: the
+    caller passes exactly those dtypes and dimensions (:func:`nearest_turn` does).
+    """
+    if _ROWS:
+        return _ROWS[0]
+    function, final = entry_point(nearest_turn_rows, _rows_signature)
+    if final:
+        _ROWS.append(function)
+    return function
+
+
 def nearest_turn(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, wide: np.ndarray,
                  reference: np.ndarray | None = None) -> np.ndarray:
     """``q`` with each ``wide`` joint moved by the whole turns that bring it nearest ``reference``.
 
-    Pure: a new array, the inputs untouched. See the module docstring for the rule.
+    Pure: a new array, the inputs untouched. See the module docstring for the rule
+    (:func:`turn_toward`, applied by the compiled :func:`nearest_turn_rows`).
 
     Args:
         q: (..., n) configurations [rad / m], finite.
@@ -58,59 +163,28 @@ def nearest_turn(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, wide: np.n
 
     Returns:
         (..., n) float64 array.
+
+    Raises:
+        ValueError: ``reference``, ``lower``, ``upper`` or ``wide`` does not broadcast
+            to ``q``'s shape (its last dimension, for the last three).
     """
     q = np.asarray(q, dtype=np.float64)
-    wide = np.asarray(wide, dtype=bool)
-    if not wide.any():
-        return q.copy()
-    ref = 0.0 if reference is None else np.asarray(reference, dtype=np.float64)
-    n = q.shape[-1] if q.ndim else -1
-    if (q.ndim == 1 and (np.ndim(ref) == 0 or np.shape(ref) == (n,)) and wide.shape == (n,)
-            and isinstance(lower, np.ndarray) and isinstance(upper, np.ndarray)
-            and lower.shape == upper.shape == (n,)):
-        # one configuration: joint by joint, cheaper than a dozen numpy calls on n values
-        return _nearest_turn_row(q, lower, upper, wide, ref)
-    with np.errstate(invalid="ignore"):  # ±inf limits give ±inf bounds on k: fine
-        k = np.rint((ref - q) / _TWO_PI)  # np.round to 0 decimals, half to even
-        k_min = np.ceil((lower - TOL - q) / _TWO_PI)
-        k_max = np.floor((upper + TOL - q) / _TWO_PI)
-    k = k.clip(k_min, k_max)  # np.clip, without its wrapper
-    # a value outside its limits with no turn inside, or too many turns away: kept
-    ok = wide & (k_min <= k_max) & (np.abs(k) <= MAX_TURNS)
-    return np.where(ok, q + _TWO_PI * np.where(ok, k, 0.0), q)
-
-
-def _nearest_turn_row(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, wide: np.ndarray,
-                      ref: np.ndarray | float) -> np.ndarray:
-    """:func:`nearest_turn` of one configuration ``q`` (n,), joint by joint in Python floats.
-
-    The same rule and the same IEEE operations in the same order as the array version
-    (whose dozen numpy calls cost more than the arithmetic on a few values), down to the
-    sign of a zero: Python's ``round`` rounds half to even as ``np.rint`` does, a zero
-    takes the sign ``np.rint``, ``np.ceil`` and ``np.floor`` give it (``copysign``), and
-    on a tie ``np.clip`` returns the bound, as here. An infinite bound stays infinite.
-    ``tests/ik/test_turns.py`` checks both versions against each other. ``ref`` is
-    (n,) or a scalar.
-    """
-    out = q.tolist()
-    refs = ref.tolist() if np.ndim(ref) == 1 else None
-    r = float(ref) if refs is None else 0.0  # a scalar reference (zero without q0)
-    lows, highs = lower.tolist(), upper.tolist()
-    for j, moves in enumerate(wide.tolist()):
-        if not moves:
-            continue
-        x = out[j]
-        t = ((r if refs is None else refs[j]) - x) / _TWO_PI
-        low, high = lows[j] - TOL, highs[j] + TOL
-        if -0.5 < t < 0.5 and low <= x <= high and x != 0.0:
-            continue  # k = ±0 inside [k_min <= 0, k_max >= 0]: x + 2π·(±0) is x
-        k = round(t) or math.copysign(0.0, t)  # np.rint: -0.0 for t in [-0.5, 0)
-        a = (low - x) / _TWO_PI
-        b = (high - x) / _TWO_PI
-        k_min = (math.ceil(a) or math.copysign(0.0, a)) if math.isfinite(a) else a
-        k_max = (math.floor(b) or math.copysign(0.0, b)) if math.isfinite(b) else b
-        k = k if k > k_min else k_min  # np.clip(k, k_min, k_max), the bound on ties
-        k = k if k < k_max else k_max
-        if k_min <= k_max and abs(k) <= MAX_TURNS:
-            out[j] = x + _TWO_PI * k
-    return np.array(out)
+    shape = q.shape
+    out = np.empty(shape)
+    if q.size == 0:
+        return out
+    n = shape[-1]
+    lower = np.asarray(lower, dtype=np.float64)
+    upper = np.asarray(upper, dtype=np.float64)
+    wide = np.asarray(wide, dtype=np.bool_)
+    if lower.shape != (n,) or upper.shape != (n,) or wide.shape != (n,):
+        lower, upper, wide = (np.broadcast_to(a, (n,)) for a in (lower, upper, wide))
+    if reference is None:
+        R = NO_REFERENCE
+    else:
+        R = np.asarray(reference, dtype=np.float64)
+        if R.shape != shape and R.shape != (n,):
+            R = np.broadcast_to(R, shape)
+        R = R.reshape(-1, n)
+    rows_entry()(q.reshape(-1, n), R, lower, upper, wide, out.reshape(-1, n))
+    return out

@@ -12,7 +12,6 @@ or nearest the middle of the joint ranges without ``q0``; a batch of targets is 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -27,7 +26,7 @@ from serialkin.ik.analytic import (
     reference_distance,
 )
 from serialkin.ik.registry import MethodSpec, register_method
-from serialkin.ik.turns import nearest_turn
+from serialkin.ik.turns import rows_entry
 from serialkin.model.robot import Robot
 
 #: Options of the method, with their defaults (passed on to ``ik_all``).
@@ -69,18 +68,26 @@ def _every_solution(robot: Robot, T: np.ndarray, kind: str,
     return Q, counts
 
 
-#: Per robot: the middle of the joint ranges (the reference without q0), read-only.
-_MIDDLE: PerObject[np.ndarray] = PerObject()
+#: Per robot: (middle of the joint ranges, lower limits, upper limits, revolute), read-only.
+_LIMITS: PerObject[tuple] = PerObject()
+
+
+def _limits(robot: Robot) -> tuple:
+    """``(middle, lower, upper, revolute)`` of ``robot``, each (n,), computed once per robot.
+
+    ``middle`` is the middle of the sampling box (the reference without q0).
+    """
+    lim = _LIMITS.get(robot)
+    if lim is None:
+        mid = robot.sampling_limits().mean(axis=1)
+        mid.setflags(write=False)
+        lim = _LIMITS.set(robot, (mid, robot.qlim[:, 0], robot.qlim[:, 1], robot.revolute))
+    return lim
 
 
 def _middle(robot: Robot) -> np.ndarray:
     """The (n,) middle of ``robot``'s sampling box (computed once per robot)."""
-    mid = _MIDDLE.get(robot)
-    if mid is None:
-        mid = robot.sampling_limits().mean(axis=1)
-        mid.setflags(write=False)
-        _MIDDLE.set(robot, mid)
-    return mid
+    return _limits(robot)[0]
 
 
 def analytic_solve(robot: Robot, T: np.ndarray, kind: str, q0: np.ndarray | None,
@@ -114,25 +121,25 @@ def analytic_solve_pose(robot: Robot, T: np.ndarray,
                         q0: np.ndarray | None) -> tuple[np.ndarray, bool, str]:
     """:func:`analytic_solve` of one pose ``T`` (4, 4) with the default options.
 
-    The same operations on the ``k`` rows of the one target (no padding, no batch
-    axis; unit weights multiply by 1.0, which changes no value), so the same answer bit
-    for bit: the rows of ``ik_all``, each revolute joint shifted by 2π towards the
-    reference (``q0`` (n,) or the middle of the ranges), the nearest in the L2
-    distance (the first of equals).
+    The rows of ``ik_all``, then one compiled call
+    (:func:`~serialkin.ik.turns.nearest_turn_rows`) that moves each revolute joint of
+    each row by the turns nearest the reference (``q0`` (n,) or the middle of the
+    ranges) and returns the first row of least L2 distance: the same operations on the
+    same values as :func:`analytic_solve`, so the same answer bit for bit (unit weights
+    multiply by 1.0, which changes no value; the closed-form classes have at most 6
+    joints, whose sum numpy takes left to right as the kernel does).
 
     Returns:
         ``(q (n,), found, reason)``: without any solution, a copy of the reference.
     """
-    ref = _middle(robot) if q0 is None else q0
-    rows = np.asarray(ik_all(robot, T).q, dtype=np.float64).reshape(-1, robot.n)
+    mid, lower, upper, revolute = _limits(robot)
+    ref = mid if q0 is None else q0
+    rows = np.asarray(ik_all(robot, T).q, dtype=np.float64)
     if rows.shape[0] == 0:
         return ref.copy(), False, NOT_FOUND
-    shifted = nearest_turn(rows, robot.qlim[:, 0], robot.qlim[:, 1], robot.revolute, ref)
-    d = shifted - ref
-    # reference_distance's sqrt(Σ d²) (the sum: add.reduce, as ndarray.sum), the first
-    # of the nearest as argmin picks it (math.sqrt rounds as np.sqrt does)
-    dist = [math.sqrt(s) for s in np.add.reduce(d * d, axis=-1).tolist()]
-    return shifted[dist.index(min(dist))].copy(), True, NOT_FOUND
+    shifted = np.empty(rows.shape)
+    best = rows_entry()(rows, ref.reshape(1, -1), lower, upper, revolute, shifted)
+    return shifted[best].copy(), True, NOT_FOUND
 
 
 def register_analytic() -> None:
