@@ -99,13 +99,58 @@ def test_report_is_self_contained_and_small(built_report):
 
 
 def test_every_timing_is_warm(built_report):
-    """Every timing the report prints is a median of warm runs with its spread."""
+    """Every timing the page prints is a median of warm runs in blocks, with the block spread."""
     _, html = built_report
-    timings = re.findall(r"median of \d+ ([^,]*), spread", html)
-    assert timings
-    ratios = {t for t in timings if t.startswith("interleaved pairs")}
-    assert set(timings) - ratios == {"warm runs"}, set(timings)
-    assert ratios and all("of warm runs" in t for t in ratios), ratios  # eq 48/QP, (c)/(b)
+    times = re.findall(r"median of \d+ warm runs in (\d+) blocks, 5th–95th percentile", html)
+    ratios = re.findall(r"× \(median of \d+ rounds in (\d+) blocks, 5th–95th percentile", html)
+    assert len(times) >= 8 and len(ratios) == 2, (times, ratios)  # (c)/(b) and QP / eq 48
+    assert {int(b) for b in times + ratios} == {7}
+    assert not re.search(r"median of \d+ (warm runs|interleaved pairs)[^,]*, spread", html)
+
+
+def test_timings_json_holds_every_run(built_report):
+    """timings.json: each timing's median and 5th-95th percentile follow from its runs."""
+    import json
+
+    import numpy as np
+
+    out, html = built_report
+    data = json.loads((out / "timings.json").read_text(encoding="utf-8"))
+    assert len(data) == 9 and {d["section"] for d in data} == {"numerical", "redundancy"}
+    for d in data:
+        runs = np.array(d["runs"])
+        assert d["n"] == runs.size == 21 and d["blocks"] == 7, d["label"]
+        assert d["median"] == np.median(runs)
+        assert (d["low"], d["high"]) == tuple(np.percentile(runs, [5, 95]))
+        assert d["low"] <= d["median"] <= d["high"]
+    labels = {d["label"] for d in data}
+    assert {"(b) free", "(c) constrained", "(c) by the QP", "six-link circle"} <= labels
+    assert "(c) by the QP / (c) constrained" in labels
+
+
+def test_every_character_is_in_a_bundled_font(built_report):
+    """Each character the page shows is in the embedded font of its role: no system font."""
+    from fontTools.ttLib import TTFont
+
+    from serialkin.chapter._fonts import FACES, LICENCES, page_characters
+
+    out, html = built_report
+    fonts = out / "fonts"
+    for name in LICENCES:
+        assert (fonts / name).read_text(encoding="utf-8").strip()
+    cover: dict[str, set[str]] = {}
+    for face in FACES:
+        data = (fonts / face.file).read_bytes()
+        assert data[:4] == b"wOFF", face.file
+        assert html.count("data:font/woff;base64,") == len(FACES)
+        cmap = {chr(c) for c in TTFont(fonts / face.file).getBestCmap()}
+        if face.weight == "normal" and face.style == "normal":
+            cover.setdefault(face.role, set()).update(cmap)
+        else:  # bold and italic text faces cover what the regular one does
+            assert page_characters(html)["text"] <= cmap, face.file
+    for role, chars in page_characters(html).items():
+        missing = sorted(chars - cover[role])
+        assert not missing, (role, missing[:20])
 
 
 def test_bold_symbols_are_unicode_bold(built_report):

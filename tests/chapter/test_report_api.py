@@ -217,6 +217,98 @@ def test_interleaved_alternates_and_gives_the_ratio(tmp_path):
     assert ctx.timings == [ta, tb]
 
 
+def _bench_with(durations, rounds=2):
+    """A bench on a fake clock; ``durations[name]`` yields that function's run times."""
+    clock = _FakeClock()
+    calls = []
+
+    def make(name):
+        def fn():
+            calls.append(name)
+            clock.now += next(durations[name])
+            return name.upper()
+        return fn
+
+    ctx = ReportContext(outdir=".", clock=clock)
+    return ctx, ctx.bench(rounds=rounds), make, calls
+
+
+def test_bench_rotates_the_order_and_warms_up_untimed():
+    """add() calls fn once untimed and returns its result; rounds rotate the order."""
+    from itertools import chain, repeat
+
+    durations = {name: chain([first], repeat(each)) for name, first, each in
+                 (("a", 50.0, 0.001), ("b", 60.0, 0.002), ("c", 70.0, 0.003))}
+    ctx, bench, make, calls = _bench_with(durations, rounds=2)
+    assert [bench.add(n, make(n)) for n in "abc"] == ["A", "B", "C"]
+    assert calls == ["a", "b", "c"]  # the warm-ups
+    bench.block()
+    bench.block()
+    assert calls[3:] == list("abc" "bca" "cab" "abc")  # round k starts at function k mod 3
+    assert bench.blocks == 2 and bench.names == ["a", "b", "c"]
+    t = bench.timing("b")
+    assert t.n == 4 and t.blocks == 2 and t.median == pytest.approx(0.002)  # no 60 s warm-up
+    assert ctx.timings == [t] and bench.timing("b") is t  # recorded once
+
+
+def test_bench_spread_is_the_5th_to_95th_percentile():
+    """Median over all runs of all blocks; spread = their 5th-95th percentile (not min..max)."""
+    runs = iter([1.0, 0.010, 0.012, 0.050, 0.020, 0.021, 0.022])  # warm-up, then 2 blocks of 3
+    ctx, bench, make, _ = _bench_with({"a": runs}, rounds=3)
+    bench.add("a", make("a"))
+    bench.block()
+    bench.block()
+    t = bench.timing("a")
+    assert t.median == pytest.approx(np.median([0.010, 0.011, 0.050, 0.020, 0.021, 0.022]))
+    # sorted 10, 12, 20, 21, 22, 50 ms: the 5th percentile is at rank 0.25, the 95th at 4.75
+    assert (t.low, t.high) == (pytest.approx(0.0105), pytest.approx(0.0430))
+    assert t.runs == pytest.approx((0.010, 0.012, 0.050, 0.020, 0.021, 0.022))
+    assert t.text == ("20.5 ms (median of 6 warm runs in 2 blocks, 5th–95th percentile "
+                      "10.5–43 ms)")
+
+
+def test_bench_ratio_is_taken_per_round():
+    """ratio(a, b): the time of a over the time of b in the same round, median and spread."""
+    durations = {"a": iter([9.0, 0.004, 0.006, 0.009, 0.0115]),
+                 "b": iter([9.0, 0.002, 0.002, 0.002, 0.004])}
+    ctx, bench, make, _ = _bench_with(durations, rounds=2)
+    bench.add("a", make("a"))
+    bench.add("b", make("b"))
+    bench.block()
+    bench.block()
+    r = bench.ratio("a", "b")
+    assert r.runs == pytest.approx((2.0, 3.0, 4.5, 2.875))
+    # sorted 2, 2.875, 3, 4.5: the percentiles at ranks 0.15 and 2.85
+    assert r.median == pytest.approx(2.9375)
+    assert (r.low, r.high) == pytest.approx((2.13125, 4.275))
+    assert r.unit == "×" and r.label == "a / b"
+    assert r.text == "2.9× (median of 4 rounds in 2 blocks, 5th–95th percentile 2.1–4.3×)"
+
+
+def test_bench_refuses_what_would_skew_it():
+    """Late add(), block() before add() or after timing(), unknown names: InputError."""
+    from itertools import repeat
+
+    ctx, bench, make, _ = _bench_with({"a": repeat(0.001), "b": repeat(0.001)})
+    with pytest.raises(InputError, match="add"):
+        bench.block()
+    with pytest.raises(InputError, match="warmup"):
+        bench.add("a", make("a"), warmup=0)
+    bench.add("a", make("a"))
+    with pytest.raises(InputError, match="block"):
+        bench.timing("a")
+    with pytest.raises(InputError, match="registered already"):
+        bench.add("a", make("a"))
+    bench.block()
+    with pytest.raises(InputError, match="before the first block"):
+        bench.add("b", make("b"))
+    with pytest.raises(InputError, match="registered: a"):
+        bench.timing("nope")
+    bench.timing("a")
+    with pytest.raises(InputError, match="after timing"):
+        bench.block()
+
+
 def test_reproduce_box_carries_the_expected_numbers():
     """A Reproduce box stores the page's numbers as JSON (unicode minus as ASCII)."""
     import html

@@ -1,4 +1,10 @@
-"""The built chapter report in headless Chromium: typeset maths, images, links, order."""
+"""The built chapter report in headless Chromium: fonts, typeset maths, images, links, order.
+
+The page embeds its fonts, so these tests run on them, not on the machine's: the
+layout tests measure against the text column and each box, and
+:func:`test_every_glyph_comes_from_an_embedded_font` checks with Chromium's own report
+(DevTools ``CSS.getPlatformFontsForNode``) that no glyph is drawn from a system font.
+"""
 
 from __future__ import annotations
 
@@ -22,6 +28,7 @@ def page(built_report):
     out, _ = built_report
     drv, profile = start_chromium()
     drv.get((out / "report.html").resolve().as_uri())
+    drv.execute_async_script("const done = arguments[0]; document.fonts.ready.then(done);")
     yield drv
     drv.quit()
     import shutil
@@ -125,3 +132,55 @@ def test_numbers_never_break_across_lines(page):
         }
         return out;""")
     assert not broken, broken[:10]
+
+
+def test_embedded_fonts_load_and_style_the_page(page):
+    """Every @font-face of the page is loaded; text, code and maths name them first."""
+    from serialkin.chapter._fonts import CODE, FACES, MATH, MATH_LETTERS, TEXT
+
+    faces = page.execute_script(
+        "return Array.from(document.fonts).map(f => [f.family, f.weight, f.style, f.status])")
+    assert sorted(faces) == sorted([f.family, f.weight, f.style, "loaded"] for f in FACES)
+    families = page.execute_script(
+        "const f = s => getComputedStyle(document.querySelector(s)).fontFamily;"
+        "return [f('body'), f('td'), f('pre'), f('code'), f('math'), f('mi')];")
+    want = [TEXT, TEXT, CODE, CODE, MATH, MATH]
+    for got, first in zip(families, want):
+        assert got.startswith(f'"{first}"'), (got, first)
+    assert f'"{MATH_LETTERS}"' in families[4]
+
+
+def test_every_glyph_comes_from_an_embedded_font(page):
+    """Chromium draws every glyph of the page from the embedded fonts, none from the system.
+
+    One element per distinct (tag, own text, font family, weight, style) is asked through
+    the DevTools protocol which platform fonts rendered its text.
+    """
+    probes = page.execute_script("""
+        const seen = new Set(); let n = 0;
+        for (const el of document.body.querySelectorAll('*')) {
+            const own = Array.from(el.childNodes).filter(c => c.nodeType === 3)
+                .map(c => c.data).join('').trim();
+            if (!own) continue;
+            const cs = getComputedStyle(el);
+            const key = [el.tagName, own, cs.fontFamily, cs.fontWeight, cs.fontStyle].join('|');
+            if (seen.has(key)) continue;
+            seen.add(key); el.setAttribute('data-fontprobe', ''); n++;
+        }
+        return n;""")
+    page.execute_cdp_cmd("DOM.enable", {})
+    page.execute_cdp_cmd("CSS.enable", {})
+    root = page.execute_cdp_cmd("DOM.getDocument", {"depth": -1})["root"]
+    ids = page.execute_cdp_cmd("DOM.querySelectorAll", {
+        "nodeId": root["nodeId"], "selector": "[data-fontprobe]"})["nodeIds"]
+    assert len(ids) == probes > 500
+    glyphs: dict[tuple[str, bool], int] = {}
+    for node in ids:
+        for font in page.execute_cdp_cmd("CSS.getPlatformFontsForNode",
+                                         {"nodeId": node})["fonts"]:
+            key = (font["familyName"], font["isCustomFont"])
+            glyphs[key] = glyphs.get(key, 0) + font["glyphCount"]
+    system = {k: v for k, v in glyphs.items() if not k[1]}
+    assert not system, system
+    assert {name for name, _ in glyphs} == {"DejaVu Sans", "DejaVu Sans Mono",
+                                             "DejaVu Serif", "serialkin Math Letters"}

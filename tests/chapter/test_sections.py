@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from serialkin.chapter.report import ReportContext
@@ -13,14 +14,16 @@ def ctx(tmp_path):
 
 
 def test_default_solver_timings_are_warm(ctx):
-    """Section 5.3's solver timings come from ctx.timing: warm-up first, 21 timed runs each."""
+    """Section 5.3's solver timings: a bench, warm-up first, 21 runs each in 7 blocks."""
     from serialkin.chapter.sections import numerical
 
     rows = numerical._default_solver_timings(ctx)
     assert len(rows) == len(ctx.timings) == 3
     for row, t in zip(rows, ctx.timings):
-        assert t.warm and t.n == 21 and 0 < t.low <= t.median <= t.high
-        assert row[-1] == t.text and "warm runs" in t.text
+        assert t.warm and t.n == len(t.runs) == 21 and t.blocks == 7
+        assert 0 < t.low <= t.median <= t.high
+        assert (t.low, t.high) == tuple(np.percentile(t.runs, [5, 95]))
+        assert row[-1] == t.text and "warm runs in 7 blocks, 5th–95th percentile" in t.text
 
 
 @pytest.mark.slow

@@ -63,15 +63,28 @@ class Section:
 
 @dataclass(frozen=True)
 class Timing:
-    """A warm wall-clock measurement: median and spread of repeated runs.
+    """A warm wall-clock measurement (or a ratio of two): median and spread of repeated runs.
+
+    Two kinds of spread, told apart by ``blocks``:
+
+    * ``blocks == 1`` (:meth:`ReportContext.timing`, :meth:`ReportContext.interleaved`):
+      the runs were taken back to back and the spread is their full range, min..max;
+    * ``blocks > 1`` (:class:`TimingBench`): the runs were taken in ``blocks`` blocks
+      spread over a section's build, and the spread is the 5th to the 95th percentile of
+      all of them (numpy's linear interpolation; for 21 runs, the second fastest and the
+      second slowest), so that one stray run at either end does not set it.
 
     Attributes:
-        median: median time of one call [s].
-        low: fastest run [s] (the spread is the full range, min..max).
-        high: slowest run [s].
-        n: number of timed runs.
+        median: median of all timed runs [s] (for a ratio: of the per-round ratios [1]).
+        low: lower end of the spread [s or 1].
+        high: upper end of the spread [s or 1].
+        n: number of timed runs (for a ratio: of rounds).
         warm: True when untimed warm-up calls preceded the timed ones (JIT compiled, caches
             filled).
+        blocks: number of blocks the runs were taken in (1: back to back).
+        unit: "s" for times, "×" for ratios.
+        label: what was timed (the name given to :meth:`TimingBench.add`), "" if unnamed.
+        runs: every timed run in the order taken [s or 1], shape (n,).
     """
 
     median: float
@@ -79,17 +92,173 @@ class Timing:
     high: float
     n: int
     warm: bool = True
+    blocks: int = 1
+    unit: str = "s"
+    label: str = ""
+    runs: tuple[float, ...] = field(default=(), repr=False, compare=False)
 
     @property
     def text(self) -> str:
-        """E.g. "0.91 ms (median of 7 warm runs, spread 0.85–0.97 ms)"."""
-        scale, unit = _time_unit(self.median)
-        kind = "warm runs" if self.warm else "runs, first one cold"
-        return (f"{_fmt3(self.median * scale)} {unit} (median of {self.n} {kind}, spread "
-                f"{_fmt3(self.low * scale)}–{_fmt3(self.high * scale)} {unit})")
+        """The timing as printed, e.g. "0.91 ms (median of 7 warm runs, spread 0.85–0.97 ms)".
+
+        Taken in blocks: "7.55 ms (median of 21 warm runs in 7 blocks, 5th–95th
+        percentile 7.47–7.62 ms)"; a ratio: "5.2× (median of 21 rounds in 7 blocks, 5th–95th
+        percentile 5.1–5.4×)".
+        """
+        if self.unit == "×":
+            value = f"{self.median:.2g}×"
+            low, high, unit = f"{self.low:.2g}", f"{self.high:.2g}", "×"
+            kind = "rounds"
+        else:
+            scale, unit = _time_unit(self.median)
+            value = f"{_fmt3(self.median * scale)} {unit}"
+            low, high, unit = _fmt3(self.low * scale), _fmt3(self.high * scale), f" {unit}"
+            kind = "warm runs" if self.warm else "runs, first one cold"
+        if self.blocks > 1:
+            return (f"{value} (median of {self.n} {kind} in {self.blocks} blocks, 5th–95th "
+                    f"percentile {low}–{high}{unit})")
+        return f"{value} (median of {self.n} {kind}, spread {low}–{high}{unit})"
 
     def __str__(self) -> str:
         return self.text
+
+
+class TimingBench:
+    """Warm timings of several functions, their runs taken in blocks spread over a build.
+
+    Runs of one function taken back to back see one state of the machine; a rebuild sees
+    another (what the other worker process or other programs do, the clock frequency, the
+    memory layout of the process), so two builds' medians can differ by more than the
+    min..max of back-to-back runs. A bench therefore takes the runs of every registered
+    function in blocks: a block is ``rounds`` rounds, a round runs each function once
+    (their order rotated from round to round, so that none always runs first or after the
+    same one), and the section calls :meth:`block` between its other work, so that the
+    blocks sample the machine over the section's whole build. A :class:`Timing` is the
+    median of all runs with their 5th to 95th percentile as its spread: the run-to-run
+    variation over the whole build, which a rebuild's median falls into where the
+    min..max of back-to-back runs was too narrow (docs/chapter-report.md). A ratio of two
+    functions is taken per round (both ran in the same round of one process, under one
+    machine state), its median and spread likewise.
+
+    Made by :meth:`ReportContext.bench`; the timings it gives are added to the
+    context's ``timings`` once each.
+    """
+
+    def __init__(self, clock: Callable[[], float], record: list[Timing], rounds: int = 3
+                 ) -> None:
+        from serialkin._checks import check_int
+
+        self._clock = clock
+        self._record = record
+        self._rounds = check_int(rounds, "rounds", minimum=1)
+        self._fns: dict[str, Callable[[], object]] = {}
+        self._runs: dict[str, list[list[float]]] = {}
+        self._round = 0
+        self._given: dict[str, Timing] = {}
+
+    @property
+    def names(self) -> list[str]:
+        """The registered functions' names, in the order added."""
+        return list(self._fns)
+
+    @property
+    def blocks(self) -> int:
+        """Blocks taken so far."""
+        return len(next(iter(self._runs.values()), []))
+
+    def add(self, name: str, fn: Callable[[], object], warmup: int = 1) -> object:
+        """Register ``fn`` under ``name`` and call it ``warmup`` times, untimed.
+
+        Returns:
+            what the last warm-up call returned (e.g. the trajectory of a tracking run,
+            so that the section need not run it again).
+
+        Raises:
+            InputError: ``name`` already registered, a block already taken (every
+                function must run in every block), or ``warmup`` below 1.
+        """
+        from serialkin._checks import check_int
+
+        warmup = check_int(warmup, "warmup", minimum=1)
+        if name in self._fns:
+            raise InputError(f"name must be new to the bench, got {name!r} which is "
+                             f"registered already (names: {', '.join(self._fns)})")
+        if self.blocks:
+            raise InputError(f"add({name!r}, ...) must come before the first block: every "
+                             f"function runs in every block, and {self.blocks} were taken")
+        result: object = None
+        for _ in range(warmup):
+            result = fn()
+        self._fns[name] = fn
+        self._runs[name] = []
+        return result
+
+    def block(self) -> None:
+        """Take one block: ``rounds`` rounds, each running every function once, timed.
+
+        Raises:
+            InputError: no function registered yet.
+        """
+        if not self._fns:
+            raise InputError("block() needs a function to time: call add(name, fn) first")
+        if self._given:
+            raise InputError("block() after timing() or ratio(): the timings already given "
+                             f"({', '.join(self._given)}) would not include it")
+        names = list(self._fns)
+        taken: dict[str, list[float]] = {name: [] for name in names}
+        clock = self._clock
+        for _ in range(self._rounds):
+            k = self._round % len(names)
+            for name in names[k:] + names[:k]:
+                t0 = clock()
+                self._fns[name]()
+                taken[name].append(clock() - t0)
+            self._round += 1
+        for name in names:
+            self._runs[name].append(taken[name])
+
+    def _blocks_of(self, name: str) -> list[list[float]]:
+        if name not in self._runs:
+            raise InputError(f"name must be a registered function, got {name!r} (registered: "
+                             f"{', '.join(self._runs) or 'none'})")
+        blocks = self._runs[name]
+        if not blocks:
+            raise InputError(f"no block taken yet: call block() before asking for {name!r}")
+        return blocks
+
+    @staticmethod
+    def _summary(blocks: list[list[float]], unit: str, label: str) -> Timing:
+        flat = [t for b in blocks for t in b]
+        if len(blocks) > 1:
+            low, high = (float(v) for v in np.percentile(flat, [5.0, 95.0]))
+        else:
+            low, high = min(flat), max(flat)
+        return Timing(median=float(np.median(flat)), low=low, high=high, n=len(flat),
+                      warm=True, blocks=len(blocks), unit=unit, label=label,
+                      runs=tuple(flat))
+
+    def timing(self, name: str) -> Timing:
+        """The :class:`Timing` of ``name`` over every block taken (added to the context once)."""
+        if name not in self._given:
+            t = self._summary(self._blocks_of(name), "s", name)
+            self._given[name] = t
+            self._record.append(t)
+        return self._given[name]
+
+    def ratio(self, numerator: str, denominator: str) -> Timing:
+        """Time of ``numerator`` / time of ``denominator`` per round, as a :class:`Timing` [1].
+
+        Both ran in the same round (one process, one machine state): the ratio of each
+        round, the median over all rounds and their 5th to 95th percentile.
+        """
+        label = f"{numerator} / {denominator}"
+        if label not in self._given:
+            a, b = self._blocks_of(numerator), self._blocks_of(denominator)
+            ratios = [[x / y for x, y in zip(ba, bb)] for ba, bb in zip(a, b)]
+            t = self._summary(ratios, "×", label)
+            self._given[label] = t
+            self._record.append(t)
+        return self._given[label]
 
 
 def _time_unit(seconds: float) -> tuple[float, str]:
@@ -269,7 +438,7 @@ class ReportContext:
             fn()
             runs.append(clock() - t0)
         t = Timing(median=float(np.median(runs)), low=float(min(runs)),
-                   high=float(max(runs)), n=repeat, warm=warmup >= 1)
+                   high=float(max(runs)), n=repeat, warm=warmup >= 1, runs=tuple(runs))
         self.timings.append(t)
         return t
 
@@ -304,14 +473,24 @@ class ReportContext:
             a_runs.append(ta)
             b_runs.append(tb)
 
-        def summary(runs: list[float]) -> Timing:
+        def summary(runs: list[float], unit: str = "s") -> Timing:
             return Timing(median=float(np.median(runs)), low=float(min(runs)),
-                          high=float(max(runs)), n=repeat, warm=warmup >= 1)
+                          high=float(max(runs)), n=repeat, warm=warmup >= 1, unit=unit,
+                          runs=tuple(runs))
 
         ratios = [b / a for a, b in zip(a_runs, b_runs)]
         ta, tb = summary(a_runs), summary(b_runs)
         self.timings.extend([ta, tb])
-        return ta, tb, summary(ratios)
+        return ta, tb, summary(ratios, "×")
+
+    def bench(self, rounds: int = 3) -> TimingBench:
+        """A :class:`TimingBench` on this context's clock.
+
+        Register the functions to time, then take blocks of ``rounds`` rounds between the
+        section's other work; its timings (and ratios) are added to :attr:`timings` when
+        asked for.
+        """
+        return TimingBench(self.clock, self.timings, rounds)
 
     # --- reproduction --------------------------------------------------------------------------
     @staticmethod
@@ -461,6 +640,7 @@ __all__ = [
     "ReportContext",
     "Section",
     "Timing",
+    "TimingBench",
     "compact_png",
     "format_number",
     "format_vector",

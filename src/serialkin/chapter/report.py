@@ -3,15 +3,21 @@
 Each section of the report is a module in :mod:`serialkin.chapter.sections` with a
 function ``build(ctx: ReportContext) -> Section | list[Section]``. :func:`build_report`
 runs them in chapter order and writes ``report.html`` (figures embedded as data URIs, so
-the file is self-contained and at most a few MB) plus every figure under ``figures/``.
+the file is self-contained and at most a few MB) plus every figure under ``figures/``,
+the fonts the page uses under ``fonts/`` (with their licences) and every timed run in
+``timings.json``.
 
 What :class:`ReportContext` gives a section:
 
 * ``ctx.eq(latex, number)`` / ``ctx.imath(latex)``: mathematics as MathML (converted from
   LaTeX by ``latex2mathml``; native in Chromium and Firefox, no JavaScript, no network),
   display equations with the chapter's number on the right, scrolling sideways when wide;
-* ``ctx.timing(fn)``: a warm measurement (untimed warm-up, then the median and the
-  min..max range of repeated calls) as a :class:`Timing`;
+* ``ctx.bench()``: a :class:`TimingBench` for a section's warm measurements: each timed
+  function is registered (and warmed up), then timed in blocks of rounds that the section
+  takes between its other work, so that the runs sample the machine over the section's
+  build; a :class:`Timing` is the median of all runs with their 5th-95th percentile as
+  its spread, a ratio of two functions is taken per round (``ctx.timing(fn)`` and
+  ``ctx.interleaved`` time back to back, with the min..max of the runs);
 * ``ctx.reproduce(code, shell)``: the snippet or ``serialkin`` command that reproduces an
   example;
 * ``ctx.table`` / ``ctx.matrix`` / ``ctx.figure``: aligned tables without negative zeros,
@@ -48,6 +54,7 @@ from serialkin.chapter._context import (
     format_number,
     format_vector,
 )
+from serialkin.chapter._fonts import FAMILY, embedded_fonts
 
 #: Section modules in chapter order (module name under serialkin.chapter.sections).
 SECTION_MODULES: tuple[str, ...] = (
@@ -61,7 +68,7 @@ SECTION_MODULES: tuple[str, ...] = (
 )
 
 _CSS = """
-body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;
+body{font-family:@text@;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;
 line-height:1.45}
 h1{border-bottom:2px solid #345}h2{margin-top:2em;border-bottom:1px solid #ccc}
 .eq{color:#555;font-size:90%}table{border-collapse:collapse;margin:0.6em 0}
@@ -75,8 +82,8 @@ figure{margin:1em 0}img{max-width:100%}pre{background:#f6f6f6;padding:0.6em;over
 .eqn{display:flex;align-items:center;margin:0.6em 0}
 .eqbody{flex:1 1 auto;min-width:0;overflow-x:auto;overflow-y:hidden;padding:2px 0}
 .eqno{flex:none;margin-left:1.5em;color:#333}
-math{font-family:"STIX Two Math","Latin Modern Math","Cambria Math","DejaVu Math TeX Gyre",
-math}math[display=block]{font-size:1.08em}
+math{font-family:@math@}math[display=block]{font-size:1.08em}
+pre,code{font-family:@code@;font-size:0.8125em}pre code{font-size:1em}
 .repro{border:1px solid #9ab;border-left:4px solid #357;background:#f4f8fb;margin:1em 0;
 padding:0.3em 0.8em}.repro pre{background:none;margin:0.3em 0;padding:0}
 .repro-label{font-weight:600;font-size:90%;color:#357}
@@ -90,6 +97,9 @@ td.num,th.num,table.matrix td,.nowrap{white-space:nowrap}
 mtd[columnalign=left]{text-align:left}mtd[columnalign=right]{text-align:right}
 ol.algorithm{background:#fafafa;border:1px solid #ccc;padding:0.5em 0.8em 0.5em 2.5em}
 """
+for _role, _family in FAMILY.items():
+    _CSS = _CSS.replace(f"@{_role}@", _family)
+del _role, _family
 
 
 def build_metadata() -> list[tuple[str, str]]:
@@ -135,6 +145,11 @@ def build_metadata() -> list[tuple[str, str]]:
 
 def _sections_of(result: Section | Sequence[Section]) -> list[Section]:
     return [result] if isinstance(result, Section) else list(result)
+
+
+def _span_text(values: Sequence[int]) -> str:
+    """"7" or "3–7" for a sorted list of counts."""
+    return f"{values[0]}" if values[0] == values[-1] else f"{values[0]}–{values[-1]}"
 
 
 def _load_text(load: tuple[float, float, float] | None) -> str:
@@ -185,7 +200,25 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
                        f'</a> <span class="eq">({eqs})</span></li>')
         body.append(f'<section id="{anchor}"><h2>{html.escape(label)}</h2>{part}'
                     f'<p class="eq">Demonstrates: {eqs}</p>{sec.html}</section>')
+    import matplotlib
+
+    times = [t for t in timings if t.unit != "×"]
     repeats = sorted({t.n for t in timings})
+    blocks = sorted({t.blocks for t in timings})
+    rounds = sorted({t.n // t.blocks for t in timings})
+    if not timings:
+        timing_text = "none measured"
+    else:
+        timing_text = (
+            f"{len(times)} times and {len(timings) - len(times)} ratios, each the median of "
+            f"{_span_text(repeats)} warm runs after an untimed warm-up"
+            + (f", taken in {_span_text(blocks)} blocks spread over their section's build "
+               f"(a block: {_span_text(rounds)} rounds, each running every timed function of "
+               "the section once, the order rotating); the spread printed with each is the "
+               "5th to 95th percentile of its runs" if blocks[-1] > 1 else
+               ", with their full range")
+            + "; a ratio between two methods is taken per round, in one process; every run "
+            "is in timings.json beside this page")
     meta = build_metadata() + [
         ("build time", f"{seconds:.1f} s wall clock ({workers}); the sections took "
                        f"{cpu:.1f} s CPU in all"),
@@ -193,11 +226,12 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
                          f"{_load_text(load[-1])} on {os.cpu_count()} CPUs: with a load "
                          "above the CPU count other processes shared the cores and the "
                          "times below are slower and more spread than on a quiet machine"),
-        ("timings", f"{len(timings)} measurements, each the median of "
-                    + (f"{repeats[0]}–{repeats[-1]}" if len(repeats) > 1 else
-                       f"{repeats[0] if repeats else 0}")
-                    + " warm runs after an untimed warm-up, with their full range; ratios "
-                    "between methods from runs interleaved in one process")]
+        ("timings", timing_text),
+        ("fonts", f"DejaVu Sans (text, and the figures), DejaVu Sans Mono (code), DejaVu "
+                  "Serif with STIX General's mathematical letters (mathematics), from "
+                  f"matplotlib {matplotlib.__version__}, cut down to the characters of this "
+                  "page and embedded in it, so that it looks the same on every machine; the "
+                  "files and their licences are in fonts/ beside it")]
     meta_html = ('<table class="meta">' + "".join(
         f"<tr><th>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>" for k, v in meta)
         + "</table>")
@@ -209,9 +243,11 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
         "<p>Every number and figure below is computed by serialkin when this report is "
         "built (<code>serialkin chapter</code>); equations carry the chapter's numbers and "
         "the corrected forms of the ERRATA are used. Times are wall-clock medians of warm "
-        "runs (after an untimed warm-up call) with their full range (min–max), measured "
-        "while the report was built: they depend on the machine and its load, stated "
-        "below. Each Reproduce box prints the numbers its section shows; run "
+        "runs (after an untimed warm-up call), measured while the report was built and "
+        "taken in blocks spread over the build, between its other work; the spread printed "
+        "with each is the 5th to 95th percentile of its runs, the run-to-run variation over "
+        "the build. They depend on the machine and its load, stated below. Each Reproduce "
+        "box prints the numbers its section shows; run "
         "<code>serialkin warmup</code> once first (or set <code>SERIALKIN_COMPILE=wait</code>"
         "): until the compiled kernels are ready the first calls run as Python, whose "
         "rounding differs in the last digits, and a long tracking run (the 20-link arm) then "
@@ -221,6 +257,10 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
     )
 
 
+#: matplotlib settings of every figure: the page's text font (whatever a matplotlibrc says).
+FIGURE_FONTS = {"font.family": "sans-serif", "font.sans-serif": ["DejaVu Sans"],
+                "mathtext.fontset": "dejavusans"}
+
 #: Relative cost of the section modules (the heaviest are started first when several
 #: worker processes build the report).
 _COST_HINT = {"workspace": 3, "redundancy": 3, "numerical": 2}
@@ -229,10 +269,13 @@ _COST_HINT = {"workspace": 3, "redundancy": 3, "numerical": 2}
 def _build_module(name: str, outdir: str, quiet: bool
                   ) -> tuple[list[Section], list[str], list[Timing], float, float]:
     """Build one section module: (sections, figure files, timings, wall s, CPU s)."""
+    import matplotlib
+
     ctx = ReportContext(outdir=Path(outdir), quiet=quiet)
     t0, c0 = time.perf_counter(), time.process_time()
     module = importlib.import_module(f"serialkin.chapter.sections.{name}")
-    built = _sections_of(module.build(ctx))
+    with matplotlib.rc_context(FIGURE_FONTS):
+        built = _sections_of(module.build(ctx))
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     built[-1].html += (f'<p class="eq">Section built in {wall:.2f} s wall clock, {cpu:.2f} s '
                        "CPU (this machine).</p>")
@@ -311,9 +354,26 @@ def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
     timings = [t for name in names for t in results[name][2]]
     page = _render(parts, time.perf_counter() - start, cpu, workers,
                    (load_start, _loadavg()), timings)
+    page = page.replace("<style>", "<style>" + embedded_fonts(page, out), 1)
     path = out / "report.html"
     write_text_atomic(path, page)
+    write_text_atomic(out / "timings.json", _timings_json(
+        [(name, t) for name in names for t in results[name][2]]))
     return path
+
+
+def _timings_json(timings: Sequence[tuple[str, Timing]]) -> str:
+    """Every timing of the page with all its runs, as JSON (times in seconds).
+
+    One object per timing: section module, label, unit ("s" or "×" for a ratio), median,
+    low and high (the printed spread), runs n, blocks and the runs in the order taken.
+    """
+    import json
+
+    return json.dumps([
+        {"section": module, "label": t.label, "unit": t.unit, "median": t.median,
+         "low": t.low, "high": t.high, "n": t.n, "blocks": t.blocks, "runs": list(t.runs)}
+        for module, t in timings], indent=1, ensure_ascii=False) + "\n"
 
 
 __all__ = [

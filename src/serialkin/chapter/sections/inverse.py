@@ -130,8 +130,10 @@ def _section_4(ctx: ReportContext) -> Section:
     three = models.three_link(1.0, 0.8, 0.5)
     target = three.fk(np.array([0.3, 0.6, -0.4]))[:2, 3]
     rows_3 = []
+    found = []
     for seed in range(4):
         res = three.ik(target, seed=seed, q0=three.random_q(seed=seed))
+        found.append(np.round(np.degrees(wrap_angle(res.q)), 2))
         rows_3.append((seed, *(format_number(v, "{:.2f}")
                                for v in np.degrees(wrap_angle(res.q))),
                        float(np.linalg.norm(three.fk(res.q)[:2, 3] - target)),
@@ -172,8 +174,9 @@ def _section_4(ctx: ReportContext) -> Section:
         f"(worst max |f(q) − T| = {err16:.1e}).</p>"
         + "<p><b>Infinitely many.</b> The planar three-link arm (L = 1.0, 0.8, 0.5 m) and a "
         f"position target ({target[0]:.4f}, {target[1]:.4f}) m: n = 3 joints for m = 2 task "
-        "coordinates, so the solutions form a curve; <code>robot.ik</code> started from four "
-        "seeded random configurations lands on four different points of it:</p>"
+        "coordinates, so the solutions form a curve; <code>robot.ik</code> started from "
+        f"{len(found)} seeded random configurations lands on "
+        f"{len({tuple(f) for f in found})} different points of it:</p>"
         + ctx.table(rows_3, ["seed", "q1 [°]", "q2 [°]", "q3 [°]", "|f(q) − x| [m]",
                              "success"], fmt="{:.3g}")
         + f"<p><b>None.</b> The two-link arm (L1 = {L1} m, L2 = {L2} m) cannot reach "
@@ -238,10 +241,13 @@ def _section_4_1(ctx: ReportContext) -> Section:
          ("27, twin", Html(ctx.imath(r"\vartheta_1 = \alpha + \beta")), cf["theta1_b"])],
         ["eq", "quantity", "value [m or rad]"]))
     bad = _misprinted_cos_beta(x, y, L1, L2)
+    inside = abs(L1 - L2) <= cf["r"] <= L1 + L2
     parts.append(
         f"<p>As printed, eq 26 uses c = x² + y² and c² in the numerator: its arccos argument "
         f"is {bad:.4f}{' &gt; 1, so no real β exists' if abs(bad) > 1 else ''}, although the "
-        "target is well inside the workspace — the corrected form is needed.</p>"
+        f"target, at r = {cf['r']:.4f} m, lies {'inside' if inside else 'outside'} the "
+        f"workspace |L1 − L2| = {abs(L1 - L2):.4g} m ≤ r ≤ L1 + L2 = {L1 + L2:.4g} m"
+        + (" — the corrected form is needed" if inside and abs(bad) > 1 else "") + ".</p>"
     )
 
     mine = np.array([[cf["theta1_a"], cf["theta2_plus"]], [cf["theta1_b"], cf["theta2_minus"]]])

@@ -290,8 +290,9 @@ def _two_link_part(ctx: ReportContext, two: Robot) -> str:
             ("|J[:2] − finite differences of fk|",
              float(np.abs(J2[:2] - _fd_planar(two, TWO_LINK_Q)).max())),
         ], ["check", "max abs difference"], fmt="{:.2e}")
-        + "<p>Rank 2: only two of the six velocity components can be assigned; for a "
-        "position task only the first two rows are kept "
+        + f"<p>Rank {np.linalg.matrix_rank(J2)} (<code>numpy.linalg.matrix_rank</code>): "
+        f"only {np.linalg.matrix_rank(J2)} of the {J2.shape[0]} velocity components can be "
+        "assigned; for a position task only the first two rows are kept "
         "(<code>robot.jacobian_planar(q)</code>).</p>"
     )
 

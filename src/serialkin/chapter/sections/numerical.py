@@ -4,7 +4,7 @@ Contents: the Jacobian control law (eqs 39-40) and one Newton-Raphson iteration 
 shown on the chapter's formulas; the numerical families of section 5.3 measured side by
 side by :func:`serialkin.ik.compare.compare` on a planar 3-link arm, the Puma 560 and the
 UR5 (every number in those tables is measured when the report is built), the default
-solver's warm timing per robot (median and spread, ``ctx.timing``), a table of the
+solver's warm timing per robot (median and block spread, ``ctx.bench``), a table of the
 trade-offs. The redundancy resolution itself (eqs 42-56, the 6- and 20-link examples) follows in
 :mod:`serialkin.chapter.sections.redundancy`.
 """
@@ -12,33 +12,41 @@ trade-offs. The redundancy resolution itself (eqs 42-56, the 6- and 20-link exam
 from __future__ import annotations
 
 import html
+from collections.abc import Callable
 
 import numpy as np
 
 from serialkin import models
-from serialkin.chapter._context import ReportContext, Section, format_number
+from serialkin.chapter._context import ReportContext, Section, TimingBench, format_number
 from serialkin.ik.compare import COLUMNS, CompareTable, compare
 
 #: Tolerance of the comparison (the accuracy bar of the IK issue) [m, rad].
 COMPARE_TOL = 1e-6
 #: Targets per robot in the comparison (kept small: BFGS/Powell are slow).
 N_PLANAR, N_SPATIAL = 20, 10
+#: Position error [m] below which the Newton demo's error is rounding, not convergence.
+ROUNDING = 1e-13
 #: Median iterations beyond which a method's row of the compare box is not checked.
 CHAOTIC_ITERATIONS = 1000
 
 
+def comparison_jobs() -> list[tuple[str, Callable[[], CompareTable]]]:
+    """(title, run) of :func:`compare` on each robot of the section (seeded, reproducible)."""
+    planar = models.planar(3, [1.0, 0.8, 0.5])
+    jobs: list[tuple[str, Callable[[], CompareTable]]] = [(
+        "Planar 3-link arm (L = 1.0, 0.8, 0.5 m, unlimited), (x, y) targets",
+        lambda: compare(planar, planar.fk(planar.random_q(N_PLANAR, seed=42))[:, :2, 3],
+                        tol=COMPARE_TOL, seed=0))]
+    for robot in (models.puma560(), models.ur5()):
+        jobs.append((f"{robot.name}, full 6-D pose targets",
+                     lambda robot=robot: compare(robot, robot.fk(robot.random_q(
+                         N_SPATIAL, seed=42)), tol=COMPARE_TOL, seed=0)))
+    return jobs
+
+
 def comparison_tables() -> list[tuple[str, CompareTable]]:
     """Run :func:`compare` on the three robots of the section (seeded, reproducible)."""
-    out = []
-    planar = models.planar(3, [1.0, 0.8, 0.5])
-    T = planar.fk(planar.random_q(N_PLANAR, seed=42))
-    out.append(("Planar 3-link arm (L = 1.0, 0.8, 0.5 m, unlimited), (x, y) targets",
-                compare(planar, T[:, :2, 3], tol=COMPARE_TOL, seed=0)))
-    for robot in (models.puma560(), models.ur5()):
-        T = robot.fk(robot.random_q(N_SPATIAL, seed=42))
-        out.append((f"{robot.name}, full 6-D pose targets",
-                    compare(robot, T, tol=COMPARE_TOL, seed=0)))
-    return out
+    return [(title, run()) for title, run in comparison_jobs()]
 
 
 #: Trade-offs of the families (general properties; the measured columns come from the
@@ -104,6 +112,12 @@ def _newton_demo(ctx: ReportContext) -> str:
     for k in range(1, 7):
         res = ur5.ik(T, method="newton", q0=q0, max_iter=k, restarts=0, tol=1e-15)
         rows.append((k, res.position_error, res.orientation_error))
+    # correct digits -log10(e) of the position error until it reaches rounding
+    err = np.array([r[1] for r in rows])
+    above = err > ROUNDING
+    digits = -np.log10(err[above])
+    growth = digits[1:] / digits[:-1]
+    floor = int(np.argmin(above)) + 1 if not above.all() else None
     return (
         "<h3>Newton-Raphson (eq 41)</h3><p>For a scalar equation f(x) = 0 one step is</p>"
         + ctx.eq(r"x_1 = x_0 - \frac{f(x_0)}{f'(x_0)}", "41")
@@ -113,8 +127,13 @@ def _newton_demo(ctx: ReportContext) -> str:
                     r"\mathbf{e}(\mathbf{q}_k)")
         + " (<code>method='newton'</code>). The UR5, target f(q) for q = (0.4, −1.1, 1.3, "
         "−0.6, 0.9, 0.2) rad, started at q + 0.15 rad in every joint, errors after k "
-        "steps: the number of correct digits roughly doubles per step (quadratic "
-        "convergence) until rounding.</p>"
+        "steps below. The correct digits of the position, "
+        + ctx.imath(r"-\log_{10} e_k")
+        + f" = {', '.join(f'{d:.1f}' for d in digits)} for k = 1 … {digits.size}, grow by "
+        f"a factor {growth.min():.2f}–{growth.max():.2f} per step (2 is quadratic "
+        "convergence)"
+        + (f"; from step {floor} the error is rounding ({err[floor - 1]:.1e} m, below "
+           f"{ROUNDING:g} m)" if floor is not None else "") + ".</p>"
         + ctx.table(rows, ["steps k", "position error [m]", "orientation error [rad]"],
                     fmt="{:.2e}")
     )
@@ -133,22 +152,125 @@ def _compare_html(ctx: ReportContext, table: CompareTable) -> str:
     return out
 
 
-def _default_solver_timings(ctx: ReportContext) -> list[tuple[str, str, str, str]]:
-    """Warm median and spread of ``robot.ik(target)`` (method 'lm') on one target each."""
-    rows = []
+def _default_solver_cases() -> list[tuple[str, str, Callable[[], object]]]:
+    """(robot name, target kind, solve) of the default solver on one target per robot."""
     planar = models.planar(3, [1.0, 0.8, 0.5])
     cases = [(planar, planar.fk(planar.random_q(1, seed=42)[0])[:2, 3], "(x, y)")]
     for robot in (models.puma560(), models.ur5()):
         cases.append((robot, robot.fk(robot.random_q(1, seed=42)[0]), "6-D pose"))
-    for robot, target, kind in cases:
-        t = ctx.timing(lambda robot=robot, target=target: robot.ik(target, seed=0),
-                       repeat=21)
-        rows.append((robot.name, kind, "lm", t.text))
-    return rows
+    return [(robot.name, kind, lambda robot=robot, target=target: robot.ik(target, seed=0))
+            for robot, target, kind in cases]
+
+
+def _default_solver_timings(ctx: ReportContext, blocks: int = 7
+                            ) -> list[tuple[str, str, str, str]]:
+    """Warm median and spread of ``robot.ik(target)`` (method 'lm') on one target each.
+
+    The three solves share one :class:`~serialkin.chapter._context.TimingBench`, timed in
+    ``blocks`` blocks of three rounds taken back to back (the section's build takes its
+    blocks between its other work instead).
+    """
+    bench = ctx.bench(rounds=3)
+    cases = _default_solver_cases()
+    for name, _, solve in cases:
+        bench.add(name, solve)
+    for _ in range(blocks):
+        bench.block()
+    return _solver_rows(bench, cases)
+
+
+def _solver_rows(bench: TimingBench, cases: list[tuple[str, str, Callable[[], object]]]
+                 ) -> list[tuple[str, str, str, str]]:
+    """The rows (robot, target, method, timing) of the default solver's timings."""
+    return [(name, kind, "lm", bench.timing(name).text) for name, kind, _ in cases]
+
+
+def _pct(rates: list[float]) -> str:
+    """Success rates as "100 %" or "70–100 %"."""
+    lo, hi = 100 * min(rates), 100 * max(rates)
+    return f"{lo:.0f} %" if f"{lo:.0f}" == f"{hi:.0f}" else f"{lo:.0f}–{hi:.0f} %"
+
+
+def _num(value: float, digits: int = 3) -> str:
+    """A number with ``digits`` significant digits, from 100 up as a whole number ("4,900")."""
+    return f"{value:,.0f}" if abs(value) >= 100 else f"{value:.{digits}g}"
+
+
+def _span(values: list[float], digits: int = 3) -> str:
+    """Values as "a" or "a–b" (:func:`_num`)."""
+    lo, hi = _num(min(values), digits), _num(max(values), digits)
+    return lo if lo == hi else f"{lo}–{hi}"
+
+
+def _reading_text(tables: list[tuple[str, CompareTable]]) -> str:
+    """What the comparison tables show, each statement computed from their rows."""
+    rows = [{r.method: r for r in t.rows} for _, t in tables]
+
+    def of(method: str, field: str, where: list[dict] | None = None) -> list[float]:
+        return [float(getattr(r[method], field)) for r in (rows if where is None else where)
+                if method in r]
+
+    out = []
+    if of("lm", "success_rate"):
+        out.append(
+            "the damped (Levenberg-Marquardt) family combines the Jacobian methods' "
+            "quadratic convergence with bounded steps near singularities, which is why it "
+            f"is the default (<code>method='lm'</code>): lm solved {_pct(of('lm', 'success_rate'))}"
+            f" of the targets in a median {_span(of('lm', 'median_iterations'))} iterations "
+            f"and {_span([1e3 * t for t in of('lm', 'median_time')])} ms per solve")
+    jac = [m for r in rows for m, row in r.items()
+           if row.family == "jacobian" and m != "transpose"]
+    if of("transpose", "median_iterations") and jac:
+        others = [float(r[m].median_iterations) for r in rows for m in set(jac) if m in r]
+        out.append(
+            "the Jacobian transpose converges linearly: a median "
+            f"{_span(of('transpose', 'median_iterations'))} iterations per solve against "
+            f"{_span(others)} for the other Jacobian methods, and it solved "
+            f"{_pct(of('transpose', 'success_rate'))} of the targets")
+    if of("bfgs", "success_rate") and of("powell", "success_rate"):
+        lm_time = [r["lm"].median_time for r in rows if "lm" in r]
+        ratio = {m: [r[m].median_time / r["lm"].median_time for r in rows
+                     if m in r and "lm" in r] for m in ("bfgs", "powell")}
+        rates = (_pct(of("bfgs", "success_rate")), _pct(of("powell", "success_rate")))
+        out.append(
+            "BFGS and Powell (scipy's optimisers, iterating in Python) solved "
+            + (f"{rates[0]} each" if rates[0] == rates[1] else " and ".join(rates))
+            + f" of the targets (lm {_pct(of('lm', 'success_rate'))}) at "
+            f"{_span(ratio['bfgs'], 2)}× and {_span(ratio['powell'], 2)}× lm's median time "
+            f"per solve ({_span([1e3 * t for t in lm_time])} ms)")
+    planar = [r for (_, t), r in zip(tables, rows) if t.target_kind.startswith("planar")]
+    poses = [r for (_, t), r in zip(tables, rows) if t.target_kind == "pose"]
+    if of("ccd", "success_rate", planar) and of("ccd", "success_rate", poses):
+        out.append(
+            "CCD solved the planar arm's position targets "
+            f"({_pct(of('ccd', 'success_rate', planar))}) in a median "
+            f"{_span(of('ccd', 'median_iterations', planar))} sweeps, but on full poses, "
+            "where it trades position against orientation joint by joint, it needed "
+            f"{_span(of('ccd', 'median_iterations', poses))} "
+            f"({_pct(of('ccd', 'success_rate', poses))} solved)")
+    skipped = [t.robot for _, t in tables if any(m == "fabrik" for m, _ in t.skipped)]
+    if of("fabrik", "success_rate"):
+        out.append(
+            f"FABRIK solved {_pct(of('fabrik', 'success_rate'))} of the planar targets in "
+            f"{_span([1e3 * t for t in of('fabrik', 'median_time')])} ms per solve"
+            + (f" and is skipped, with the reason shown, on {' and '.join(skipped)}"
+               if skipped else ""))
+    return "<p>Reading the tables (ranges over the robots where a method ran): " + "; ".join(
+        out) + ".</p>"
 
 
 def build(ctx: ReportContext) -> Section:
-    """Measure the numerical IK families of section 5.3 and return the section's first part."""
+    """Measure the numerical IK families of section 5.3 and return the section's first part.
+
+    The default solver's timings share one :class:`~serialkin.chapter._context.TimingBench`
+    whose seven blocks of three rounds are taken between the section's other work (the
+    Newton demonstration and the three comparisons).
+    """
+    bench = ctx.bench(rounds=3)
+    cases = _default_solver_cases()
+    for name, _, solve in cases:
+        bench.add(name, solve)
+    bench.block()
     parts: list[str] = [
         "<p>A redundant arm has more joints n than task coordinates m; its inverse "
         "kinematics is solved numerically from the differential relation</p>",
@@ -160,6 +282,7 @@ def build(ctx: ReportContext) -> Section:
                r"\mathbf{J}\right)^{-1}\mathbf{J}^T\ (m > n)", "40"),
         _newton_demo(ctx),
     ]
+    bench.block()
     # --- section 5.3: the numerical families ------------------------------------------------
     parts.append(
         "<h3>Numerical families (section 5.3), measured</h3>"
@@ -176,17 +299,24 @@ def build(ctx: ReportContext) -> Section:
         "times per solve on the machine that built this report (restarts included); "
         "targets are FK of seeded random configurations inside the limits.</p>"
     )
-    tables = comparison_tables()
+    tables = []
+    for title, run in comparison_jobs():
+        tables.append((title, run()))
+        bench.block()
     for title, table in tables:
         parts.append(f"<h4>{html.escape(title)}</h4>" + _compare_html(ctx, table))
+    measured = _measured_summary(tables)
+    reading = _reading_text(tables)
+    bench.block()
+    bench.block()
     parts.append(
         "<p>The comparison times are warm too: each method solves the first target once, "
-        "untimed, before the timed solves; the median and mean are over the targets. For "
-        "the spread of repeated runs, the default solver on one target per robot "
-        "(<code>ctx.timing</code>: one warm-up call, then 21 timed calls):</p>"
-        + ctx.table(_default_solver_timings(ctx), ["robot", "target", "method", "time"]))
-
-    measured = _measured_summary(tables)
+        "untimed, before the timed solves; the median and mean are over the targets (one "
+        "solve each, so they carry no spread of repeated runs). For that spread, the "
+        "default solver on one target per robot, each solve timed "
+        f"{bench.timing(cases[0][0]).n} times in {bench.blocks} blocks taken between the "
+        "comparisons above:</p>"
+        + ctx.table(_solver_rows(bench, cases), ["robot", "target", "method", "time"]))
     parts.append(
         "<h4>Trade-offs</h4><p>The first four columns are properties of the algorithms; the "
         "last is measured in the tables above (range over the robots where the family ran: "
@@ -194,18 +324,7 @@ def build(ctx: ReportContext) -> Section:
             [row + (measured.get(row[0], "not run"),) for row in TRADE_OFFS],
             ["family (methods)", "cost per iteration", "convergence", "near singularities",
              "joint limits", "measured here"]))
-    parts.append(
-        "<p>Reading the tables: the damped (Levenberg-Marquardt) family combines the "
-        "Jacobian methods' quadratic convergence with bounded steps near singularities, "
-        "which is why it is the default (<code>method='lm'</code>). The Jacobian transpose "
-        "converges linearly: compare its median iterations with the others'. BFGS and "
-        "Powell reach the same accuracy but pay for a Python-level optimiser (Powell also "
-        "for the lack of gradients). CCD is cheap per sweep and excellent for position "
-        "targets, but full poses trade position against orientation joint by joint and "
-        "converge slowly. "
-        "FABRIK is exact and fast on planar revolute chains and is skipped (with the reason "
-        "shown) on spatial arms.</p>"
-    )
+    parts.append(reading)
     # a method that runs thousands of iterations amplifies the last bits of each step,
     # which differ between a kernel's optimisation levels: its row is not checked
     chaotic = [r.method for r in tables[1][1].rows if r.median_iterations > CHAOTIC_ITERATIONS]

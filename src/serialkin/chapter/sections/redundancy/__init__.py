@@ -20,28 +20,74 @@ from __future__ import annotations
 
 from serialkin.chapter._context import ReportContext, Section
 from serialkin.chapter.sections.redundancy._common import eq48_by_hand, timed_run
-from serialkin.chapter.sections.redundancy.nullspace import _nullspace_part, _six_link_part
-from serialkin.chapter.sections.redundancy.qp import _qp_part, side_by_side
-from serialkin.chapter.sections.redundancy.twenty_link import _twenty_link_part
+from serialkin.chapter.sections.redundancy.nullspace import (
+    _nullspace_part,
+    _six_link_part,
+    six_link_prepare,
+)
+from serialkin.chapter.sections.redundancy.qp import (
+    _qp_part,
+    qp_figures,
+    qp_scenario,
+    side_by_side,
+    side_by_side_rows,
+)
+from serialkin.chapter.sections.redundancy.twenty_link import (
+    _twenty_link_part,
+    twenty_link_figures,
+)
 from serialkin.chapter.sections.redundancy.weights import _figure10_part, _weights_part
 from serialkin.tracking import load_scenario
-from serialkin.tracking.analysis import ablation
+from serialkin.tracking.analysis import ablation, compare_row
 
 __all__ = ["build", "eq48_by_hand", "side_by_side", "timed_run"]
 
+#: Names of the timed whole-path runs on the section's bench.
+SIX, FREE, CONSTRAINED, QP = ("six-link circle", "(b) free", "(c) constrained",
+                              "(c) by the QP")
+
 
 def build(ctx: ReportContext) -> list[Section]:
-    """Run the redundancy examples of section 5.3 and return the report's parts."""
+    """Run the redundancy examples of section 5.3 and return the report's parts.
+
+    The four whole-path runs the section times (six-link circle, 20-link (b) and (c), and
+    (c) by the QP) are registered on one :class:`~serialkin.chapter._context.TimingBench`
+    and timed in seven blocks of three rounds, taken between the section's other work
+    (null space, ablation, eqs 48-56, the figures); the parts that print a time are
+    assembled at the end.
+    """
+    sa = load_scenario("six_link_circle")
     sb = load_scenario("twenty_link_free")
     sc = load_scenario("twenty_link_obstacles")
-    tb, tc = sb.run(), sc.run()  # the trajectories (every run gives the same)
-    time_b, time_c, ratio = ctx.interleaved(sb.run, sc.run, warmup=1, repeat=15)
+    qp = qp_scenario(sc)
+    bench = ctx.bench(rounds=3)
+    ta = bench.add(SIX, sa.run)  # each warm-up run's trajectory (every run gives the same)
+    tb = bench.add(FREE, sb.run)
+    tc = bench.add(CONSTRAINED, sc.run)
+    tq = bench.add(QP, qp.run)
+    bench.block()
+    nullspace = _nullspace_part(ctx)
+    bench.block()
     runs = ablation(sc, tc)
+    six = six_link_prepare(ctx, sa, ta)
+    bench.block()
+    weights = _weights_part(ctx, sc, tc)
+    figure10 = _figure10_part(ctx, sc, tc)
+    bench.block()
+    twenty = twenty_link_figures(ctx, sb, sc, tb, tc, runs)
+    bench.block()
+    qp_figs = qp_figures(ctx, sc, [compare_row("weighted tasks, eq 48 (soft)", tc),
+                                   compare_row("QP with hard constraints", tq)])
+    bench.block()
+    bench.block()
+    time_c = bench.timing(CONSTRAINED)
+    rows = side_by_side_rows(tc, time_c, tq, bench.timing(QP), bench.ratio(QP, CONSTRAINED))
     return [
-        _nullspace_part(ctx),
-        _six_link_part(ctx),
-        _weights_part(ctx, sc, tc),
-        _figure10_part(ctx, sc, tc),
-        _twenty_link_part(ctx, sb, sc, tb, tc, time_b, time_c, runs, ratio),
-        _qp_part(ctx, sc, side_by_side(ctx, sc, tc)),
+        nullspace,
+        _six_link_part(ctx, sa, ta, bench.timing(SIX), six),
+        weights,
+        figure10,
+        _twenty_link_part(ctx, sb, sc, tb, tc, bench.timing(FREE), time_c, runs,
+                          bench.ratio(CONSTRAINED, FREE), twenty),
+        _qp_part(ctx, sc, rows, qp_figs),
     ]

@@ -35,6 +35,36 @@ class SideBySide(list):
     ratio: Timing | None = None
 
 
+def qp_scenario(scenario: Scenario) -> Scenario:
+    """``scenario`` with the QP resolver of :func:`serialkin.tracking.analysis.qp_resolver`."""
+    from dataclasses import replace
+
+    return replace(scenario, solver=qp_resolver(scenario), options={})
+
+
+def side_by_side_rows(weighted: Any, weighted_time: Timing, qp: Any, qp_time: Timing,
+                      ratio: Timing | None) -> SideBySide:
+    """The rows of the side-by-side table from runs timed elsewhere.
+
+    Args:
+        weighted: the eq 48 trajectory of the scenario.
+        weighted_time: its timing (whole path) [s].
+        qp: the QP trajectory of the same scenario.
+        qp_time: its timing (whole path) [s].
+        ratio: QP / eq 48 time per round of runs in one process, or None.
+
+    Returns:
+        :class:`SideBySide` with each run's :func:`compare_row` (per-point time from the
+        median) and its timing.
+    """
+    rows = SideBySide([
+        (compare_row("weighted tasks, eq 48 (soft)", weighted, weighted_time.median),
+         weighted_time),
+        (compare_row("QP with hard constraints", qp, qp_time.median), qp_time)])
+    rows.ratio = ratio
+    return rows
+
+
 def side_by_side(ctx: ReportContext, scenario: Scenario, weighted: Any,
                  weighted_time: Timing | None = None, repeat: int = 7) -> SideBySide:
     """Eq 48 (the given run) and the QP on one scenario, timed in alternation in this process.
@@ -42,24 +72,19 @@ def side_by_side(ctx: ReportContext, scenario: Scenario, weighted: Any,
     Both whole-path runs are warmed up, then timed ``repeat`` times each in alternating
     order (:meth:`ReportContext.interleaved`), so their ratio is measured under the same
     machine state. ``weighted_time`` is accepted for callers of the earlier signature and
-    not used (eq 48 is timed again, interleaved with the QP).
+    not used (eq 48 is timed again, interleaved with the QP). The report itself times both
+    on its section's :class:`~serialkin.chapter._context.TimingBench` and calls
+    :func:`side_by_side_rows`.
 
     Returns:
         :class:`SideBySide`: rows of :func:`serialkin.tracking.analysis.compare_row`, each
         with its timing, and the ratio QP / eq 48.
     """
-    from dataclasses import replace
-
     del weighted_time
-    qp_scenario = replace(scenario, solver=qp_resolver(scenario), options={})
-    tq = qp_scenario.run()
-    tw_t, tq_t, ratio = ctx.interleaved(scenario.run, qp_scenario.run, warmup=1,
-                                        repeat=repeat)
-    rows = SideBySide([
-        (compare_row("weighted tasks, eq 48 (soft)", weighted, tw_t.median), tw_t),
-        (compare_row("QP with hard constraints", tq, tq_t.median), tq_t)])
-    rows.ratio = ratio
-    return rows
+    qp = qp_scenario(scenario)
+    tq = qp.run()
+    tw_t, tq_t, ratio = ctx.interleaved(scenario.run, qp.run, warmup=1, repeat=repeat)
+    return side_by_side_rows(weighted, tw_t, tq, tq_t, ratio)
 
 
 def _qp_intro(ctx: ReportContext, res: QPResolver) -> str:
@@ -94,44 +119,56 @@ def _qp_table(ctx: ReportContext, sc: Scenario,
               _mm(r.min_clearance), f"{r.worst_margin * DEG:.2f}",
               f"{int(r.trajectory.iterations.sum())}", f"{r.per_point * 1e3:.3g} ms",
               t.text) for r, t in timed]
-    return ctx.table(table, ["run", "reached (±5 mm)", "max tracking error [mm]",
+    return ctx.table(table, ["run", f"reached (±{sc.tolerance * 1e3:g} mm)",
+                             "max tracking error [mm]",
                              "min clearance [mm] (negative: collision)",
                              "worst joint-limit margin [°] (negative: outside)",
                              "iterations", "time per path point", "whole path"])
 
 
-def _qp_discussion(w: ResolverRun, q: ResolverRun, safety: float,
+def _qp_discussion(w: ResolverRun, q: ResolverRun, safety: float, buffer: float,
                    ratio: Timing | None) -> str:
-    """What the two runs show: berth, limit margin, guarantees and cost, in prose."""
+    """What the two runs show: berth, limit margin, guarantees and cost, in prose.
+
+    Args:
+        w: the eq 48 run (timed: ``per_point`` set).
+        q: the QP run (timed).
+        safety: the QP's safety distance d_s [m].
+        buffer: eq 49's buffer of the eq 48 run, a fraction of each joint's range.
+        ratio: QP / eq 48 time of the whole path per round of runs in one process.
+    """
     per_point = q.trajectory.clearance.min(axis=1)
     below = int((per_point < safety).sum())
     if below:
-        qp_berth = (f"while the QP's linearised distance rows let links come to the safety "
+        qp_berth = (f"the QP's linearised distance rows let links come to the safety "
                     f"distance d_s = {safety * 1e3:g} mm and, between linearisation points, "
                     f"below it: at {below} of {len(per_point)} path points, down to "
                     f"{_mm(q.min_clearance)} mm")
     else:
-        qp_berth = (f"while the QP lets links come to the safety distance d_s = "
+        qp_berth = (f"the QP lets links come to the safety distance d_s = "
                     f"{safety * 1e3:g} mm (measured minimum {_mm(q.min_clearance)} mm)")
     reach = ("both runs reach every point" if w.unreached == 0 and q.unreached == 0 else
              f"eq 48 misses {w.unreached} and the QP {q.unreached} points")
     hit = ("neither collides" if min(w.min_clearance, q.min_clearance) > 0 else
            "a link enters an obstacle in " + " and ".join(
                r.label for r in (w, q) if r.min_clearance <= 0))
+    berth = "a wider" if w.min_clearance > q.min_clearance else "a narrower"
+    qp_at_limit = int((q.trajectory.limit_margin.min(axis=1) < 1e-6).sum())
+    faster = ("the QP is faster" if q.per_point < w.per_point else "eq 48 is faster")
     return (
-        f"<p>Here {reach} and {hit}. Eq 48 keeps "
-        f"a wider berth ({_mm(w.min_clearance)} mm against the QP's {_mm(q.min_clearance)} mm: "
-        f"its obstacle weight starts acting at the distance of influence and pushes away, "
-        f"{qp_berth}) and stays "
-        f"{w.worst_margin * DEG:.1f}° inside every limit thanks to its 10 % buffer, while "
-        "the QP runs joints right up to their limits (margin 0° is allowed, beyond is "
-        "impossible). The guarantee is the difference: the QP's limits hold by "
+        f"<p>Here {reach} and {hit}. Eq 48 keeps {berth} berth ({_mm(w.min_clearance)} mm "
+        f"against the QP's {_mm(q.min_clearance)} mm: its obstacle weight starts acting at "
+        f"the distance of influence and pushes away, while {qp_berth}) and stays "
+        f"{w.worst_margin * DEG:.1f}° inside every limit, where its {buffer:.0%} buffer "
+        f"raises the eq 49 weight; the QP's worst margin is {q.worst_margin * DEG:.2f}° "
+        f"(a joint at its limit, within 1 µrad, at {qp_at_limit} of "
+        f"{len(q.trajectory)} path points: margin 0° is allowed, beyond is impossible). "
+        "The guarantee is the difference: the QP's limits hold by "
         "construction for any path and any weights, eq 48's only as long as its weights "
         f"win. Time per path point: {q.per_point * 1e3:.2g} ms for the QP against "
-        f"{w.per_point * 1e3:.2g} ms for eq 48"
-        + (f"; the ratio QP / eq 48 of the whole path is {ratio.median:.2g}× (median of "
-           f"{ratio.n} interleaved pairs of warm runs in one process, spread "
-           f"{ratio.low:.2g}–{ratio.high:.2g}×)" if ratio is not None else "")
+        f"{w.per_point * 1e3:.2g} ms for eq 48 ({faster} here)"
+        + (f"; the ratio QP / eq 48 of the whole path is {ratio.text}, each round timing "
+           "both in one process" if ratio is not None else "")
         + ". Both run their iterations in compiled "
         "loops, the QP with a dual active-set solver compiled with numba; the QP needs "
         f"{int(q.trajectory.iterations.sum())} iterations against eq 48's "
@@ -185,9 +222,29 @@ def _qp_motion_figure(ctx: ReportContext, sc: Scenario, q: ResolverRun) -> str:
                       "The QP's motion between the obstacles A-D (compare Figure 12).")
 
 
-def _qp_part(ctx: ReportContext, sc: Scenario,
-             timed: list[tuple[ResolverRun, Timing]]) -> Section:
-    """Eq 48 (soft weights) against the differential-IK QP (hard constraints) on (c)."""
+def qp_figures(ctx: ReportContext, sc: Scenario, rows: list[ResolverRun]) -> str:
+    """The figures of the side-by-side part (no timing needed), HTML.
+
+    Args:
+        ctx: the report context (the figures are saved through it).
+        sc: scenario (c), ``twenty_link_obstacles``.
+        rows: the eq 48 run and the QP run, in that order (``compare_row``; untimed will do).
+    """
+    res = qp_resolver(sc)
+    return _qp_margins_figure(ctx, sc, res, rows) + _qp_motion_figure(ctx, sc, rows[1])
+
+
+def _qp_part(ctx: ReportContext, sc: Scenario, timed: list[tuple[ResolverRun, Timing]],
+             figures: str | None = None) -> Section:
+    """Eq 48 (soft weights) against the differential-IK QP (hard constraints) on (c).
+
+    Args:
+        ctx: the report context.
+        sc: scenario (c), ``twenty_link_obstacles``.
+        timed: (eq 48 run, its timing) and (QP run, its timing), e.g. a
+            :class:`SideBySide` (whose ``ratio`` is shown when set).
+        figures: :func:`qp_figures` of the same runs (made here when None).
+    """
     ratio = getattr(timed, "ratio", None)
     res = qp_resolver(sc)
     rows = [r for r, _ in timed]
@@ -195,9 +252,8 @@ def _qp_part(ctx: ReportContext, sc: Scenario,
     parts = [
         _qp_intro(ctx, res),
         _qp_table(ctx, sc, timed),
-        _qp_discussion(w, q, res.safety, ratio),
-        _qp_margins_figure(ctx, sc, res, rows),
-        _qp_motion_figure(ctx, sc, q),
+        _qp_discussion(w, q, res.safety, sc.solver.limit_buffer, ratio),
+        figures if figures is not None else qp_figures(ctx, sc, rows),
         ctx.reproduce(
             "import dataclasses\n"
             "from serialkin.tracking import load_scenario\n"

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from serialkin.chapter._context import ReportContext, Section, Timing
+from serialkin.chapter._context import ReportContext, Section, Timing, format_number
 from serialkin.chapter.sections.redundancy._common import (
     DEG,
     _gif,
@@ -21,29 +21,71 @@ from serialkin.tracking.analysis import (
 from serialkin.tracking.scenario import Scenario
 
 
-def _design_text(ctx: ReportContext, sb: Scenario, sc: Scenario) -> str:
-    """The designed path, obstacles and weights of cases (b) and (c), in prose."""
+def _q0_text(q0: np.ndarray) -> str:
+    """q0 in degrees: "(75°, −2°, …, −2°)" when the joints after the first are all equal."""
+    deg = [format_number(v, "{:.3g}").replace("-", "−") + "°" for v in np.degrees(q0)]
+    if len(deg) > 3 and len(set(deg[1:])) == 1:
+        return f"({deg[0]}, {deg[1]}, …, {deg[-1]})"
+    return "(" + ", ".join(deg) + ")"
+
+
+def _design_text(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any,
+                 act: dict[str, np.ndarray]) -> str:
+    """The designed path, obstacles and weights of cases (b) and (c), in prose.
+
+    Args:
+        ctx: the report context.
+        sb: scenario (b), ``twenty_link_free``.
+        sc: scenario (c), ``twenty_link_obstacles``.
+        tb: the trajectory of (b).
+        tc: the trajectory of (c).
+        act: :func:`serialkin.tracking.analysis.task_activity` of (c).
+    """
     res = sc.solver
-    gaps = np.linalg.norm(np.diff(sc.path.points, axis=0), axis=1) * 1e3
-    R = float(sum(row.a for row in sc.robot.dh))
-    beyond = (float(np.linalg.norm(sc.path.points, axis=1).max()) - R) * 1e3
+    robot = sc.robot
+    L = float(robot.dh[0].a)
+    R = float(sum(row.a for row in robot.dh))
+    P = sc.path.points[:, :2]
+    gaps = np.linalg.norm(np.diff(P, axis=0), axis=1) * 1e3
+    radius = np.linalg.norm(P, axis=1)
+    wp = np.asarray(sc.data["path"]["waypoints"], dtype=float)
+    step = float(sc.data["path"]["step"])
+    phases = _phases(sc)
+    (a1, b1, _), (a2, b2, _), _ = phases
+    far = int(np.argmax(radius[a1:b1 + 1])) + a1
+    beyond = (radius.max() - R) * 1e3
+    ring = np.linalg.norm(wp[2:10], axis=1) / R  # the boundary waypoints of phase 2
+    ang = np.degrees(np.arctan2(wp[[2, 9], 1], wp[[2, 9], 0]))
+    lim = np.degrees(np.asarray(robot.qlim, dtype=float)[0])
+    buffer_from = lim[1] - res.limit_buffer * (lim[1] - lim[0])
+    q1_c = float(np.degrees(tc.q[a2:b2 + 1, 0]).max())
+    q1_b = float(np.degrees(tb.q[a2:b2 + 1, 0]).max())
+    w_far = float(act["manipulability"][far])
+    names = [o.name for o in sc.obstacles]
+    lims = sorted({f"±{hi:g}°" if lo == -hi else f"[{lo:g}°, {hi:g}°]"
+                   for lo, hi in np.degrees(np.asarray(robot.qlim, dtype=float))})
     return (
-        "<p>20 links of L = 16.75 mm (reach " + ctx.imath(r"R = 20L = 0.335\ \mathrm{m}")
+        f"<p>{robot.n} links of L = {L * 1e3:g} mm (reach "
+        + ctx.imath(rf"R = {robot.n}L = {R:.4g}\ \mathrm{{m}}")
         + "). The chapter gives neither the path, nor q0, nor the obstacles (ERRATA); our "
         "design has one phase per secondary task of eq 48, so that each of them acts "
-        "somewhere: from q0 = (75°, −2°, …, −2°) (1) straight out to 1.01R, "
-        f"{beyond:.1f} mm beyond the reach: the arm stretches into the singular "
-        "configuration; (2) along the boundary at "
-        "0.998R from 60° to 125°: the nearly straight arm points where joint 1 points, so "
-        "joint 1 meets its +100° limit and the next joints must bend instead; (3) back over "
-        "the top and along a wave between four obstacles A-D. The polyline is resampled at "
-        f"spacing ≤ 6 mm; the measured spacing of consecutive path points is {gaps.min():.2f}–"
+        f"somewhere: from q0 = {_q0_text(np.asarray(sc.q0, dtype=float))} (1) straight out to "
+        f"{radius[far] / R:.3g}R, {beyond:.1f} mm beyond the reach: the arm stretches into "
+        f"the singular configuration (w of eq 43 down to {w_far:.2g} at path point {far} "
+        f"in (c)); (2) along the boundary at {np.median(ring):.3g}R from {ang[0]:.0f}° to "
+        f"{ang[1]:.0f}°: the nearly straight arm points where joint 1 points, so joint 1 "
+        f"would pass its {lim[1]:+g}° limit (the free case (b) turns it to {q1_b:.1f}° "
+        f"there); in (c) the eq 49 weight holds it at {q1_c:.1f}° at most, inside the "
+        f"buffer that starts at {buffer_from:g}°, and the next joints bend instead; (3) back "
+        f"over the top and along a wave between {len(names)} obstacles "
+        f"{names[0]}-{names[-1]}. The polyline is resampled at spacing ≤ {step * 1e3:g} mm; "
+        f"the measured spacing of consecutive path points is {gaps.min():.2f}–"
         f"{gaps.max():.2f} mm (each straight piece is divided evenly, so pieces whose length "
-        f"is not a multiple of 6 mm get shorter steps; {len(sc.path)} points). Both cases "
-        "use eq 48 with "
+        f"is not a multiple of {step * 1e3:g} mm get shorter steps; {len(sc.path)} points). "
+        "Both cases use eq 48 with "
         + ctx.imath(r"\mathbf{W} = \mathbf{I}") + "; (b) adds only a constant damping "
         + ctx.imath(r"\mathbf{W}_s = \lambda^2\mathbf{I}") + f", λ = {sb.solver.damping:g} m; "
-        "(c) has the joint limits ±100° (eq 49, "
+        f"(c) has the joint limits {', '.join(lims)} (eq 49, "
         + ctx.imath(r"W_{L,\max} = " + f"{res.joint_limit_weight:g}")
         + f", buffer {res.limit_buffer:.0%} of the range), the obstacle task (weight up to "
         + ctx.imath(r"W_{c,\max} = " + f"{res.obstacle_weight:g}") + " at contact, "
@@ -79,29 +121,50 @@ def _results_table(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: 
                             "max |q| [°]", "iterations"])
 
 
-def _timings_text(ctx: ReportContext, sc: Scenario, tb: Any, tc: Any, time_b: Timing,
-                  time_c: Timing, ratio: Timing | None = None) -> str:
-    """Warm timings of (b) and (c), per path and per iteration, and the self-motion."""
-    per_it_b = time_b.median / max(int(tb.iterations.sum()), 1)
-    per_it_c = time_c.median / max(int(tc.iterations.sum()), 1)
+def _timings_text(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any,
+                  time_b: Timing, time_c: Timing, ratio: Timing | None = None) -> str:
+    """Warm timings of (b) and (c), per path and per iteration, and the self-motion.
+
+    Args:
+        ctx: the report context.
+        sb: scenario (b), ``twenty_link_free``.
+        sc: scenario (c), ``twenty_link_obstacles``.
+        tb: the trajectory of (b).
+        tc: the trajectory of (c).
+        time_b: the timing of the whole path of (b) [s].
+        time_c: the timing of the whole path of (c) [s].
+        ratio: their ratio (c)/(b) per round of runs in one process (None: the ratio of
+            the medians).
+    """
+    it_b, it_c = int(tb.iterations.sum()), int(tc.iterations.sum())
+    per_it_b = time_b.median / max(it_b, 1)
+    per_it_c = time_c.median / max(it_c, 1)
+    path_ratio = ratio.median if ratio is not None else time_c.median / time_b.median
     dq = np.abs(tb.q - tc.q).max() * DEG
     dx = np.linalg.norm(tb.positions - tc.positions, axis=1).max()
+    budget = sc.solver.max_iter
+    full_c = tc.iterations >= budget
+    full_b = int((tb.iterations >= sb.solver.max_iter).sum())
+    blocks = ("an untimed warm-up run of each first, then the runs in blocks spread over "
+              "this section's build, each block a few rounds that run every timed function "
+              "of the section once" if time_b.blocks > 1 else
+              "an untimed warm-up run of each first, then the two cases run in alternation")
+    costs = "costs more" if path_ratio > 1 else "costs less here, unlike in the chapter"
     return (
-        "<p>Timings (whole path, compiled eq 48 loop; an untimed warm-up run of each first, "
-        "then the two cases run in alternation, median and range of the repeated runs):</p>"
+        f"<p>Timings (whole path, compiled eq 48 loop; {blocks}):</p>"
         + ctx.table([
             ("(b) free", time_b.text, f"{per_it_b * 1e6:.3g} µs"),
             ("(c) constrained", time_c.text, f"{per_it_c * 1e6:.3g} µs"),
-            ("ratio (c)/(b)", (f"{ratio.median:.2g} × (median of {ratio.n} interleaved pairs "
-                               f"of warm runs, spread {ratio.low:.2g}–{ratio.high:.2g} ×)")
-             if ratio is not None else f"{time_c.median / time_b.median:.2g} ×",
-             f"{per_it_c / per_it_b:.2g} ×"),
+            ("ratio (c)/(b)", ratio.text if ratio is not None else f"{path_ratio:.2g}×",
+             f"{per_it_c / per_it_b:.2g}×"),
         ], ["case", "time for the whole path", "per iteration"])
-        + "<p>As the chapter says, the constrained case costs more: every iteration adds the "
-        "link-obstacle distances and obstacle rows, the eq 49 weights and the manipulability "
-        "to the normal equations, and the tasks' compromises need more iterations (points "
-        "that cannot be reached exactly — beyond the reach in phase 1, held by a limit in "
-        f"phase 2 — use the whole budget of {sc.solver.max_iter} iterations).</p>"
+        + f"<p>As the chapter says, the constrained case {costs}: {path_ratio:.2g}× the "
+        f"time of (b) for the whole path, {per_it_c / per_it_b:.2g}× per iteration (every "
+        "iteration adds the link-obstacle distances and obstacle rows, the eq 49 weights and "
+        f"the manipulability to the normal equations) and {it_c / max(it_b, 1):.2g}× the "
+        f"iterations ({it_c} against {it_b}): in (c) {_where(sc, full_c)} use the whole "
+        f"budget of {budget} iterations (points that cannot be reached exactly, beyond the "
+        f"reach or held by a limit), in (b) {full_b} point{'' if full_b == 1 else 's'}.</p>"
         f"<p>Self-motion: the joint trajectories of (b) and (c) differ by up to "
         f"{dq:.1f}°, while their end-effector paths agree within {dx * 1e3:.3g} mm.</p>"
     )
@@ -256,26 +319,32 @@ def _ablation_figure(ctx: ReportContext, sc: Scenario, tc: Any, runs: list[Ablat
     full = runs[0]
     by = {r.label: r for r in runs}
     steps = np.arange(len(tc))
+    lo, hi = np.degrees(np.asarray(sc.robot.qlim, dtype=float)[0])
+    buffer_from = hi - sc.solver.limit_buffer * (hi - lo)
+    tol = sc.tolerance * 1e3
     fig, axes = plt.subplots(1, 3, figsize=(12.5, 3.8))
     no_obs = by["without the obstacle task"].trajectory
     axes[0].plot(steps, full.trajectory.clearance.min(axis=1) * 1e3, label="all tasks")
     axes[0].plot(steps, no_obs.clearance.min(axis=1) * 1e3, label="without obstacle task")
     axes[0].axhline(0, color="k", lw=1)
     axes[0].set_ylabel("smallest clearance [mm]")
-    axes[0].set_title("collision without the obstacle task", fontsize=10)
+    axes[0].set_title("without the obstacle task: clearance down to "
+                      f"{no_obs.clearance.min() * 1e3:.1f} mm", fontsize=10)
     no_lim = by["without the joint-limit task"].trajectory
     axes[1].plot(steps, full.trajectory.q[:, 0] * DEG, label="all tasks")
     axes[1].plot(steps, no_lim.q[:, 0] * DEG, label="without joint-limit task")
-    axes[1].axhline(100, color="k", lw=1)
-    axes[1].axhline(80, color="k", lw=0.8, ls=":")
-    axes[1].set_ylabel("q1 [°] (limit 100°, buffer from 80°)")
-    axes[1].set_title("joint 1 leaves its range without the limit task", fontsize=10)
+    axes[1].axhline(hi, color="k", lw=1)
+    axes[1].axhline(buffer_from, color="k", lw=0.8, ls=":")
+    axes[1].set_ylabel(f"q1 [°] (limit {hi:g}°, buffer from {buffer_from:g}°)")
+    axes[1].set_title(f"without the limit task: q1 up to {no_lim.q[:, 0].max() * DEG:.1f}°",
+                      fontsize=10)
     no_sing = by["without the singularity task"].trajectory
     axes[2].plot(steps, full.trajectory.errors * 1e3, label="all tasks")
     axes[2].plot(steps, no_sing.errors * 1e3, label="without singularity task")
-    axes[2].axhline(sc.tolerance * 1e3, color="k", lw=1)
-    axes[2].set_ylabel("tracking error [mm] (tolerance 5 mm)")
-    axes[2].set_title("lost points near the singularity", fontsize=10)
+    axes[2].axhline(tol, color="k", lw=1)
+    axes[2].set_ylabel(f"tracking error [mm] (tolerance {tol:g} mm)")
+    axes[2].set_title(f"without the singularity task: {int((no_sing.errors > sc.tolerance).sum())}"
+                      f" points beyond {tol:g} mm", fontsize=10)
     phases = _phases(sc)
     for a in axes:
         _shade(a, phases)
@@ -297,15 +366,55 @@ def _joints_figure(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: 
     fig, axes = plt.subplots(1, 2, figsize=(11.0, 3.8), sharey=True)
     plot_joint_trajectories(tb.q, ax=axes[0], robot=sb.robot, title="(b) joint angles")
     plot_joint_trajectories(tc.q, ax=axes[1], robot=sc.robot, title="(c) joint angles")
+    lo, hi = np.degrees(np.asarray(sc.robot.qlim, dtype=float)[0])
     return ctx.figure(fig, "twenty_link_joints",
                       "Joint angles of the 20-link arm, free (b) and constrained (c); "
-                      "dashed: the limits ±100° of (c).")
+                      f"dashed: the limits [{lo:g}°, {hi:g}°] of (c).")
+
+
+def twenty_link_figures(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any,
+                        runs: list[AblationRun]) -> dict[str, str]:
+    """The figures of the 20-link part (no timing needed), HTML by name.
+
+    Args:
+        ctx: the report context (the figures are saved through it).
+        sb: scenario (b), ``twenty_link_free``.
+        sc: scenario (c), ``twenty_link_obstacles``.
+        tb: the trajectory of (b).
+        tc: the trajectory of (c).
+        runs: :func:`serialkin.tracking.analysis.ablation` of (c).
+
+    Returns:
+        {"motion", "activity", "ablation", "joints"}: Figures 11-12 with the GIF, the task
+        activity, the ablation and the joint angles.
+    """
+    return {"motion": _motion_figures(ctx, sb, sc, tb, tc),
+            "activity": _activity_figure(ctx, sc, tc),
+            "ablation": _ablation_figure(ctx, sc, tc, runs),
+            "joints": _joints_figure(ctx, sb, sc, tb, tc)}
 
 
 def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any,
                       time_b: Timing, time_c: Timing, runs: list[AblationRun],
-                      ratio: Timing | None = None) -> Section:
-    """The 20-link example: free (b, Figure 11) and constrained (c, Figure 12), ablation."""
+                      ratio: Timing | None = None,
+                      figures: dict[str, str] | None = None) -> Section:
+    """The 20-link example: free (b, Figure 11) and constrained (c, Figure 12), ablation.
+
+    Args:
+        ctx: the report context.
+        sb: scenario (b), ``twenty_link_free``.
+        sc: scenario (c), ``twenty_link_obstacles``.
+        tb: the trajectory of (b).
+        tc: the trajectory of (c).
+        time_b: the timing of the whole path of (b) [s].
+        time_c: the timing of the whole path of (c) [s].
+        runs: :func:`serialkin.tracking.analysis.ablation` of (c).
+        ratio: the ratio (c)/(b) per round of runs in one process (None: of the medians).
+        figures: :func:`twenty_link_figures` of the same runs (made here when None).
+    """
+    from serialkin.tracking.analysis import task_activity
+
+    figs = figures if figures is not None else twenty_link_figures(ctx, sb, sc, tb, tc, runs)
     track_numbers = [v for s, tr in ((sb, tb), (sc, tc))
                      for v in (str(int(tr.reached.sum())), str(len(s.path)), _mm(tr.max_error),
                                str(int(tr.iterations.sum())))] + [
@@ -329,14 +438,14 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
             (1, "END CYCLE WHILE 2"),
             (0, "END CYCLE WHILE 1"),
         ]),
-        _design_text(ctx, sb, sc),
+        _design_text(ctx, sb, sc, tb, tc, task_activity(sc, tc)),
         _results_table(ctx, sb, sc, tb, tc),
-        _timings_text(ctx, sc, tb, tc, time_b, time_c, ratio),
-        _motion_figures(ctx, sb, sc, tb, tc),
-        _activity_figure(ctx, sc, tc),
+        _timings_text(ctx, sb, sc, tb, tc, time_b, time_c, ratio),
+        figs["motion"],
+        figs["activity"],
         _ablation_table(ctx, sc, runs),
-        _ablation_figure(ctx, sc, tc, runs),
-        _joints_figure(ctx, sb, sc, tb, tc),
+        figs["ablation"],
+        figs["joints"],
         ctx.reproduce("serialkin track twenty_link_free --out out/track\n"
                       "serialkin track twenty_link_obstacles --out out/track", shell=True,
                       expect=track_numbers),
