@@ -3,7 +3,8 @@
 The arm-angle solutions were computed with numpy before the compiled kernel
 (``serialkin.ik.analytic.arm_angle._srs_one``) replaced them; this is that computation,
 kept here (never imported by the library) so that a test can show the kernel gives the
-same rows. Steps and symbols as in the module docstring of
+same rows. Likewise :func:`intervals`, the grid search and bisection the closed-form
+feasible intervals replaced. Steps and symbols as in the module docstring of
 :mod:`serialkin.ik.analytic.arm_angle`.
 """
 
@@ -67,8 +68,12 @@ def _elbow(arm: SRSArm, L: np.ndarray):
     return np.stack([base + phi, base - phi], axis=-1), np.abs(ratio) <= 1.0 + 1e-12
 
 
-def solve(arm: SRSArm, T: np.ndarray, psi: np.ndarray, r: np.ndarray):
-    """Every branch at each (pose T (4, 4), ψ (N,)): (N, 8, 7) wrapped angles, (N, 8) inside."""
+def solve(arm: SRSArm, T: np.ndarray, psi: np.ndarray, r: np.ndarray, limits: bool = True):
+    """Every branch at each (pose T (4, 4), ψ (N,)): (N, 8, 7) wrapped angles, (N, 8) inside.
+
+    With ``limits`` False the flags say only that the branch exists (its subproblems
+    have solutions), inside the limits or not.
+    """
     H, P, S = arm.H, arm.P, arm.S
     N = len(psi)
     T = np.broadcast_to(T, (N, 4, 4))
@@ -116,4 +121,36 @@ def solve(arm: SRSArm, T: np.ndarray, psi: np.ndarray, r: np.ndarray):
                 ok[:, j] = ok4 & ok_s & ok_w
     Qw = Q - 2 * np.pi * np.round((Q - arm.mid) / (2 * np.pi))
     inside = np.all((Qw >= arm.lo - LIMIT_TOL) & (Qw <= arm.hi + LIMIT_TOL), axis=-1)
-    return Qw, ok & inside
+    return Qw, (ok & inside) if limits else ok
+
+
+def intervals(arm: SRSArm, T: np.ndarray, r: np.ndarray, step: float = math.radians(0.5),
+              steps: int = 40) -> dict[int, list[tuple[float, float]]]:
+    """The feasible ψ of each branch by a grid and bisection (the search the closed form replaced).
+
+    Every branch is evaluated by the compiled closed form (``_solve``) on a grid of ψ over
+    [−π, π] of the given step [rad]; each change between neighbours is bisected ``steps``
+    times onto its feasible side. Stretches narrower than the step can be missed.
+    """
+    from serialkin.ik.analytic.arm_angle import _solve
+
+    n = int(math.ceil(2 * math.pi / step))
+    grid = -math.pi + 2 * math.pi * np.arange(n + 1) / n
+    ok = _solve(arm, T, grid, r)[1]
+    out: dict[int, list[tuple[float, float]]] = {}
+    for j in range(8):
+        f = ok[:, j]
+        edges = np.flatnonzero(f[1:] != f[:-1])
+        bad = np.where(f[edges], grid[edges + 1], grid[edges])
+        good = np.where(f[edges], grid[edges], grid[edges + 1])
+        for _ in range(steps):
+            mid = 0.5 * (bad + good)
+            inside = _solve(arm, T, mid, r)[1][:, j] if len(mid) else np.zeros(0, bool)
+            good = np.where(inside, mid, good)
+            bad = np.where(inside, bad, mid)
+        ends = dict(zip(edges.tolist(), good.tolist()))
+        starts = ([-math.pi] if f[0] else []) + [ends[i] for i in edges if not f[i]]
+        stops = [ends[i] for i in edges if f[i]] + ([math.pi] if f[-1] else [])
+        if starts:
+            out[j] = list(zip(starts, stops))
+    return out

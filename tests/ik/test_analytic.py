@@ -781,8 +781,8 @@ def test_subproblem_cosines_match_angles():
         v = rotation(w1, rng.uniform(-3, 3)) @ rotation(w2, rng.uniform(-3, 3)) @ u
         out2, out6 = np.zeros((2, 2)), np.zeros((2, 6))
         vecs = (tuple(w1), tuple(w2), tuple(u), tuple(v))
-        m = sp2_dir(*vecs, out2)
-        assert m == sp2_dir(*vecs, out6) >= 1
+        m = sp2_dir(*vecs, 0.0, out2)
+        assert m == sp2_dir(*vecs, 0.0, out6) >= 1
         assert np.array_equal(out2[:m], out6[:m, :2])
         for t1, t2, c1, s1, c2, s2 in out6[:m]:
             assert np.allclose([c1, s1, c2, s2], [math.cos(t1), math.sin(t1), math.cos(t2),
@@ -802,8 +802,8 @@ def test_sp4_cosines_match_angles():
         c = a @ rotation(w, rng.uniform(-3, 3)) @ b
         out2, out6 = np.zeros(2), np.zeros(6)
         vecs = (tuple(w), tuple(b), tuple(a))  # as tuples, as the solvers pass them
-        m = sp4(*vecs, c, out2)
-        assert m == sp4(*vecs, c, out6) >= 1 and np.array_equal(out2[:m], out6[:m])
+        m = sp4(*vecs, c, 0.0, out2)
+        assert m == sp4(*vecs, c, 0.0, out6) >= 1 and np.array_equal(out2[:m], out6[:m])
         for i in range(m):
             th, cs, sn = out6[i], out6[2 + 2 * i], out6[3 + 2 * i]
             assert abs(cs - math.cos(th)) < 1e-14 and abs(sn - math.sin(th)) < 1e-14

@@ -165,6 +165,148 @@ def test_intervals_agree_with_dense_sampling_and_end_on_a_limit():
                     assert gap < 1e-7, (j, end, gap)
 
 
+def test_closed_form_intervals_equal_the_grid_search():
+    """iiwa7: the closed-form intervals are the grid search's and bisection's to 1e-9.
+
+    The reference evaluates every branch at 721 values of ψ and bisects each change 40
+    times (:func:`_arm_angle_reference.intervals`); on these poses no feasible stretch or
+    gap is narrower than its grid step, so both find the same stretches.
+    """
+    robot = models.get("iiwa7")
+    arm = srs_structure(robot)
+    for seed in range(40, 46):
+        T = robot.fk(robot.random_q(1, seed=seed)[0])
+        got = arm_angle_intervals(robot, T).branches
+        want = reference_closed_form.intervals(arm, T, np.array([0.0, 0.0, 1.0]))
+        assert got.keys() == want.keys()
+        for j in got:
+            assert len(got[j]) == len(want[j])
+            assert np.abs(np.array(got[j]) - np.array(want[j])).max() < 1e-9
+
+
+def _limited_srs(seed: int, orthogonal: bool) -> Robot:
+    """A random S-R-S arm (:func:`_random_srs`) with random limits, some joints unlimited."""
+    rng = np.random.default_rng(seed + 7)
+    lo, hi = -rng.uniform(0.3, 3.2, 7), rng.uniform(0.3, 3.2, 7)
+    free = rng.random(7) < 0.2
+    lo[free], hi[free] = -np.inf, np.inf
+    return _random_srs(seed, orthogonal).with_limits(np.stack([lo, hi], axis=1))
+
+
+def _check_intervals(robot: Robot, T: np.ndarray, reference, extra: np.ndarray = None):
+    """Every property of arm_angle_intervals(robot, T) against the closed form at given ψ.
+
+    * ψ (2,001 on the circle and ``extra``) farther than 1e-7 from every end is feasible on
+      branch j iff the interval list of j contains it (the compiled ``_solve``);
+    * each inner end where the branch does not jump (a pivot joint at a singular
+      shoulder or wrist) is feasible on its branch (ik_arm_angle has a row there), and
+      there a joint is at a limit (to 1e-7) or, just outside, the branch does not exist.
+    Returns the intervals.
+    """
+    arm = srs_structure(robot)
+    r = np.array([0.0, 0.0, 1.0] if reference is None else reference, dtype=float)
+    r /= np.linalg.norm(r)
+    iv = arm_angle_intervals(robot, T, reference)
+    psi = np.linspace(-math.pi, math.pi, 2001)
+    if extra is not None:
+        psi = np.concatenate([psi, extra])
+    ok = compiled_solve(arm, T, psi, r)[1]
+    ends = np.array([x for spans in iv.branches.values() for s in spans for x in s] + [9.0])
+    far = np.abs(psi[:, None] - ends[None, :]).min(axis=1) > 1e-7
+    for j in range(8):
+        listed = np.array([iv.contains(x, j) for x in psi[far]])
+        assert np.array_equal(listed, ok[far, j]), j
+    assert np.array_equal(np.array([iv.contains(x) for x in psi[far]]), ok[far].any(axis=1))
+    lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
+    for j, spans in iv.branches.items():
+        assert all(a < b for a, b in spans)
+        assert all(b < c for (_, b), (c, _) in zip(spans[:-1], spans[1:]))
+        for a, b in spans:
+            for end, out in ((a, -1.0), (b, 1.0)):
+                if abs(abs(end) - math.pi) < 1e-12:
+                    continue  # the ±π seam
+                sides = end + np.array([-1e-6, 1e-6])
+                Q, exists = reference_closed_form.solve(arm, T, sides, r, limits=False)
+                if exists[:, j].all() and _wrapped(Q[0, j], Q[1, j]).max() > 0.1:
+                    continue  # a pivot jumps (singular shoulder or wrist): no limit here
+                sols = ik_arm_angle(robot, T, end, reference)
+                row = sols.q[sols.branch == j]
+                assert len(row) == 1, (j, end)
+                with np.errstate(invalid="ignore"):
+                    gap = np.nanmin(np.minimum(np.abs(row[0] - lo), np.abs(row[0] - hi)))
+                beyond = end + out * np.array([1e-7, 1e-6])
+                gone = ~reference_closed_form.solve(arm, T, beyond, r, limits=False)[1][:, j]
+                assert gap < 1e-7 or gone.all(), (j, end, gap)
+    return iv
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), orthogonal=st.booleans(),
+       reference=st.sampled_from([None, (1.0, 0.0, 0.0), (0.3, -0.5, 0.8)]))
+def test_closed_form_intervals_on_random_limited_srs_arms(seed, orthogonal, reference):
+    """Random S-R-S arms with random limits: intervals agree with dense evaluation, ends hold.
+
+    Non-orthogonal twists make branches appear and vanish along ψ (subproblem 2 loses
+    its solutions): ends there have no joint at a limit, and the branch is gone beyond.
+    The generating configuration's arm angle is feasible on its branch.
+    """
+    robot = _limited_srs(seed, orthogonal)
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(np.clip(robot.qlim[:, 0], -3, 3), np.clip(robot.qlim[:, 1], -3, 3))
+    T = robot.fk(q)
+    iv = _check_intervals(robot, T, reference)
+    psi = float(arm_angle(robot, q, reference))
+    sols = ik_arm_angle(robot, T, psi, reference)
+    j = int(sols.branch[np.argmin(_wrapped(sols.q, q).max(axis=1))])
+    assert iv.contains(psi, j)
+
+
+@pytest.mark.parametrize(("joint", "pivot_limits"), [(1, (-1.5, 1.5)), (5, (-2.5, 0.6))])
+def test_intervals_across_a_shoulder_or_wrist_singularity(joint, pivot_limits):
+    """iiwa7 at a pose whose arm angle ψ₀ has a singular shoulder (q2 = 0) or wrist (q6 = 0).
+
+    Along each branch the pivot joint before it (1 or 5) jumps by π at ψ₀ (from −0.87 to
+    2.27 rad, or from −1.57 to 1.57 rad, on branch 0); with that joint limited so that
+    one value is inside and the other outside, branch 0 ends at ψ₀ with no joint at a
+    limit. The intervals agree with dense evaluation, also within ±1e-3 of ψ₀, and ψ₀
+    (the generating configuration's) is feasible.
+    """
+    base = models.get("iiwa7")
+    limits = base.qlim.copy()
+    limits[joint - 1] = pivot_limits
+    robot = base.with_limits(limits)
+    q = np.array([0.5, 0.7, 0.2, -1.2, 0.4, 0.8, 0.1])
+    q[joint] = 0.0
+    T = robot.fk(q)
+    psi0 = float(arm_angle(robot, q))
+    iv = _check_intervals(robot, T, None, psi0 + np.linspace(-1e-3, 1e-3, 2001))
+    assert iv.contains(psi0)
+    assert iv.contains(psi0 - 1e-3, 0) and not iv.contains(psi0 + 1e-3, 0)
+    assert min(abs(b - psi0) for _, b in iv.branches[0]) < 1e-6
+
+
+def test_branch_feasible_everywhere_and_nowhere():
+    """No limits, orthogonal twists: every branch on all of [−π, π]; elbow limits: none or half.
+
+    Limiting the elbow to one of its two angles leaves only that elbow's four branches;
+    limiting it to neither leaves no interval at all.
+    """
+    robot = _random_srs(11, orthogonal=True)
+    T = robot.fk(np.full(7, 0.4))
+    iv = arm_angle_intervals(robot, T)
+    assert iv.branches == {j: [(-math.pi, math.pi)] for j in range(8)}
+    assert iv.feasible == [(-math.pi, math.pi)]
+    q4 = ik_arm_angle(robot, T, 0.0).q[:, 3]
+    a, b = q4[0], q4[-1]                          # branch 0's elbow and branch 7's
+    limits = np.tile([-np.inf, np.inf], (7, 1))
+    limits[3] = [a - 1e-3, a + 1e-3]
+    one = arm_angle_intervals(robot.with_limits(limits), T)
+    assert set(one.branches) == ({0, 1, 2, 3} if abs(_wrapped(a, b)) > 1e-3 else set(range(8)))
+    limits[3] = [0.5 * (a + b) - 1e-4, 0.5 * (a + b) + 1e-4]
+    none = arm_angle_intervals(robot.with_limits(limits), T)
+    assert none.branches == {} and none.feasible == []
+
+
 def test_generating_arm_angle_lies_in_the_feasible_intervals():
     """The arm angle of a configuration inside the limits is feasible on its branch's pose."""
     robot = models.get("iiwa7")
@@ -216,8 +358,10 @@ def test_bad_input_is_named():
         ik_arm_angle(robot, np.eye(3), 0.0)
     with pytest.raises(InputError, match="T must be one"):
         ik_arm_angle(robot, np.stack([T, T]), 0.0)
-    with pytest.raises(InputError, match="resolution"):
-        arm_angle_intervals(robot, T, resolution=0.0)
+    with pytest.raises(InputError, match="T must be one"):
+        arm_angle_intervals(robot, np.stack([T, T]))
+    with pytest.raises(InputError, match="reference"):
+        arm_angle_intervals(robot, T, reference=(0.0, 0.0, 0.0))
 
 
 # ------------------------------------------------- offset 7R arms: a sweep of one joint

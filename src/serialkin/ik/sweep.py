@@ -6,9 +6,18 @@ one-parameter family of configurations reaching a pose T is followed instead by 
 one joint j at a value v and solving the remaining 6R arm for every solution
 (``ik_all(T, free={j: v})``, the locked-joint solver), for v on a grid. Rows at
 neighbouring values are connected into *branches* by minimum-cost matching (the
-assignment problem, scipy's ``linear_sum_assignment``) on the largest joint change,
-as ssik's 7R sweep and Descartes' planning graph connect samples; a branch ends where
-its row disappears (a limit, a singularity, out of reach) or would have to jump.
+assignment problem, as ssik's 7R sweep and Descartes' planning graph connect samples)
+on the largest joint change; a branch ends where its row disappears (a limit, a
+singularity, out of reach) or would have to jump.
+
+The first or the last joint moves the base or the tool end of the others rigidly, so
+the arm with it locked at 0 is one 6R arm for every value, and the whole grid is one
+batch of targets (:func:`_targets`). Matching rows is an assignment problem per value;
+when each row's nearest row at the next value is strictly nearest and no two rows share
+it, that choice is the unique optimum and no assignment is solved (:func:`_connect`).
+The ends of the feasible intervals are found by safeguarded interpolation
+(:func:`_refine`): a joint crossing its limit is a root of a smooth margin, a pair of
+solutions meeting at the edge of reach closes like √(v* − v).
 
 Units: radians (revolute joints), metres (prismatic).
 """
@@ -16,19 +25,26 @@ Units: radians (revolute joints), metres (prismatic).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from serialkin._checks import check_transform
+from serialkin._checks import check_transform, readonly
+from serialkin._jit import entry_point, njit
+from serialkin._memo import PerObject
 from serialkin.errors import InputError
-from serialkin.ik.analytic import ik_all
+from serialkin.ik.analytic import _locked, ik_all
 from serialkin.model.robot import Robot
-from serialkin.spatial.rotations import wrap_angle
-from serialkin.spatial.transforms import inv_transform
+from serialkin.spatial.kernels import wrap_pi
 
 __all__ = ["JointSweep", "joint_sweep"]
+
+#: Width [rad or m] to which the ends of the feasible intervals are refined.
+END_TOL = 1e-9
+#: Tolerance on the limits in a refinement probe [rad or m]: the closed-form solvers'.
+_PROBE_LIMIT_TOL = 1e-10
 
 
 @dataclass(frozen=True, eq=False)
@@ -44,9 +60,8 @@ class JointSweep:
             contiguous run of values along which its joints change continuously (at most
             ``max_jump`` between neighbouring values).
         feasible: [(v_lo, v_hi), ...] the closed intervals of values at which some
-            configuration reaches the pose inside the limits, ends refined by bisection
-            to 1e-9 (their width is exact to the refinement; a stretch narrower than the
-            grid step can be missed).
+            configuration reaches the pose inside the limits, ends refined to
+            :data:`END_TOL` (a stretch narrower than the grid step can be missed).
         max_jump: the largest joint change [rad or m] allowed between neighbours.
     """
 
@@ -102,45 +117,92 @@ def joint_sweep(robot: Robot, T: object, joint: int, values: object = None, *,
     if not (max_jump > 0.0 and math.isfinite(max_jump)):
         raise InputError(f"max_jump must be a positive length or angle, got {max_jump!r}")
     v = _values(robot, j, values, resolution)
-    rows = _rows(robot, Tt, j, v)
-    q, valid = _connect(rows, n, max_jump)
+    Q, count = _solve(robot, Tt, j, v, limited=True)
+    q, valid = _connect(Q, count, float(max_jump))
 
-    def exists(x: np.ndarray) -> np.ndarray:
-        return np.array([len(r) > 0 for r in _rows(robot, Tt, j, x)], dtype=bool)
+    def probe(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return _solve(robot, Tt, j, x, limited=False)
 
-    ways = _BATCH_WAYS if j in (0, n - 1) else 2  # a batch solve costs about one solve
     return JointSweep(joint=j, values=v, q=q, valid=valid,
-                      feasible=_intervals(v, [len(r) > 0 for r in rows], exists, ways),
+                      feasible=_intervals(robot, v, Q, count, probe),
                       max_jump=float(max_jump))
 
 
-def _rows(robot: Robot, T: np.ndarray, j: int, v: np.ndarray) -> list[np.ndarray]:
-    """``ik_all(robot, T, free={j: x}).q`` for every value x of v (m,): m arrays (k, n).
+# ------------------------------------------------------------------ the locked solves
 
-    The first or the last joint moves the base or the tool end of the others rigidly:
-    ``fk(q) = fk(q with q_j = 0)·D(q_j)`` for the last joint, with ``D(x) =
-    fk(0)⁻¹·fk(x·e_j)``, and ``fk(q) = G(q_j)·fk(q with q_j = 0)`` for the first, with
-    ``G(x) = fk(x·e_j)·fk(0)⁻¹``. Locking it at 0 then leaves one reduced arm for every
-    value, whose targets ``T·D(x)⁻¹`` (or ``G(x)⁻¹·T``) are solved as one batch (one
-    reduced robot, one compiled call); the locked column is then set to x. A joint in
-    between changes the reduced arm's geometry: one locked solve per value.
+def _solve(robot: Robot, T: np.ndarray, j: int, x: np.ndarray, *, limited: bool
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """``ik_all(robot, T, free={j: x_i})`` for every value x_i of x (m,): (m, K, n), (m,).
+
+    Row r of value i is a solution for r < count[i], zeros after. With ``limited``
+    False the robot's limits are ignored (every solution, for :func:`_refine`); the
+    angles are then those of the unlimited solve (:func:`_margin` wraps them).
+
+    The first or the last joint moves the base or the tool end of the others rigidly
+    (:func:`_targets`): one batch solve of the arm locked at 0. A joint in between
+    changes the locked arm's geometry: one locked solve per value.
     """
     n = robot.n
+    target = robot if limited else _unlimited(robot)
     if j not in (0, n - 1):
-        return [np.asarray(ik_all(robot, T, free={j: float(x)}).q) for x in v]
-    Q = np.zeros((len(v), n))
-    Q[:, j] = v
-    F = robot.fk(Q)                                       # (m, 4, 4)
-    inv0 = inv_transform(robot.fk(np.zeros(n)), check=False)
-    moved = inv_transform(inv0 @ F if j == n - 1 else F @ inv0, check=False)
-    targets = T @ moved if j == n - 1 else moved @ T
-    res = ik_all(robot, targets, free={j: 0.0})
-    out = []
-    for i, k in enumerate(np.asarray(res.count).tolist()):
-        r = res.q[i, :k].copy()
-        r[:, j] = v[i]
-        out.append(r)
-    return out
+        sols = [np.asarray(ik_all(target, T, free={j: float(xi)}).q) for xi in x]
+        K = max([len(s) for s in sols] + [1])
+        Q = np.zeros((len(x), K, n))
+        count = np.array([len(s) for s in sols], dtype=np.int64)
+        for i, s in enumerate(sols):
+            Q[i, :len(s)] = s
+        return Q, count
+    reduced = _locked(target, {j: 0.0})[0]
+    res = ik_all(reduced, _targets(robot, T, j, x))
+    count = np.asarray(res.count, dtype=np.int64).reshape(len(x))
+    q = res.q.reshape(len(x), -1, n - 1)
+    Q = np.empty((len(x), q.shape[1], n))
+    Q[:, :, :j] = q[:, :, :j]
+    Q[:, :, j + 1:] = q[:, :, j:]
+    Q[:, :, j] = np.where(np.arange(q.shape[1])[None, :] < count[:, None], x[:, None], 0.0)
+    return Q, count
+
+
+def _targets(robot: Robot, T: np.ndarray, j: int, x: np.ndarray) -> np.ndarray:
+    """Targets (m, 4, 4) of the arm with joint j (first or last) locked at 0, one per x.
+
+    For the last joint ``fk(q) = fk(q with q_j = 0)·D(q_j)`` with ``D(x) =
+    fk(0)⁻¹·fk(x·e_j)``, so the locked arm must reach ``T·D(x)⁻¹ = T·fk(x·e_j)⁻¹·fk(0)``;
+    for the first ``fk(q) = G(q_j)·fk(q with q_j = 0)`` with ``G(x) =
+    fk(x·e_j)·fk(0)⁻¹``, target ``G(x)⁻¹·T = fk(0)·fk(x·e_j)⁻¹·T``.
+    """
+    Q = np.zeros((len(x), robot.n))
+    Q[:, j] = x
+    F = robot.fk(Q)
+    Rt = np.swapaxes(F[:, :3, :3], 1, 2)
+    inv = np.zeros_like(F)
+    inv[:, :3, :3] = Rt
+    inv[:, :3, 3] = -(Rt @ F[:, :3, 3:])[:, :, 0]
+    inv[:, 3, 3] = 1.0
+    F0 = _home(robot)
+    return T @ inv @ F0 if j == robot.n - 1 else F0 @ inv @ T
+
+
+def _home(robot: Robot) -> np.ndarray:
+    """fk(0) (4, 4), cached per robot."""
+    got = _HOME.get(robot)
+    if got is None:
+        got = _HOME.set(robot, readonly(robot.fk(np.zeros(robot.n))))
+    return got
+
+
+_HOME: PerObject[np.ndarray] = PerObject()
+
+
+def _unlimited(robot: Robot) -> Robot:
+    """The robot without joint limits (cached per robot)."""
+    got = _UNLIMITED.get(robot)
+    if got is None:
+        got = _UNLIMITED.set(robot, robot.with_limits(np.tile([-np.inf, np.inf], (robot.n, 1))))
+    return got
+
+
+_UNLIMITED: PerObject[Robot] = PerObject()
 
 
 def _values(robot: Robot, j: int, values: object, resolution: float) -> np.ndarray:
@@ -159,91 +221,352 @@ def _values(robot: Robot, j: int, values: object, resolution: float) -> np.ndarr
     return np.linspace(lo, hi, m)
 
 
-def _distance(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """(a, b) the largest change of any joint between rows of A and B (angles wrapped)."""
-    return np.abs(wrap_angle(A[:, None, :] - B[None, :, :])).max(axis=2)
+# ------------------------------------------------------------------------ branches
+
+@njit(cache=True)
+def _link(Q, count, max_jump, cost, nxt, unsure):
+    """Match rows of neighbouring values where the minimum-cost matching is certain.
+
+    Q (m, K, n) rows, count (m,) of them per value. For each step t → t + 1, ``cost[t,
+    a, b]`` is the largest change of any joint (wrapped to (−π, π], as
+    :func:`~serialkin.spatial.wrap_angle`) from row a to row b. On the smaller side each
+    row (column) takes its smallest entry; when every such minimum is strict and no two
+    share their partner, that matching is the unique optimum of the assignment problem
+    (any other takes a larger entry in some row and nothing smaller elsewhere), and
+    ``nxt[t, a]`` is a's partner (−1: none, or farther than ``max_jump``). Otherwise
+    ``unsure[t]`` is set and ``nxt[t]`` left at −1 for the caller's assignment solver.
+    """
+    m, K, n = Q.shape
+    for t in range(m - 1):
+        ka, kb = count[t], count[t + 1]
+        for a in range(K):
+            nxt[t, a] = -1
+        for a in range(ka):
+            for b in range(kb):
+                worst = 0.0
+                for c in range(n):
+                    d = abs(wrap_pi(Q[t, a, c] - Q[t + 1, b, c]))
+                    if d > worst:
+                        worst = d
+                cost[t, a, b] = worst
+        rows_first = ka <= kb
+        small, big = min(ka, kb), max(ka, kb)
+        used = 0
+        sure = True
+        for s in range(small):
+            best, second, arg = math.inf, math.inf, -1
+            for o in range(big):
+                x = cost[t, s, o] if rows_first else cost[t, o, s]
+                if x < best:
+                    best, second, arg = x, best, o
+                elif x < second:
+                    second = x
+            if arg < 0 or not second > best or (used >> arg) & 1:
+                sure = False
+                break
+            used |= 1 << arg
+            if best <= max_jump:
+                if rows_first:
+                    nxt[t, s] = arg
+                else:
+                    nxt[t, arg] = s
+        unsure[t] = not sure
+        if not sure:
+            for a in range(K):
+                nxt[t, a] = -1
 
 
-def _connect(rows: list[np.ndarray], n: int, max_jump: float) -> tuple[np.ndarray, np.ndarray]:
-    """Branches through the rows of each value: (m, b, n) and (m, b) valid."""
-    track_of: list[np.ndarray] = []   # per value: the branch index of each row
-    count = 0
-    prev = np.zeros((0, n))
-    for cur in rows:
-        ids = np.full(len(cur), -1)
-        if len(prev) and len(cur):
-            cost = _distance(prev, cur)
-            a, b = linear_sum_assignment(cost)
-            ok = cost[a, b] <= max_jump
-            ids[b[ok]] = track_of[-1][a[ok]]
-        for i in np.flatnonzero(ids < 0):
-            ids[i] = count
-            count += 1
-        track_of.append(ids)
-        prev = cur
-    m = len(rows)
-    q = np.zeros((m, count, n))
-    valid = np.zeros((m, count), dtype=bool)
-    for i, (cur, ids) in enumerate(zip(rows, track_of)):
-        q[i, ids] = cur
-        valid[i, ids] = True
+@njit(cache=True)
+def _label(nxt, count, ids):
+    """Branch numbers ``ids[i, r]`` of the rows from the matches: returns how many branches.
+
+    A row matched from the previous value continues its branch; any other row starts
+    the next number, in the order of values and then rows.
+    """
+    m = count.shape[0]
+    b = 0
+    for r in range(count[0]):
+        ids[0, r] = b
+        b += 1
+    for t in range(m - 1):
+        for r in range(count[t + 1]):
+            ids[t + 1, r] = -1
+        for a in range(count[t]):
+            if nxt[t, a] >= 0:
+                ids[t + 1, nxt[t, a]] = ids[t, a]
+        for r in range(count[t + 1]):
+            if ids[t + 1, r] < 0:
+                ids[t + 1, r] = b
+                b += 1
+    return b
+
+
+def _connect(Q: np.ndarray, count: np.ndarray, max_jump: float
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """Branches through the rows of each value: (m, b, n) and (m, b) valid.
+
+    Q (m, K, n) rows (count[i] of them at value i). Consecutive rows are matched by
+    minimum total cost, the cost the largest joint change (the assignment problem);
+    a matched pair more than ``max_jump`` apart is not joined. :func:`_link` settles the
+    steps whose optimum is certain; scipy's ``linear_sum_assignment`` the others.
+    """
+    m, K, n = Q.shape
+    Q = np.ascontiguousarray(Q, dtype=np.float64)
+    count = np.ascontiguousarray(count, dtype=np.int64)
+    cost = np.zeros((max(m - 1, 0), K, K))
+    nxt = np.full((max(m - 1, 0), K), -1, dtype=np.int64)
+    unsure = np.zeros(max(m - 1, 0), dtype=np.bool_)
+    _kernel("link")(readonly(Q), readonly(count), float(max_jump), cost, nxt, unsure)
+    for t in np.flatnonzero(unsure):
+        c = cost[t, :count[t], :count[t + 1]]
+        a, b = linear_sum_assignment(c)
+        ok = c[a, b] <= max_jump
+        nxt[t, a[ok]] = b[ok]
+    ids = np.full((m, K), -1, dtype=np.int64)
+    b = int(_kernel("label")(readonly(nxt), readonly(count), ids))
+    q = np.zeros((m, b, n))
+    valid = np.zeros((m, b), dtype=bool)
+    i, r = np.nonzero(ids >= 0)
+    q[i, ids[i, r]] = Q[i, r]
+    valid[i, ids[i, r]] = True
     return q, valid
 
 
-#: Parts each bracket of an interval end is cut into per round when the values are solved
-#: as one batch (the first or last joint swept): 16 parts, 4 bits a round instead of 1.
-_BATCH_WAYS = 16
+_KERNELS: dict[str, object] = {}
 
 
-def _intervals(v: np.ndarray, some: list[bool], exists, ways: int) -> list[tuple[float, float]]:
-    """Closed runs of values with a solution; inner ends refined to 1e-9 (:func:`_refine`).
+def _kernel(name: str):
+    """The compiled entry point of :func:`_link` or :func:`_label`, for the types passed.
 
-    ``exists(x)`` says for each value of x (k,) whether a solution exists there.
+    Read-only C-contiguous inputs (Q float64 (m, K, n), count int64 (m,); nxt int64
+    (m − 1, K) for the labels), a float, and fresh outputs (cost float64 (m − 1, K, K),
+    nxt int64 (m − 1, K), unsure bool (m − 1,); ids int64 (m, K)).
     """
-    runs, ends = [], []
-    i, m = 0, len(v)
-    while i < m:
-        if not some[i]:
-            i += 1
-            continue
-        k = i
-        while k + 1 < m and some[k + 1]:
-            k += 1
-        runs.append((i, k))
-        if i > 0:
-            ends.append((v[i - 1], v[i]))
-        if k < m - 1:
-            ends.append((v[k + 1], v[k]))
-        i = k + 1
-    refined = iter(_refine(ends, exists, ways))
-    return [(float(v[i] if i == 0 else next(refined)),
-             float(v[k] if k == m - 1 else next(refined))) for i, k in runs]
+    found = _KERNELS.get(name)
+    if found is not None:
+        return found
+
+    def sig() -> tuple:  # numba's types, imported only when the kernel is loaded
+        import numba
+
+        Array, f64, i64 = numba.types.Array, numba.float64, numba.int64
+        if name == "link":
+            return (Array(f64, 3, "C", readonly=True), Array(i64, 1, "C", readonly=True), f64,
+                    Array(f64, 3, "C"), Array(i64, 2, "C"), Array(numba.boolean, 1, "C"))
+        return (Array(i64, 2, "C", readonly=True), Array(i64, 1, "C", readonly=True),
+                Array(i64, 2, "C"))
+
+    found, final = entry_point(_link if name == "link" else _label, sig)
+    if final:  # else the Python function while it compiles: ask again next call
+        _KERNELS[name] = found
+    return found
 
 
-def _refine(ends: list[tuple[float, float]], exists, ways: int) -> list[float]:
-    """The feasible end of each (infeasible value, feasible value) bracket, to 1e-9.
+# ---------------------------------------------------------------- feasible intervals
 
-    Every round cuts each bracket wider than 1e-9 into ``ways`` equal parts and keeps the
-    part where, walking from the infeasible end, the first feasible point is met; all
-    brackets' points are solved in one ``exists`` call. With ``ways = 2``: bisection.
+def _margin(robot: Robot, Q: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """(m,) how far inside its limits the best row of each value lies [rad or m]; −inf: none.
+
+    A row's margin is ``min over joints of min(q − lower, upper − q)``, each revolute
+    angle first moved by whole turns into the middle of its limits; joints whose limits
+    leave out no angle (a range of 2π or more, or one side open) are left out.
     """
-    if not ends:
-        return []
-    bad = np.array([e[0] for e in ends], dtype=float)
-    good = np.array([e[1] for e in ends], dtype=float)
-    t = np.arange(1, ways) / ways
-    while True:
-        open_ = np.flatnonzero(np.abs(good - bad) > 1e-9)
-        if not len(open_):
-            return good.tolist()
-        b, g = bad[open_], good[open_]
-        pts = b[:, None] + (g - b)[:, None] * t                  # (e, ways − 1)
-        if ways == 2:
-            pts = 0.5 * (b + g)[:, None]                         # bisection's midpoint
-        ok = exists(pts.reshape(-1)).reshape(pts.shape)
-        first = np.where(ok.any(axis=1), ok.argmax(axis=1), pts.shape[1])
-        rows = np.arange(len(open_))
-        new_bad = np.where(first > 0, pts[rows, np.maximum(first - 1, 0)], b)
-        new_good = np.where(first < pts.shape[1], pts[rows, np.minimum(first, pts.shape[1] - 1)],
-                            g)
-        bad[open_], good[open_] = new_bad, new_good
+    lo, hi, mid, limited, rev = _limits(robot)
+    x = Q[:, :, limited]
+    x = np.where(rev, x - 2.0 * math.pi * np.floor((x - mid) / (2.0 * math.pi) + 0.5), x)
+    best = np.minimum(x - lo, hi - x).min(axis=-1, initial=np.inf)   # (m, K)
+    best[np.arange(Q.shape[1])[None, :] >= count[:, None]] = -np.inf
+    return best.max(axis=-1, initial=-np.inf)
+
+
+def _limits(robot: Robot) -> tuple:
+    """``(lo, hi, mid, limited, revolute)`` of :func:`_margin`, for the limited joints."""
+    got = _LIMITS.get(robot)
+    if got is None:
+        lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
+        rev = np.asarray(robot.revolute, dtype=bool)
+        with np.errstate(invalid="ignore"):
+            limited = ~rev | (np.isfinite(lo) & np.isfinite(hi) & (hi - lo < 2.0 * math.pi))
+        limited &= np.isfinite(lo) | np.isfinite(hi)
+        mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), 0.0)
+        got = _LIMITS.set(robot, (lo[limited], hi[limited], mid[limited],
+                                  np.flatnonzero(limited), rev[limited]))
+    return got
+
+
+_LIMITS: PerObject[tuple] = PerObject()
+
+
+def _closeness(Q: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """(m,) the smallest squared distance between two rows of each value (inf: < 2 rows).
+
+    Two solutions meeting at the edge of reach (a fold) approach each other like
+    √(v* − v), so this is linear in v near a fold.
+    """
+    d = Q[:, :, None, :] - Q[:, None, :, :]
+    d = d - 2.0 * math.pi * np.floor(d / (2.0 * math.pi) + 0.5)
+    d2 = (d * d).sum(axis=-1)
+    K = Q.shape[1]
+    pad = np.arange(K)[None, :] >= count[:, None]
+    d2[pad[:, :, None] | pad[:, None, :] | np.eye(K, dtype=bool)[None]] = np.inf
+    return d2.min(axis=(1, 2), initial=np.inf)
+
+
+def _intervals(robot: Robot, v: np.ndarray, Q: np.ndarray, count: np.ndarray,
+               probe: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+               ) -> list[tuple[float, float]]:
+    """Closed runs of values with a solution; inner ends refined (:func:`_refine`).
+
+    ``probe(x)`` solves the locked arm without limits at the values x (k,).
+    """
+    some = count > 0
+    m = len(v)
+    edges = np.flatnonzero(some[1:] != some[:-1])
+    if not len(edges):
+        return [(float(v[0]), float(v[-1]))] if some[0] else []
+    good = np.where(some[edges], edges, edges + 1)
+    step = np.where(some[edges], -1, 1)                      # from the end inwards
+    near = good[:, None] + step[:, None] * np.arange(3)[None, :]   # (e, 3) grid samples
+    inside = (near >= 0) & (near < m)
+    near = np.clip(near, 0, m - 1)
+    inside &= some[near]
+    inside = np.cumprod(inside, axis=1).astype(bool)          # a run of feasible values
+    sub = np.unique(near[inside])
+    f = _margin(robot, Q[sub], count[sub]) + _PROBE_LIMIT_TOL
+    c = _closeness(Q[sub], count[sub])
+    where = np.searchsorted(sub, near)
+    samples = np.stack([np.where(inside, v[near], np.nan), np.where(inside, f[where], np.nan),
+                        np.where(inside, c[where], np.nan)], axis=-1)   # (e, 3, 3)
+    ends = _refine(robot, v[np.where(some[edges], edges + 1, edges)], samples, probe)
+    starts = ([float(v[0])] if some[0] else []) + [float(x) for x, s in zip(ends, step)
+                                                   if s > 0]
+    stops = [float(x) for x, s in zip(ends, step) if s < 0] + ([float(v[-1])] if some[-1]
+                                                                else [])
+    return list(zip(starts, stops))
+
+
+#: Probes around each estimate of an end, in units of its bracket's width.
+_AROUND = np.array([-3e-3, -3e-5, 0.0, 3e-5, 3e-3])
+#: The safeguard: probes at these fractions of every bracket, every round.
+_SPLIT = np.array([0.25, 0.5, 0.75])
+
+
+def _estimates(b: float, fb: float, samples: np.ndarray) -> list[float]:
+    """Where an end between the infeasible value b and the feasible samples may lie.
+
+    ``samples`` (3, 3): (value, margin f, closeness c) of the feasible values nearest
+    the end, nearest first (NaN rows missing). A limit is where f = 0: the root of the
+    line or parabola through the samples' f and, when f is known at b too, of the
+    inverse quadratic (or the secant) through b and the two nearest samples; an edge of
+    reach is where c = 0, c linear near it: the same through the samples' c. Roots
+    outside the bracket are dropped.
+    """
+    rows = [r for r in samples.tolist() if r[0] == r[0]]   # drop NaN rows
+    g = rows[0][0]
+    lo, hi = min(b, g), max(b, g)
+    out = []
+    for k in (1, 2):
+        pts = [(r[0], r[k]) for r in rows if math.isfinite(r[k])]
+        if len(pts) >= 2:
+            r = _root(pts, g)
+            if r is not None and lo < r < hi:
+                out.append(r)
+    if math.isfinite(fb) and math.isfinite(rows[0][1]):
+        pts = [(b, fb)] + [(r[0], r[1]) for r in rows[:2] if math.isfinite(r[1])]
+        (x0, y0), (x1, y1) = pts[0], pts[1]
+        r = x1 - y1 * (x1 - x0) / (y1 - y0) if y1 != y0 else None
+        if len(pts) == 3 and len({y0, y1, pts[2][1]}) == 3:   # inverse quadratic
+            x2, y2 = pts[2]
+            r = (x0 * y1 * y2 / ((y0 - y1) * (y0 - y2)) + x1 * y0 * y2 / ((y1 - y0) * (y1 - y2))
+                 + x2 * y0 * y1 / ((y2 - y0) * (y2 - y1)))
+        if r is not None and lo < r < hi:
+            out.append(r)
+    return out
+
+
+def _root(pts: list[tuple[float, float]], g: float) -> float | None:
+    """The root nearest g of the line (2 points) or parabola (3 points) through pts."""
+    (x0, y0), (x1, y1) = pts[0], pts[1]
+    if x1 == x0:
+        return None
+    s01 = (y1 - y0) / (x1 - x0)
+    if len(pts) == 2:
+        return x0 - y0 / s01 if s01 != 0.0 else None
+    x2, y2 = pts[2]
+    if x2 == x1 or x2 == x0:
+        return None
+    a = ((y2 - y1) / (x2 - x1) - s01) / (x2 - x0)      # y = y0 + s·u + a·u·(u − (x1 − x0))
+    s = s01 - a * (x1 - x0)                             # in u = x − x0: y0 + s·u + a·u²
+    if a == 0.0:
+        return x0 - y0 / s if s != 0.0 else None
+    disc = s * s - 4.0 * a * y0
+    if disc < 0.0:
+        return None
+    q = -0.5 * (s + math.copysign(math.sqrt(disc), s))
+    roots = [q / a] + ([y0 / q] if q != 0.0 else [])
+    return x0 + min(roots, key=lambda u: abs(x0 + u - g))
+
+
+def _refine(robot: Robot, bad: np.ndarray, samples: np.ndarray,
+            probe: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+    """The feasible end next to each infeasible value ``bad`` (e,), to :data:`END_TOL`.
+
+    ``samples`` (e, 3, 3): per end the (value, margin, closeness) of the nearest
+    feasible values (:func:`_estimates`), the first one the bracket's feasible side.
+    Every round solves, for all open brackets at once (one ``probe`` call, without
+    limits), the points ``_AROUND`` each estimate and the safeguard points ``_SPLIT``
+    (and, the first time, the infeasible value itself, whose margin the secant needs);
+    the bracket becomes the stretch between the last infeasible and the first feasible
+    point met walking from the infeasible side. A joint reaching a limit is a smooth
+    root of the margin; two solutions meeting at the edge of reach close like √(v* − v),
+    a smooth root of their squared distance: either way the estimates converge fast, and
+    the safeguard shrinks every bracket at least fourfold per round.
+    """
+    e = len(bad)
+    bad = bad.astype(float).copy()
+    fb = np.full(e, np.nan)
+    samples = samples.copy()
+    first = True
+    for _ in range(64):
+        g = samples[:, 0, 0]
+        live = np.flatnonzero(np.abs(g - bad) > END_TOL)
+        if not len(live):
+            break
+        pts = []
+        for i in live:
+            b, w = bad[i], g[i] - bad[i]
+            est = _estimates(b, fb[i], samples[i])
+            here = [b + w * _SPLIT] + [x + w * _AROUND for x in est] + ([[b]] if first else [])
+            pts.append(np.concatenate(here))
+        sizes = [len(x) for x in pts]
+        X = np.concatenate(pts)
+        Qp, cp = probe(X)
+        f = _margin(robot, Qp, cp) + _PROBE_LIMIT_TOL
+        c = _closeness(Qp, cp)
+        start = 0
+        for i, k in zip(live, sizes):
+            x, fx, cx = X[start:start + k], f[start:start + k], c[start:start + k]
+            start += k
+            b, gi = bad[i], g[i]
+            t = (x - b) / (gi - b)                               # 0: bad, 1: good
+            if first:
+                fb[i] = fx[np.argmin(np.abs(t))]
+            keep = (t > 0.0) & (t < 1.0)
+            x, fx, cx, t = x[keep], fx[keep], cx[keep], t[keep]
+            order = np.argsort(t)
+            x, fx, cx = x[order], fx[order], cx[order]
+            ok = fx >= 0.0
+            if not ok.any():
+                if len(x):
+                    bad[i], fb[i] = x[-1], fx[-1]
+                continue
+            h = int(np.argmax(ok))
+            if h > 0:
+                bad[i], fb[i] = x[h - 1], fx[h - 1]
+            more = np.stack([x[h:][ok[h:]], fx[h:][ok[h:]], cx[h:][ok[h:]]], axis=1)
+            old = samples[i][np.isfinite(samples[i, :, 0])]
+            merged = np.concatenate([more, old])[:3]
+            samples[i] = np.nan
+            samples[i, :len(merged)] = merged
+        first = False
+    return samples[:, 0, 0].copy()

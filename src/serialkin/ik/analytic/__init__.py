@@ -131,16 +131,24 @@ class _Prepared:
                 self.mid[j] = lo + math.pi
             elif math.isfinite(hi):
                 self.mid[j] = hi - math.pi
+        self.limited = bool(np.isfinite(self.qlim).any())
+        # a nearly ideal arm is solved without its limits (the rows still wrapped about
+        # ``mid``), so that the parity test of _near_rows counts every solution; the
+        # limits are applied after it (_inside_limits)
+        self.solve_qlim = self.qlim
+        if mode == "near":
+            self.solve_qlim = np.ascontiguousarray(np.tile([-np.inf, np.inf], (robot.n, 1)))
         self.F = robot.chain.F
         self.meta = robot.chain.meta
         self.n = robot.n
+        self.wrist = _wrist_coefficients(robot) if mode == "near" else None
         R0 = s.M[:3, :3]
         if math.hypot(R0[0, 0], R0[1, 0]) > 0.5:
             self.phi0 = math.atan2(R0[1, 0], R0[0, 0])
         else:  # tool x axis out of the plane: use the y axis, heading φ + π/2
             self.phi0 = math.atan2(R0[1, 1], R0[0, 1]) - 0.5 * math.pi
         for a in (self.W, self.P, self.M, self.aux, self.order, self.revolute, self.qlim,
-                  self.mid):
+                  self.solve_qlim, self.mid):
             a.setflags(write=False)
 
 
@@ -613,6 +621,62 @@ def sort_by_reference(robot: Robot, sols: np.ndarray, reference: object, *,
     return q[order]
 
 
+def _near_rows(robot: Robot, p: _Prepared, T: np.ndarray, rows: np.ndarray,
+               conv: np.ndarray, tol: float, grid: int) -> np.ndarray:
+    """A nearly ideal arm's rows: the refined branches ``rows`` (k, n), completed, then limited.
+
+    ``rows`` come from a solve without the joint limits (``p.solve_qlim``), so they are
+    every distinct solution the refined branches reached; ``conv`` (17,) is the kernel's
+    record of them. When they are doubtful (:func:`_doubtful`) the general solver's rows
+    are merged in (:func:`_with_general`). Then the limits are applied.
+    """
+    if _doubtful(p, rows[None], conv[None], np.array([len(rows)]))[0]:
+        rows = _with_general(robot, T, rows, tol, grid)
+    return _inside_limits(p, rows) if p.limited else rows
+
+
+def _doubtful(p: _Prepared, rows: np.ndarray, conv: np.ndarray,
+              counts: np.ndarray) -> np.ndarray:
+    """(N,) whether a nearly ideal arm's refined branches may have missed a solution.
+
+    ``rows`` (N, K, n) with ``counts`` (N,) valid rows each: the distinct solutions of a
+    solve without limits; ``conv`` (N, 17) the kernels' records (branches, then a flag per
+    branch). Doubtful when
+
+    * no branch, or an odd number of branches, converged (as
+      :func:`~serialkin.ik.analytic.dispatch.refined_doubtful`);
+    * the number of distinct solutions is odd: real solutions of a 6-joint arm come in
+      pairs, so one was lost;
+    * more branches converged than there are distinct solutions: two seeds met on one
+      solution, so its neighbour (the pair of a fold, a member of a cluster) may have
+      none (measured on a UR5 whose parameters deviate by 1e-5, at a folded elbow near
+      the shoulder's tangency: 8 branches on 6 solutions, 2 of the 8 missing);
+    * a row is near the wrist singularity (:func:`_wrist_singular`), where the true
+      arm's solutions cluster along the ideal wrist's continuum, more than its seeds
+      may reach.
+    """
+    branches = conv[:, 0]
+    good = (conv[:, 1:] * (np.arange(conv.shape[1] - 1) < branches[:, None])).sum(axis=1)
+    out = (good % 2 == 1) | (good == 0) | (counts % 2 == 1) | (good > counts)
+    for i in np.flatnonzero(~out):
+        out[i] = _wrist_singular(p, rows[i, :counts[i]])
+    return out
+
+
+def _inside_limits(p: _Prepared, rows: np.ndarray) -> np.ndarray:
+    """The rows (k, n) inside the limits ``p.qlim``, those within LIMIT_TOL outside clipped.
+
+    What :func:`~serialkin.ik.analytic.subproblems.finalize` does with the limits, for the
+    rows of a solve without them (the rows are already wrapped about ``p.mid``); the
+    order is kept.
+    """
+    from serialkin.ik.analytic.subproblems import LIMIT_TOL
+
+    lo, hi = p.qlim[:, 0], p.qlim[:, 1]
+    keep = np.all((rows >= lo - LIMIT_TOL) & (rows <= hi + LIMIT_TOL), axis=1)
+    return np.clip(rows[keep], lo, hi)
+
+
 def _with_general(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
                   grid: int) -> np.ndarray:
     """``sols`` of a nearly ideal arm merged with the general search's (when it applies).
@@ -651,23 +715,59 @@ def _with_general(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
 WRIST_SINGULAR = 0.05
 
 
+def _wrist_coefficients(robot: Robot) -> np.ndarray:
+    """The coefficients of the angle between axes i and i + 2, a function of q_(i+1) alone.
+
+    Returns (2, 4): per triple (i, j, k) = (4, 5, 6), (1, 2, 3) (1-based) the A, B, C of
+    ``w_i·Rot(w_j, q_j)·w_k = A + B cos q_j + C sin q_j`` (zero-configuration directions),
+    then j (0-based). Joint i's rotation keeps w_i and earlier joints turn both axes
+    alike, so the angle between axes i and k of any configuration depends on q_j alone:
+    ``A = (w_i·w_j)(w_j·w_k)``, ``B = w_i·w_k − A``, ``C = w_i·(w_j × w_k)``.
+    """
+    W = robot.joint_axes(np.zeros(robot.n))[1]
+    W = W / np.linalg.norm(W, axis=1, keepdims=True)
+    out = np.zeros((2, 4))
+    for row, (i, j, k) in enumerate(((3, 4, 5), (0, 1, 2))):
+        a = (W[i] @ W[j]) * (W[j] @ W[k])
+        out[row] = (a, W[i] @ W[k] - a, W[i] @ np.cross(W[j], W[k]), j)
+    return out
+
+
+def _wrist_singular(p: _Prepared, rows: np.ndarray) -> bool:
+    """Whether a row of ``rows`` (k, 6) has axes 4, 6 (or 1, 3) within 0.05 rad of parallel.
+
+    There (q5 ≈ 0 on a Puma 560 or a UR5) a nearly ideal arm's true solutions split and
+    merge within O(√deviation) of the idealised ones, along the ideal wrist's continuum:
+    the kernels' extra seeds there (``WRIST_SEED``) find some, the general solver's rows
+    the others (:func:`_near_rows`). Measured before those seeds, on UR5 and Puma 560 arms
+    whose DH parameters deviate by 1e-5 to 1e-3: 21 of 48 poses with q5 in
+    {0, 1e-6, 1e-3} lost 1 to 6 solutions the general solver finds, and none of 72 random
+    poses did; about 3 % of random poses are this close to the singularity. The angle
+    of axes i and i + 2 depends on q_(i+1) alone (:func:`_wrist_coefficients`).
+    """
+    if not len(rows) or p.wrist is None:
+        return False
+    c = p.wrist
+    dots = np.abs(c[:, :1] + c[:, 1:2] * np.cos(rows[:, [4, 1]].T)
+                  + c[:, 2:3] * np.sin(rows[:, [4, 1]].T))
+    return bool(dots.max() > _WRIST_COS)
+
+
+#: cos of WRIST_SINGULAR: |w_i · w_(i+2)| above it is within WRIST_SINGULAR of parallel.
+_WRIST_COS = math.sqrt(1.0 - WRIST_SINGULAR ** 2)
+
+
 def _near_wrist_singular(robot: Robot, sols: np.ndarray) -> bool:
     """Whether a row of ``sols`` (k, 6) has axes 4, 6 (or 1, 3) within 0.05 rad of parallel.
 
-    There (q5 ≈ 0 on a Puma 560 or a UR5) a nearly ideal arm's true solutions split and
-    merge within O(√deviation) of the idealised ones, so the refined branches can miss
-    a pair, the generating configuration included: measured on UR5 and Puma 560 arms
-    whose DH parameters deviate by 1e-5 to 1e-3, 21 of 48 poses with q5 in {0, 1e-6, 1e-3}
-    lost 1 to 6 solutions the general solver finds, and none of 72 random poses did. The
-    caller then adds the general solver's rows (:func:`_with_general`); about 3 % of
-    random poses are this close to the singularity.
+    :func:`_wrist_singular` for any 6-joint robot (False for others), from its axes.
     """
     if robot.n != 6 or not len(sols):
         return False
-    W = np.array([robot.joint_axes(q)[1] for q in sols])  # (k, 6, 3) unit axes
-    # |w_i × w_j| < s  ⇔  |w_i · w_j| > √(1 − s²) for unit vectors
-    dots = np.abs(np.einsum("kij,kij->ki", W[:, [3, 0]], W[:, [5, 2]]))
-    return bool(dots.max() > math.sqrt(1.0 - WRIST_SINGULAR ** 2))
+    c = _wrist_coefficients(robot)
+    q = np.asarray(sols, dtype=float)[:, [4, 1]].T
+    return bool(np.abs(c[:, :1] + c[:, 1:2] * np.cos(q) + c[:, 2:3] * np.sin(q)).max()
+                > _WRIST_COS)
 
 
 def _sort_batch(robot: Robot, res: AllSolutions, reference: object, weights: object,
@@ -702,7 +802,7 @@ def _solve_batch(p: _Prepared, robot: Robot, T: np.ndarray, tol: float,
     counts = np.zeros(N, dtype=np.int64)
     conv = np.zeros((N, MAX_ROWS + 1), dtype=np.int64)
     args = (p.arm, p.prismatic3, T, p.W, p.P, p.M, p.aux, p.order, p.revolute,
-            p.qlim, p.mid, p.F, p.meta, p.refine, grid, tol * p.s.scale, tol,
+            p.solve_qlim, p.mid, p.F, p.meta, p.refine, grid, tol * p.s.scale, tol,
             REFINE_TOL * p.s.scale, REFINE_TOL, out, counts, conv)
     grain = 4 if p.code == GENERAL else 64
     run(for_class(p.code, p.refine).solve_range, args, N, grain)
@@ -774,19 +874,19 @@ def _packed_entry(code: int, refine: bool) -> Any:
 def _fast_entry(robot: object) -> tuple:
     """The fast path's cached data for ``robot`` (default ``tol``, ``near_tol``, grid).
 
-    ``(None, entry point, I, D, B, (16, n), kind, mode)``: the packed arguments of
-    :func:`~serialkin.ik.analytic.dispatch.solve_packed`, the shape of its output and the
-    class solved.
+    ``(None, entry point, I, D, B, (16, n), kind, mode, prepared)``: the packed arguments
+    of :func:`~serialkin.ik.analytic.dispatch.solve_packed`, the shape of its output, the
+    class solved and its :class:`_Prepared` data.
     """
     from serialkin.ik.analytic.dispatch import pack
     from serialkin.ik.analytic.general import DEFAULT_GRID
 
     p = _prepared(robot, NEAR_TOL)  # raises the ordinary path's errors
     I, D, B = pack(p.code, p.arm, p.prismatic3, p.W, p.P, p.M, p.aux, p.order, p.revolute,
-                   p.qlim, p.mid, p.F, p.meta, p.refine, DEFAULT_GRID, 1e-8 * p.s.scale, 1e-8,
-                   REFINE_TOL * p.s.scale, REFINE_TOL)
+                   p.solve_qlim, p.mid, p.F, p.meta, p.refine, DEFAULT_GRID, 1e-8 * p.s.scale,
+                   1e-8, REFINE_TOL * p.s.scale, REFINE_TOL)
     entry = (None, _packed_entry(p.code, p.refine), I, D, B, (MAX_ROWS, p.n), p.s.kind,
-             p.mode)
+             p.mode, p)
     if (p.code, p.refine) in _SOLVE_PACKED:  # compiled: kept (else its Python, asked again)
         _FAST.set(robot, entry)
     return entry
@@ -890,12 +990,12 @@ def _ik_all_fast(robot: Robot, target: np.ndarray) -> AllSolutions | None:
     k = entry[1](target, entry[2], entry[3], entry[4], out, conv)
     if k == -1:
         return None
-    rows = out[:k] if k >= 0 else out[:-2 - k]  # k < -1: refined branches doubtful
-    if k >= 0 and not (entry[7] == "near" and _near_wrist_singular(robot, rows)):
-        return _ALL(rows, k, conv, entry[6], entry[7])
-    from serialkin.ik.analytic.general import DEFAULT_GRID  # a nearly ideal arm: merge
+    if entry[7] != "near":
+        return _ALL(out[:k], k, conv, entry[6], entry[7])
+    from serialkin.ik.analytic.general import DEFAULT_GRID  # a nearly ideal arm
 
-    rows = _with_general(robot, target, rows, _TOL, DEFAULT_GRID)
+    rows = out[:k] if k >= 0 else out[:-2 - k]  # k < -1: refined branches doubtful
+    rows = _near_rows(robot, entry[8], target, rows, conv, _TOL, DEFAULT_GRID)
     return _ALL(rows, rows.shape[0], conv, entry[6], entry[7])
 
 
@@ -993,14 +1093,22 @@ def _ik_all_batch(p: Any, robot: Robot, a: np.ndarray, tol: float, grid: int,
             for j in range(int(counts[i])):
                 cont[i, j] = continuous_family(robot, T[i], out[i, j])
         cont = cont.reshape(lead + (kmax,))
-    if p.mode == "near":  # doubtful refined branches: general search too
-        from serialkin.ik.analytic.dispatch import refined_doubtful
+    if p.mode == "near":  # doubtful refined branches: general search too; then limits
+        for i in np.flatnonzero(_doubtful(p, out, conv, counts)):
+            rows = _with_general(robot, T[i], out[i, :counts[i]], tol, grid)
+            out[i] = 0.0
+            counts[i] = min(len(rows), MAX_ROWS)
+            out[i, :counts[i]] = rows[:MAX_ROWS]
+        if p.limited:  # the limits, all targets at once: rows inside first, in order
+            from serialkin.ik.analytic.subproblems import LIMIT_TOL
 
-        for i in range(T.shape[0]):
-            if refined_doubtful(conv[i]) or _near_wrist_singular(robot, out[i, :counts[i]]):
-                rows = _with_general(robot, T[i], out[i, :counts[i]], tol, grid)
-                counts[i] = min(len(rows), MAX_ROWS)
-                out[i, :counts[i]] = rows[:MAX_ROWS]
+            lo, hi = p.qlim[:, 0], p.qlim[:, 1]
+            keep = (np.arange(MAX_ROWS) < counts[:, None]) & np.all(
+                (out >= lo - LIMIT_TOL) & (out <= hi + LIMIT_TOL), axis=2)
+            order = np.argsort(~keep, axis=1, kind="stable")
+            out = np.clip(np.take_along_axis(out, order[..., None], axis=1), lo, hi)
+            counts = keep.sum(axis=1)
+            out[np.arange(MAX_ROWS) >= counts[:, None]] = 0.0
         kmax = int(counts.max(initial=0))
     return _ALL(out[:, :kmax].reshape(lead + (kmax, p.n)), counts.reshape(lead),
                 conv.reshape(lead + (MAX_ROWS + 1,)), p.s.kind, p.mode, cont)
@@ -1015,14 +1123,11 @@ def _ik_all_one(p: Any, robot: Robot, a: np.ndarray, tol: float, grid: int, all_
     out = np.empty((MAX_ROWS, p.n))
     conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
     k = solve_into(p.code, p.arm, p.prismatic3, T, p.W, p.P, p.M, p.aux, p.order, p.revolute,
-                   p.qlim, p.mid, p.F, p.meta, check_rot, p.refine, grid, tol * p.s.scale, tol,
-                   REFINE_TOL * p.s.scale, REFINE_TOL, out, conv)
+                   p.solve_qlim, p.mid, p.F, p.meta, check_rot, p.refine, grid,
+                   tol * p.s.scale, tol, REFINE_TOL * p.s.scale, REFINE_TOL, out, conv)
     sols = out[:k]
     if p.mode == "near":
-        from serialkin.ik.analytic.dispatch import refined_doubtful
-
-        if refined_doubtful(conv) or _near_wrist_singular(robot, sols):
-            sols = _with_general(robot, T, sols, tol, grid)
+        sols = _near_rows(robot, p, T, sols, conv, tol, grid)
     if all_turns and k:
         sols = _expand_turns(sols, p.revolute, p.qlim)
     if reference is not None:

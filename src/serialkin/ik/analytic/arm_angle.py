@@ -25,14 +25,18 @@ stretched or folded). At a given ψ the configurations follow in closed form, up
 
 A solution's *branch* ``4·i₄ + 2·i_s + i_w`` (i₄ the elbow's, i_s the shoulder's and
 i_w the wrist's choice of sign, 0 or 1) is continuous in ψ away from singular
-configurations, so a branch can be followed along ψ (:func:`arm_angle_intervals`).
+configurations, so a branch can be followed along ψ. At a fixed pose the shoulder
+rotation is linear in (cos ψ, sin ψ), so the ψ at which a joint meets a limit are roots
+of ``k₀ + k_c cos ψ + k_s sin ψ = const``: the feasible intervals of ψ follow in closed
+form (:func:`arm_angle_intervals`, eqs 2 and 3 below).
 
 Units: angles in radians, lengths in metres. Steps 1–4 run compiled, one pose at one ψ
 per call of :func:`_srs_one` (3-vectors as tuples: nothing allocated per ψ), batched over
-poses and ψ by :func:`_srs_solve` and over interval ends by :func:`_srs_bisect`; the
-arm's constants are packed once per robot. One pose at one ψ with the defaults takes one
-compiled call (the rigidity check, the solve, a forward-kinematics check of each row).
-The kernels belong to the ``ik-all`` compile feature (``serialkin warmup``).
+poses and ψ by :func:`_srs_solve`; the feasible intervals of one pose take one call of
+:func:`_srs_spans`; the arm's constants are packed once per robot. One pose at one ψ
+with the defaults takes one compiled call (the rigidity check, the solve, a
+forward-kinematics check of each row). The kernels belong to the ``ik-all`` compile
+feature (``serialkin warmup``).
 """
 
 from __future__ import annotations
@@ -57,7 +61,6 @@ __all__ = ["ArmAngleIntervals", "ArmAngleSolutions", "SRSArm", "arm_angle",
 MEET_TOL = 1e-9
 #: Feasibility tolerance on joint limits [rad].
 LIMIT_TOL = 1e-9
-_TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,8 +122,6 @@ class ArmAngleIntervals:
             touching both −π and π is one interval across ±π, listed as its two parts.
         feasible: the union over branches, the same form: every ψ at which some
             configuration reaches the pose inside the limits.
-        resolution: the grid step [rad] of the search; interval ends are refined by
-            bisection to ``1e-10`` rad.
         singular: the pose leaves ψ undefined (the line S–W parallel to the reference,
             or the elbow on that line): every configuration reaching it has the same
             shoulder-elbow-wrist plane up to rotation; ``branches`` then describes ψ = 0.
@@ -128,7 +129,6 @@ class ArmAngleIntervals:
 
     branches: dict[int, list[tuple[float, float]]]
     feasible: list[tuple[float, float]]
-    resolution: float
     singular: bool
 
     def contains(self, psi: float, branch: int | None = None) -> bool:
@@ -287,16 +287,22 @@ def _psi_of(arm: SRSArm, E: np.ndarray, Wt: np.ndarray, r: np.ndarray) -> np.nda
 
 # ------------------------------------------------------------------- the compiled form
 # One pose at one ψ in compiled code (:func:`_srs_one`, the same steps as the module
-# docstring), called by :func:`_srs_solve` (poses × ψ) and :func:`_srs_bisect` (the
-# interval ends). 3-vectors are tuples and rotations tuples of three rows, so nothing is
-# allocated per ψ. The arm's constants are packed once per robot (:func:`_packed`):
+# docstring), called by :func:`_srs_solve` (poses × ψ); its steps are shared with
+# :func:`_srs_spans` (the feasible intervals). 3-vectors are tuples and rotations tuples
+# of three rows, so nothing is allocated per ψ. The arm's constants are packed once per
+# robot (:func:`_packed`):
 #
 # * ``H``, ``P``: (7, 3) joint directions and points, ``M``: (4, 4) the pose at q = 0;
 # * ``V``: (_NV,) S (0:3), W0 (3:6), E0 (6:9), lo (9:16), hi (16:23), mid (23:30), then
 #   scale, the wrist point in the tool frame (31:34), x3 = perpendicular(h3) (34:37),
 #   x7 = perpendicular(h7) (37:40) and the elbow's constants A, B, atan2(B, A), |(A, B)|,
-#   |u|² + |v|², v·u∥ (40:46) of :func:`_elbow_angles`.
-_NV = 46
+#   |u|² + |v|², v·u∥ (40:46). The elbow is subproblem 3: with u = W₀ − p₄ split along
+#   and across h₄ (u∥, u⊥) and v = S − p₄, ``|p₄ + Rot(h₄, q₄)·u − S| = L`` reads
+#   ``A cos q₄ + B sin q₄ = k`` (A = v·u⊥, B = v·(h₄ × u⊥), k = (|u|² + |v|² − L²)/2 −
+#   v·u∥): q₄ = atan2(B, A) ± acos(k/|(A, B)|). Then, for :func:`_srs_spans`, each
+#   joint's arc of limits (46:67, :func:`_arcs`) and the equations of the cuts, eq (3)
+#   (67:147, :func:`_cut_table`).
+_NV = 147
 
 
 @njit(cache=True)
@@ -403,15 +409,24 @@ def _row(A, i):
 
 
 @njit(cache=True)
-def _srs_one(T, psi, r, H, P, M, V, Q, ok):
-    """Every branch at one pose T (4, 4) and arm angle ψ: Q (8, 7) [rad], ok (8,) bool.
-
-    :func:`_solve` for one (pose, ψ), in the same steps; the angles are moved by whole
-    turns nearest ``mid`` (:func:`_into_limits`) and ``ok[j]`` is True when branch j
-    exists and lies inside the limits. ``r`` (3,) is the unit reference direction.
-    """
+def _inside(V, c, x):
+    """Joint c's angle x [rad] moved by whole turns nearest its ``mid``; whether in its limits."""
     two_pi = 2.0 * math.pi
-    S, W0, E0 = (V[0], V[1], V[2]), (V[3], V[4], V[5]), (V[6], V[7], V[8])
+    y = x - two_pi * np.rint((x - V[23 + c]) / two_pi)
+    return y, V[9 + c] - LIMIT_TOL <= y <= V[16 + c] + LIMIT_TOL
+
+
+@njit(cache=True)
+def _pose_frame(T, r, M, V):
+    """What a pose T (4, 4) fixes for every ψ: ``(e, er, L, Lm, nr, Rw, ratio)``.
+
+    ``e`` the unit direction from S to the wrist target ``W_t = T·M⁻¹·W₀``, ``L = |W_t −
+    S|`` [m] and ``Lm = max(L, 1e-12·size)``; ``er`` the unit part of the reference r (3,)
+    perpendicular to e, of length ``nr`` before normalising (a fixed perpendicular of e
+    when nr = 0); ``Rw = R_T·R_Mᵀ``; ``ratio = k/ρ`` of the elbow's subproblem 3
+    (:func:`_elbow_angles`): the elbow reaches L iff |ratio| ≤ 1.
+    """
+    S = (V[0], V[1], V[2])
     tiny = 1e-12 * V[30]
     rr = (r[0], r[1], r[2])
     loc = (V[31], V[32], V[33])
@@ -425,65 +440,102 @@ def _srs_one(T, psi, r, H, P, M, V, Q, ok):
     rp = _lin(1.0, rr, -_dot(e, rr), e)
     nr = math.sqrt(_dot(rp, rp))
     er = (rp[0] / nr, rp[1] / nr, rp[2] / nr) if nr > 0.0 else _perp(e)
-    c_dir = _lin(math.cos(psi), er, math.sin(psi), _crs(e, er))
-    # Rw = R_T · R_Mᵀ
     RT = ((T[0, 0], T[0, 1], T[0, 2]), (T[1, 0], T[1, 1], T[1, 2]),
           (T[2, 0], T[2, 1], T[2, 2]))
     RMt = ((M[0, 0], M[1, 0], M[2, 0]), (M[0, 1], M[1, 1], M[2, 1]),
            (M[0, 2], M[1, 2], M[2, 2]))
     Rw = _mm(RT, RMt)
-    # 1. the elbow (subproblem 3, :func:`_elbow_angles`)
     k = 0.5 * (V[44] - L * L) - V[45]
     rho = V[43]
     ratio = k / rho if rho > 0.0 else math.inf
+    return e, er, L, Lm, nr, Rw, ratio
+
+
+@njit(cache=True)
+def _elbow_frame(H, P, V, q4, Lm):
+    """At elbow angle q4: ``(R4, â, b⊥, |b⊥|)``, what the shoulder rotation maps.
+
+    ``â = (p4 + R4·(W₀ − p4) − S)/Lm`` the unit shoulder-to-wrist direction at q = 0 but
+    q4 (length L when the elbow solves subproblem 3) and ``b⊥`` the part of the upper
+    arm ``b = E₀ − S`` across â; R₁₂₃ maps â to e and b⊥/|b⊥| to the elbow's direction.
+    """
+    S, W0, E0 = (V[0], V[1], V[2]), (V[3], V[4], V[5]), (V[6], V[7], V[8])
+    p4 = _row(P, 3)
+    R4 = _rot3(_row(H, 3), q4)
+    a = _lin(1.0, _lin(1.0, p4, 1.0, _mv(R4, _lin(1.0, W0, -1.0, p4))), -1.0, S)
+    a_hat = (a[0] / Lm, a[1] / Lm, a[2] / Lm)
+    b = _lin(1.0, E0, -1.0, S)
+    b_perp = _lin(1.0, b, -_dot(a_hat, b), a_hat)
+    return R4, a_hat, b_perp, math.sqrt(_dot(b_perp, b_perp))
+
+
+@njit(cache=True)
+def _shoulder_rotation(e, cd, a_hat, bp):
+    """``R₁₂₃ = F2·F1ᵀ``, F1 = [â, b̂⊥, â × b̂⊥], F2 = [e, c, e × c] (columns; rows returned)."""
+    ab = _crs(a_hat, bp)
+    ec = _crs(e, cd)
+    return (_lin(1.0, _lin(e[0], a_hat, cd[0], bp), ec[0], ab),
+            _lin(1.0, _lin(e[1], a_hat, cd[1], bp), ec[1], ab),
+            _lin(1.0, _lin(e[2], a_hat, cd[2], bp), ec[2], ab))
+
+
+@njit(cache=True)
+def _spherical(h1, h2, h3, x3, R, v, sign):
+    """One solution of ``Rot(h1, t1)·Rot(h2, t2)·Rot(h3, t3) = R``: ``(t1, t2, t3, exists)``.
+
+    Subproblem 2 for (t1, t2) with ``v = R·h3`` and the sign of γ (the branch),
+    subproblem 1 for t3 on ``x3 ⊥ h3``. Angles in (−π, π] [rad].
+    """
+    t1, t2, ok = _sp2_3(h1, h2, h3, v, sign)
+    R3 = _mtm(_mm(_rot3(h1, t1), _rot3(h2, t2)), R)
+    return t1, t2, _sp1_3(h3, x3, _mv(R3, x3)), ok
+
+
+@njit(cache=True)
+def _srs_one(T, psi, r, H, P, M, V, Q, ok):
+    """Every branch at one pose T (4, 4) and arm angle ψ: Q (8, 7) [rad], ok (8,) bool.
+
+    :func:`_solve` for one (pose, ψ), in the same steps; the angles are moved by whole
+    turns nearest ``mid`` (:func:`_inside`) and ``ok[j]`` is True when branch j exists
+    and lies inside the limits. ``r`` (3,) is the unit reference direction.
+    """
+    e, er, L, Lm, _, Rw, ratio = _pose_frame(T, r, M, V)
+    tiny = 1e-12 * V[30]
+    c_dir = _lin(math.cos(psi), er, math.sin(psi), _crs(e, er))
+    # 1. the elbow (subproblem 3, see :data:`_NV`)
     ok4 = abs(ratio) <= 1.0 + 1e-12 and L > tiny
     phi = math.acos(min(max(ratio, -1.0), 1.0))
     h = (_row(H, 0), _row(H, 1), _row(H, 2), _row(H, 3), _row(H, 4), _row(H, 5), _row(H, 6))
-    p4 = _row(P, 3)
-    u = _lin(1.0, W0, -1.0, p4)
-    b = _lin(1.0, E0, -1.0, S)
     x3 = (V[34], V[35], V[36])
     x7 = (V[37], V[38], V[39])
     for i4 in range(2):
         q4 = V[42] + phi if i4 == 0 else V[42] - phi
-        R4 = _rot3(h[3], q4)
-        a = _lin(1.0, _lin(1.0, p4, 1.0, _mv(R4, u)), -1.0, S)
-        a_hat = (a[0] / Lm, a[1] / Lm, a[2] / Lm)
-        b_perp = _lin(1.0, b, -_dot(a_hat, b), a_hat)
-        nb = math.sqrt(_dot(b_perp, b_perp))
+        R4, a_hat, b_perp, nb = _elbow_frame(H, P, V, q4, Lm)
         if nb < tiny:  # the elbow on the line S–W: ψ undefined, any plane
             cd = er
             bp = _perp(a_hat)
         else:
             cd = c_dir
-            nbm = max(nb, 1e-300)
-            bp = (b_perp[0] / nbm, b_perp[1] / nbm, b_perp[2] / nbm)
-        # R123 = F2·F1ᵀ with F1 = [a, b⊥, a × b⊥], F2 = [e, c⊥, e × c⊥] (columns)
-        ab = _crs(a_hat, bp)
-        ec = _crs(e, cd)
-        R123 = (_lin(1.0, _lin(e[0], a_hat, cd[0], bp), ec[0], ab),
-                _lin(1.0, _lin(e[1], a_hat, cd[1], bp), ec[1], ab),
-                _lin(1.0, _lin(e[2], a_hat, cd[2], bp), ec[2], ab))
+            bp = (b_perp[0] / nb, b_perp[1] / nb, b_perp[2] / nb)
+        # 2. the shoulder rotation; 3., 4. the shoulder's and the wrist's angles
+        R123 = _shoulder_rotation(e, cd, a_hat, bp)
         X = _mtm(_mm(R123, R4), Rw)                      # (R123·R4)ᵀ·R_T·R_Mᵀ
         v3 = _mv(R123, h[2])
         v7 = _mv(X, h[6])
+        wrists = (_spherical(h[4], h[5], h[6], x7, X, v7, 1.0),
+                  _spherical(h[4], h[5], h[6], x7, X, v7, -1.0))
         for i_s in range(2):
-            t1, t2, ok_s = _sp2_3(h[0], h[1], h[2], v3, 1.0 if i_s == 0 else -1.0)
-            R3 = _mtm(_mm(_rot3(h[0], t1), _rot3(h[1], t2)), R123)
-            q3 = _sp1_3(h[2], x3, _mv(R3, x3))
+            t1, t2, q3, ok_s = _spherical(h[0], h[1], h[2], x3, R123, v3,
+                                          1.0 if i_s == 0 else -1.0)
             for i_w in range(2):
-                t5, t6, ok_w = _sp2_3(h[4], h[5], h[6], v7, 1.0 if i_w == 0 else -1.0)
-                R7 = _mtm(_mm(_rot3(h[4], t5), _rot3(h[5], t6)), X)
-                q7 = _sp1_3(h[6], x7, _mv(R7, x7))
+                t5, t6, q7, ok_w = wrists[i_w]
                 j = 4 * i4 + 2 * i_s + i_w
                 Q[j, 0], Q[j, 1], Q[j, 2], Q[j, 3] = t1, t2, q3, q4
                 Q[j, 4], Q[j, 5], Q[j, 6] = t5, t6, q7
                 inside = ok4 and ok_s and ok_w
                 for c in range(7):
-                    x = Q[j, c] - two_pi * np.rint((Q[j, c] - V[23 + c]) / two_pi)
-                    Q[j, c] = x
-                    if not (V[9 + c] - LIMIT_TOL <= x <= V[16 + c] + LIMIT_TOL):
-                        inside = False
+                    Q[j, c], good = _inside(V, c, Q[j, c])
+                    inside = inside and good
                 ok[j] = inside
 
 
@@ -579,25 +631,329 @@ def _srs_solve(T, psi, r, H, P, M, V, check, Q, found):
     return total
 
 
-@njit(cache=True)
-def _srs_bisect(T, r, H, P, M, V, branch, bad, good, steps):
-    """Bisect each (branch, infeasible ψ, feasible ψ) ``steps`` times; ``good`` (m,) updated.
+# ------------------------------------------------------- feasible ψ in closed form
+# At a fixed pose and elbow angle the shoulder rotation built by :func:`_srs_one` is
+#
+#     R₁₂₃(ψ) = e·âᵀ + cos ψ·(e_r·b̂ᵀ + f·ĉᵀ) + sin ψ·(f·b̂ᵀ − e_r·ĉᵀ)                (2)
+#
+# with f = e × e_r, b̂ = b⊥/|b⊥| and ĉ = â × b̂: linear in (cos ψ, sin ψ) (Shimizu et al.
+# 2008, sec. III), and so is the wrist's X = R₄ᵀ·R₁₂₃ᵀ·R_w. For a spherical group
+# Rot(h₁, t₁)·Rot(h₂, t₂)·Rot(h₃, t₃) = R (R₁₂₃ or X) the two vectors
+#
+#     v(ψ) = R·h₃ = v₀ + v_c cos ψ + v_s sin ψ,    u(ψ) = Rᵀ·h₁ = u₀ + u_c cos ψ + u_s sin ψ
+#
+# decide everything (:func:`_sinusoid` gives the coefficients):
+#
+#     t₁ = λ  ⇔  (Rot(h₁, λ)·h₂)·v(ψ) = h₂·h₃          (h₂ is fixed by Rot(h₂, t₂))
+#     t₂ = λ  ⇔  h₁·v(ψ) = h₁·Rot(h₂, λ)·h₃            (h₁ is fixed by Rot(h₁, t₁))
+#     t₃ = λ  ⇔  u(ψ)·(Rot(h₃, −λ)·h₂) = h₁·h₂         (h₂ is fixed by Rot(h₂, t₂))   (3)
+#
+# (each "⇔": one of the group's two solutions has that angle, modulo 2π); the group has
+# solutions where subproblem 2's γ² ≥ 0, a quadratic in w = h₁·v(ψ). So every ψ at which
+# a joint meets a limit, or a group's solutions appear or vanish, is a root of
+# ``k₀ + k_c cos ψ + k_s sin ψ = const``: at most two each, in closed form
+# (:func:`_roots`). The pivot angles t₁, t₃ jump where h₁ ∥ v (w = ±1, an extremum of
+# w(ψ)): those ψ are cuts too. Between consecutive cuts no angle meets a limit or jumps,
+# so one evaluation of the group at the middle decides the whole stretch
+# (:func:`_group_feasible`: the same subproblems as :func:`_srs_one`, but each angle kept
+# as its (cos, sin) and tested against its arc of limits, without atan2).
 
-    The feasible end of each of the m stretches: ``good[k]`` ends feasible on branch
-    ``branch[k]`` (:func:`_srs_one`), ``bad[k]`` infeasible, |bad − good| halved per step.
+#: Cuts of ψ per spherical group: 3 joints × 2 limits × 2 roots, 2 × 2 existence roots,
+#: 2 extrema, and the ends −π, π.
+_MAX_CUTS = 20
+#: Feasible stretches per branch: ≤ 9 per group; an intersection of 9 and 9 has ≤ 17.
+_MAX_SPANS = 18
+#: Limits are met at ``limit ∓ (LIMIT_TOL − _MARGIN)``: just inside the kernels' test.
+_MARGIN = 1e-12
+
+
+@njit(cache=True)
+def _sinusoid(y, e, er, f, a, b, c, line, transposed):
+    """R·y (or Rᵀ·y) as ``v₀ + v_c cos ψ + v_s sin ψ``: the three 3-tuples (v₀, v_c, v_s).
+
+    ``R = e·aᵀ + cos ψ (er·bᵀ + f·cᵀ) + sin ψ (f·bᵀ − er·cᵀ)``: eq (2) with (a, b, c) =
+    (â, b̂, ĉ). ``transposed``: Rᵀ·y, whose coefficients are
+    those of R·y with the triples swapped and v_s negated. ``line``: the elbow on the line
+    S–W, where :func:`_srs_one` takes ψ = 0 whatever ψ (v_c, v_s = 0).
     """
-    Q = np.empty((8, 7))
-    ok = np.zeros(8, dtype=np.bool_)
-    for k in range(branch.shape[0]):
-        lo, hi = bad[k], good[k]
-        for _ in range(steps):
-            mid = 0.5 * (lo + hi)
-            _srs_one(T, mid, r, H, P, M, V, Q, ok)
-            if ok[branch[k]]:
-                hi = mid
+    if transposed:
+        e, er, f, a, b, c = a, b, c, e, er, f
+    ay, by, cy = _dot(a, y), _dot(b, y), _dot(c, y)
+    v0 = (e[0] * ay, e[1] * ay, e[2] * ay)
+    vc = _lin(by, er, cy, f)
+    vs = _lin(-by, f, cy, er) if transposed else _lin(by, f, -cy, er)
+    if line:
+        return _lin(1.0, v0, 1.0, vc), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    return v0, vc, vs
+
+
+@njit(cache=True)
+def _wrap_pi(x):
+    """The angle x [rad] moved by whole turns into [−π, π]."""
+    return x - 2.0 * math.pi * np.rint(x / (2.0 * math.pi))
+
+
+@njit(cache=True)
+def _roots(k0, kc, ks, rhs, cuts, n):
+    """Append the ψ in [−π, π] with ``k0 + kc cos ψ + ks sin ψ = rhs`` to cuts; the new n.
+
+    ``kc cos ψ + ks sin ψ = ρ cos(ψ − φ)``, ρ = |(kc, ks)|, φ = atan2(ks, kc): ψ = φ ±
+    acos((rhs − k0)/ρ), both kept (clamped) when the ratio is within 1e-12 of ±1.
+    """
+    rho = math.hypot(kc, ks)
+    if not rho > 0.0:
+        return n
+    t = (rhs - k0) / rho
+    if abs(t) > 1.0 + 1e-12:
+        return n
+    phi = math.atan2(ks, kc)
+    d = math.acos(min(max(t, -1.0), 1.0))
+    cuts[n] = _wrap_pi(phi + d)
+    cuts[n + 1] = _wrap_pi(phi - d)
+    return n + 2
+
+
+@njit(cache=True)
+def _in_arc(V, c, x, y):
+    """Joint c's angle atan2(y, x) lies in its limits (± LIMIT_TOL), modulo 2π.
+
+    The arc's middle (cos, sin) and the cosine of its half width are ``V[46 + 3c:49 + 3c]``
+    (cosine −2, middle (1, 0): no limit).
+    """
+    return x * V[46 + 3 * c] + y * V[47 + 3 * c] >= V[48 + 3 * c] * math.hypot(x, y)
+
+
+@njit(cache=True)
+def _solution_ok(V, base, h1, h2, h3, z, v, u):
+    """One solution of a spherical group, given subproblem 2's z = Rot(h2, t2)·h3, in limits.
+
+    The angles as (cos, sin) pairs, unnormalised: ``t2`` takes h3 to z about h2, ``t1``
+    takes z to v = R·h3 about h1, ``t3`` takes u = Rᵀ·h1 to Rot(h2, −t2)·h1 about h3
+    (R = Rot(h1, t1)·Rot(h2, t2)·Rot(h3, t3) gives Rᵀ·h1 = Rot(h3, −t3)·Rot(h2, −t2)·h1).
+    """
+    h3p = _lin(1.0, h3, -_dot(h3, h2), h2)
+    zp = _lin(1.0, z, -_dot(z, h2), h2)
+    c2, s2 = _dot(h3p, zp), _dot(h2, _crs(h3p, zp))
+    if not _in_arc(V, base + 1, c2, s2):
+        return False
+    zq = _lin(1.0, z, -_dot(z, h1), h1)
+    vq = _lin(1.0, v, -_dot(v, h1), h1)
+    if not _in_arc(V, base, _dot(zq, vq), _dot(h1, _crs(zq, vq))):
+        return False
+    n2 = math.hypot(c2, s2)
+    if n2 > 0.0:
+        c2, s2 = c2 / n2, s2 / n2
+    c12 = _dot(h1, h2)
+    target = _lin(1.0, _lin(c2, _lin(1.0, h1, -c12, h2), -s2, _crs(h2, h1)), c12, h2)
+    up = _lin(1.0, u, -_dot(u, h3), h3)
+    tp = _lin(1.0, target, -_dot(target, h3), h3)
+    return _in_arc(V, base + 2, _dot(up, tp), _dot(h3, _crs(up, tp)))
+
+
+@njit(cache=True)
+def _group_feasible(psi, base, gv, gu, h, V):
+    """Whether each solution of a spherical group exists inside its limits at ψ [rad].
+
+    Joints base..base + 2 with axes h1, h2, h3; ``gv``, ``gu`` the sinusoids of v = R·h3
+    and u = Rᵀ·h1 (eq 3). Subproblem 2 as in :func:`_sp2_3` (exists iff γ² > −1e-9),
+    the angles tested by :func:`_solution_ok`. Returns (γ ≥ 0 solution ok, γ ≤ 0 ok).
+    """
+    h1, h2, h3 = h[base], h[base + 1], h[base + 2]
+    cs, sn = math.cos(psi), math.sin(psi)
+    v = _lin(1.0, gv[0], 1.0, _lin(cs, gv[1], sn, gv[2]))
+    u = _lin(1.0, gu[0], 1.0, _lin(cs, gu[1], sn, gu[2]))
+    c12 = _dot(h1, h2)
+    den = c12 * c12 - 1.0
+    a2u = _dot(h2, h3)
+    w = _dot(v, h1)
+    alpha = (c12 * a2u - w) / den
+    beta = (c12 * w - a2u) / den
+    x = _crs(h1, h2)
+    g2 = (1.0 - alpha * alpha - beta * beta - 2.0 * alpha * beta * c12) / _dot(x, x)
+    if not g2 > -1e-9:
+        return False, False
+    g = math.sqrt(max(g2, 0.0))
+    z = _lin(1.0, _lin(alpha, h1, beta, h2), g, x)
+    first = _solution_ok(V, base, h1, h2, h3, z, v, u)
+    z = _lin(1.0, _lin(alpha, h1, beta, h2), -g, x)
+    return first, _solution_ok(V, base, h1, h2, h3, z, v, u)
+
+
+@njit(cache=True)
+def _group_cuts(base, gv, gu, h, V, cuts):
+    """The sorted ψ where one group's feasibility can change (eq 3); returns how many.
+
+    Each of the group's eight equations ``d·v(ψ) = rhs`` or ``d·u(ψ) = rhs`` (its row of
+    ``V[67:147]``, :func:`_cut_table`: the limits of its three joints and the two
+    bounds of existence), the extrema of w(ψ) = h1·v(ψ) within 1e-9 of ±1, and −π, π.
+    """
+    cuts[0], cuts[1] = -math.pi, math.pi
+    n = 2
+    o = 67 + 10 * base  # 40 numbers per group: base 0 or 4
+    for row in range(8):
+        i = o + 5 * row
+        if V[i + 3] < 0.0:
+            continue  # no limit (or no bound)
+        g = gu if V[i + 3] > 0.0 else gv
+        d = (V[i], V[i + 1], V[i + 2])
+        n = _roots(_dot(d, g[0]), _dot(d, g[1]), _dot(d, g[2]), V[i + 4], cuts, n)
+    h1 = h[base]
+    k0, kc, ks = _dot(h1, gv[0]), _dot(h1, gv[1]), _dot(h1, gv[2])
+    rho = math.hypot(kc, ks)
+    if rho > 0.0:  # h1 ∥ v at an extremum of w(ψ): the pivots t1, t3 jump
+        phi = math.atan2(ks, kc)
+        if k0 + rho >= 1.0 - 1e-9:
+            cuts[n] = _wrap_pi(phi)
+            n += 1
+        if k0 - rho <= -1.0 + 1e-9:
+            cuts[n] = _wrap_pi(phi + math.pi)
+            n += 1
+    for i in range(1, n):  # insertion sort: n ≤ 20
+        x = cuts[i]
+        j = i - 1
+        while j >= 0 and cuts[j] > x:
+            cuts[j + 1] = cuts[j]
+            j -= 1
+        cuts[j + 1] = x
+    return n
+
+
+@njit(cache=True)
+def _nudge(x, toward, s, base, gv, gu, h, V):
+    """x, or the point nearest x towards ``toward`` where solution s of the group is feasible.
+
+    A cut is a root computed in floating point, with the limits moved inwards by
+    ``_MARGIN``: should rounding still leave it outside, steps of 1e-15 rad, doubling, at
+    most to ``toward`` (the middle of the feasible stretch). The seam ±π is kept.
+    """
+    if abs(x) >= math.pi:
+        return x
+    step = 1e-15 if toward > x else -1e-15
+    y = x
+    for _ in range(64):
+        if _group_feasible(y, base, gv, gu, h, V)[s]:
+            return y
+        y = x + step
+        if (toward - y) * step <= 0.0:
+            return toward
+        step *= 2.0
+    return toward
+
+
+@njit(cache=True)
+def _group_runs(base, gv, gu, h, V, cuts, feasible, runs, found):
+    """The closed stretches of ψ in [−π, π] where each solution of one group is feasible.
+
+    Each stretch between consecutive cuts (:func:`_group_cuts`) is decided at its middle
+    (:func:`_group_feasible`, into the scratch ``feasible`` (2, _MAX_CUTS)); feasible
+    neighbours join; ends are moved onto feasible ψ (:func:`_nudge`). Writes
+    ``runs[s, :found[s]]`` (ψ_lo, ψ_hi) for the solution with γ ≥ 0 (s = 0) and γ ≤ 0
+    (s = 1).
+    """
+    n = _group_cuts(base, gv, gu, h, V, cuts)
+    for i in range(n - 1):
+        if cuts[i + 1] > cuts[i]:
+            feasible[0, i], feasible[1, i] = _group_feasible(0.5 * (cuts[i] + cuts[i + 1]),
+                                                             base, gv, gu, h, V)
+    for s in range(2):
+        k = 0
+        inside = False
+        start = middle = 0.0  # the run's start, the middle of its last stretch
+        for i in range(n - 1):
+            a, b = cuts[i], cuts[i + 1]
+            if not b > a:
+                continue
+            if feasible[s, i] and not inside:
+                start = _nudge(a, 0.5 * (a + b), s, base, gv, gu, h, V)
+            elif inside and not feasible[s, i]:
+                runs[s, k, 0] = start
+                runs[s, k, 1] = _nudge(a, middle, s, base, gv, gu, h, V)
+                k += 1
+            if feasible[s, i]:
+                middle = 0.5 * (a + b)
+            inside = feasible[s, i]
+        if inside:
+            runs[s, k, 0] = start
+            runs[s, k, 1] = math.pi
+            k += 1
+        found[s] = k
+
+
+@njit(cache=True)
+def _intersect(A, na, B, nb, out):
+    """The intersection of two sorted lists of disjoint closed stretches: out[:k], k returned.
+
+    A (na, 2) and B (nb, 2); stretches that only touch (no width) are left out.
+    """
+    i = j = k = 0
+    while i < na and j < nb:
+        lo = max(A[i, 0], B[j, 0])
+        hi = min(A[i, 1], B[j, 1])
+        if lo < hi:
+            out[k, 0] = lo
+            out[k, 1] = hi
+            k += 1
+        if A[i, 1] < B[j, 1]:
+            i += 1
+        else:
+            j += 1
+    return k
+
+
+@njit(cache=True)
+def _srs_spans(T, r, H, P, M, V, check, out, counts):
+    """The feasible ψ of every branch at pose T (4, 4): ``out[j, :counts[j]]`` (ψ_lo, ψ_hi).
+
+    For each elbow angle inside its limits, the shoulder's and the wrist's feasible
+    stretches (:func:`_group_runs`) on the sinusoids v(ψ), u(ψ) of eq (3): for the
+    shoulder v = R₁₂₃·h3, u = R₁₂₃ᵀ·h1; for the wrist v = X·h7 = R4ᵀ·(R₁₂₃ᵀ·R_w·h7),
+    u = Xᵀ·h5 = R_wᵀ·(R₁₂₃·R4·h5). They are intersected per branch ``4·i4 + 2·is + iw``
+    (:func:`_intersect`). ``out`` is (8, _MAX_SPANS, 2), ``counts`` (8,). Returns 1 when
+    ψ is undefined at T (the line S–W along r or of no length, or the elbow on it), 0
+    otherwise; with ``check``, −1 (nothing done) when T is not rigid to 1e-13
+    (:func:`_rigid`).
+    """
+    for j in range(8):
+        counts[j] = 0
+    if check and not _rigid(T):
+        return -1
+    e, er, L, Lm, nr, Rw, ratio = _pose_frame(T, r, M, V)
+    tiny = 1e-12 * V[30]
+    singular = L < tiny or nr < 1e-12
+    if not (abs(ratio) <= 1.0 + 1e-12 and L > tiny):
+        return 1 if singular else 0
+    phi = math.acos(min(max(ratio, -1.0), 1.0))
+    f = _crs(e, er)
+    h = (_row(H, 0), _row(H, 1), _row(H, 2), _row(H, 3), _row(H, 4), _row(H, 5), _row(H, 6))
+    eye = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    cuts = np.empty(_MAX_CUTS)
+    feasible = np.empty((2, _MAX_CUTS), dtype=np.bool_)
+    runs = np.empty((2, 2, _MAX_SPANS, 2))   # group, solution, stretch, (lo, hi)
+    found = np.empty((2, 2), dtype=np.int64)
+    for i4 in range(2):
+        q4 = V[42] + phi if i4 == 0 else V[42] - phi
+        R4, a_hat, b_perp, nb = _elbow_frame(H, P, V, q4, Lm)
+        line = nb < tiny
+        singular = singular or line
+        if not _inside(V, 3, q4)[1]:
+            continue
+        bp = _perp(a_hat) if line else (b_perp[0] / nb, b_perp[1] / nb, b_perp[2] / nb)
+        ab = _crs(a_hat, bp)
+        for g in range(2):
+            if g == 0:
+                yv, tv, Pv, yu, tu, Pu = h[2], False, eye, h[0], True, eye
             else:
-                lo = mid
-        good[k] = hi
+                yv, tv, Pv, yu, tu, Pu = _mv(Rw, h[6]), True, R4, _mv(R4, h[4]), False, Rw
+            sv = _sinusoid(yv, e, er, f, a_hat, bp, ab, line, tv)
+            su = _sinusoid(yu, e, er, f, a_hat, bp, ab, line, tu)
+            gv = (_mtv(Pv, sv[0]), _mtv(Pv, sv[1]), _mtv(Pv, sv[2]))
+            gu = (_mtv(Pu, su[0]), _mtv(Pu, su[1]), _mtv(Pu, su[2]))
+            _group_runs(4 * g, gv, gu, h, V, cuts, feasible, runs[g], found[g])
+        for j in range(4 * i4, 4 * i4 + 4):
+            i_s, i_w = (j >> 1) & 1, j & 1
+            counts[j] = _intersect(runs[0, i_s], found[0, i_s], runs[1, i_w], found[1, i_w],
+                                   out[j])
+    return 1 if singular else 0
 
 
 # ------------------------------------------------------------- solving at given ψ
@@ -623,19 +979,77 @@ def _packed(arm: SRSArm) -> tuple:
             arm.M[:3, :3].T @ (arm.W0 - arm.M[:3, 3]), perpendicular(arm.H[2]),
             perpendicular(arm.H[6]),
             [A, B, math.atan2(B, A), math.hypot(A, B), float(u @ u + v @ v),
-             float(v @ u_par)]])
+             float(v @ u_par)], _arcs(arm), _cut_table(arm)])
         got = _PACKED.set(arm, tuple(readonly(np.ascontiguousarray(x, dtype=np.float64))
                                      for x in (arm.H, arm.P, arm.M, V)))
     return got
 
 
+def _restricted(arm: SRSArm) -> np.ndarray:
+    """(7,) bool: joints whose limits (± LIMIT_TOL) leave out part of the circle."""
+    lo, hi = arm.lo - LIMIT_TOL, arm.hi + LIMIT_TOL
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(lo) & np.isfinite(hi) & (hi - lo < 2.0 * math.pi)
+
+
+def _arcs(arm: SRSArm) -> np.ndarray:
+    """(21,) per joint: cos m, sin m, cos w of its arc of limits m ± w (± LIMIT_TOL).
+
+    ``(cos t, sin t)·(cos m, sin m) ≥ cos w`` iff t lies in the arc, modulo 2π; −2 for
+    cos w (and m = 0) where the limits leave out no angle (:func:`_in_arc`).
+    """
+    out = np.tile([1.0, 0.0, -2.0], (7, 1))
+    for c in np.flatnonzero(_restricted(arm)):
+        m = 0.5 * (arm.lo[c] + arm.hi[c])
+        out[c] = [math.cos(m), math.sin(m), math.cos(0.5 * (arm.hi[c] - arm.lo[c]) + LIMIT_TOL)]
+    return out.reshape(-1)
+
+
+def _cut_table(arm: SRSArm) -> np.ndarray:
+    """(80,) per group (shoulder, wrist) the eight equations of its cuts (eq 3), 5 numbers each.
+
+    A row ``(d, which, rhs)`` is ``d·v(ψ) = rhs`` (which = 0) or ``d·u(ψ) = rhs``
+    (which = 1), or nothing (which = −1): t1 at its lower and upper limit λ (moved out by
+    ``LIMIT_TOL − _MARGIN``, joints without limits skipped), ``d = Rot(h1, λ)·h2``, rhs
+    h2·h3; t2, ``d = h1``, rhs ``h1·Rot(h2, λ)·h3``; t3, ``d = Rot(h3, −λ)·h2`` on u, rhs
+    h1·h2; and the two bounds of w = h1·v between which subproblem 2's γ² > −(1e-9 −
+    _MARGIN) (γ² is a quadratic in w: α = (c12·h2·h3 − w)/(c12² − 1), β = (c12·w −
+    h2·h3)/(c12² − 1), γ² = (1 − α² − β² − 2αβ c12)/|h1 × h2|²).
+    """
+    out = np.zeros((2, 8, 5))
+    out[:, :, 3] = -1.0
+    restricted = _restricted(arm)
+    for g, base in enumerate((0, 4)):
+        h1, h2, h3 = arm.H[base:base + 3]
+        for side, (lim, sign) in enumerate(((arm.lo, -1.0), (arm.hi, 1.0))):
+            lam = lim[base:base + 3] + sign * (LIMIT_TOL - _MARGIN)
+            if restricted[base]:
+                out[g, side] = [*(_rot(h1, np.array(lam[0])) @ h2), 0.0, h2 @ h3]
+            if restricted[base + 1]:
+                out[g, 2 + side] = [*h1, 0.0, h1 @ _rot(h2, np.array(lam[1])) @ h3]
+            if restricted[base + 2]:
+                out[g, 4 + side] = [*(_rot(h3, np.array(-lam[2])) @ h2), 1.0, h1 @ h2]
+        c12, a2u = float(h1 @ h2), float(h2 @ h3)
+        den = c12 * c12 - 1.0
+        a0, a1, b0, b1 = c12 * a2u / den, -1.0 / den, -a2u / den, c12 / den
+        qa = a1 * a1 + b1 * b1 + 2.0 * c12 * a1 * b1
+        qb = 2.0 * (a0 * a1 + b0 * b1 + c12 * (a0 * b1 + a1 * b0))
+        qc = (a0 * a0 + b0 * b0 + 2.0 * c12 * a0 * b0 - 1.0
+              - (1e-9 - _MARGIN) * float(np.cross(h1, h2) @ np.cross(h1, h2)))
+        disc = qb * qb - 4.0 * qa * qc
+        if disc >= 0.0:
+            for k, sign in enumerate((1.0, -1.0)):
+                out[g, 6 + k] = [*h1, 0.0, (-qb + sign * math.sqrt(disc)) / (2.0 * qa)]
+    return out.reshape(-1)
+
+
 def _entry(name: str):
-    """The compiled entry point of ``_srs_solve`` or ``_srs_bisect`` (no type dispatch).
+    """The compiled entry point of ``_srs_solve`` or ``_srs_spans`` (no type dispatch).
 
     Compiled for exactly the types the callers pass: read-only C-contiguous float64
     inputs (T (N, 4, 4), ψ (N,), r (3,), H, P, M, V), a bool, and fresh outputs
-    (Q float64 (N, 8, 7), found int64 (N, 8)); for the bisection T (4, 4), the branches
-    read-only int64, the ends float64 and an int64 step count.
+    (Q float64 (N, 8, 7), found int64 (N, 8)); for the spans T (4, 4), r, H, P, M, V
+    read-only, a bool and fresh outputs (float64 (8, _MAX_SPANS, 2), int64 (8,)).
     """
     found = _ENTRIES.get(name)
     if found is not None:
@@ -652,10 +1066,10 @@ def _entry(name: str):
         if name == "solve":
             return (ro(3), ro(1), ro(1), ro(2), ro(2), ro(2), ro(1), numba.boolean,
                     Array(f64, 3, "C"), Array(numba.int64, 2, "C"))
-        return (ro(2), ro(1), ro(2), ro(2), ro(2), ro(1), ro(1, numba.int64), ro(1),
-                Array(f64, 1, "C"), numba.int64)
+        return (ro(2), ro(1), ro(2), ro(2), ro(2), ro(1), numba.boolean, Array(f64, 3, "C"),
+                Array(numba.int64, 1, "C"))
 
-    found, final = entry_point(_srs_solve if name == "solve" else _srs_bisect, sig)
+    found, final = entry_point(_srs_solve if name == "solve" else _srs_spans, sig)
     if final:  # else the Python function while it compiles: ask again next call
         _ENTRIES[name] = found
     return found
@@ -677,30 +1091,6 @@ def _solve(arm: SRSArm, T: np.ndarray, psi: np.ndarray, r: np.ndarray
     found = np.empty((len(psi), 8), dtype=np.int64)
     _entry("solve")(T, psi, readonly(r), H, P, M, V, False, Q, found)
     return Q, found == 1
-
-
-def _elbow_angles(arm: SRSArm, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Subproblem 3: the two q4 with ``|p4 + Rot(h4, q4)·(W0 − p4) − S| = L`` for each L (N,).
-
-    With u = W0 − p4 split along and across h4 and v = S − p4, the distance condition is
-    ``A cos q4 + B sin q4 = k`` (A = v·u⊥, B = v·(h4 × u⊥), k = (|u|² + |v|² − L²)/2 −
-    v·u∥): q4 = atan2(B, A) ± acos(k / hypot(A, B)). Returns (N, 2) angles and (N,)
-    flags, False beyond reach (beyond rounding).
-    """
-    h4, p4 = arm.H[3], arm.P[3]
-    u = arm.W0 - p4
-    v = arm.S - p4
-    u_par = (u @ h4) * h4
-    u_perp = u - u_par
-    A = float(v @ u_perp)
-    B = float(v @ np.cross(h4, u_perp))
-    k = 0.5 * (float(u @ u + v @ v) - np.asarray(L) ** 2) - float(v @ u_par)
-    rho = math.hypot(A, B)
-    ratio = k / rho if rho > 0.0 else np.full(np.shape(L), np.inf)
-    ok = np.abs(ratio) <= 1.0 + 1e-12
-    phi = np.arccos(np.clip(ratio, -1.0, 1.0))
-    base = math.atan2(B, A)
-    return np.stack([base + phi, base - phi], axis=-1), ok
 
 
 def ik_arm_angle(robot: Robot, T: object, psi: float, reference: object = None, *,
@@ -827,95 +1217,54 @@ def _reaches(robot: Robot, Q: np.ndarray, T: np.ndarray, tol: float, scale: floa
 
 # ------------------------------------------------------------- feasible intervals
 
-def arm_angle_intervals(robot: Robot, T: object, reference: object = None, *,
-                        resolution: float = math.radians(0.5)) -> ArmAngleIntervals:
+def arm_angle_intervals(robot: Robot, T: object, reference: object = None) -> ArmAngleIntervals:
     """The arm angles ψ at which each branch reaches pose T inside the joint limits.
 
-    Every branch is evaluated in closed form on a grid of ψ over [−π, π] with step
-    ``resolution`` [rad]; each change from feasible to infeasible is then refined by
-    bisection (all ends at once) to 1e-10 rad. A feasible stretch narrower than the grid
-    step can be missed (a branch grazing a limit): lower ``resolution`` to find those.
+    In closed form (eqs 2 and 3 above, after Shimizu et al. 2008): for each elbow angle,
+    every ψ at which a shoulder or wrist angle meets a limit, at which a group's solutions
+    appear or vanish, or at which a pivot angle jumps (h₁ ∥ R·h₃), is a root of
+    ``k₀ + k_c cos ψ + k_s sin ψ = const``; between consecutive roots one evaluation of
+    the closed form decides feasibility. Each inner end is feasible, with a joint at its
+    limit (within ``LIMIT_TOL``), or at the edge of a group's existence or at a jump.
+    Compiled: :func:`_srs_spans`, one call.
+
+    Args:
+        robot: a 7R arm with a spherical shoulder and wrist (:func:`srs_structure`).
+        T: (4, 4) target pose of the tool in the base frame.
+        reference: the direction r of eq (1) (default the base z axis).
 
     Returns:
         :class:`ArmAngleIntervals`.
 
     Raises:
         NoClosedFormError: the robot is not an S-R-S arm.
-        InputError: T is not one rigid transform, or ``resolution`` not in (0, π/8].
+        InputError: T is not one rigid transform, r not a direction.
     """
     arm = srs_structure(robot)
-    Tt = check_transform(T, "T")
-    if Tt.shape != (4, 4):
-        raise InputError(f"T must be one (4, 4) pose, got shape {Tt.shape}")
-    if not (0.0 < float(resolution) <= math.pi / 8):
-        raise InputError(f"resolution must be in (0, π/8] rad, got {resolution!r}")
-    r = _reference(reference)
-    n = int(math.ceil(_TWO_PI / float(resolution)))
-    grid = -math.pi + _TWO_PI * np.arange(n + 1) / n          # both ends: −π and π
-    ok = _feasible(arm, Tt, grid, r)                           # (n + 1, 8)
-    # runs of feasible grid points per branch; each inner end lies between two points
-    runs = []
-    for j in range(8):
-        edges = np.flatnonzero(np.diff(ok[:, j].astype(np.int8)))
-        starts = ([0] if ok[0, j] else []) + [int(i) + 1 for i in edges if not ok[i, j]]
-        stops = [int(i) for i in edges if ok[i, j]] + ([n] if ok[n, j] else [])
-        runs += [(j, a, b) for a, b in zip(starts, stops)]
-    # the inner ends: (branch, infeasible ψ, feasible ψ), bisected together
-    ends = [(j, grid[a - 1], grid[a]) for j, a, _ in runs if a > 0]
-    ends += [(j, grid[b + 1], grid[b]) for j, _, b in runs if b < n]
-    refined = _bisect(arm, Tt, r, ends)
-    at = dict(zip([(j, g) for j, _, g in ends], refined))
-    branches: dict[int, list[tuple[float, float]]] = {}
-    for j, a, b in runs:
-        lo = grid[a] if a == 0 else at[(j, grid[a])]
-        hi = grid[b] if b == n else at[(j, grid[b])]
-        branches.setdefault(j, []).append((float(lo), float(hi)))
-    feasible = _union([s for spans in branches.values() for s in spans])
-    return ArmAngleIntervals(branches=branches, feasible=feasible,
-                             resolution=_TWO_PI / n, singular=_undefined(arm, Tt, r))
-
-
-def _feasible(arm: SRSArm, T: np.ndarray, psi: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """(N, 8): branch j reaches T at ψ[i] inside the joint limits."""
-    return _solve(arm, T, psi, r)[1]
-
-
-def _bisect(arm: SRSArm, T: np.ndarray, r: np.ndarray, ends: list, steps: int = 36
-            ) -> list[float]:
-    """Bisect every (branch, infeasible ψ, feasible ψ) ``steps`` times: the feasible ends.
-
-    36 halvings of the grid step: below 1e-10 rad. Compiled: :func:`_srs_bisect`.
-    """
-    if not ends:
-        return []
     H, P, M, V = _packed(arm)
-    j = readonly(np.array([e[0] for e in ends], dtype=np.int64))
-    bad = readonly(np.array([e[1] for e in ends], dtype=np.float64))
-    good = np.array([e[2] for e in ends], dtype=np.float64)
-    T = readonly(np.ascontiguousarray(T, dtype=np.float64))
-    _entry("bisect")(T, readonly(r), H, P, M, V, j, bad, good, steps)
-    return good.tolist()
-
-
-def _undefined(arm: SRSArm, T: np.ndarray, r: np.ndarray) -> bool:
-    """ψ is undefined at pose T: the line S–W parallel to r, or the elbow on that line."""
-    d = _wrist_target(arm, T) - arm.S
-    L = float(np.linalg.norm(d))
-    if L < 1e-12 * arm.scale:
-        return True
-    e = d / L
-    if np.linalg.norm(r - (r @ e) * e) < 1e-12:
-        return True
-    b = arm.E0 - arm.S
-    q4s, ok = _elbow_angles(arm, np.array([L]))
-    for q4 in q4s[0] if ok[0] else ():
-        a = arm.P[3] + _rot(arm.H[3], np.array(q4)) @ (arm.W0 - arm.P[3]) - arm.S
-        if np.linalg.norm(_cross(a, b)) < 1e-12 * arm.scale * max(L, 1e-300):
-            return True
-    return False
+    out = np.empty((8, _MAX_SPANS, 2))
+    counts = np.empty(8, dtype=np.int64)
+    spans = _entry("spans")
+    if (type(T) is np.ndarray and reference is None and T.shape == (4, 4)
+            and T.dtype == np.float64 and T.flags.c_contiguous):
+        singular = spans(readonly(T), _Z_REF, H, P, M, V, True, out, counts)  # −1: not rigid
+    else:
+        singular = -1
+    if singular < 0:  # the ordinary checks (messages), then the kernel without its own
+        Tt = check_transform(T, "T")
+        if Tt.shape != (4, 4):
+            raise InputError(f"T must be one (4, 4) pose, got shape {Tt.shape}")
+        singular = spans(readonly(np.ascontiguousarray(Tt)), readonly(_reference(reference)),
+                         H, P, M, V, False, out, counts)
+    branches = {j: list(map(tuple, out[j, :k].tolist()))
+                for j, k in enumerate(counts.tolist()) if k}
+    return ArmAngleIntervals(branches=branches,
+                             feasible=_union([s for spans in branches.values() for s in spans]),
+                             singular=bool(singular))
 
 
 def _union(spans: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """The union of closed stretches (lo, hi), sorted; stretches within 1e-12 rad join."""
     out: list[list[float]] = []
     for lo, hi in sorted(spans):
         if out and lo <= out[-1][1] + 1e-12:

@@ -43,6 +43,8 @@ import numpy as np
 
 from serialkin.ik.analytic.subproblems import (
     CLAMP,
+    SEED_GAP,
+    WRIST_SEED,
     add3,
     dot3,
     finalize,
@@ -70,14 +72,26 @@ from ..._jit import njit
 
 #: Most candidate solutions of a 6-joint arm.
 MAX_SOLUTIONS = 8
+#: Largest move [rad, or m per m of stroke] of a Pieper quartic's root by its Newton
+#: polish; beyond it the polish is undone (it was heading for another root).
+POLISH_MOVE = 1e-4
 
 
 @njit(cache=True)
-def wrist_into(gw, gv, W, v, q1, q2, q3, prismatic3, sol, out, k):
+def wrist_into(gw, gv, W, v, q1, q2, q3, prismatic3, slack, sol, out, k):
     """Append the wrist solutions (q4, q5, q6) for arm joints (q1, q2, q3) to ``out``.
 
     The arm's rotation is ``R123 = Rot(w1, q1)·Rot(w2, q2)·Rot(w3, q3)`` (without the
     last factor when joint 3 is prismatic), and ``X = R123ᵀ·R_g = R4·R5·R6``.
+
+    ``slack`` > 0 (a nearly ideal arm's seeds): the wrist's subproblem 2 gives its two
+    seeds also where the true axes (not quite a spherical wrist) miss the tangency, and
+    near the wrist singularity (axis 6 turned by joint 5 within :data:`WRIST_SEED` rad
+    of axis 4, ``R5 w6 ≈ s·w4``), where the ideal wrist has the continuum
+    ``(q4 + t, q5, q6 − s·t)`` and the true arm isolated solutions anywhere along it,
+    two more seeds at t = ±π/2 (the two rows are t = 0 and, flipped, t ≈ π), while
+    ``out`` has room: more than :data:`MAX_SOLUTIONS` candidates say that a seed lay
+    there.
 
     Args:
         gw: ``R_g·w6`` (3,), ``R_g = R_T·R_Mᵀ`` the rotation the six joints must produce.
@@ -88,8 +102,10 @@ def wrist_into(gw, gv, W, v, q1, q2, q3, prismatic3, sol, out, k):
         q2: arm joint 2 value [rad].
         q3: arm joint 3 value [rad, or m when prismatic].
         prismatic3: True when joint 3 slides (Stanford class).
+        slack: 0 for an exact solve, > 0 for a nearly ideal arm's seeds.
         sol: (2, 6) scratch array (see :func:`~serialkin.ik.analytic.subproblems.sp2_dir`).
-        out: (8, 6) candidate rows; rows k, k+1 are written.
+        out: (K, 6) candidate rows; rows k, k+1 (and two more near the singularity) are
+            written.
         k: number of rows already in ``out``.
 
     Returns:
@@ -114,9 +130,11 @@ def wrist_into(gw, gv, W, v, q1, q2, q3, prismatic3, sol, out, k):
         sn3 = -math.sin(q3)
         xw = rot3(w3, c3, sn3, xw)
         xv = rot3(w3, c3, sn3, xv)
-    m = sp2_dir(w4, w5, w6, xw, sol)  # (q4, q5) with their cosines and sines
+    m = sp2_dir(w4, w5, w6, xw, slack, sol)  # (q4, q5) with their cosines and sines
     for r in range(m):
         q6 = sp1_dir(w6, v, rot3(w5, sol[r, 4], -sol[r, 5], rot3(w4, sol[r, 2], -sol[r, 3], xv)))
+        if k == out.shape[0]:
+            return k
         out[k, 0] = q1
         out[k, 1] = q2
         out[k, 2] = q3
@@ -124,6 +142,20 @@ def wrist_into(gw, gv, W, v, q1, q2, q3, prismatic3, sol, out, k):
         out[k, 4] = sol[r, 1]
         out[k, 5] = q6
         k += 1
+        if slack > 0.0 and r == 0:
+            a = rot3(w5, sol[r, 4], sol[r, 5], w6)  # R5·w6
+            s = dot3(a, w4)
+            if 1.0 - s * s < WRIST_SEED * WRIST_SEED:
+                for t in (0.5 * math.pi, -0.5 * math.pi):
+                    if k == out.shape[0]:
+                        return k
+                    out[k, 0] = q1
+                    out[k, 1] = q2
+                    out[k, 2] = q3
+                    out[k, 3] = sol[r, 0] + t
+                    out[k, 4] = sol[r, 1]
+                    out[k, 5] = q6 - t if s > 0.0 else q6 + t
+                    k += 1
     return k
 
 
@@ -131,8 +163,9 @@ def wrist_into(gw, gv, W, v, q1, q2, q3, prismatic3, sol, out, k):
 def puma_positions(pw, W, P, aux, slack, out):
     """Arm joints (q1, q2, q3) of a ``puma``-class arm putting c on ``pw``.
 
-    aux = (c, w, e1 ⟂ w, ...); ``slack``: elbow seeds beyond the reach
-    (:func:`~serialkin.ik.analytic.subproblems.planar2r_solve`; 0 for an exact solve).
+    aux = (c, w, e1 ⟂ w, ...); ``slack``: 0 for an exact solve, > 0 for a nearly ideal
+    arm's seeds: shoulder and elbow give two seeds on both sides of their tangencies, also
+    just beyond the ideal arm's reach (:func:`~serialkin.ik.analytic.subproblems.acos_seed`).
 
     Writes rows into ``out`` (4, 3) and returns their count.
     """
@@ -148,7 +181,7 @@ def puma_positions(pw, W, P, aux, slack, out):
     sol = buf[6:10].reshape((2, 2))
     frame = planar2r_frame(w, e1, c2, c3, c)  # joints 2, 3 carrying c, once, not per branch
     d = sub3((pw[0], pw[1], pw[2]), r1)
-    n1 = sp4(w1, w, d, dot3(w, sub3(c, r1)), q1s)
+    n1 = sp4(w1, w, d, dot3(w, sub3(c, r1)), slack, q1s)
     k = 0
     s2 = dot3(row3(W, 1), w)
     s3 = dot3(row3(W, 2), w)
@@ -165,7 +198,7 @@ def puma_positions(pw, W, P, aux, slack, out):
 
 
 @njit(cache=True)
-def intersecting_positions(pw, W, P, aux, prismatic3, out):
+def intersecting_positions(pw, W, P, aux, prismatic3, slack, out):
     """Arm joints when axes 1 and 2 meet at o; aux = (c, o, ...). Rows into ``out`` (4, 3).
 
     Rotations about axes 1 and 2 keep the distance to ``o``, so joint 3 alone must give
@@ -174,7 +207,8 @@ def intersecting_positions(pw, W, P, aux, prismatic3, out):
     for a prismatic one (``prismatic3``, ``stanford``). Up to two values of q3; q1, q2
     then carry the moved centre onto ``p_w`` (subproblem 2, two solutions each).
     Returns the count. The subproblems take their vectors as tuples (:func:`row3`,
-    :func:`tup3`).
+    :func:`tup3`). ``slack``: 0 for an exact solve, > 0 for a nearly ideal arm's seeds
+    (both sides of the tangencies of q3 and of q1, q2; not for a slide).
     """
     c = aux[0].copy()
     o = aux[1].copy()
@@ -187,7 +221,7 @@ def intersecting_positions(pw, W, P, aux, prismatic3, out):
     if prismatic3:
         n3 = sp3_slide(tup3(w3), tup3(h), dot3(gt, gt), q3s)
     else:
-        n3 = sp3(tup3(w3), tup3(r3), tup3(c), tup3(o), np.sqrt(dot3(gt, gt)), q3s)
+        n3 = sp3(tup3(w3), tup3(r3), tup3(c), tup3(o), np.sqrt(dot3(gt, gt)), slack, q3s)
     sol = np.empty((2, 2))
     k = 0
     for i in range(n3):
@@ -196,7 +230,7 @@ def intersecting_positions(pw, W, P, aux, prismatic3, out):
             x = h + q3 * w3
         else:
             x = rotate_point(w3, r3, q3, c) - o
-        m = sp2_dir(row3(W, 0), row3(W, 1), tup3(x), gt, sol)
+        m = sp2_dir(row3(W, 0), row3(W, 1), tup3(x), gt, slack, sol)
         for j in range(m):
             out[k, 0] = sol[j, 0]
             out[k, 1] = sol[j, 1]
@@ -220,7 +254,7 @@ def _general_residual(theta, c, w3, r3, r2, w2, a1, ca, sa, rho2, h):
 
 
 @njit(cache=True)
-def general_positions(pw, W, P, aux, prismatic3, out):
+def general_positions(pw, W, P, aux, prismatic3, slack, out):
     """Arm joints of a ``pieper_general`` / ``stanford_general`` arm; aux = (c, r1, r2, n, m, ...).
 
     Writes rows (q1, q2, q3) putting c on ``pw`` into ``out`` (4, 3); returns the count.
@@ -244,6 +278,11 @@ def general_positions(pw, W, P, aux, prismatic3, out):
     When axes 1 and 2 are parallel (sα = 0) the second invariant reads w2·u = cα·w1·(p_w − r1)
     instead: θ3 by :func:`~serialkin.ik.analytic.subproblems.sp4` (two values) or d directly
     (one), and g2 = ±sqrt(|u|² − (w2·u)² − g1²) (two values of θ2 each).
+
+    ``slack``: 0 for an exact solve; > 0 for a nearly ideal arm's seeds: a pair of roots
+    just off the real axis (a near-double root the ideal arm lacks) gives two seeds
+    mirrored onto it, and tangencies give two seeds on both sides
+    (:func:`~serialkin.ik.analytic.subproblems.acos_seed`).
 
     The subproblems take their vectors as tuples (:func:`row3`, :func:`tup3`); the
     intermediate vectors stay in arrays, so that no rounding changes (fused operations
@@ -270,11 +309,11 @@ def general_positions(pw, W, P, aux, prismatic3, out):
     parallel = abs(sa) < 1e-9
     thetas = np.empty(4)
     if prismatic3:
-        nt = _quartic_stroke(tup3(h0), w3t, w2t, a1, ca, sa, rho2, h, parallel, thetas)
+        nt = _quartic_stroke(tup3(h0), w3t, w2t, a1, ca, sa, rho2, h, parallel, slack, thetas)
     elif parallel:  # axes 1 ∥ 2: w2·u(θ3) = cα·h fixes θ3 (two values), g2 = ±sqrt(..)
-        nt = sp4(w3t, tup3(c - r3), w2t, ca * h - dot3(w2t, tup3(r3 - r2)), thetas)
+        nt = sp4(w3t, tup3(c - r3), w2t, ca * h - dot3(w2t, tup3(r3 - r2)), slack, thetas)
     else:
-        nt = _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas)
+        nt = _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, slack, thetas)
     k = 0
     for i in range(nt):
         th = thetas[i]
@@ -288,7 +327,12 @@ def general_positions(pw, W, P, aux, prismatic3, out):
         g1 = (rho2 - uu - a1 * a1) / (2.0 * a1)
         if parallel:
             g2sq = uu - wu * wu - g1 * g1
-            if g2sq < -CLAMP * max(uu, 1e-300):
+            if slack > 0.0:  # seeds on both sides of the tangency (as acos_seed)
+                perp = max(uu - wu * wu, 1e-300)
+                if g2sq < -slack * perp:
+                    continue
+                g2sq = max(abs(g2sq), SEED_GAP * SEED_GAP * perp)
+            elif g2sq < -CLAMP * max(uu, 1e-300):
                 continue
             g2 = math.sqrt(max(g2sq, 0.0))
             ng = 1 if g2 == 0.0 else 2
@@ -315,13 +359,24 @@ _FIVE = np.array([[np.exp(-1j * k * 2.0 * np.pi * j / 5.0) / 5.0 for k in range(
 
 
 @njit(cache=True)
-def _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas):
+def _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, slack, thetas):
     """Real roots θ3 of E(θ3) (degree-2 trigonometric polynomial) into ``thetas``; the count.
 
     The Fourier coefficients c0, c1, c2 of E come exactly from 5 equally spaced samples;
     the roots of ``z²·E(z)`` (z = e^{iθ}) near the unit circle
     (:func:`~serialkin.ik.analytic.subproblems.poly_roots`) are polished by Newton's
-    method on E and kept when E vanishes there.
+    method on E and kept when E vanishes there. The polish keeps the root it started
+    from: near a double root E' nearly vanishes and a Newton step can jump to another
+    root (two solutions 1e-3 rad apart then came back as one, the other pair lost), so
+    a polish that moves more than :data:`POLISH_MOVE` is undone.
+
+    ``slack`` > 0 (a nearly ideal arm's seeds): a root z = e^{i(θ0 + iτ)} off the circle
+    (|τ| > 1e-7) with |τ| <= ``slack`` (a real pair of the true arm that the ideal one
+    has as a complex pair, or a double root) gives the seed θ0 + τ, so the pair z, 1/z̄
+    gives θ0 ± τ, at least :data:`~serialkin.ik.analytic.subproblems.SEED_GAP` apart
+    (:func:`_spread`); seeds are not required to make E vanish. Measured on a Pieper arm
+    perturbed by 1e-8: at a pose 1e-3 rad from its elbow singularity the ideal arm's pair
+    was complex (τ = 6e-4) where the true arm's solutions lie 1.4e-3 apart.
     """
     coef = np.zeros(3, dtype=np.complex128)
     scale = 0.0
@@ -349,9 +404,18 @@ def _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas):
     c2i = coef[2].imag
     count = 0
     for z in roots[:nr]:
-        if abs(abs(z) - 1.0) > 1e-3 or count == thetas.shape[0]:
+        if count == thetas.shape[0]:
             continue
         th = math.atan2(z.imag, z.real)
+        tau = -math.log(max(abs(z), 1e-300))  # z = e^{i(θ0 + iτ)}
+        if slack > 0.0 and abs(tau) > 1e-7:  # complex, or a double root: both sides
+            if abs(tau) <= slack:
+                thetas[count] = th + math.copysign(max(abs(tau), SEED_GAP), tau)
+                count += 1
+            continue
+        if abs(abs(z) - 1.0) > 1e-3:
+            continue
+        start = th
         for _ in range(8):  # Newton on E(θ) = c0 + 2 Re(c1 e^{iθ} + c2 e^{2iθ}), real form
             cs = math.cos(th)
             sn = math.sin(th)
@@ -365,15 +429,36 @@ def _quartic_theta3(c, w3, r3, r2, w2, a1, ca, sa, rho2, h, thetas):
             th -= step
             if abs(step) < 1e-15:
                 break
-        if abs(_general_residual(th, c, w3, r3, r2, w2, a1, ca, sa, rho2, h)) \
+        if not abs(th - start) <= POLISH_MOVE:
+            th = start  # jumped towards another root: keep the one it started from
+        if slack > 0.0 or abs(_general_residual(th, c, w3, r3, r2, w2, a1, ca, sa, rho2, h)) \
                 <= 1e-8 * max(scale, 1e-300):
             thetas[count] = th
             count += 1
+    if slack > 0.0:
+        _spread(thetas, count)
     return count
 
 
 @njit(cache=True)
-def _quartic_stroke(h0, b, w2, a1, ca, sa, rho2, h, parallel, strokes):
+def _spread(seeds, count):
+    """Move seeds closer than :data:`~serialkin.ik.analytic.subproblems.SEED_GAP` apart.
+
+    Two seeds of a nearly ideal arm at (nearly) one double root become their midpoint
+    ± SEED_GAP / 2, one on each side of the tangency (Newton's method converges to the
+    solution on its side); ``seeds[:count]`` in place.
+    """
+    for i in range(count):
+        for j in range(i + 1, count):
+            if abs(seeds[i] - seeds[j]) < SEED_GAP:
+                mid = 0.5 * (seeds[i] + seeds[j])
+                lo = seeds[i] <= seeds[j]
+                seeds[i] = mid - 0.5 * SEED_GAP if lo else mid + 0.5 * SEED_GAP
+                seeds[j] = mid + 0.5 * SEED_GAP if lo else mid - 0.5 * SEED_GAP
+
+
+@njit(cache=True)
+def _quartic_stroke(h0, b, w2, a1, ca, sa, rho2, h, parallel, slack, strokes):
     """Real roots d of E(d), joint 3 prismatic (see :func:`general_candidates`); the count.
 
     With u = h0 + d·b (h0 = c − r2, b = w3): g1 = K2 d² + K1 d + K0, g2 = L1 d + L0 and
@@ -381,7 +466,10 @@ def _quartic_stroke(h0, b, w2, a1, ca, sa, rho2, h, parallel, strokes):
     quartic, solved by :func:`~serialkin.ik.analytic.subproblems.poly_roots`; the real
     roots are polished by Newton's method and kept when E vanishes there. With ``parallel``
     axes 1, 2 the height w2·u(d) = cα·h gives the one stroke d directly. ``h0``, ``b``,
-    ``w2`` tuples.
+    ``w2`` tuples. A polish that moves a root more than :data:`POLISH_MOVE`·max(1, |d|) is
+    undone (as in :func:`_quartic_theta3`); ``slack`` > 0 (a nearly ideal arm's seeds): a
+    root d0 + iτ with |τ| <= ``slack``·max(1, |d0|) gives the seed d0 + τ (the conjugate
+    pair gives d0 ± τ), not required to make E vanish.
     """
     wb = dot3(w2, b)
     wh = dot3(w2, h0)
@@ -407,13 +495,22 @@ def _quartic_stroke(h0, b, w2, a1, ca, sa, rho2, h, parallel, strokes):
     for cf in coefs:
         big = max(big, abs(cf))
     for z in roots:
-        if abs(z.imag) > 1e-4 * max(1.0, abs(z.real)) or ns == strokes.shape[0]:
+        if ns == strokes.shape[0]:
+            continue
+        size = max(1.0, abs(z.real))
+        if abs(z.imag) > 1e-4 * size:
+            if slack > 0.0 and abs(z.imag) <= slack * size:
+                strokes[ns] = z.real + math.copysign(max(abs(z.imag), SEED_GAP * size),
+                                                     z.imag)
+                ns += 1
             continue
         d = polish_real_root(coefs, z.real)
+        if not abs(d - z.real) <= POLISH_MOVE * size:
+            d = z.real
         f = 0.0
         for cf in coefs:
             f = f * d + cf
-        if abs(f) <= 1e-9 * big * max(1.0, d * d * d * d):
+        if slack > 0.0 or abs(f) <= 1e-9 * big * max(1.0, d * d * d * d):
             strokes[ns] = d
             ns += 1
     return ns
@@ -425,14 +522,15 @@ def arm_positions(pw, W, P, aux, arm, prismatic3, slack, out):
 
     ``arm`` 0: axes 2 ∥ 3 (:func:`puma_positions`); 1: axes 1, 2 meet
     (:func:`intersecting_positions`); 2: otherwise (:func:`general_positions`). Rows into
-    ``out`` (4, 3); returns their count (0-4). ``slack``: elbow seeds beyond the reach
-    for ``arm`` 0 (:func:`puma_positions`; 0 for an exact solve).
+    ``out`` (4, 3); returns their count (0-4). ``slack``: 0 for an exact solve, > 0 for
+    the seeds of a nearly ideal arm (two on both sides of every tangency, also just
+    beyond the ideal arm's reach; :func:`~serialkin.ik.analytic.subproblems.acos_seed`).
     """
     if arm == 0:
         return puma_positions(pw, W, P, aux, slack, out)
     if arm == 1:
-        return intersecting_positions(pw, W, P, aux, prismatic3, out)
-    return general_positions(pw, W, P, aux, prismatic3, out)
+        return intersecting_positions(pw, W, P, aux, prismatic3, slack, out)
+    return general_positions(pw, W, P, aux, prismatic3, slack, out)
 
 
 @njit(cache=True)
@@ -440,7 +538,7 @@ def wrist_candidates(T, W, P, M, aux, arm, prismatic3, slack, out):
     """Candidate rows (8, 6) of a spherical-wrist arm: the arm joints, then the wrist.
 
     ``aux[0]`` is the wrist centre c and ``aux[-1]`` a unit vector ⟂ w6; returns the count.
-    ``slack``: elbow seeds beyond the reach (:func:`arm_positions`; 0 for an exact solve).
+    ``slack``: 0 for an exact solve, > 0 for a nearly ideal arm's seeds (:func:`arm_positions`).
     """
     Rg = target_rotation(T, M)
     scratch = np.empty(27)  # wrist centre, arm rows, wrist scratch: one allocation
@@ -455,8 +553,8 @@ def wrist_candidates(T, W, P, M, aux, arm, prismatic3, slack, out):
     gv = mv3(Rg, v)
     k = 0
     for i in range(m):
-        k = wrist_into(gw, gv, W, v, arm3[i, 0], arm3[i, 1], arm3[i, 2], prismatic3, sol,
-                       out, k)
+        k = wrist_into(gw, gv, W, v, arm3[i, 0], arm3[i, 1], arm3[i, 2], prismatic3, slack,
+                       sol, out, k)
     return k
 
 

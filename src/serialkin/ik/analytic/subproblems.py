@@ -52,6 +52,14 @@ DUPLICATE_TOL = 1e-9
 #: Elbow cosines this far beyond ±1 still seed a nearly ideal arm's two elbow branches
 #: (:func:`planar2r_solve`); see docs/ik-analytic.md for the measurement.
 ELBOW_SLACK = 0.25
+#: Smallest half-angle [rad] between the two seeds a nearly ideal arm's subproblem gives at
+#: or beyond a tangency (:func:`acos_seed`): Newton's method from either side of a fold
+#: converges to the solution on that side, never from the fold itself.
+SEED_GAP = 1e-3
+#: A nearly ideal arm's seed within this angle [rad] of its wrist singularity (the axis
+#: after the wrist parallel to the one before it) gets two more seeds along the ideal
+#: wrist's continuum (``spherical_wrist.wrist_into``, ``ur.ur_candidates``).
+WRIST_SEED = 0.05
 #: Solutions within this distance outside a joint limit are clipped onto it.
 LIMIT_TOL = 1e-10
 TWO_PI = 2.0 * math.pi
@@ -303,6 +311,29 @@ def _acos_clamped(x):
 
 
 @njit(cache=True)
+def acos_seed(x, slack):
+    """arccos(x) for an exact solve (``slack`` 0), or the seed angle of a nearly ideal arm.
+
+    ``slack`` 0: :func:`_acos_clamped` (clamped within :data:`CLAMP`, snapped within
+    :data:`SNAP`, NaN beyond). ``slack`` > 0, the candidates of an idealised arm that
+    Newton's method refines on the true one: every |x| <= 1 + slack gives an angle,
+    arccos of x or, beyond ±1, of the mirrored ``sign(x)·(2 − |x|)`` (as far inside as x
+    is outside: the true arm may reach what the ideal one just misses), kept at least
+    :data:`SEED_GAP` from 0 and π, so that the two seeds ``±angle`` lie on both sides of
+    the tangency; NaN beyond.
+    """
+    if slack <= 0.0:
+        return _acos_clamped(x)
+    ax = abs(x)
+    if not ax <= 1.0 + slack:
+        return math.nan
+    if ax > 1.0:
+        x = math.copysign(2.0 - ax, x)
+    a = math.acos(max(-1.0, min(1.0, x)))
+    return min(max(a, SEED_GAP), math.pi - SEED_GAP)
+
+
+@njit(cache=True)
 def sp1_dir_cs(w, u, v):
     """Subproblem 1 on directions with the cosine and sine of the angle: ``(θ, cos θ, sin θ)``.
 
@@ -346,14 +377,16 @@ def sp1_dir(w, u, v):
 
 
 @njit(cache=True)
-def sp2_dir(w1, w2, u, v, out):
+def sp2_dir(w1, w2, u, v, slack, out):
     """Subproblem 2: θ1, θ2 with ``Rot(w1, θ1)·Rot(w2, θ2)·u = v`` (axes meet; w1 ∦ w2).
 
     ``u`` and ``v`` are vectors from the common point (or directions). The intermediate
     vector is ``z = α w1 + β w2 ± γ (w1 × w2)`` with ``w2·z = w2·u``, ``w1·z = w1·v`` and
     ``|z| = |u|``. Writes rows (θ1, θ2) into ``out`` (2, 2), or (θ1, θ2, cos θ1, sin θ1,
     cos θ2, sin θ2) when ``out`` has 6 columns (:func:`sp1_dir_cs`: no trigonometric
-    call); returns 0, 1 or 2.
+    call); returns 0, 1 or 2. ``slack`` > 0 (a nearly ideal arm's seeds): γ² down to
+    −slack·|u|²/|w1 × w2|² gives the two mirrored seeds ±sqrt(|γ²|), and γ is kept at
+    least :data:`SEED_GAP`·|u|/|w1 × w2| (as :func:`acos_seed`); 0 for an exact solve.
     """
     c12 = dot3(w1, w2)
     den = c12 * c12 - 1.0
@@ -365,7 +398,11 @@ def sp2_dir(w1, w2, u, v, out):
     nx2 = dot3(x, x)
     uu = dot3(u, u)
     g2 = (uu - alpha * alpha - beta * beta - 2.0 * alpha * beta * c12) / nx2
-    if g2 < 0.0:
+    if slack > 0.0:
+        if g2 < -slack * uu / nx2:
+            return 0
+        g2 = max(abs(g2), SEED_GAP * SEED_GAP * uu / nx2)
+    elif g2 < 0.0:
         if g2 < -CLAMP * max(uu, 1e-300) / nx2:
             return 0
         g2 = 0.0
@@ -388,12 +425,13 @@ def sp2_dir(w1, w2, u, v, out):
 
 
 @njit(cache=True)
-def sp3(w, r, p, q, delta, out):
+def sp3(w, r, p, q, delta, slack, out):
     """Subproblem 3: θ with ``|Rot(w, θ; r)·p − q| = δ`` (rotation about the line (w, r)).
 
     Projected on the plane ⟂ w: ``|u'|² + |v'|² − 2|u'||v'| cos(θ − θ0) = δ'²`` with
     ``u = p − r``, ``v = q − r``, ``δ'² = δ² − (w·(p − q))²``. Writes θ into ``out``
     (2,), returns 0, 1 or 2 (0 also when p or q lies on the axis). Vectors as tuples.
+    ``slack``: 0 for an exact solve, > 0 for a nearly ideal arm's seeds (:func:`acos_seed`).
     """
     u = sub3(p, r)
     v = sub3(q, r)
@@ -408,7 +446,7 @@ def sp3(w, r, p, q, delta, out):
     h = dot3(w, sub3(p, q))
     d2 = delta * delta - h * h
     theta0 = math.atan2(dot3(w, cross3t(up, vp)), dot3(up, vp))
-    c = _acos_clamped((nu * nu + nv * nv - d2) / (2.0 * nu * nv))
+    c = acos_seed((nu * nu + nv * nv - d2) / (2.0 * nu * nv), slack)
     if math.isnan(c):
         return 0
     out[0] = theta0 - c
@@ -442,7 +480,7 @@ def sp3_slide(w, h, delta2, out):
     return 2
 
 @njit(cache=True)
-def sp4(w, b, a, c, out):
+def sp4(w, b, a, c, slack, out):
     """θ with ``a·Rot(w, θ)·b = c``: ``A cos θ + B sin θ = c − (a·w)(w·b)``.
 
     ``A = a·b'``, ``B = a·(w × b')``, ``b'`` the part of b ⟂ w, so θ = atan2(B, A) ±
@@ -450,7 +488,9 @@ def sp4(w, b, a, c, out):
     θ = 0 is returned as the representative. Writes θ into ``out`` (2,), returns 0, 1 or
     2. With ``out`` of 6 entries also ``cos θ, sin θ`` of each solution into
     ``out[2:4]`` and ``out[4:6]``, by the angle-sum formulas from A, B, D (no
-    trigonometric call; ``sin(arccos x) = sqrt((1 − x)(1 + x))``).
+    trigonometric call; ``sin(arccos x) = sqrt((1 − x)(1 + x))``). ``slack``: 0 for an
+    exact solve, > 0 for a nearly ideal arm's seeds (:func:`acos_seed`: two seeds on both
+    sides of a tangency, also just beyond it).
     """
     wb = w[0] * b[0] + w[1] * b[1] + w[2] * b[2]
     b0 = b[0] - wb * w[0]
@@ -474,14 +514,16 @@ def sp4(w, b, a, c, out):
         return 0
     phi = math.atan2(B, A)
     cx = D / Rn
-    x = _acos_clamped(cx)
+    x = acos_seed(cx, slack)
     if math.isnan(x):
         return 0
     out[0] = phi + x
     if cs:
         cp = A / Rn
         sp = B / Rn
-        if x == 0.0:
+        if slack > 0.0:
+            cx, sx = math.cos(x), math.sin(x)
+        elif x == 0.0:
             cx, sx = 1.0, 0.0
         elif x == math.pi:
             cx, sx = -1.0, 0.0
@@ -545,9 +587,10 @@ def planar2r_solve(frame, t, out, slack):
 
     ``slack`` ≥ 0: a target out of reach whose elbow cosine ``c`` lies within
     ``1 + slack`` of the boundary (|c| ≤ 1 + slack) still gives two rows, those of the
-    mirrored cosine ``sign(c)·(2 − |c|)`` (as far inside the reach as c is outside): the
-    seeds of an idealised arm's refinement (:data:`ELBOW_SLACK`), where the true arm may
-    reach what the ideal one does not. 0 for an exact solve.
+    mirrored cosine ``sign(c)·(2 − |c|)`` (as far inside the reach as c is outside), and
+    a nearly stretched or folded elbow two rows at least :data:`SEED_GAP` apart
+    (:func:`acos_seed`): the seeds of an idealised arm's refinement (:data:`ELBOW_SLACK`),
+    where the true arm may reach what the ideal one does not. 0 for an exact solve.
     """
     e1, e2, c1, L1, L2, phi10, phi20 = frame
     d = sub3(t, c1)
@@ -555,11 +598,9 @@ def planar2r_solve(frame, t, out, slack):
     y = dot3(e2, d)
     r2 = x * x + y * y
     c = (r2 - L1 * L1 - L2 * L2) / (2.0 * L1 * L2)
-    th2 = _acos_clamped(c)
+    th2 = acos_seed(c, slack)
     if math.isnan(th2):
-        if not abs(c) <= 1.0 + slack:
-            return 0
-        th2 = math.acos(math.copysign(2.0 - abs(c), c))
+        return 0
     alpha = math.atan2(y, x)
     beta = math.atan2(L2 * math.sin(th2), L1 + L2 * math.cos(th2))
     out[0, 0] = alpha - beta - phi10

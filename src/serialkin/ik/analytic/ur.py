@@ -24,6 +24,7 @@ import math
 import numpy as np
 
 from serialkin.ik.analytic.subproblems import (
+    WRIST_SEED,
     add3,
     cross3t,
     dot3,
@@ -50,8 +51,15 @@ MAX_SOLUTIONS = 8
 def ur_candidates(T, W, P, M, aux, slack, out):
     """Candidates for a ``ur``-class arm; aux = (p56, w, e ⟂ w). Returns the count.
 
-    ``slack``: elbow seeds beyond the reach (:func:`~serialkin.ik.analytic.subproblems.
-    planar2r_solve`; 0 for an exact solve).
+    ``slack``: 0 for an exact solve; > 0 for the seeds of a nearly ideal arm: the
+    shoulder (q1), the wrist (q5) and the elbow give two seeds on both sides of their
+    tangencies, also just beyond the ideal arm's reach
+    (:func:`~serialkin.ik.analytic.subproblems.acos_seed`), and near the wrist
+    singularity (axis 6 turned by joint 5 within
+    :data:`~serialkin.ik.analytic.subproblems.WRIST_SEED` rad of ``w``: the ideal arm
+    has a continuum, q6 free and joints 2-4 following) the first q5 also gets the seeds
+    q6 ± π/2, while ``out`` has room: more than :data:`MAX_SOLUTIONS` candidates say
+    that a seed lay there.
 
     Vectors are tuples (no allocation per branch) and every rotation is applied by
     Rodrigues' formula from one sin/cos per joint value (``Rot(w, −θ) = Rot(w, θ)ᵀ``).
@@ -85,7 +93,7 @@ def ur_candidates(T, W, P, M, aux, slack, out):
     q1s = buf[0:6]  # angles, then the cosine and sine of each (sp4)
     q5s = buf[6:12]
     sol = buf[12:16].reshape((2, 2))
-    n1 = sp4(w1, w, sub3(p5, r1), dot3(w, sub3(p56, r1)), q1s)
+    n1 = sp4(w1, w, sub3(p5, r1), dot3(w, sub3(p56, r1)), slack, q1s)
     k = 0
     for i in range(n1):
         q1 = q1s[i]
@@ -93,27 +101,39 @@ def ur_candidates(T, W, P, M, aux, slack, out):
         sn1 = q1s[3 + 2 * i]
         R1w = rot3(w1, c1, sn1, w)
         Xtw = mtv3(Rg, R1w)  # Xᵀ·w with X = R1ᵀ·R_g
-        n5 = sp4(w5, w6, w, dot3(R1w, w6t), q5s)
+        n5 = sp4(w5, w6, w, dot3(R1w, w6t), slack, q5s)
         for j in range(n5):
             q5 = q5s[j]
             c5 = q5s[2 + 2 * j]
             sn5 = q5s[3 + 2 * j]
             q6, c6, sn6 = sp1_dir_cs(w6, Xtw, rot3(w5, c5, -sn5, w))
-            # G = e1⁻¹·T·M⁻¹·e6⁻¹·e5⁻¹ applied to e and x4 by rotations (no 4 × 4 products)
-            ve = rot3(w1, c1, -sn1, mv3(Rg, rot3(w6, c6, -sn6, rot3(w5, c5, -sn5, e))))
-            s = math.atan2(dot3(w, cross3t(e, ve)), dot3(e, ve))
-            a = add3(rot3(w5, c5, -sn5, x4r5), r5r6)
-            b = add3(mv3(Rg, add3(rot3(w6, c6, -sn6, a), r6)), tgr1)
-            y = add3(rot3(w1, c1, -sn1, b), r1)
-            m = planar2r_solve(frame, y, sol, slack)
-            for r in range(m):
-                out[k, 0] = q1
-                out[k, 1] = s2 * sol[r, 0]
-                out[k, 2] = s3 * sol[r, 1]
-                out[k, 3] = s4 * (s - sol[r, 0] - sol[r, 1])
-                out[k, 4] = q5
-                out[k, 5] = q6
-                k += 1
+            seeds = 1
+            if slack > 0.0 and j == 0:  # near the wrist singularity: along its continuum
+                aw = dot3(rot3(w5, c5, sn5, w6), w)  # w·R5·w6
+                if 1.0 - aw * aw < WRIST_SEED * WRIST_SEED:
+                    seeds = 3
+            for t in range(seeds):
+                if t == 1:  # q6 + π/2
+                    q6, c6, sn6 = q6 + 0.5 * math.pi, -sn6, c6
+                elif t == 2:  # q6 − π/2 (from q6 + π/2)
+                    q6, c6, sn6 = q6 - math.pi, -c6, -sn6
+                # G = e1⁻¹·T·M⁻¹·e6⁻¹·e5⁻¹ applied to e and x4 by rotations (no 4 × 4 products)
+                ve = rot3(w1, c1, -sn1, mv3(Rg, rot3(w6, c6, -sn6, rot3(w5, c5, -sn5, e))))
+                s = math.atan2(dot3(w, cross3t(e, ve)), dot3(e, ve))
+                a = add3(rot3(w5, c5, -sn5, x4r5), r5r6)
+                b = add3(mv3(Rg, add3(rot3(w6, c6, -sn6, a), r6)), tgr1)
+                y = add3(rot3(w1, c1, -sn1, b), r1)
+                m = planar2r_solve(frame, y, sol, slack)
+                for r in range(m):
+                    if k == out.shape[0]:
+                        return k
+                    out[k, 0] = q1
+                    out[k, 1] = s2 * sol[r, 0]
+                    out[k, 2] = s3 * sol[r, 1]
+                    out[k, 3] = s4 * (s - sol[r, 0] - sol[r, 1])
+                    out[k, 4] = q5
+                    out[k, 5] = q6
+                    k += 1
     return k
 
 
