@@ -156,7 +156,7 @@ def test_lm_active_set_step_is_the_reduced_solve(n, seed):
     q[at] = np.where(rng.random(at.sum()) < 0.5, -1.0, 1.0)
     revolute = readonly(np.zeros(n))  # prismatic-like: no 2π shift
     sw = np.ones(6)
-    _, _, _, dq, _, _, _, ws, _, _ = _carve(_workspace(n))
+    _, _, _, dq, _, _, _, ws, _, _, _, _ = _carve(_workspace(n))
     ws[W_JW][:] = J
     ws[W_R][:] = e
     cost = 0.5 * float(e @ e)

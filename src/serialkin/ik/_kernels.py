@@ -94,7 +94,7 @@ import numpy as np
 from serialkin.collision.queries import PAIR_NONE, clearance_at, pair_distance_at
 from serialkin.ik.turns import turn_toward
 from serialkin.kinematics.dls import dls_step_into, spd_solve_into
-from serialkin.kinematics.kernels import fk_all_into, fk_into, jacobian_into
+from serialkin.kinematics.kernels import fk_all_into, jacobian_into
 from serialkin.model.limits import inside as interval_inside
 from serialkin.model.limits import normalize as interval_normalize
 from serialkin.model.limits import project as interval_project
@@ -472,12 +472,12 @@ def _limit_step(dq, max_step):
 def _workspace(n):
     """The loop's four buffers for n joints, ``(B, C, T2, state)``; :func:`_carve` cuts them.
 
-    ``B`` (3n + 25, n), ``C`` (12, 6), ``T2`` (2, 4, 4) float64 and ``state`` (1,) uint64.
+    ``B`` (3n + 26, n), ``C`` (13, 6), ``T2`` (2, 4, 4) float64 and ``state`` (1,) uint64.
     Four allocations rather than one per array; the views are cut where they are used
     (:func:`_carve`), in a function without reference counting when it can be: with it,
     each view costs an atomic increment and decrement of its buffer's count.
     """
-    return (np.empty((3 * n + 25, n)), np.empty((12, 6)), np.empty((2, 4, 4)),
+    return (np.empty((3 * n + 26, n)), np.empty((13, 6)), np.empty((2, 4, 4)),
             np.empty(1, dtype=np.uint64))
 
 
@@ -486,18 +486,20 @@ def _carve(buffers):
     """The loop's arrays, C-contiguous views of :func:`_workspace`'s buffers.
 
     Returns ``(J (6, n), T (4, 4), e (6,), dq (n,), q (n,), be (6,), sw (6,), ws, Jn (6, n),
-    state (1,) uint64)`` with ``ws`` the step kernels' scratch tuple (``W_*``), ``Jn`` the
-    polish's trial Jacobian and ``state`` the random stream. Arrays of one width share a
-    buffer as its rows or blocks of rows: such a view costs a few ns, where a reshaped
-    slice of one flat buffer costs tens (numba's reshape helper).
+    state (1,) uint64, hit_q (n,), hit_e (6,))`` with ``ws`` the step kernels' scratch
+    tuple (``W_*``), ``Jn`` the polish's trial Jacobian, ``state`` the random stream and
+    ``hit_q``, ``hit_e`` the best target-reaching configuration a guard refused and its
+    error (:func:`_restarts`). Arrays of one width share a buffer as its rows or blocks of
+    rows: such a view costs a few ns, where a reshaped slice of one flat buffer costs
+    tens (numba's reshape helper).
     """
     B, C, T2, state = buffers
     n = B.shape[1]
     J, Jw, Jn = B[3 * n:3 * n + 6], B[3 * n + 6:3 * n + 12], B[3 * n + 12:3 * n + 18]
-    V = B[3 * n + 18:]  # dq, q, g, free, qn, idx, u
+    V = B[3 * n + 18:]  # dq, q, g, free, qn, idx, u, hit_q
     return (J, T2[0], C[0], V[0], V[1], C[1], C[2],
-            (Jw, C[3], B[:n], V[2], C[6:], C[4], V[3], V[4], T2[1], C[5], B[n:2 * n],
-             B[2 * n:3 * n], V[5], V[6]), Jn, state)
+            (Jw, C[3], B[:n], V[2], C[6:12], C[4], V[3], V[4], T2[1], C[5], B[n:2 * n],
+             B[2 * n:3 * n], V[5], V[6]), Jn, state, V[7], C[12])
 
 
 @njit(cache=True, inline="always")
@@ -721,14 +723,35 @@ def _write_info(info, success, total, be, w, used, best_cost, q_out, lo, hi, cle
 def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
     """Solve one target with restarts; write the best q into ``q_out`` (n,) and ``info``.
 
-    Arguments as :func:`_solve_one_in`, which it calls with a fresh workspace.
+    Arguments as :func:`_restarts` (without a guard), which it calls with a fresh
+    workspace.
     """
     solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info,  # noqa: F821
-                 _workspace(meta.shape[0]))
+                 _workspace(meta.shape[0]), ())
 
 
-def _solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp):
+def _restarts(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp, guard):
     """Solve one target with restarts in the workspace ``wsp`` (:func:`_workspace`).
+
+    The one restart loop of every compiled method, plain and collision-aware: a template
+    that :func:`compile_method` binds twice, to the method's ``attempt_loop`` and to one
+    of two guards, ``accept`` and ``final``, that decide whether a configuration reaching
+    the target is a solution:
+
+    * plain (:func:`_accept_all`, :func:`_no_clearance`; ``guard`` the empty tuple):
+      every one is;
+    * collision-aware (:func:`_push_accept`, :func:`_final_clearance`; ``guard`` from
+      :func:`_solve_one_collision`): one whose clearance is at least the margin, after up
+      to a number of push-out steps, each followed by the attempt loop again.
+
+    The first start (q0, else the stream's first draw) is evaluated once: it is the
+    fallback best (finite, inside the limits) and the first attempt starts there; each
+    later attempt starts from the stream's next draw. A finite attempt that does not
+    reach the target becomes the best when its cost is lower, until a guard has refused
+    a target-reaching one; the first accepted attempt ends the loop. Without one, the
+    refused attempt of largest clearance is returned (``hit_q``); else the best attempt
+    is polished (``cfg[C_POLISH]``, :func:`_polish_best`). q is then tidied
+    (:func:`_tidy`) and ``info`` written (``final`` gives the clearance and the pair).
 
     Args:
         F: (n+1, 4, 4) chain fixed transforms (see :mod:`serialkin.kinematics.kernels`).
@@ -742,19 +765,19 @@ def _solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp):
         q_out: (n,) output, the best configuration found.
         info: (N_INFO,) output, see ``I_*``.
         wsp: the loop's buffers (:func:`_workspace` of n), overwritten.
+        guard: the guard's data (see above).
     """
     (w, p, lo, hi, slo, shi, revolute, tol, max_iter, restarts, respect, use_q0, window,
      ratio) = _settings(cfg, box)
     Tt = as_readonly(Tt)  # only read: the loop's kernels see read-only targets, as all do
-    J, T, e, dq, q, be, sw, ws, Jn, state = _carve(wsp)
+    J, T, e, dq, q, be, sw, ws, Jn, state, hit_q, hit_e = _carve(wsp)
     for i in range(6):
         sw[i] = math.sqrt(w[i])
     state[0] = seed
     total = 0
     success = False
     used = 0
-    # the first start (q0, else the stream's first draw), evaluated once: it is the
-    # fallback best (finite, inside the limits) and the first attempt starts there
+    hit_d = -math.inf  # clearance of hit_q; -inf: no target-reaching attempt refused yet
     if use_q0:
         _copy(q0, q)
     else:
@@ -776,24 +799,55 @@ def _solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp):
                                      respect, p, window, ratio, tol, max_iter, q, J, T, e,
                                      dq, ws, attempt > 0)
         total += its
-        finite = _finite_attempt(cost, q)
-        if finite and (ok or cost < best_cost):
+        if not _finite_attempt(cost, q):
+            continue
+        if not ok:
+            if hit_d == -math.inf and cost < best_cost:
+                best_cost = cost
+                _copy(q, q_out)
+                _copy(e, be)
+            continue
+        ok, cost, its, hit_d = accept(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
+                                      respect, p, window, ratio, tol, max_iter, q, J, T, e,
+                                      dq, ws, cost, guard, hit_q, hit_e, hit_d)
+        total += its
+        if ok:
+            success = True
             best_cost = cost
             _copy(q, q_out)
             _copy(e, be)
-        if ok:
-            success = True
             break
-    if not success and cfg[C_POLISH] > 0.5:
+    if not success and hit_d > -math.inf:
+        _copy(hit_q, q_out)
+        _copy(hit_e, be)
+        best_cost = task_cost(be, w)
+    elif not success and cfg[C_POLISH] > 0.5:
         success, best_cost, its = _polish_best(F, meta, Tt, w, sw, lo, hi, revolute, respect,
                                                tol, max_iter, q, q_out, J, T, e, be, dq, ws,
                                                Jn, best_cost)
         total += its
     _tidy(q_out, q0, use_q0, lo, hi, revolute, respect)
-    _write_info(info, success, total, be, w, used, best_cost, q_out, lo, hi, math.inf)
+    d, clear = final(q_out, guard, info)  # noqa: F821
+    _write_info(info, success and clear, total, be, w, used, best_cost, q_out, lo, hi, d)
+
+
+@njit(cache=True, inline="always")
+def _accept_all(F, meta, Tt, w, sw, lo, hi, revolute, respect, p, window, ratio, tol,
+                max_iter, q, J, T, e, dq, ws, cost, guard, hit_q, hit_e, hit_d):
+    """The plain guard of :func:`_restarts`: every configuration reaching the target is one.
+
+    Returns ``(accepted, cost, iterations, hit_d)``: True and the arguments, unchanged.
+    """
+    return True, cost, 0, hit_d
+
+
+@njit(cache=True, inline="always")
+def _no_clearance(q, guard, info):
+    """The plain guard's report: clearance +inf (nothing checked), no closest pair."""
     for k in range(5):
         info[I_PAIR + k] = -1.0
     info[I_PAIR] = PAIR_NONE
+    return math.inf, True
 
 
 def _solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
@@ -809,7 +863,8 @@ def _solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
     """
     wsp = _workspace(meta.shape[0])
     for k in range(start, stop):
-        solve_one_in(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k], wsp)  # noqa: F821
+        solve_one_in(F, meta, Tt[k], box, Q0[k], cfg, seed, Q_out[k], info[k], wsp,  # noqa: F821
+                     ())
 
 
 # ---------------------------------------------------------------- the single call from Python
@@ -858,7 +913,7 @@ def _solve_fast(S, Tt, q0, seed, use_q0, q_out):
     # solve_one_in directly, not through solve_one: one level less of compiled calls (each
     # level re-optimises everything below it at its first compile: 2 s of a first ik)
     solve_one_in(F, meta, Tt, box, q0, cfg, np.uint64(seed), q_out, info,  # noqa: F821
-                 _workspace(n))
+                 _workspace(n), ())
     ok = info[I_SUCCESS] > 0.5 and info[I_INSIDE] > 0.5
     return (1 if ok else 0), int(info[I_ITERATIONS]), info[I_POS_ERR], info[I_ORI_ERR], \
         int(info[I_RESTARTS])
@@ -949,133 +1004,85 @@ def _push_out(q, d, margin, J, sw, joints, chain, model, near, work):
     return True
 
 
-def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, pa, pb, scene,
-                         ccfg, q_out, info):
-    """``solve_one`` whose success also asks for a clearance ≥ ``ccfg[K_MARGIN]``.
+def _push_accept(F, meta, Tt, w, sw, lo, hi, revolute, respect, p, window, ratio, tol,
+                 max_iter, q, J, T, e, dq, ws, cost, guard, hit_q, hit_e, hit_d):
+    """The collision guard of :func:`_restarts`: accept q (reaching the target) when clear.
 
-    Every attempt that reaches the target is checked (:func:`_clearance`: the checked self
-    pairs ``pa, pb`` and the encoded ``scene``); while it collides, up to
-    ``ccfg[K_PUSHES]`` push-out steps (:func:`_push_out`) each followed by the attempt loop
-    again (which brings the tool back onto the target); then the next restart. The
-    returned q is the first collision-free solution; else the solution with the largest
-    clearance; else (no attempt reached the target) the lowest-cost attempt, polished as
-    in ``solve_one``. ``info[I_CLEARANCE]`` and ``info[I_PAIR:I_PAIR + 3]`` describe the
-    returned q; ``info[I_SUCCESS]`` is 1 only when it reaches the target and its clearance
-    is ≥ the margin. Arguments as ``solve_one`` plus the collision model's flat arrays
-    (``sf`` shape frames, ``A``, ``B``, ``rad``, ``sb`` shape bodies), the checked pairs,
-    the scene (k, 16) and ``ccfg`` (:data:`N_CCFG`,).
-
-    One piece (over 80 lines) on purpose: the restarts, the push-out steps and the
-    best-hit bookkeeping share a dozen mutable locals, and each compiled level split off
-    would link and re-optimise the attempt loop again (seconds of compile per level,
-    docs/compile-time.md); the steps it takes are functions of their own
-    (:func:`_clearance`, :func:`_push_out`, the bound ``attempt_loop``).
+    ``guard = (chain, model, near, work, margin, pushes)`` (:func:`_solve_one_collision`).
+    While the clearance of q (:func:`_clearance`) is below ``margin``, up to ``pushes``
+    push-out steps (:func:`_push_out`), each followed by the attempt loop again (which
+    brings the tool back onto the target); the refused configuration of largest clearance
+    so far is kept in ``hit_q``, ``hit_e`` (clearance ``hit_d``). Returns ``(accepted,
+    cost, iterations, hit_d)``; q, J, T, e describe the last configuration.
     """
-    n = meta.shape[0]
-    (w, p, lo, hi, slo, shi, revolute, tol, max_iter, restarts, respect, use_q0, window,
-     ratio) = _settings(cfg, box)
-    Tt = as_readonly(Tt)  # only read (as in solve_one)
-    margin = ccfg[K_MARGIN]
-    pushes = int(ccfg[K_PUSHES])
-    m = A.shape[0]
-    J, T, e, dq, q, be, sw, ws, Jn, state = _carve(_workspace(n))
-    frames = np.empty((n + 1, 4, 4))
-    W0 = np.empty((m, 3))
-    W1 = np.empty((m, 3))
-    pair = np.empty(5)
-    g = np.empty(n)
-    qn = np.empty(n)
-    Jw = np.empty((6, n))
-    M6 = np.empty((6, 6))
-    y6 = np.empty(6)
-    v6 = np.empty(6)
-    chain = (F, L, meta, frames)
-    model = (sf, A, B, rad, sb, pa, pb, scene)
-    near = (W0, W1, pair)
-    work = (g, qn, Jw, M6, y6, v6, dq)
+    chain, model, near, work, margin, pushes = guard
     joints = (lo, hi, revolute, respect)
-    hit_q = np.empty(n)
-    hit_e = np.empty(6)
-    hit_d = -np.inf
-    have_hit = False
-    for i in range(6):
-        sw[i] = math.sqrt(w[i])
-    state[0] = seed
     total = 0
-    success = False
-    used = 0
-    if use_q0:
-        q_out[:] = q0
-    else:
-        state_copy = np.empty(1, dtype=np.uint64)
-        state_copy[0] = seed
-        random_q_into(state_copy, slo, shi, q_out)
-    if respect:
-        project_into(q_out, lo, hi, revolute)
-    fk_into(q_out, F, meta, T)
-    pose_error_into(T, Tt, be)
-    best_cost = task_cost(be, w)
-    for attempt in range(restarts + 1):
-        used = attempt
-        if attempt == 0 and use_q0:
-            q[:] = q0
-        else:
-            random_q_into(state, slo, shi, q)
-        if respect:
-            project_into(q, lo, hi, revolute)
+    ok = True
+    d = _clearance(q, chain, model, near)
+    for push in range(pushes + 1):
+        if d >= margin:
+            break
+        if d > hit_d:
+            hit_d = d
+            _copy(q, hit_q)
+            _copy(e, hit_e)
+        if push == pushes or not _push_out(q, d, margin, J, sw, joints, chain, model, near,
+                                           work):
+            break
         its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
                                      respect, p, window, ratio, tol, max_iter, q, J, T, e,
                                      dq, ws, True)
         total += its
-        finite = _finite_attempt(cost, q)
-        if not finite:
-            continue
-        if not ok:
-            if not have_hit and cost < best_cost:
-                best_cost = cost
-                q_out[:] = q
-                be[:] = e
-            continue
-        d = _clearance(q, chain, model, near)
-        for push in range(pushes + 1):
-            if d >= margin:
-                break
-            if d > hit_d:
-                hit_d = d
-                hit_q[:] = q
-                hit_e[:] = e
-                have_hit = True
-            if push == pushes or not _push_out(q, d, margin, J, sw, joints, chain, model, near,
-                                               work):
-                break
-            its, ok, cost = attempt_loop(F, meta, Tt, w, sw, lo, hi, revolute,  # noqa: F821
-                                         respect, p, window, ratio, tol, max_iter, q, J, T,
-                                         e, dq, ws, True)
-            total += its
-            if not ok or not math.isfinite(cost):
-                ok = False
-                break
-            d = _clearance(q, chain, model, near)
-        if ok and d >= margin:
-            success = True
-            best_cost = cost
-            q_out[:] = q
-            be[:] = e
+        if not ok or not math.isfinite(cost):
+            ok = False
             break
-    if not success and have_hit:
-        q_out[:] = hit_q
-        be[:] = hit_e
-        best_cost = task_cost(be, w)
-    elif not success and cfg[C_POLISH] > 0.5:
-        success, best_cost, its = _polish_best(F, meta, Tt, w, sw, lo, hi, revolute, respect,
-                                               tol, max_iter, q, q_out, J, T, e, be, dq, ws,
-                                               Jn, best_cost)
-        total += its
-    _tidy(q_out, q0, use_q0, lo, hi, revolute, respect)
-    d = _clearance(q_out, chain, model, near)
-    _write_info(info, success and d >= margin, total, be, w, used, best_cost, q_out, lo, hi, d)
+        d = _clearance(q, chain, model, near)
+    return ok and d >= margin, cost, total, hit_d
+
+
+@njit(cache=True)
+def _final_clearance(q, guard, info):
+    """The collision guard's report: the clearance of the returned q and its closest pair.
+
+    Writes the pair into ``info[I_PAIR:I_PAIR + 5]``; returns ``(clearance, clearance >=
+    margin)``.
+    """
+    chain, model, near, work, margin, pushes = guard
+    d = _clearance(q, chain, model, near)
+    pair = near[2]
     for k in range(5):
         info[I_PAIR + k] = pair[k]
+    return d, d >= margin
+
+
+def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, pa, pb, scene,
+                         ccfg, q_out, info):
+    """``solve_one`` whose success also asks for a clearance ≥ ``ccfg[K_MARGIN]``.
+
+    :func:`_restarts` with the collision guard (:func:`_push_accept`): every attempt that
+    reaches the target is checked (:func:`_clearance`: the checked self pairs ``pa, pb``
+    and the encoded ``scene``); while it collides, up to ``ccfg[K_PUSHES]`` push-out steps
+    (:func:`_push_out`) each followed by the attempt loop again; then the next restart.
+    The returned q is the first collision-free solution; else the solution with the
+    largest clearance; else (no attempt reached the target) the lowest-cost attempt,
+    polished as in ``solve_one``. ``info[I_CLEARANCE]`` and ``info[I_PAIR:I_PAIR + 3]``
+    describe the returned q; ``info[I_SUCCESS]`` is 1 only when it reaches the target and
+    its clearance is ≥ the margin. Arguments as ``solve_one`` plus the collision model's
+    flat arrays (``sf`` shape frames, ``A``, ``B``, ``rad``, ``sb`` shape bodies), the
+    checked pairs, the scene (k, 16) and ``ccfg`` (:data:`N_CCFG`,). Allocates the loop's
+    workspace and the guard's work arrays.
+    """
+    n = meta.shape[0]
+    m = A.shape[0]
+    chain = (F, L, meta, np.empty((n + 1, 4, 4)))
+    model = (sf, A, B, rad, sb, pa, pb, scene)
+    near = (np.empty((m, 3)), np.empty((m, 3)), np.empty(5))
+    work = (np.empty(n), np.empty(n), np.empty((6, n)), np.empty((6, 6)), np.empty(6),
+            np.empty(6), np.empty(n))
+    guard = (chain, model, near, work, ccfg[K_MARGIN], int(ccfg[K_PUSHES]))
+    restarts_collision(F, meta, Tt, box, q0, cfg, seed, q_out, info,  # noqa: F821
+                       _workspace(n), guard)
 
 
 def _solve_chunk_collision(F, L, meta, Tt, box, Q0, cfg, seed, sf, A, B, rad, sb, pa, pb, scene,
@@ -1154,11 +1161,18 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
     # unpacks from the workspace and slices from cfg and box cost an atomic increment
     # and decrement each, per target (about 0.35 µs of a Panda target's 0.7 µs outside
     # its iterations)
-    one_in = compiled(_nrt=allocates)(_bind(_solve_one_in, name, tag + str(int(allocates)),
-                                            attempt_loop=attempt))
+    one_in = compiled(_nrt=allocates)(_bind(_restarts, name, tag + str(int(allocates)),
+                                            attempt_loop=attempt, accept=_accept_all,
+                                            final=_no_clearance))
     one = compiled()(_bind(_solve_one, name, tag, solve_one_in=one_in))
     chunk = compiled(nogil=True)(_bind(_solve_chunk, name, tag, solve_one_in=one_in))
-    one_c = compiled()(_bind(_solve_one_collision, name, tag, attempt_loop=attempt))
+    # the same restart loop with the collision guard (with reference counting: the
+    # guard's tuples hold arrays the wrapper allocates)
+    push = compiled()(_bind(_push_accept, name, tag, attempt_loop=attempt))
+    restarts_c = compiled()(_bind(_restarts, name, tag + "c", attempt_loop=attempt,
+                                  accept=push, final=_final_clearance))
+    one_c = compiled()(_bind(_solve_one_collision, name, tag,
+                             restarts_collision=restarts_c))
     chunk_c = compiled(nogil=True)(_bind(_solve_chunk_collision, name, tag,
                                          solve_one_collision=one_c))
     fast = compiled()(_bind(_solve_fast, name, tag, solve_one_in=one_in))

@@ -264,6 +264,10 @@ def run_attempts(spec: MethodSpec, problem: IKProblem, q0: np.ndarray | None, ma
                  restarts: int, seed: int, options: Mapping[str, Any]) -> tuple:
     """The shared loop for Python methods: attempts from q0 / seeded random starts.
 
+    The same semantics as the compiled loop (:func:`serialkin.ik._kernels._restarts`:
+    the same random stream, starts, best-attempt rule), in Python because its attempts
+    are Python (scipy's optimisers, CCD, FABRIK): a compiled loop cannot call them.
+
     Returns ``(q, success, iterations, position_error, orientation_error, reason,
     restarts_used)`` for one target.
     """
