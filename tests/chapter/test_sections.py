@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from serialkin.chapter.report import ReportContext
+
+#: The folder of the section modules, and the most lines one of them may have.
+SECTIONS = Path(__file__).resolve().parents[2] / "src" / "serialkin" / "chapter" / "sections"
+MAX_SECTION_LINES = 400
 
 
 @pytest.fixture
@@ -71,3 +77,53 @@ def test_section_4_shows_sixteen_solutions(ctx):
     assert "in <b>16</b> ways" in html
     err = float(html.split("worst max |f(q) − T| = ")[1].split(")")[0])
     assert err < 1e-10
+
+
+def test_no_section_module_is_longer_than_400_lines():
+    """Every file under chapter/sections/ has at most 400 lines (a longer one is split)."""
+    files = sorted(SECTIONS.rglob("*.py"))
+    assert len(files) > 10  # the folder was found, with its subpackages
+    lengths = {str(f.relative_to(SECTIONS)): len(f.read_text(encoding="utf-8").splitlines())
+               for f in files}
+    too_long = {name: n for name, n in lengths.items() if n > MAX_SECTION_LINES}
+    assert not too_long, f"split these along a seam (at most {MAX_SECTION_LINES} lines): {too_long}"
+
+
+def _radial_area(L: tuple[float, float, float], every_heading: bool) -> float:
+    """Area of the tool positions p of a planar 3R arm whose wrist p − L3·e_φ is reachable.
+
+    For every heading φ (total orientation) or for some φ (maximal workspace): the wrist
+    must lie in the 2-link annulus |L1 − L2| ≤ |w| ≤ L1 + L2. The set is a union of rings,
+    so it is tested on radii r (p = (r, 0)) and integrated as ∫ 2πr dr.
+    """
+    L1, L2, L3 = L
+    r = np.linspace(0.0, sum(L), 20_001)
+    phi = np.linspace(0.0, 2 * np.pi, 721)  # holds 0 and π, where |w| is extreme
+    wrist = np.hypot(r[:, None] - L3 * np.cos(phi), L3 * np.sin(phi))
+    ok = (wrist >= abs(L1 - L2)) & (wrist <= L1 + L2)
+    inside = ok.all(axis=1) if every_heading else ok.any(axis=1)
+    return float(np.sum(2 * np.pi * r * inside) * (r[1] - r[0]))
+
+
+_ARMS = [(1.0, 0.8, 0.3), (1.0, 1.0, 0.5), (1.0, 0.6, 0.2), (0.7, 0.4, 0.5), (2.0, 0.5, 0.3)]
+
+
+@pytest.mark.parametrize("L", _ARMS + [(0.5, 0.4, 2.0), (1.0, 1.0, 1.5)])
+def test_closed_form_reachable_areas_match_a_radial_integration(L):
+    """Section 1's 2R annulus and 3R maximal-workspace areas equal ∫ 2πr dr over the rings."""
+    from serialkin.chapter.sections.workspace.closed_forms import (
+        annulus_area,
+        three_link_reachable_area,
+    )
+
+    assert three_link_reachable_area(L) == pytest.approx(_radial_area(L, False), rel=1e-3)
+    assert annulus_area(L[0], L[1]) == pytest.approx(
+        _radial_area((L[0], L[1], 0.0), False), rel=1e-3)
+
+
+@pytest.mark.parametrize("L", _ARMS + [(1.0, 1.0, 1.5), (0.5, 0.4, 2.0)])
+def test_closed_form_total_orientation_area_matches_a_radial_integration(L):
+    """Section 1's 3R total-orientation area equals ∫ 2πr dr over radii every heading reaches."""
+    from serialkin.chapter.sections.workspace.closed_forms import three_link_total_area
+
+    assert three_link_total_area(L) == pytest.approx(_radial_area(L, True), rel=1e-3)

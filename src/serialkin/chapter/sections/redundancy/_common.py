@@ -163,6 +163,23 @@ def _phases(scenario: Scenario) -> list[tuple[int, int, str]]:
     return [(0, m[2], "1"), (m[2], m[9], "2"), (m[13], len(scenario.path) - 1, "3")]
 
 
+def _where(sc: Scenario, mask: np.ndarray) -> str:
+    """The path points of ``mask`` as "path points a–b (phase k)", phases by their ranges."""
+    idx = np.flatnonzero(mask)
+    if not idx.size:
+        return "no path point"
+    phases = _phases(sc)
+    names = []
+    for a, b, name in phases:
+        if ((idx >= a) & (idx <= b)).any():
+            names.append(f"phase {name}")
+    if any(not any(a <= k <= b for a, b, _ in phases) for k in idx):
+        names.append("the return between phases 2 and 3" if phases else "")
+    where = " and ".join(n for n in names if n)
+    return (f"{idx.size} path point{'s' if idx.size > 1 else ''} between {idx[0]} and "
+            f"{idx[-1]}" + (f" ({where})" if where else ""))
+
+
 def _shade(ax: Any, phases: list[tuple[int, int, str]], label: bool = False) -> None:
     for k, (a, b, name) in enumerate(phases):
         ax.axvspan(a, b, color=("tab:purple", "tab:orange", "tab:green")[k], alpha=0.13, lw=0,

@@ -1,4 +1,9 @@
-"""Section 5.3: the 20-link example (Figures 11-12), task activity and the ablation of eq 48."""
+"""Section 5.3: the 20-link example (Figures 11-12), task activity and the ablation of eq 48.
+
+The ablation's prose, table and figure are in
+:mod:`serialkin.chapter.sections.redundancy.twenty_link_ablation`; this module assembles
+the part.
+"""
 
 from __future__ import annotations
 
@@ -13,6 +18,12 @@ from serialkin.chapter.sections.redundancy._common import (
     _mm,
     _phases,
     _shade,
+    _where,
+)
+from serialkin.chapter.sections.redundancy.twenty_link_ablation import (
+    ablation_cells,
+    ablation_figure,
+    ablation_table,
 )
 from serialkin.tracking.analysis import (
     AblationRun,
@@ -234,129 +245,6 @@ def _activity_figure(ctx: ReportContext, sc: Scenario, tc: Any) -> str:
                       f"{len(tc)} path points (shaded: the three phases).")
 
 
-def _ablation_cells(r: AblationRun) -> tuple[str, str, str, str, str, str]:
-    """One row of the ablation table: label, degrees and millimetres as printed."""
-    return (r.label, f"{r.max_joint_difference * DEG:.1f}", _mm(r.min_clearance),
-            f"{r.limit_violation * DEG:.1f}", _mm(r.max_error), f"{r.unreached}")
-
-
-def _where(sc: Scenario, mask: np.ndarray) -> str:
-    """The path points of ``mask`` as "path points a–b (phase k)", phases by their ranges."""
-    idx = np.flatnonzero(mask)
-    if not idx.size:
-        return "no path point"
-    phases = _phases(sc)
-    names = []
-    for a, b, name in phases:
-        if ((idx >= a) & (idx <= b)).any():
-            names.append(f"phase {name}")
-    if any(not any(a <= k <= b for a, b, _ in phases) for k in idx):
-        names.append("the return between phases 2 and 3" if phases else "")
-    where = " and ".join(n for n in names if n)
-    return (f"{idx.size} path point{'s' if idx.size > 1 else ''} between {idx[0]} and "
-            f"{idx[-1]}" + (f" ({where})" if where else ""))
-
-
-def _ablation_prose(sc: Scenario, runs: list[AblationRun]) -> str:
-    """What goes wrong in each ablated run, measured: where, which obstacle or joint, how much."""
-    by = {r.label: r for r in runs}
-    full = by["all tasks"].trajectory
-    names = [o.name for o in sc.obstacles]
-    out = []
-    r = by["without the obstacle task"]
-    tr = r.trajectory
-    hit = tr.clearance.min(axis=1) < 0
-    depth = tr.clearance.min(axis=0)
-    hit_obs = [f"{n} (down to {c * 1e3:.1f} mm)" for n, c in zip(names, depth) if c < 0]
-    out.append("without the obstacle task links enter "
-               + (", ".join(hit_obs) if hit_obs else "no obstacle")
-               + f" at {_where(sc, hit)}")
-    r = by["without the joint-limit task"]
-    lim = np.asarray(sc.robot.qlim, dtype=float)
-    over = np.maximum(r.trajectory.q - lim[:, 1], lim[:, 0] - r.trajectory.q)
-    out_mask = (over > 0).any(axis=1)
-    joints = sorted({int(j) + 1 for j in np.flatnonzero((over > 0).any(axis=0))})
-    out.append("without the joint-limit task joint" + ("s " if len(joints) > 1 else " ")
-               + ", ".join(map(str, joints)) + f" leave{'' if len(joints) > 1 else 's'} its "
-               f"range by up to {r.limit_violation * DEG:.1f}° at {_where(sc, out_mask)}"
-               if joints else "without the joint-limit task no joint leaves its range")
-    r = by["without the singularity task"]
-    bad = r.trajectory.errors > sc.tolerance
-    out.append(f"without the singularity task the tracking error exceeds the ±"
-               f"{sc.tolerance * 1e3:g} mm tolerance at {_where(sc, bad)}, up to "
-               f"{_mm(r.max_error)} mm (with all tasks at most "
-               f"{_mm(float(full.errors[bad].max()) if bad.any() else full.max_error)} mm "
-               "there)")
-    return "; ".join(out)
-
-
-def _ablation_table(ctx: ReportContext, sc: Scenario, runs: list[AblationRun]) -> str:
-    """What each secondary task of eq 48 contributes: one run with each switched off."""
-    arows = [_ablation_cells(r) for r in runs]
-    R = float(sum(row.a for row in sc.robot.dh))
-    beyond = float(np.linalg.norm(sc.path.points, axis=1).max()) - R
-    return (
-        "<h4>Ablation: each secondary task switched off in turn</h4>"
-        "<p>The scenario of (c) run again with one weight of eq 48 set to zero (the obstacle "
-        "weight, the eq 49 maximum, or the singularity damping, leaving λ_min = "
-        f"{sc.solver.damping:g} m). Measured: " + _ablation_prose(sc, runs) + ". The farthest "
-        f"path point lies {beyond * 1e3:.1f} mm beyond the reach R, so no configuration "
-        "reaches it exactly.</p><p><b>This ablation is circular by design.</b> The path and "
-        "the obstacles were designed (the chapter gives neither) with one phase per "
-        "secondary task, so that each task has something to do; that switching a task off "
-        "then breaks its phase confirms the design and the implementation, not that the "
-        "tasks are needed on an arbitrary path.</p>"
-        + ctx.table(arows, ["run", "max |q − q_all| [°]", "min clearance [mm]",
-                            "worst limit violation [°]", "max tracking error [mm]",
-                            "points outside ±5 mm"])
-    )
-
-
-def _ablation_figure(ctx: ReportContext, sc: Scenario, tc: Any, runs: list[AblationRun]) -> str:
-    """Clearance, joint 1 and tracking error with all tasks and with one switched off."""
-    import matplotlib.pyplot as plt
-
-    full = runs[0]
-    by = {r.label: r for r in runs}
-    steps = np.arange(len(tc))
-    lo, hi = np.degrees(np.asarray(sc.robot.qlim, dtype=float)[0])
-    buffer_from = hi - sc.solver.limit_buffer * (hi - lo)
-    tol = sc.tolerance * 1e3
-    fig, axes = plt.subplots(1, 3, figsize=(12.5, 3.8))
-    no_obs = by["without the obstacle task"].trajectory
-    axes[0].plot(steps, full.trajectory.clearance.min(axis=1) * 1e3, label="all tasks")
-    axes[0].plot(steps, no_obs.clearance.min(axis=1) * 1e3, label="without obstacle task")
-    axes[0].axhline(0, color="k", lw=1)
-    axes[0].set_ylabel("smallest clearance [mm]")
-    axes[0].set_title("without the obstacle task: clearance down to "
-                      f"{no_obs.clearance.min() * 1e3:.1f} mm", fontsize=10)
-    no_lim = by["without the joint-limit task"].trajectory
-    axes[1].plot(steps, full.trajectory.q[:, 0] * DEG, label="all tasks")
-    axes[1].plot(steps, no_lim.q[:, 0] * DEG, label="without joint-limit task")
-    axes[1].axhline(hi, color="k", lw=1)
-    axes[1].axhline(buffer_from, color="k", lw=0.8, ls=":")
-    axes[1].set_ylabel(f"q1 [°] (limit {hi:g}°, buffer from {buffer_from:g}°)")
-    axes[1].set_title(f"without the limit task: q1 up to {no_lim.q[:, 0].max() * DEG:.1f}°",
-                      fontsize=10)
-    no_sing = by["without the singularity task"].trajectory
-    axes[2].plot(steps, full.trajectory.errors * 1e3, label="all tasks")
-    axes[2].plot(steps, no_sing.errors * 1e3, label="without singularity task")
-    axes[2].axhline(tol, color="k", lw=1)
-    axes[2].set_ylabel(f"tracking error [mm] (tolerance {tol:g} mm)")
-    axes[2].set_title(f"without the singularity task: {int((no_sing.errors > sc.tolerance).sum())}"
-                      f" points beyond {tol:g} mm", fontsize=10)
-    phases = _phases(sc)
-    for a in axes:
-        _shade(a, phases)
-        a.set_xlabel("path point")
-        a.grid(True, alpha=0.3)
-        a.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize="small", ncol=1)
-    fig.subplots_adjust(wspace=0.35)
-    return ctx.figure(fig, "twenty_link_ablation",
-                      "What goes wrong when one task is switched off (shaded: the three "
-                      "phases).")
-
-
 def _joints_figure(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any) -> str:
     """The joint angles of (b) and (c) side by side."""
     import matplotlib.pyplot as plt
@@ -390,7 +278,7 @@ def twenty_link_figures(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any,
     """
     return {"motion": _motion_figures(ctx, sb, sc, tb, tc),
             "activity": _activity_figure(ctx, sc, tc),
-            "ablation": _ablation_figure(ctx, sc, tc, runs),
+            "ablation": ablation_figure(ctx, sc, tc, runs),
             "joints": _joints_figure(ctx, sb, sc, tb, tc)}
 
 
@@ -419,7 +307,7 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
                      for v in (str(int(tr.reached.sum())), str(len(s.path)), _mm(tr.max_error),
                                str(int(tr.iterations.sum())))] + [
         f"{tc.clearance.min() * 1e3:.1f}"]
-    ablation_numbers = [v for r in runs for v in _ablation_cells(r)[1:]]
+    ablation_numbers = [v for r in runs for v in ablation_cells(r)[1:]]
     parts = [
         ctx.algorithm("Inverse kinematic model for 20-link manipulator (step 6 corrected)", [
             (0, "CYCLE WHILE 1"),
@@ -443,7 +331,7 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
         _timings_text(ctx, sb, sc, tb, tc, time_b, time_c, ratio),
         figs["motion"],
         figs["activity"],
-        _ablation_table(ctx, sc, runs),
+        ablation_table(ctx, sc, runs),
         figs["ablation"],
         figs["joints"],
         ctx.reproduce("serialkin track twenty_link_free --out out/track\n"
