@@ -91,13 +91,16 @@ def _general(T, W, P, M, aux, arm, prismatic3, order, grid, F, meta, newton_p, n
              cand):
     """Candidates of a general 6R (:func:`general_candidates`); returns the count.
 
-    Real solutions of a 6R come in even numbers: an odd count searches once more on a
-    grid twice as fine.
+    ``order`` is (arm code, searched chain reversed, elimination starts on the reversed
+    chain) (:func:`~serialkin.ik.analytic.structure.general_structure`). Real solutions
+    of a 6R come in even numbers: an odd count searches once more on a grid twice as fine.
     """
-    k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, grid, F, meta, newton_p,
+    reverse = order[1] == 1
+    rr_other = order.shape[0] > 2 and (order[2] == 1) != reverse
+    k = general_candidates(T, W, P, M, aux, arm, reverse, rr_other, grid, F, meta, newton_p,
                            newton_r, cand)
     if k % 2 == 1:
-        k = general_candidates(T, W, P, M, aux, arm, order[1] == 1, 2 * grid, F, meta,
+        k = general_candidates(T, W, P, M, aux, arm, reverse, rr_other, 2 * grid, F, meta,
                                newton_p, newton_r, cand)
     return k
 

@@ -42,7 +42,7 @@ import math
 
 import numpy as np
 
-from serialkin.ik.analytic.raghavan_roth import NEAR_SPECIAL, rr_candidates
+from serialkin.ik.analytic.raghavan_roth import NEAR_SPECIAL, rr_candidates_from
 from serialkin.ik.analytic.refine import refine_new, wrapped_dist
 from serialkin.ik.analytic.spherical_wrist import arm_positions
 from serialkin.ik.analytic.subproblems import (
@@ -70,10 +70,13 @@ DEFAULT_GRID = 24
 
 
 @njit(cache=True, inline="always")
-def general_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r, out):
+def general_candidates(T, W, P, M, aux, arm, reverse, rr_other, grid, F, meta, tol_p, tol_r,
+                       out):
     """Every solution of a general 6R arm into ``out`` (16, 6).
 
-    By :func:`~serialkin.ik.analytic.raghavan_roth.rr_candidates` when it applies and
+    By :func:`~serialkin.ik.analytic.raghavan_roth.rr_candidates_from` (starting on the
+    reversal of the searched chain's splits when ``rr_other``: ``order[2]`` of
+    :func:`~serialkin.ik.analytic.structure.general_structure`) when it applies and
     accounts for every root of its eliminant with an even count, else by
     :func:`search_candidates`. When the elimination declines the arm as a whole
     (:data:`~serialkin.ik.analytic.raghavan_roth.NEAR_SPECIAL`: near a special class,
@@ -86,7 +89,7 @@ def general_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_
     beside the search's (the union, duplicates dropped in joint space): a search that
     misses one cannot lose it. Arguments and result as for :func:`search_candidates`.
     """
-    k = rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out)
+    k = rr_candidates_from(T, W, P, M, reverse, rr_other, F, meta, tol_p, tol_r, out)
     if k >= 0 and k % 2 == 0:
         return k
     near_special = k == NEAR_SPECIAL

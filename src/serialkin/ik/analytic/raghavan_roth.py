@@ -553,6 +553,16 @@ def _half_angle(v, stride, count):
 def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
     """Every solution of a 6R arm by Raghavan–Roth elimination into ``out`` (16, 6).
 
+    :func:`rr_candidates_from` starting on the splits of the chain W, P, M (arguments
+    and result as there, without ``other_first``).
+    """
+    return rr_candidates_from(T, W, P, M, reverse, False, F, meta, tol_p, tol_r, out)
+
+
+@njit(cache=True)
+def rr_candidates_from(T, W, P, M, reverse, other_first, F, meta, tol_p, tol_r, out):
+    """Every solution of a 6R arm by Raghavan–Roth elimination into ``out`` (16, 6).
+
     Args:
         T: (4, 4) target pose (world).
         W: (6, 3) unit joint directions at q = 0.
@@ -560,6 +570,10 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
         M: (4, 4) tool pose at q = 0.
         reverse: W, P, M describe the reversed chain (joint j is joint 7 − j, tool pose
             M⁻¹), solved for ``T⁻¹``; rows are returned in the robot's joint order.
+        other_first: try the splits of the reversal of W, P, M before their own (the
+            first split that does not degenerate exactly decides, so the order matters
+            on arms near a special class; see
+            :func:`~serialkin.ik.analytic.structure.general_structure`).
         F: (7, 4, 4) chain transforms (refinement).
         meta: (6, 5) chain joint data.
         tol_p: Newton position tolerance [m].
@@ -593,7 +607,7 @@ def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
                         + Minv[i, 2] * P[5 - j, 2] + Minv[i, 3])
     for attempt in range(6):  # eliminated joint 6, 5, 4 of the chain, then of its reversal
         e = 5 - attempt % 3
-        if attempt < 3:
+        if (attempt < 3) != other_first:
             k = _rr_split(T, Wf, Pf, Mf, reverse, e, F, meta, tol_p, tol_r, out)
         else:
             k = _rr_split(T, Wr, Pr, Minv, not reverse, e, F, meta, tol_p, tol_r, out)
