@@ -166,10 +166,13 @@ def _loadavg() -> tuple[float, float, float] | None:
         return None
 
 
-def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
-            workers: str, load: tuple[tuple[float, float, float] | None, ...] = (None, None),
-            timings: Sequence[Timing] = ()) -> str:
-    """The whole page: header with build metadata, contents, sections."""
+def _sections_html(parts: list[tuple[str, Section]]) -> tuple[str, str]:
+    """The contents list's items and the sections' HTML, in order: ``(toc, body)``.
+
+    A section with the number of the one before it continues it (a part of the same
+    chapter section: an h3 under the same heading); each section's anchor is its own or
+    its module's name, numbered from the second section of one module on.
+    """
     toc: list[str] = []
     body: list[str] = []
     previous = None
@@ -200,25 +203,35 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
                        f'</a> <span class="eq">({eqs})</span></li>')
         body.append(f'<section id="{anchor}"><h2>{html.escape(label)}</h2>{part}'
                     f'<p class="eq">Demonstrates: {eqs}</p>{sec.html}</section>')
-    import matplotlib
+    return "".join(toc), "".join(body)
 
+
+def _timing_text(timings: Sequence[Timing]) -> str:
+    """The header's line on how the page's timings were taken (counts, repeats, blocks)."""
+    if not timings:
+        return "none measured"
     times = [t for t in timings if t.unit != "×"]
     repeats = sorted({t.n for t in timings})
     blocks = sorted({t.blocks for t in timings})
     rounds = sorted({t.n // t.blocks for t in timings})
-    if not timings:
-        timing_text = "none measured"
-    else:
-        timing_text = (
-            f"{len(times)} times and {len(timings) - len(times)} ratios, each the median of "
-            f"{_span_text(repeats)} warm runs after an untimed warm-up"
-            + (f", taken in {_span_text(blocks)} blocks spread over their section's build "
-               f"(a block: {_span_text(rounds)} rounds, each running every timed function of "
-               "the section once, the order rotating); the spread printed with each is the "
-               "5th to 95th percentile of its runs" if blocks[-1] > 1 else
-               ", with their full range")
-            + "; a ratio between two methods is taken per round, in one process; every run "
-            "is in timings.json beside this page")
+    return (
+        f"{len(times)} times and {len(timings) - len(times)} ratios, each the median of "
+        f"{_span_text(repeats)} warm runs after an untimed warm-up"
+        + (f", taken in {_span_text(blocks)} blocks spread over their section's build "
+           f"(a block: {_span_text(rounds)} rounds, each running every timed function of "
+           "the section once, the order rotating); the spread printed with each is the "
+           "5th to 95th percentile of its runs" if blocks[-1] > 1 else
+           ", with their full range")
+        + "; a ratio between two methods is taken per round, in one process; every run "
+        "is in timings.json beside this page")
+
+
+def _meta_html(seconds: float, cpu: float, workers: str,
+               load: tuple[tuple[float, float, float] | None, ...],
+               timings: Sequence[Timing]) -> str:
+    """The header's table: versions, commit, build time, load, timings, fonts."""
+    import matplotlib
+
     meta = build_metadata() + [
         ("build time", f"{seconds:.1f} s wall clock ({workers}); the sections took "
                        f"{cpu:.1f} s CPU in all"),
@@ -226,15 +239,22 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
                          f"{_load_text(load[-1])} on {os.cpu_count()} CPUs: with a load "
                          "above the CPU count other processes shared the cores and the "
                          "times below are slower and more spread than on a quiet machine"),
-        ("timings", timing_text),
+        ("timings", _timing_text(timings)),
         ("fonts", f"DejaVu Sans (text, and the figures), DejaVu Sans Mono (code), DejaVu "
                   "Serif with STIX General's mathematical letters (mathematics), from "
                   f"matplotlib {matplotlib.__version__}, cut down to the characters of this "
                   "page and embedded in it, so that it looks the same on every machine; the "
                   "files and their licences are in fonts/ beside it")]
-    meta_html = ('<table class="meta">' + "".join(
+    return ('<table class="meta">' + "".join(
         f"<tr><th>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>" for k, v in meta)
         + "</table>")
+
+
+def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
+            workers: str, load: tuple[tuple[float, float, float] | None, ...] = (None, None),
+            timings: Sequence[Timing] = ()) -> str:
+    """The whole page: header with build metadata, contents, sections."""
+    toc, body = _sections_html(parts)
     return (
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
         "<title>Kinematics of Serial Manipulators — reproduced by serialkin</title>"
@@ -252,8 +272,8 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
         "): until the compiled kernels are ready the first calls run as Python, whose "
         "rounding differs in the last digits, and a long tracking run (the 20-link arm) then "
         "takes a slightly different path.</p>"
-        f"{meta_html}<nav><h2 id='contents'>Contents</h2><ul>{''.join(toc)}</ul></nav>"
-        f"{''.join(body)}</body></html>"
+        f"{_meta_html(seconds, cpu, workers, load, timings)}"
+        f"<nav><h2 id='contents'>Contents</h2><ul>{toc}</ul></nav>{body}</body></html>"
     )
 
 

@@ -259,6 +259,49 @@ def _reading_text(tables: list[tuple[str, CompareTable]]) -> str:
         out) + ".</p>"
 
 
+#: The opening of the numerical families' part (section 5.3).
+_FAMILIES_INTRO = (
+    "<h3>Numerical families (section 5.3), measured</h3>"
+    "<p>Section 5.3 lists the numerical approaches: linearisation by the Jacobian "
+    "(transpose, Moore-Penrose pseudoinverse eq 40, damped least squares / "
+    "Levenberg-Marquardt eq 46 with the ERRATA's JJᵀ, selectively damped least squares "
+    "by SVD), Newton methods (eq 41), minimisation (Powell, BFGS) and the heuristics CCD "
+    "and FABRIK. serialkin implements each behind one interface "
+    "(<code>robot.ik(target, method=...)</code>) with the same targets, tolerance, "
+    "restarts from seeded random configurations and joint-limit handling, so "
+    "<code>serialkin.ik.compare</code> can run them on the same targets from the same "
+    f"starts. Success means FK of the answer within {COMPARE_TOL:g} m and "
+    f"{COMPARE_TOL:g} rad of the target with q inside the joint limits. Times are wall "
+    "times per solve on the machine that built this report (restarts included); "
+    "targets are FK of seeded random configurations inside the limits.</p>")
+
+
+def _compare_box(ctx: ReportContext, table: object) -> str:
+    """The Reproduce box of the Puma 560 comparison ``table``, with its unchecked rows.
+
+    A method that runs thousands of iterations amplifies the last bits of each step,
+    which differ between a kernel's optimisation levels: its row is named and not checked.
+    """
+    chaotic = [r.method for r in table.rows if r.median_iterations > CHAOTIC_ITERATIONS]
+    note = ""
+    if chaotic:
+        note = (f"<p>{', '.join(chaotic)} ran more than {CHAOTIC_ITERATIONS:,} iterations "
+                "per solve: over that many steps the last bits of each step (which depend "
+                "on how the kernels were compiled) decide the exact count, so a rerun of "
+                "the box below may differ in that row; every other row reproduces to the "
+                "digits shown.</p>")
+    return note + ctx.reproduce(
+        "import serialkin as sk\n"
+        "from serialkin.ik.compare import compare\n"
+        "robot = sk.models.puma560()\n"
+        f"print(compare(robot, robot.fk(robot.random_q({N_SPATIAL}, seed=42)), "
+        f"tol={COMPARE_TOL:g}, seed=0))",
+        expect=[format_number(v, "{:.3g}") for r in table.rows
+                if r.method not in chaotic
+                for v in (r.success_rate, r.median_iterations, r.median_position_error,
+                          r.max_position_error)])
+
+
 def build(ctx: ReportContext) -> Section:
     """Measure the numerical IK families of section 5.3 and return the section's first part.
 
@@ -284,21 +327,7 @@ def build(ctx: ReportContext) -> Section:
     ]
     bench.block()
     # --- section 5.3: the numerical families ------------------------------------------------
-    parts.append(
-        "<h3>Numerical families (section 5.3), measured</h3>"
-        "<p>Section 5.3 lists the numerical approaches: linearisation by the Jacobian "
-        "(transpose, Moore-Penrose pseudoinverse eq 40, damped least squares / "
-        "Levenberg-Marquardt eq 46 with the ERRATA's JJᵀ, selectively damped least squares "
-        "by SVD), Newton methods (eq 41), minimisation (Powell, BFGS) and the heuristics CCD "
-        "and FABRIK. serialkin implements each behind one interface "
-        "(<code>robot.ik(target, method=...)</code>) with the same targets, tolerance, "
-        "restarts from seeded random configurations and joint-limit handling, so "
-        "<code>serialkin.ik.compare</code> can run them on the same targets from the same "
-        f"starts. Success means FK of the answer within {COMPARE_TOL:g} m and "
-        f"{COMPARE_TOL:g} rad of the target with q inside the joint limits. Times are wall "
-        "times per solve on the machine that built this report (restarts included); "
-        "targets are FK of seeded random configurations inside the limits.</p>"
-    )
+    parts.append(_FAMILIES_INTRO)
     tables = []
     for title, run in comparison_jobs():
         tables.append((title, run()))
@@ -325,26 +354,7 @@ def build(ctx: ReportContext) -> Section:
             ["family (methods)", "cost per iteration", "convergence", "near singularities",
              "joint limits", "measured here"]))
     parts.append(reading)
-    # a method that runs thousands of iterations amplifies the last bits of each step,
-    # which differ between a kernel's optimisation levels: its row is not checked
-    chaotic = [r.method for r in tables[1][1].rows if r.median_iterations > CHAOTIC_ITERATIONS]
-    if chaotic:
-        parts.append(
-            f"<p>{', '.join(chaotic)} ran more than {CHAOTIC_ITERATIONS:,} iterations per "
-            "solve: over that many steps the last bits of each step (which depend on how "
-            "the kernels were compiled) decide the exact count, so a rerun of the box "
-            "below may differ in that row; every other row reproduces to the digits "
-            "shown.</p>")
-    parts.append(ctx.reproduce(
-        "import serialkin as sk\n"
-        "from serialkin.ik.compare import compare\n"
-        "robot = sk.models.puma560()\n"
-        f"print(compare(robot, robot.fk(robot.random_q({N_SPATIAL}, seed=42)), "
-        f"tol={COMPARE_TOL:g}, seed=0))",
-        expect=[format_number(v, "{:.3g}") for r in tables[1][1].rows
-                if r.method not in chaotic
-                for v in (r.success_rate, r.median_iterations, r.median_position_error,
-                          r.max_position_error)]))
+    parts.append(_compare_box(ctx, tables[1][1]))
     return Section(title="5.3 Kinematically redundant manipulators",
                    part="Numerical inverse kinematics, measured",
                    equations="eqs 39-41", html="".join(parts))
