@@ -215,14 +215,28 @@ def load_numba() -> None:
 def _define_numba_objects():
     """The numba-side definitions (see :func:`load_numba`); returns the two intrinsics.
 
-    ``(fma, as_readonly)``.
+    ``(fma, as_readonly)``: the dispatcher class (:func:`_define_dispatcher`), the
+    intrinsics (:func:`_define_intrinsics`), the type of a :class:`Kernel` met as a value
+    and the cache locators.
     """
+    from numba.extending import typeof_impl
+
+    _define_dispatcher()
+    real_fma, real_readonly = _define_intrinsics()
+
+    @typeof_impl.register(Kernel)
+    def _typeof_kernel(val, c):  # a Kernel numba meets as a value: its dispatcher's type
+        return typeof_impl(val.dispatcher, c)
+
+    globals()["_UserDirLocator"], globals()["_InTreeLocator"] = _install_locators()
+    return real_fma, real_readonly
+
+
+def _define_dispatcher() -> None:
+    """Define ``_Dispatcher`` (a module global, so that it pickles by reference)."""
     import numba
-    from llvmlite import ir
-    from numba.core import cgutils, types
+    from numba.core import types
     from numba.core.dispatcher import OmittedArg
-    from numba.core.imputils import impl_ret_borrowed
-    from numba.extending import intrinsic, typeof_impl
 
     class _Dispatcher(numba.core.registry.CPUDispatcher):
         """numba's dispatcher, but a call from another kernel never specialises on a literal.
@@ -264,6 +278,18 @@ def _define_numba_objects():
     _Dispatcher.__qualname__ = "_Dispatcher"
     globals()["_Dispatcher"] = _Dispatcher  # pickled by reference
 
+
+def _define_intrinsics() -> tuple:
+    """``(fma, as_readonly)``: numba intrinsics, each with its Python equivalent registered.
+
+    ``fma(a, b, c)`` is LLVM's fused ``a·b + c`` (one rounding); ``as_readonly(a)`` the
+    same array typed read-only (a new reference to the same memory, no copy).
+    """
+    from llvmlite import ir
+    from numba.core import cgutils, types
+    from numba.core.imputils import impl_ret_borrowed
+    from numba.extending import intrinsic
+
     def fma_intrinsic(typingctx, a, b, c):
         f64 = types.float64
         sig = f64(a, b, c)
@@ -296,12 +322,6 @@ def _define_numba_objects():
     readonly_intrinsic.__name__ = readonly_intrinsic.__qualname__ = "as_readonly"
     real_readonly = intrinsic(readonly_intrinsic)
     _background.PYTHON_EQUIVALENTS[id(real_readonly)] = _readonly_view
-
-    @typeof_impl.register(Kernel)
-    def _typeof_kernel(val, c):  # a Kernel numba meets as a value: its dispatcher's type
-        return typeof_impl(val.dispatcher, c)
-
-    globals()["_UserDirLocator"], globals()["_InTreeLocator"] = _install_locators()
     return real_fma, real_readonly
 
 

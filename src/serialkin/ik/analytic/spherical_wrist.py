@@ -288,6 +288,9 @@ def general_positions(pw, W, P, aux, prismatic3, slack, out):
     intermediate vectors stay in arrays, so that no rounding changes (fused operations
     across the tuples would).
     """
+    # One piece over 80 lines: the quartic's coefficients, its roots and their polish
+    # share the arm's lines and the target's terms; split into compiled calls it would
+    # add levels that each re-link and re-optimise their callees (docs/compile-time.md).
     c = aux[0].copy()
     r1 = aux[1].copy()
     r2 = aux[2].copy()

@@ -64,6 +64,10 @@ def ur_candidates(T, W, P, M, aux, slack, out):
     Vectors are tuples (no allocation per branch) and every rotation is applied by
     Rodrigues' formula from one sin/cos per joint value (``Rot(w, −θ) = Rot(w, θ)ᵀ``).
     """
+    # One piece over 80 lines: the nested branches (q1, then q5, q6, then the elbow) share
+    # the rotated vectors of the levels above; split into compiled calls it would pass
+    # them as arguments and add levels that each re-link and re-optimise their callees
+    # (docs/compile-time.md).
     p56 = row3(aux, 0)
     w = row3(aux, 1)
     e = row3(aux, 2)
