@@ -9,6 +9,12 @@ from __future__ import annotations
 
 from .._jit import njit
 
+#: sin²θ of two segments' directions below which their closest points are computed from
+#: cross products (:func:`closest_segment_segment`).
+NEAR_PARALLEL = 1e-4
+#: sin²θ below which two segments are parallel (θ < 1e-14 rad: rounding of the directions).
+PARALLEL = 1e-28
+
 
 @njit(cache=True, nogil=True)
 def closest_segment_segment(p0, p1, a, b):
@@ -16,8 +22,10 @@ def closest_segment_segment(p0, p1, a, b):
 
     Minimises ``‖(p0 + s (p1 − p0)) − (a + t (b − a))‖`` over ``s, t ∈ [0, 1]``: the
     unconstrained minimiser of the two lines, clamped to the segments and re-projected
-    (C. Ericson, *Real-Time Collision Detection*, 2005, §5.1.9). Parallel segments
-    (``aa·ee − bb² ≈ 0``) take s = 0; zero-length segments are points.
+    (C. Ericson, *Real-Time Collision Detection*, 2005, §5.1.9), its determinant
+    ``aa·ee − bb² = |d1 × d2|²`` taken from the cross product when the segments are
+    nearly parallel (:data:`NEAR_PARALLEL`). Parallel segments (:data:`PARALLEL`) take
+    s = 0; zero-length segments are points.
 
     Points are ``(x, y, z)`` tuples: every caller passes its points as tuples (registers,
     no array views), so that the kernel compiles once.
@@ -53,7 +61,21 @@ def closest_segment_segment(p0, p1, a, b):
         return min(max(-cc / aa, 0.0), 1.0), 0.0
     bb = d1x * d2x + d1y * d2y + d1z * d2z
     den = aa * ee - bb * bb
-    s = min(max((bb * ff - cc * ee) / den, 0.0), 1.0) if den > eps else 0.0
+    num = bb * ff - cc * ee
+    if den <= NEAR_PARALLEL * aa * ee:
+        # nearly parallel: aa·ee − bb² = |d1 × d2|² cancels to a relative error of about
+        # 1e-16/sin²θ (1 % at θ = 1e-7 rad, which put touching segments 4e-10 m apart);
+        # by Lagrange's identity den = |d1 × d2|² and num = (d1 × d2)·(d2 × r), whose
+        # cross products lose only 1e-16/sin θ
+        cx = d1y * d2z - d1z * d2y
+        cy = d1z * d2x - d1x * d2z
+        cz = d1x * d2y - d1y * d2x
+        den = cx * cx + cy * cy + cz * cz
+        num = (cx * (d2y * rz - d2z * ry) + cy * (d2z * rx - d2x * rz)
+               + cz * (d2x * ry - d2y * rx))
+        if den <= PARALLEL * aa * ee:
+            den = 0.0
+    s = min(max(num / den, 0.0), 1.0) if den > eps else 0.0
     t = (bb * s + ff) / ee
     if t < 0.0:
         t = 0.0
