@@ -97,6 +97,15 @@ def test_bad_srdf(panda):
                   '</robot>')
 
 
+def test_missing_srdf_file_is_named_as_an_srdf(panda, tmp_path):
+    """A missing SRDF file is reported as an SRDF file (not a URDF), by read_srdf and clearance."""
+    missing = str(tmp_path / "nope.srdf")
+    with pytest.raises(RobotDefinitionError, match=r"^SRDF file '.*nope\.srdf' does not exist"):
+        read_srdf(missing)
+    with pytest.raises(RobotDefinitionError, match="SRDF file"):
+        panda[0].clearance(np.zeros(7), srdf=missing)
+
+
 def test_bad_sampling_options(panda):
     """Sampling needs at least one sample and a finite margin."""
     robot, model = panda

@@ -56,7 +56,7 @@ def read_srdf(path_or_string: str | os.PathLike[str]) -> Srdf:
             ``<disable_collisions>`` without both links, a joint value that is not a
             finite number (the message names the element).
     """
-    root, source = read_robot_xml(path_or_string)
+    root, source = read_robot_xml(path_or_string, "SRDF")
     disabled = []
     for k, el in enumerate(root.findall("disable_collisions")):
         a, b = el.get("link1"), el.get("link2")

@@ -22,13 +22,15 @@ from serialkin.errors import RobotDefinitionError
 __all__ = ["parse_floats", "read_robot_xml"]
 
 
-def read_robot_xml(path_or_string: str | os.PathLike[str]) -> tuple[ET.Element, str]:
+def read_robot_xml(path_or_string: str | os.PathLike[str], what: str = "URDF"
+                   ) -> tuple[ET.Element, str]:
     """Parse a URDF or SRDF file or string; ``(root element, source)``.
 
     ``path_or_string`` is XML text when it starts with ``<`` (after blanks), else a file
-    path. A file is read as bytes (at most :data:`serialkin._files.MAX_FILE_BYTES`) so
-    that ``<?xml ... encoding="ISO-8859-1"?>`` is decoded as declared (UTF-8 by
-    default). ``source`` is the file path, or ``"<string>"`` for text.
+    path; ``what`` ("URDF", "SRDF") names the kind of file in the messages. A file is
+    read as bytes (at most :data:`serialkin._files.MAX_FILE_BYTES`) so that ``<?xml ...
+    encoding="ISO-8859-1"?>`` is decoded as declared (UTF-8 by default). ``source`` is
+    the file path, or ``"<string>"`` for text.
 
     Raises:
         RobotDefinitionError: a missing or oversized file, malformed XML (with line and
@@ -41,9 +43,9 @@ def read_robot_xml(path_or_string: str | os.PathLike[str]) -> tuple[ET.Element, 
     else:
         path = Path(text)
         if not path.exists():
-            raise RobotDefinitionError(f"URDF file {short_repr(text)} does not exist")
+            raise RobotDefinitionError(f"{what} file {short_repr(text)} does not exist")
         source = str(path)
-        data = read_bytes(path, what="URDF file", error=RobotDefinitionError)
+        data = read_bytes(path, what=f"{what} file", error=RobotDefinitionError)
     root = parse_xml(data, source, error=RobotDefinitionError)
     if root.tag != "robot":
         raise RobotDefinitionError(f"{source}: the root element must be <robot>, got <{root.tag}>")
