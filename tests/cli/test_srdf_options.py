@@ -208,6 +208,29 @@ def test_track_cli_and_python_api_agree(extra, tmp_path):
     np.testing.assert_array_equal(cli_q, api.q)
 
 
+def test_scenario_srdf_key_is_the_srdf_option(tmp_path):
+    """A scenario's ``srdf:`` (relative to its file) tracks as ``--srdf``; --srdf replaces it."""
+    from serialkin.tracking import ScenarioError, load_scenario
+
+    srdf = _fold_srdf(tmp_path)
+    by_flag = _track_q(tmp_path, _fold(tmp_path), "--srdf", str(srdf))
+    keyed = tmp_path / "keyed"
+    keyed.mkdir()
+    (keyed / "pairs.srdf").write_bytes(srdf.read_bytes())
+    scenario = _fold(keyed, FOLD + "srdf: pairs.srdf\n")
+    assert load_scenario(scenario).options["srdf"] == str(keyed / "pairs.srdf")
+    np.testing.assert_array_equal(_track_q(keyed, scenario), by_flag)
+    kept = _track_q(tmp_path, _fold(tmp_path))  # no pair skipped: differs from by_flag
+    assert not np.array_equal(kept, by_flag)
+    other = _fold_srdf(tmp_path, "link2", "link5")  # the flag wins over the file's key
+    np.testing.assert_array_equal(_track_q(keyed, scenario, "--srdf", str(other)),
+                                  _track_q(tmp_path, _fold(tmp_path), "--srdf", str(other)))
+    with pytest.raises(ScenarioError, match="field 'srdf' must name an SRDF file"):
+        load_scenario(_fold(keyed, FOLD + "srdf: missing.srdf\n"))
+    with pytest.raises(ScenarioError, match="field 'skip_links' names links of an SRDF"):
+        load_scenario(_fold(keyed, FOLD + "skip_links: [hand]\n"))
+
+
 def test_track_srdf_lets_the_disabled_pair_cross(tmp_path):
     """With link1–link6 disabled by --srdf the fold completes through them; not without."""
     from serialkin import models

@@ -302,7 +302,9 @@ def _with_self_collision(sc: Any, self_collision: bool, acm: Any) -> Any:
         if not (qp and sc.solver.self_collision):
             raise CLIError("--srdf lists the pairs a self-collision check skips: add "
                            "--self-collision" + ("" if qp else " and --solver qp"))
-        sc = replace(sc, options={**sc.options, "acm": acm})
+        # the command line's --srdf replaces the scenario's srdf / skip_links
+        kept = {k: v for k, v in sc.options.items() if k not in ("srdf", "skip_links")}
+        sc = replace(sc, options={**kept, "acm": acm})
     return sc
 
 

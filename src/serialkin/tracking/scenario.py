@@ -39,6 +39,10 @@ Schema (fields marked * are required)::
       manipulability_threshold, repulsive_gain, gain, max_task_step, link_radius (multitask)
     tolerance: float [m]            (default 0.005)
     on_unreachable: continue | stop (default continue)
+    srdf: path                      # the robot's SRDF (relative to the scenario file): its
+                                    # <disable_collisions> pairs are skipped by the QP's
+                                    # self-collision check (as `track --srdf`)
+    skip_links: [str, ...]          # links of the SRDF without a collision body (needs srdf)
 
 Angles: every angle field (``q0``, ``rpy``, ``angle``, ``max_angle``, a circle's ``start``,
 ``stop`` and ``step``, DH ``alpha``/``theta``, the φ column of ``planar_pose`` points) is
@@ -110,7 +114,7 @@ def planar_arm(links: int, length: float, *, name: str | None = None,
 
 
 _ROOT_FIELDS = {"name", "description", "units", "robot", "q0", "q0_deg", "path", "obstacles",
-                "solver", "tolerance", "on_unreachable"}
+                "solver", "tolerance", "on_unreachable", "srdf", "skip_links"}
 #: Angle units of ``units: {angle: ...}`` and their factor to radians.
 ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0}
 _DEGREES_HINT = ("are these degrees? write units: {angle: deg} at the top of the file, or "
@@ -525,6 +529,7 @@ def scenario_from_dict(data: object, source: str = "<dict>",
     obstacles = tuple(obstacle_from_field(o) for o in obs_f.items(max_len=10_000)) \
         if obs_f.present else ()
     solver, options, link_radius = _solver(doc["solver"], path, obstacles)
+    options = {**options, **_srdf_options(doc, base_dir)}
     tolerance = doc["tolerance"].number(lo=0.0, lo_open=True, default=5e-3, unit="m")
     on_unreach = doc["on_unreachable"].string(choices=ON_UNREACHABLE, default="continue")
     try:
@@ -537,6 +542,29 @@ def scenario_from_dict(data: object, source: str = "<dict>",
                     path=path, q0=q0, obstacles=obstacles, solver=solver, options=options,
                     tolerance=tolerance, on_unreachable=on_unreach, link_radius=link_radius,
                     source=source, data=dict(doc.value))
+
+
+def _srdf_options(doc: Field, base_dir: str | os.PathLike[str] | None) -> dict[str, Any]:
+    """``track``'s ``srdf`` and ``skip_links`` from the scenario's fields ({} when absent).
+
+    ``srdf`` is a file path relative to the scenario's folder; it must exist (the file is
+    read when the scenario is tracked, where a solver that checks no self-collision is
+    refused). ``skip_links`` needs ``srdf``.
+    """
+    out: dict[str, Any] = {}
+    sf, kf = doc["srdf"], doc["skip_links"]
+    if sf.present:
+        rel = FsPath(sf.string(max_len=4096))
+        path = rel if rel.is_absolute() or base_dir is None else FsPath(base_dir) / rel
+        if not path.is_file():
+            raise sf.fail(f"must name an SRDF file (relative to the scenario's folder), got "
+                          f"{short_repr(str(rel))}: {short_repr(str(path))} is not a file")
+        out["srdf"] = str(path)
+    if kf.present:
+        if not sf.present:
+            raise kf.fail("names links of an SRDF: give srdf too")
+        out["skip_links"] = tuple(f.string(max_len=1000) for f in kf.items(max_len=10_000))
+    return out
 
 
 def _shipped_dir():
