@@ -103,7 +103,8 @@ def test_every_timing_is_warm(built_report):
     _, html = built_report
     times = re.findall(r"median of \d+ warm runs in (\d+) blocks, 5th–95th percentile", html)
     ratios = re.findall(r"× \(median of \d+ rounds in (\d+) blocks, 5th–95th percentile", html)
-    assert len(times) >= 8 and len(ratios) == 2, (times, ratios)  # (c)/(b) and QP / eq 48
+    # (c)/(b), QP / eq 48, and BFGS / lm and Powell / lm on each of three robots
+    assert len(times) >= 14 and len(ratios) == 8, (times, ratios)
     assert {int(b) for b in times + ratios} == {7}
     assert not re.search(r"median of \d+ (warm runs|interleaved pairs)[^,]*, spread", html)
 
@@ -116,7 +117,8 @@ def test_timings_json_holds_every_run(built_report):
 
     out, html = built_report
     data = json.loads((out / "timings.json").read_text(encoding="utf-8"))
-    assert len(data) == 9 and {d["section"] for d in data} == {"numerical", "redundancy"}
+    # numerical: lm, BFGS and Powell on three robots and 6 ratios; redundancy: 4 runs, 2 ratios
+    assert len(data) == 21 and {d["section"] for d in data} == {"numerical", "redundancy"}
     for d in data:
         runs = np.array(d["runs"])
         assert d["n"] == runs.size == 21 and d["blocks"] == 7, d["label"]
@@ -168,6 +170,23 @@ def test_equation_numbers_follow_the_chapter(built_report):
     values = [int(n) for n in numbers]
     assert 2 in values and values == sorted(values), values
     assert len(set(values)) == len(values), values
+
+
+#: The equations the ERRATA corrects (its table: 17; 23/26 with the pairing of 27; 44; 46;
+#: 51-52, the clamped projection; 54). Eq 48 is printed right: the ERRATA corrects step 6
+#: of the 20-link algorithm to it.
+CORRECTED = {17, 23, 26, 27, 44, 46, 51, 52, 54}
+
+
+def test_each_equation_has_its_own_number_and_corrections_are_marked(built_report):
+    """Every label is one chapter number ("(30)", never "(30-31)"); the ERRATA's are marked."""
+    _, html = built_report
+    labels = re.findall(r'<span class="eqno">\(([^)]*)\)</span>', html)
+    assert labels and all(re.fullmatch(r"\d+(, corrected)?", n) for n in labels), labels
+    numbers = {int(n.split(",")[0]) for n in labels}
+    assert {30, 31, 32} <= numbers
+    marked = {int(n.split(",")[0]) for n in labels if n.endswith(", corrected")}
+    assert marked == CORRECTED & numbers == CORRECTED, marked
 
 
 def test_angles_in_the_half_open_interval(built_report):

@@ -331,3 +331,32 @@ def test_algorithm_box_numbers_its_steps():
     """An algorithm box is an ordered list: one numbered item per step, indented by level."""
     box = ReportContext.algorithm("demo", [(0, "first"), (1, "second")])
     assert box.count("<li") == 2 and "<ol" in box and "margin-left:1.6em" in box
+
+
+def test_numbers_are_kept_together_in_text():
+    """A number with its unit, range, exponent or name is wrapped so no line breaks inside it."""
+    from serialkin.chapter._context import keep_numbers_together
+
+    def kept(text: str) -> list[str]:
+        return re.findall(r'<span class="nowrap">(.*?)</span>', keep_numbers_together(text))
+
+    assert kept("100 %, 1.04-18.6 ms") == ["100 %", "1.04-18.6 ms"]
+    assert kept("spread 0.105-0.3 ms, 0.098 ms") == ["0.105-0.3 ms", "0.098 ms"]
+    assert kept("percentile 0.285–0.438 ms") == ["0.285–0.438 ms"]
+    assert kept("W_L1 = 0.15 (q1 = 80.5°)") == ["W_L1 = 0.15", "q1 = 80.5°"]
+    assert kept("rounding (2.2e-16).") == ["2.2e-16"]
+    assert kept("&gt; 1,000 iterations") == ["&gt; 1,000"]
+    # nothing that cannot break, nothing in code, maths, numeric cells, tags or entities
+    for text in ("5.2× (median of 21 rounds", "5th–95th", "&#39;x&#39;", "<code>1 - 2 ms</code>",
+                 '<td class="num">1.2e-05</td>', '<img alt="3 mm">',
+                 '<math><mn>2</mn><mo>-</mo><mn>3</mn></math>'):
+        assert keep_numbers_together(text) == text
+
+
+def test_large_ratios_print_without_exponent():
+    """A ratio of 1,100 prints as "1,100×", never "1.1e+03×"; small ones keep two digits."""
+    t = Timing(median=1113.0, low=720.0, high=1234.0, n=21, blocks=7, unit="×")
+    assert t.text.startswith("1,100× (median of 21 rounds in 7 blocks")
+    assert "percentile 720–1,200×" in t.text
+    assert Timing(median=5.24, low=3.5, high=6.0, n=21, blocks=7, unit="×").text.startswith(
+        "5.2×")

@@ -121,6 +121,49 @@ def test_wide_content_scrolls_inside_its_box(page):
         assert scroll_w <= client_w + 1 or overflow in ("auto", "scroll"), name
 
 
+#: Finds, in every text node outside code and mathematics, what must stay on one line:
+#: a number with an exponent, a number with its unit, a range a–b, an assignment "q1 = 80.5"
+#: (patterns of its own, not the page's, so that what the page forgets to keep together is
+#: found); returns [text, node text] of each that the layout breaks across lines.
+_BROKEN_NUMBERS_JS = r"""
+    const n = String.raw`\d+(?:,\d{3})*(?:\.\d+)?`;
+    const patterns = [
+        String.raw`[-−+±]?${n}e[-−+]?\d+`,
+        String.raw`${n}\s?(?:%|°|×|µs|ms|mm|µm|rad|m|s)(?![\w²])`,
+        String.raw`${n}\s?[–-]\s?[-−]?${n}`,
+        String.raw`\b[A-Za-zα-ωλ]\w{0,6} = [-−]?${n}`,
+    ].map(p => new RegExp(String.raw`(?<![\w.,])` + p, 'g'));
+    const skip = 'math, pre, code, style, script, title';
+    const walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+    const broken = [];
+    let checked = 0;
+    for (let node = walker.nextNode(); node; node = walker.nextNode()) {
+        if (!node.parentElement || node.parentElement.closest(skip)) continue;
+        for (const re of patterns) {
+            re.lastIndex = 0;
+            for (let m = re.exec(node.data); m; m = re.exec(node.data)) {
+                const range = document.createRange();
+                range.setStart(node, m.index);
+                range.setEnd(node, m.index + m[0].length);
+                const rects = Array.from(range.getClientRects()).filter(r => r.width > 0);
+                checked++;
+                if (rects.length < 2) continue;
+                const first = rects[0];
+                if (rects.some(r => r.top >= first.bottom - 2))
+                    broken.push([m[0], node.data.slice(0, 80)]);
+            }
+        }
+    }
+    return [checked, broken];"""
+
+
+def _at_width(page, width: int):
+    """Lay the page out at ``width`` CSS pixels (until the returned callable is called)."""
+    page.execute_cdp_cmd("Emulation.setDeviceMetricsOverride", {
+        "width": width, "height": 800, "deviceScaleFactor": 1, "mobile": False})
+    return lambda: page.execute_cdp_cmd("Emulation.clearDeviceMetricsOverride", {})
+
+
 def test_numbers_never_break_across_lines(page):
     """Every numeric table cell and matrix entry is laid out on one line."""
     broken = page.execute_script("""
@@ -132,6 +175,52 @@ def test_numbers_never_break_across_lines(page):
         }
         return out;""")
     assert not broken, broken[:10]
+
+
+@pytest.mark.parametrize("width", [None, 420])
+def test_numbers_in_text_and_prose_never_break(page, width):
+    """In prose and text cells, a number stays on one line with its unit, range and exponent.
+
+    At the page's width and in a narrow window (420 px), where nearly every line breaks.
+    """
+    restore = _at_width(page, width) if width else (lambda: None)
+    try:
+        checked, broken = page.execute_script(_BROKEN_NUMBERS_JS)
+    finally:
+        restore()
+    assert checked > 500
+    assert not broken, broken[:10]
+
+
+def test_display_equations_fit_their_box(page):
+    """At the page's width every display equation fits its box; narrower, it scrolls inside it.
+
+    Measured relative to the box: the equation's own width against the box's, so that it
+    holds for any fonts.
+    """
+    script = """
+        return Array.from(document.querySelectorAll('.eqbody')).map(b => {
+            // a display <math> is a block as wide as its box: measure what it holds
+            const m = b.querySelector('math');
+            const width = Math.max(...Array.from(m.children).map(
+                c => c.getBoundingClientRect().width));
+            return [width, b.clientWidth, b.scrollWidth,
+                    getComputedStyle(b).overflowX,
+                    b.parentElement.querySelector('.eqno')?.textContent || ''];
+        });"""
+    boxes = page.execute_script(script)
+    assert len(boxes) > 40
+    wide = [(no, round(w), client) for w, client, _, _, no in boxes if w > client + 1]
+    assert not wide, wide
+    restore = _at_width(page, 420)
+    try:
+        narrow = page.execute_script(script)
+    finally:
+        restore()
+    scrolled = [b for b in narrow if b[0] > b[1] + 1]
+    assert scrolled  # some equations are wider than a 420 px column ...
+    for w, _client, scroll_w, overflow, no in scrolled:  # ... and scroll inside their box
+        assert overflow in ("auto", "scroll") and scroll_w >= w - 1, no
 
 
 def test_embedded_fonts_load_and_style_the_page(page):

@@ -29,7 +29,8 @@ def test_default_solver_timings_are_warm(ctx):
         assert t.warm and t.n == len(t.runs) == 21 and t.blocks == 7
         assert 0 < t.low <= t.median <= t.high
         assert (t.low, t.high) == tuple(np.percentile(t.runs, [5, 95]))
-        assert row[-1] == t.text and "warm runs in 7 blocks, 5th–95th percentile" in t.text
+        assert row[2] == "lm" and row[3] == t.text and row[4] == ""  # no ratio to itself
+        assert "warm runs in 7 blocks, 5th–95th percentile" in t.text
 
 
 @pytest.mark.slow

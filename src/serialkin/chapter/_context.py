@@ -106,8 +106,8 @@ class Timing:
         percentile 5.1–5.4×)".
         """
         if self.unit == "×":
-            value = f"{self.median:.2g}×"
-            low, high, unit = f"{self.low:.2g}", f"{self.high:.2g}", "×"
+            value = f"{format_ratio(self.median)}×"
+            low, high, unit = format_ratio(self.low), format_ratio(self.high), "×"
             kind = "rounds"
         else:
             scale, unit = _time_unit(self.median)
@@ -270,6 +270,13 @@ def _time_unit(seconds: float) -> tuple[float, str]:
     return 1e6, "µs"
 
 
+def format_ratio(value: float) -> str:
+    """A ratio to two significant digits, from 100 up as a whole number ("3,100", not "3.1e+03")."""
+    if value >= 100:
+        return f"{float(f'{value:.2g}'):,.0f}"
+    return f"{value:.2g}"
+
+
 def _fmt3(value: float) -> str:
     """Three significant digits, no exponent for the ranges :func:`_time_unit` produces."""
     return f"{value:.3g}" if value < 1000 else f"{value:.0f}"
@@ -307,7 +314,7 @@ def format_vector(values: object, fmt: str = "{:.6g}") -> str:
 
 
 _NUMERIC_TEXT = re.compile(
-    r"^[+\-−]?(?:\d[\d,\u202f ]*(?:\.\d*)?|\.\d+)(?:[eE][+\-−]?\d+)?"
+    r"^(?:[<>≤≥]\s*)?[+\-−]?(?:\d[\d,\u202f ]*(?:\.\d*)?|\.\d+)(?:[eE][+\-−]?\d+)?"
     r"(?:\s*(?:%|°|s|ms|µs|m|mm|rad|m²|×))?$|^[+\-−]?(?:∞|inf|nan)$"
 )
 
@@ -322,8 +329,71 @@ def _is_numeric(value: object) -> bool:
         _NUMERIC_TEXT.match(value.strip()))
 
 
+#: A table cell in place of a number that is not reproducible from build to build (the
+#: page says why); like an empty cell, it does not decide its column's alignment.
+VARIES = "varies"
+
+
 def _is_blank(value: object) -> bool:
-    return isinstance(value, str) and not hasattr(value, "__html__") and not value.strip()
+    """Empty text or :data:`VARIES`: a cell that leaves its column's alignment to the others."""
+    return isinstance(value, str) and not hasattr(value, "__html__") and (
+        not value.strip() or value.strip() == VARIES)
+
+
+#: A number as the page prints it, kept on one line with what belongs to it: an optional
+#: name and "=" ("q1 = 80.5°"), a comparison ("&gt; 1,000", escaped), a sign, an exponent
+#: ("2.2e-16"), a unit ("0.098 ms") and a second number of a range ("0.285–0.438 ms").
+_NUMBER_PART = r"[+\-−±]?(?:\d+(?:,\d{3})*(?:\.\d+)?|\.\d+)(?:e[+\-−]?\d+)?"
+_UNIT = r"(?:\s?(?:%|°|×|µs|ms|ns|mm|µm|m²|m³|m/rad|mrad|µrad|rad|deg|m|s|R)(?![\w²³]))?"
+NUMBER_RUN = re.compile(
+    r"(?<![\w.,#&;+\-−±])"
+    r"(?:[A-Za-zα-ωΑ-Ω][\w]{0,6} ?= ?)?"
+    r"(?:(?:&lt;|&gt;|[<>≤≥~≈]) ?)?"
+    + _NUMBER_PART + _UNIT
+    + r"(?:\s?[–\-]\s?" + _NUMBER_PART + _UNIT + r")?"
+    r"(?!\w|\.\d)")
+#: Where a browser may break a line inside a :data:`NUMBER_RUN` match.
+_BREAKABLE = re.compile(r"[\s–/]|(?<=.)[-−]")
+#: Elements whose text is left as it is: code, mathematics, and cells already on one line.
+_VERBATIM = ("math", "pre", "code", "style", "script", "title")
+_TAG = re.compile(r"(<[^>]*>)")
+_TAG_PARTS = re.compile(r"<(/?)([A-Za-z][\w-]*)([^>]*)>")
+
+
+def _keeps_verbatim(name: str, attrs: str) -> bool:
+    return (name in _VERBATIM or (name == "td" and 'class="num"' in attrs)
+            or (name == "table" and 'class="matrix"' in attrs))
+
+
+def keep_numbers_together(markup: str) -> str:
+    """Wrap each number of the text that a line could break inside in ``<span class="nowrap">``.
+
+    A number with its unit ("0.098 ms"), a range ("0.285–0.438 ms", "1.04-18.6 ms"), an
+    exponent ("2.2e-16"), a bound ("&gt; 1,000") or an assignment ("q1 = 80.5°"): the
+    matches of :data:`NUMBER_RUN` that hold a break opportunity (a space, a dash, a
+    slash). Only text is changed, never a tag, an attribute or an entity; the text of
+    ``math``, ``pre``, ``code``, numeric cells and matrices (one line already) is left
+    alone.
+    """
+    def wrap(m: re.Match[str]) -> str:
+        text = m.group(0)
+        return f'<span class="nowrap">{text}</span>' if _BREAKABLE.search(text) else text
+
+    out = []
+    verbatim: list[str] = []
+    for part in _TAG.split(markup):
+        if part.startswith("<"):
+            tag = _TAG_PARTS.match(part)
+            if tag:
+                closing, name, attrs = tag.group(1), tag.group(2).lower(), tag.group(3)
+                if not closing and _keeps_verbatim(name, attrs) and not attrs.endswith("/"):
+                    verbatim.append(name)
+                elif closing and verbatim and verbatim[-1] == name:
+                    verbatim.pop()
+            out.append(part)
+        else:
+            out.append(part if verbatim else NUMBER_RUN.sub(wrap, part))
+    return "".join(out)
 
 
 #: First code point of the Unicode mathematical alphanumerics per style, for A, a, Α, α, 0.
@@ -641,7 +711,10 @@ __all__ = [
     "Section",
     "Timing",
     "TimingBench",
+    "VARIES",
     "compact_png",
     "format_number",
+    "format_ratio",
     "format_vector",
+    "keep_numbers_together",
 ]

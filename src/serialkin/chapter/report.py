@@ -53,6 +53,7 @@ from serialkin.chapter._context import (
     compact_png,
     format_number,
     format_vector,
+    keep_numbers_together,
 )
 from serialkin.chapter._fonts import FAMILY, embedded_fonts
 
@@ -253,9 +254,13 @@ def _meta_html(seconds: float, cpu: float, workers: str,
 def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
             workers: str, load: tuple[tuple[float, float, float] | None, ...] = (None, None),
             timings: Sequence[Timing] = ()) -> str:
-    """The whole page: header with build metadata, contents, sections."""
+    """The whole page: header with build metadata, contents, sections.
+
+    Numbers are kept on one line with their units, ranges and exponents
+    (:func:`~serialkin.chapter._context.keep_numbers_together`).
+    """
     toc, body = _sections_html(parts)
-    return (
+    return keep_numbers_together(
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
         "<title>Kinematics of Serial Manipulators — reproduced by serialkin</title>"
         f"<style>{_CSS}</style></head><body>"

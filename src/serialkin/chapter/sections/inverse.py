@@ -217,7 +217,10 @@ def _section_4_1(ctx: ReportContext) -> Section:
         + "<p>and the inverse below. The chapter's eqs 23 and 26 carry misprints (ERRATA: "
         "as printed, " + ctx.imath(r"c = x^2 + y^2") + " and "
         + ctx.imath(r"\beta = \arccos\frac{L_1^2 - L_2^2 + c^2}{2L_1c}")
-        + "); the corrected forms, with the two solutions paired by sign, are</p>"
+        + "), and eq 27 gives only " + ctx.imath(r"\vartheta_1 = \alpha - \beta")
+        + " (the ERRATA pairs it with the + sign of eq 25 and adds "
+        + ctx.imath(r"\vartheta_1 = \alpha + \beta") + " for the − sign); the corrected "
+        "forms, with the two solutions paired by sign, are</p>"
         + ctx.eq(r"r = \sqrt{x^2 + y^2}", "23, corrected")
         + ctx.eq(r"\alpha = \mathrm{atan2}(y, x)", "24")
         + ctx.eq(r"\vartheta_2 = \pm\arccos\left(\frac{x^2 + y^2 - L_1^2 - L_2^2}"
@@ -226,7 +229,7 @@ def _section_4_1(ctx: ReportContext) -> Section:
                  "26, corrected")
         + ctx.eq(r"\vartheta_1 = \alpha \mp \beta\quad(\text{upper signs together: }"
                  r"\vartheta_1 = \alpha - \beta \text{ with } \vartheta_2 = +\arccos(\cdot))",
-                 "27")
+                 "27, corrected")
         + f"<p>Worked example (the chapter gives no numbers): L1 = {L1} m, L2 = {L2} m, "
         f"target x<sub>E</sub> = ({x}, {y}) m, step by step:</p>"
     )
@@ -236,9 +239,10 @@ def _section_4_1(ctx: ReportContext) -> Section:
          ("25", Html(ctx.imath(r"\cos\vartheta_2")), cf["cos_theta2"]),
          ("25", Html(ctx.imath(r"\vartheta_2 = +\arccos(\cdot)")), cf["theta2_plus"]),
          ("26 (corrected)", Html(ctx.imath(r"\cos\beta")), cf["cos_beta"]),
-         ("26", Html(ctx.imath(r"\beta")), cf["beta"]),
+         ("26 (corrected)", Html(ctx.imath(r"\beta")), cf["beta"]),
          ("27", Html(ctx.imath(r"\vartheta_1 = \alpha - \beta")), cf["theta1_a"]),
-         ("27, twin", Html(ctx.imath(r"\vartheta_1 = \alpha + \beta")), cf["theta1_b"])],
+         ("27 (corrected), twin", Html(ctx.imath(r"\vartheta_1 = \alpha + \beta")),
+          cf["theta1_b"])],
         ["eq", "quantity", "value [m or rad]"]))
     bad = _misprinted_cos_beta(x, y, L1, L2)
     inside = abs(L1 - L2) <= cf["r"] <= L1 + L2

@@ -126,6 +126,26 @@ def _section_5(ctx: ReportContext) -> Section:
     return Section(title="5. Differential kinematics", equations="eqs 28-38", html=html_)
 
 
+def _eq32(ctx: ReportContext, Ja: sp.Matrix) -> str:
+    """Eq 32 as the chapter sets it: the matrix of partials, then its entries line by line.
+
+    The entries come from symbolic differentiation (``.jacobian('planar')``); one line
+    each, aligned on "=", so that the equation fits the text column.
+    """
+    names = [rf"\dfrac{{\partial {x}}}{{\partial q_{j}}}" for x in ("x_E", "y_E")
+             for j in range(1, Ja.shape[1] + 1)]
+    matrix = (r"\mathbf{J}(\mathbf{q}) = \begin{bmatrix}"
+              + r"\\ ".join(" & ".join(names[i * Ja.shape[1]:(i + 1) * Ja.shape[1]])
+                             for i in range(Ja.shape[0])) + r"\end{bmatrix}")
+    lines = r"\\ ".join(f"{name} & = & {sp.latex(entry)}"
+                         for name, entry in zip(names, Ja))
+    return (ctx.eq(matrix, "32")
+            + "<p>whose entries, by symbolic differentiation "
+            "(<code>.jacobian('planar')</code>), are the ones the chapter lists under "
+            "eq 32:</p>"
+            + ctx.eq(r"\begin{array}{rcl}" + lines + r"\end{array}"))
+
+
 def _section_5_1(ctx: ReportContext, three: Robot) -> Section:
     parts: list[str] = [
         ctx.eq(r"\dot{\mathbf{x}} = \frac{\partial\mathbf{f}(\mathbf{q})}{\partial\mathbf{q}}"
@@ -147,10 +167,9 @@ def _section_5_1(ctx: ReportContext, three: Robot) -> Section:
         "<h3>The three-link arm (Figure 6, eqs 30-32)</h3>"
         "<p>Position of E from the symbolic forward kinematics "
         "(<code>derive(three_link, params='lengths').task('planar')</code>):</p>"
-        + ctx.eq(r"\begin{bmatrix}x_E\\ y_E\end{bmatrix} = " + sp.latex(x3), "30-31")
-        + "<p>and its Jacobian by symbolic differentiation (<code>.jacobian('planar')</code>), "
-        "the entries the chapter lists under eq 32:</p>"
-        + ctx.eq(r"\mathbf{J}(\mathbf{q}) = " + sp.latex(Ja), "32")
+        + ctx.eq("x_E = " + sp.latex(x3[0]), "30") + ctx.eq("y_E = " + sp.latex(x3[1]), "31")
+        + "<p>and its Jacobian, the matrix of eq 29 for these two coordinates,</p>"
+        + _eq32(ctx, Ja)
         + "<p>With the heading φ = q1 + q2 + q3 as a third task coordinate the extra row is "
         + ctx.imath(sp.latex(Jpose[2, :])) + ".</p>"
         + f"<p>Evaluated with L = {THREE_LINK} m at q = "

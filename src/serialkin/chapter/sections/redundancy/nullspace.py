@@ -105,7 +105,7 @@ def _nullspace_part(ctx: ReportContext) -> Section:
         + " the self-motion climbs the manipulability of eq 43 or descends the distance from "
         "mid-range of eq 44. <b>Eq 44 is corrected</b> (ERRATA): the chapter prints the "
         "mid-range as the half-range " + ctx.imath(r"(q_{M,i} - q_{m,i})/2") + ".</p>"
-        + ctx.eq(EQ["43"], "43") + ctx.eq(EQ["44"], "44")
+        + ctx.eq(EQ["43"], "43") + ctx.eq(EQ["44"], "44, corrected")
         + "<p>Checks on a 6-link planar arm, L = 0.1 m, task (x, y). The self-motion "
         "integrates " + ctx.imath(r"\Delta\mathbf{q} = (\mathbf{I} - \mathbf{J}^{\dagger}"
                                   r"\mathbf{J})\,k\,(\pm\nabla H)")
@@ -138,7 +138,7 @@ def _six_link_algorithm(ctx: ReportContext, sa: Any) -> str:
         + ctx.imath(r"\mathbf{J}^{T}(\mathbf{J}^{T} + \lambda^2\mathbf{I})^{-1}")
         + " and the update " + ctx.imath(r"\Delta\mathbf{q} = \mathbf{q} + \ldots;\ "
                                          r"\mathbf{q} = \Delta\mathbf{q}") + ".</p>"
-        + ctx.eq(EQ["46"], "46")
+        + ctx.eq(EQ["46"], "46, corrected")
         + ctx.algorithm("Inverse kinematic model for 6-link manipulator (steps 7-8 corrected)", [
             (0, "Set the desired path of the end effector, the matrix X<sub>path</sub>, and "
                 "the parameters L, λ."),

@@ -13,6 +13,7 @@ from serialkin.chapter.sections.redundancy._common import (
     _phases,
     _shade,
 )
+from serialkin.chapter.sections.redundancy.step_cap import StepCap, cap_note
 from serialkin.tracking.analysis import (
     ResolverRun,
     compare_row,
@@ -127,7 +128,7 @@ def _qp_table(ctx: ReportContext, sc: Scenario,
 
 
 def _qp_discussion(w: ResolverRun, q: ResolverRun, safety: float, buffer: float,
-                   ratio: Timing | None) -> str:
+                   ratio: Timing | None, cap: str = "") -> str:
     """What the two runs show: berth, limit margin, guarantees and cost, in prose.
 
     Args:
@@ -136,6 +137,7 @@ def _qp_discussion(w: ResolverRun, q: ResolverRun, safety: float, buffer: float,
         safety: the QP's safety distance d_s [m].
         buffer: eq 49's buffer of the eq 48 run, a fraction of each joint's range.
         ratio: QP / eq 48 time of the whole path per round of runs in one process.
+        cap: a clause stating eq 48's step cap and what a larger one does, or "".
     """
     per_point = q.trajectory.clearance.min(axis=1)
     below = int((per_point < safety).sum())
@@ -156,7 +158,10 @@ def _qp_discussion(w: ResolverRun, q: ResolverRun, safety: float, buffer: float,
     qp_at_limit = int((q.trajectory.limit_margin.min(axis=1) < 1e-6).sum())
     faster = ("the QP is faster" if q.per_point < w.per_point else "eq 48 is faster")
     return (
-        f"<p>Here {reach} and {hit}. Eq 48 keeps {berth} berth ({_mm(w.min_clearance)} mm "
+        f"<p>Here {reach} and {hit}"
+        + (f". {cap}: eq 48's clearance and iteration count here are those of the capped "
+           "run" if cap else "")
+        + f". Eq 48 keeps {berth} berth ({_mm(w.min_clearance)} mm "
         f"against the QP's {_mm(q.min_clearance)} mm: its obstacle weight starts acting at "
         f"the distance of influence and pushes away, while {qp_berth}) and stays "
         f"{w.worst_margin * DEG:.1f}° inside every limit, where its {buffer:.0%} buffer "
@@ -235,7 +240,7 @@ def qp_figures(ctx: ReportContext, sc: Scenario, rows: list[ResolverRun]) -> str
 
 
 def _qp_part(ctx: ReportContext, sc: Scenario, timed: list[tuple[ResolverRun, Timing]],
-             figures: str | None = None) -> Section:
+             figures: str | None = None, cap: StepCap | None = None) -> Section:
     """Eq 48 (soft weights) against the differential-IK QP (hard constraints) on (c).
 
     Args:
@@ -244,6 +249,8 @@ def _qp_part(ctx: ReportContext, sc: Scenario, timed: list[tuple[ResolverRun, Ti
         timed: (eq 48 run, its timing) and (QP run, its timing), e.g. a
             :class:`SideBySide` (whose ``ratio`` is shown when set).
         figures: :func:`qp_figures` of the same runs (made here when None).
+        cap: :func:`~serialkin.chapter.sections.redundancy.step_cap.step_cap_study` of
+            the eq 48 run, whose step cap is then stated (nothing said when None).
     """
     ratio = getattr(timed, "ratio", None)
     res = qp_resolver(sc)
@@ -252,7 +259,8 @@ def _qp_part(ctx: ReportContext, sc: Scenario, timed: list[tuple[ResolverRun, Ti
     parts = [
         _qp_intro(ctx, res),
         _qp_table(ctx, sc, timed),
-        _qp_discussion(w, q, res.safety, sc.solver.limit_buffer, ratio),
+        _qp_discussion(w, q, res.safety, sc.solver.limit_buffer, ratio,
+                       "Eq 48 runs " + cap_note(cap) if cap is not None else ""),
         figures if figures is not None else qp_figures(ctx, sc, rows),
         ctx.reproduce(
             "import dataclasses\n"

@@ -20,6 +20,12 @@ from serialkin.chapter.sections.redundancy._common import (
     _shade,
     _where,
 )
+from serialkin.chapter.sections.redundancy.step_cap import (
+    StepCap,
+    cap_note,
+    cap_paragraph,
+    step_cap_study,
+)
 from serialkin.chapter.sections.redundancy.twenty_link_ablation import (
     ablation_cells,
     ablation_figure,
@@ -201,10 +207,13 @@ def _motion_figures(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc:
             plot_obstacles(ax, sc.obstacles, alpha=0.12, labels=True)
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
+        cap = f"eq 48 steps capped at ‖q̇‖ ≤ {s.solver.max_step:g} rad per iteration"
         caption = (f"Figure {fig_no} — " + (
-            "free motion (the obstacles of (c) drawn faintly); start pose q0 dashed"
+            f"free motion (the obstacles of (c) drawn faintly); start pose q0 dashed; {cap} "
+            "(a cap that never binds here)"
             if free else "motion between the obstacles A-D (influence zones dashed) with "
-            "joint limits ±100°; start pose q0 dashed"))
+            f"joint limits ±100°; start pose q0 dashed; {cap}, which decides this outcome "
+            "(see the step cap)"))
         parts.append(ctx.figure(fig, name, caption))
         if not free:  # one animation (GIFs are the costly part of the report)
             parts.append(_gif(ctx, s.robot, tr, name, title, obstacles=s.obstacles))
@@ -285,7 +294,8 @@ def twenty_link_figures(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any,
 def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any,
                       time_b: Timing, time_c: Timing, runs: list[AblationRun],
                       ratio: Timing | None = None,
-                      figures: dict[str, str] | None = None) -> Section:
+                      figures: dict[str, str] | None = None,
+                      cap: StepCap | None = None) -> Section:
     """The 20-link example: free (b, Figure 11) and constrained (c, Figure 12), ablation.
 
     Args:
@@ -299,10 +309,13 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
         runs: :func:`serialkin.tracking.analysis.ablation` of (c).
         ratio: the ratio (c)/(b) per round of runs in one process (None: of the medians).
         figures: :func:`twenty_link_figures` of the same runs (made here when None).
+        cap: :func:`~serialkin.chapter.sections.redundancy.step_cap.step_cap_study` of the
+            same runs (made here when None).
     """
     from serialkin.tracking.analysis import task_activity
 
     figs = figures if figures is not None else twenty_link_figures(ctx, sb, sc, tb, tc, runs)
+    cap = cap if cap is not None else step_cap_study(sb, sc, tb, tc)
     track_numbers = [v for s, tr in ((sb, tb), (sc, tc))
                      for v in (str(int(tr.reached.sum())), str(len(s.path)), _mm(tr.max_error),
                                str(int(tr.iterations.sum())))] + [
@@ -318,7 +331,8 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
             (2, "Compute " + ctx.imath(r"\dot{\mathbf{q}}") + " by eq 48 (corrected: "
                 + ctx.imath(r"\mathbf{J}^{T}") + " where the chapter prints "
                 + ctx.imath(r"\mathbf{J}^{-1}") + ")"),
-            (2, ctx.imath(r"\mathbf{q} = \mathbf{q}_{previous} + \dot{\mathbf{q}}\,dt")),
+            (2, ctx.imath(r"\mathbf{q} = \mathbf{q}_{previous} + \dot{\mathbf{q}}\,dt")
+                + f" (serialkin caps ‖q̇‖ at {cap.cap:g} rad, see the step cap below)"),
             (2, ctx.imath(r"\mathbf{q}_{previous} = \mathbf{q}")),
             (2, f"IF x<sub>d</sub> = x (here: within {sc.solver.tol * 1e3:g} mm, or "
                 f"{sc.solver.max_iter} iterations spent) THEN end CYCLE WHILE 2, ELSE "
@@ -328,10 +342,11 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
         ]),
         _design_text(ctx, sb, sc, tb, tc, task_activity(sc, tc)),
         _results_table(ctx, sb, sc, tb, tc),
+        cap_paragraph(ctx, sc, cap),
         _timings_text(ctx, sb, sc, tb, tc, time_b, time_c, ratio),
         figs["motion"],
         figs["activity"],
-        ablation_table(ctx, sc, runs),
+        ablation_table(ctx, sc, runs, "All runs of the ablation are made " + cap_note(cap)),
         figs["ablation"],
         figs["joints"],
         ctx.reproduce("serialkin track twenty_link_free --out out/track\n"

@@ -56,8 +56,17 @@ def _ablation_prose(sc: Scenario, runs: list[AblationRun]) -> str:
     return "; ".join(out)
 
 
-def ablation_table(ctx: ReportContext, sc: Scenario, runs: list[AblationRun]) -> str:
-    """What each secondary task of eq 48 contributes: one run with each switched off."""
+def ablation_table(ctx: ReportContext, sc: Scenario, runs: list[AblationRun],
+                   cap: str = "") -> str:
+    """What each secondary task of eq 48 contributes: one run with each switched off.
+
+    Args:
+        ctx: the report context.
+        sc: scenario (c), ``twenty_link_obstacles``.
+        runs: :func:`serialkin.tracking.analysis.ablation` of (c).
+        cap: a clause stating the step cap of the runs
+            (:func:`~serialkin.chapter.sections.redundancy.step_cap.cap_note`), or "".
+    """
     arows = [ablation_cells(r) for r in runs]
     R = float(sum(row.a for row in sc.robot.dh))
     beyond = float(np.linalg.norm(sc.path.points, axis=1).max()) - R
@@ -67,7 +76,8 @@ def ablation_table(ctx: ReportContext, sc: Scenario, runs: list[AblationRun]) ->
         "weight, the eq 49 maximum, or the singularity damping, leaving λ_min = "
         f"{sc.solver.damping:g} m). Measured: " + _ablation_prose(sc, runs) + ". The farthest "
         f"path point lies {beyond * 1e3:.1f} mm beyond the reach R, so no configuration "
-        "reaches it exactly.</p><p><b>This ablation is circular by design.</b> The path and "
+        "reaches it exactly." + (f" {cap}." if cap else "")
+        + "</p><p><b>This ablation is circular by design.</b> The path and "
         "the obstacles were designed (the chapter gives neither) with one phase per "
         "secondary task, so that each task has something to do; that switching a task off "
         "then breaks its phase confirms the design and the implementation, not that the "

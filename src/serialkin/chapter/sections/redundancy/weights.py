@@ -151,7 +151,8 @@ def _weights_part(ctx: ReportContext, sc: Scenario, tc: Any) -> Section:
     ]
     return Section(title="5.3 Kinematically redundant manipulators",
                    part="Weighted multi-task resolution (eqs 47-50)",
-                   equations="eqs 47-50 (48 corrected, 49 designed)", html="".join(parts))
+                   equations="eqs 47-50 (step 6 corrected to eq 48, 49 designed)",
+                   html="".join(parts))
 
 
 @dataclass(frozen=True)
@@ -232,7 +233,7 @@ def _clearance_gradient(sc: Scenario, g: _LinkObstacle, h: float) -> np.ndarray:
 
 
 def _figure10_text(ctx: ReportContext, g: _LinkObstacle) -> list[str]:
-    """Eqs 51-56 (51-54 corrected) and the table of their values on the closest pair."""
+    """Eqs 51-56 (51, 52, 54 corrected) and the table of their values on the closest pair."""
     s_i, e_i, s0, s_ci, u_i = g.s_i, g.e_i, g.s0, g.s_ci, g.u_i
     p_i, ell, obs = g.p_i, g.ell, g.obs
     return [
@@ -240,12 +241,15 @@ def _figure10_text(ctx: ReportContext, g: _LinkObstacle) -> list[str]:
         + ctx.imath(r"\mathbf{s}_0") + " whose distance of influence is drawn dashed; link i "
         "runs from joint position " + ctx.imath(r"\mathbf{s}_i") + " along the unit vector "
         + ctx.imath(r"\mathbf{e}_i") + " over its length " + ctx.imath(r"\ell_i")
-        + ". <b>Eqs 51-54 are corrected</b> (ERRATA): the projection is clamped to the link "
-        "segment (the chapter projects onto the infinite line) and eq 54 divides "
+        + ". <b>Eqs 51, 52 and 54 are corrected</b> (ERRATA): the projection is clamped to "
+        "the link segment (the chapter projects onto the infinite line), so that eq 52's "
+        "closest point lies on the link and eq 53's distance is to the segment, and eq 54 "
+        "divides "
         + ctx.imath(r"\mathbf{s}_{ci} - \mathbf{s}_0") + " (the chapter prints "
         + ctx.imath(r"\mathbf{s}_{ai}") + ").</p>",
-        ctx.eq(EQ["51"], "51") + ctx.eq(EQ["52"], "52") + ctx.eq(EQ["53"], "53")
-        + ctx.eq(EQ["54"], "54") + ctx.eq(EQ["55"], "55") + ctx.eq(EQ["56"], "56"),
+        ctx.eq(EQ["51"], "51, corrected") + ctx.eq(EQ["52"], "52, corrected")
+        + ctx.eq(EQ["53"], "53") + ctx.eq(EQ["54"], "54, corrected") + ctx.eq(EQ["55"], "55")
+        + ctx.eq(EQ["56"], "56"),
         f"<p>Computed by <code>closest_pairs</code> at path point {g.k} of the constrained run, "
         f"link {g.link} and obstacle {html.escape(obs.name)} (the closest pair of the whole "
         "run):</p>",
@@ -356,4 +360,4 @@ def _figure10_part(ctx: ReportContext, sc: Scenario, tc: Any) -> Section:
     ]
     return Section(title="5.3 Kinematically redundant manipulators",
                    part="Figure 10: a link and an obstacle (eqs 51-56)",
-                   equations="eqs 51-56 (51-54 corrected)", html="".join(parts))
+                   equations="eqs 51-56 (51, 52, 54 corrected)", html="".join(parts))
