@@ -18,7 +18,7 @@ from serialkin.ik.analytic.arm_angle import (
     ik_arm_angle,
     srs_structure,
 )
-from serialkin.ik.sweep import joint_sweep
+from serialkin.ik.sweep import END_TOL, joint_sweep
 from serialkin.model.dh import DHLink
 
 from . import _arm_angle_reference as reference_closed_form
@@ -401,6 +401,43 @@ def test_sweep_branches_never_jump_and_match_a_fine_sweep():
         if b < sweep.values[-1]:
             assert len(robot.ik_all(T, free={6: b + 1e-6})) == 0
             assert len(robot.ik_all(T, free={6: b - 1e-7})) > 0
+
+
+def test_sweep_ends_are_refined_to_end_tol():
+    """Joint 7 swept (one batch per refinement round): ends within END_TOL.
+
+    Each inner end has solutions and 2·END_TOL outside it none (fresh locked solves,
+    with the limits).
+    """
+    robot = models.get("panda")
+    checked = 0
+    for q in [np.array([0.2, -0.3, 0.1, -2.0, 0.1, 1.8, 0.6])] + list(robot.random_q(4, seed=5)):
+        T = robot.fk(q)
+        sweep = joint_sweep(robot, T, 6)
+        for a, b in sweep.feasible:
+            for end, out in ((a, -1.0), (b, 1.0)):
+                if sweep.values[0] < end < sweep.values[-1]:
+                    assert len(robot.ik_all(T, free={6: end})) > 0
+                    assert len(robot.ik_all(T, free={6: end + out * 2 * END_TOL})) == 0
+                    checked += 1
+    assert checked >= 4
+
+
+def test_sweep_of_a_middle_joint_has_refined_ends():
+    """Joint 4 (a locked solve per value): the feasible ends are found and refined.
+
+    Regression: an end whose neighbouring grid samples were not all feasible raised
+    IndexError (a masked sample was looked up past the end of the samples' array).
+    """
+    robot = models.get("panda")
+    T = robot.fk(np.array([0.2, -0.3, 0.1, -2.0, 0.1, 1.8, 0.6]))
+    sweep = joint_sweep(robot, T, 3, resolution=math.radians(10.0))
+    assert sweep.feasible
+    for a, b in sweep.feasible:
+        for end, out in ((a, -1.0), (b, 1.0)):
+            if sweep.values[0] < end < sweep.values[-1]:
+                assert len(robot.ik_all(T, free={3: end + out * 1e-6})) == 0
+                assert len(robot.ik_all(T, free={3: end - out * 1e-7})) > 0
 
 
 def test_sweep_bad_input_is_named():

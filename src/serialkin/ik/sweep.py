@@ -124,7 +124,7 @@ def joint_sweep(robot: Robot, T: object, joint: int, values: object = None, *,
         return _solve(robot, Tt, j, x, limited=False)
 
     return JointSweep(joint=j, values=v, q=q, valid=valid,
-                      feasible=_intervals(robot, v, Q, count, probe),
+                      feasible=_intervals(robot, v, Q, count, probe, j in (0, n - 1)),
                       max_jump=float(max_jump))
 
 
@@ -152,8 +152,7 @@ def _solve(robot: Robot, T: np.ndarray, j: int, x: np.ndarray, *, limited: bool
         for i, s in enumerate(sols):
             Q[i, :len(s)] = s
         return Q, count
-    reduced = _locked(target, {j: 0.0})[0]
-    res = ik_all(reduced, _targets(robot, T, j, x))
+    res = ik_all(_reduced(target, j), _targets(robot, T, j, x))
     count = np.asarray(res.count, dtype=np.int64).reshape(len(x))
     q = res.q.reshape(len(x), -1, n - 1)
     Q = np.empty((len(x), q.shape[1], n))
@@ -181,6 +180,19 @@ def _targets(robot: Robot, T: np.ndarray, j: int, x: np.ndarray) -> np.ndarray:
     inv[:, 3, 3] = 1.0
     F0 = _home(robot)
     return T @ inv @ F0 if j == robot.n - 1 else F0 @ inv @ T
+
+
+def _reduced(robot: Robot, j: int) -> Robot:
+    """The robot with joint j locked at 0 (:func:`~serialkin.ik.analytic._locked`), cached."""
+    got = _REDUCED.get(robot)
+    if got is None:
+        got = _REDUCED.set(robot, {})
+    if j not in got:
+        got[j] = _locked(robot, {j: 0.0})[0]
+    return got[j]
+
+
+_REDUCED: PerObject[dict[int, Robot]] = PerObject()
 
 
 def _home(robot: Robot) -> np.ndarray:
@@ -373,14 +385,24 @@ def _margin(robot: Robot, Q: np.ndarray, count: np.ndarray) -> np.ndarray:
     """
     lo, hi, mid, limited, rev = _limits(robot)
     x = Q[:, :, limited]
-    x = np.where(rev, x - 2.0 * math.pi * np.floor((x - mid) / (2.0 * math.pi) + 0.5), x)
-    best = np.minimum(x - lo, hi - x).min(axis=-1, initial=np.inf)   # (m, K)
+    turned = x - 2.0 * math.pi * np.floor((x - mid) / (2.0 * math.pi) + 0.5)
+    x = turned if rev is True else np.where(rev, turned, x)
+    d = np.minimum(x - lo, hi - x)
+    if d.shape[0] * d.shape[1] <= 256:
+        best = d.min(axis=-1, initial=np.inf)                         # (m, K)
+    else:  # a loop over the joints: numpy's reduction of a short last axis is slow
+        best = np.full(Q.shape[:2], np.inf)
+        for k in range(d.shape[-1]):
+            np.minimum(best, d[..., k], out=best)
     best[np.arange(Q.shape[1])[None, :] >= count[:, None]] = -np.inf
     return best.max(axis=-1, initial=-np.inf)
 
 
 def _limits(robot: Robot) -> tuple:
-    """``(lo, hi, mid, limited, revolute)`` of :func:`_margin`, for the limited joints."""
+    """``(lo, hi, mid, limited, revolute)`` of :func:`_margin`, for the limited joints.
+
+    ``limited`` is a slice when every joint is, ``revolute`` True when every one is.
+    """
     got = _LIMITS.get(robot)
     if got is None:
         lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
@@ -390,7 +412,8 @@ def _limits(robot: Robot) -> tuple:
         limited &= np.isfinite(lo) | np.isfinite(hi)
         mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), 0.0)
         got = _LIMITS.set(robot, (lo[limited], hi[limited], mid[limited],
-                                  np.flatnonzero(limited), rev[limited]))
+                                  slice(None) if limited.all() else np.flatnonzero(limited),
+                                  True if rev[limited].all() else rev[limited]))
     return got
 
 
@@ -413,11 +436,12 @@ def _closeness(Q: np.ndarray, count: np.ndarray) -> np.ndarray:
 
 
 def _intervals(robot: Robot, v: np.ndarray, Q: np.ndarray, count: np.ndarray,
-               probe: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
-               ) -> list[tuple[float, float]]:
+               probe: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+               batched: bool = False) -> list[tuple[float, float]]:
     """Closed runs of values with a solution; inner ends refined (:func:`_refine`).
 
-    ``probe(x)`` solves the locked arm without limits at the values x (k,).
+    ``probe(x)`` solves the locked arm without limits at the values x (k,); ``batched``:
+    in one batch, where a probe costs little beside a round (:func:`_refine`).
     """
     some = count > 0
     m = len(v)
@@ -434,10 +458,10 @@ def _intervals(robot: Robot, v: np.ndarray, Q: np.ndarray, count: np.ndarray,
     sub = np.unique(near[inside])
     f = _margin(robot, Q[sub], count[sub]) + _PROBE_LIMIT_TOL
     c = _closeness(Q[sub], count[sub])
-    where = np.searchsorted(sub, near)
+    where = np.minimum(np.searchsorted(sub, near), len(sub) - 1)   # outside runs: masked
     samples = np.stack([np.where(inside, v[near], np.nan), np.where(inside, f[where], np.nan),
                         np.where(inside, c[where], np.nan)], axis=-1)   # (e, 3, 3)
-    ends = _refine(robot, v[np.where(some[edges], edges + 1, edges)], samples, probe)
+    ends = _refine(robot, v[np.where(some[edges], edges + 1, edges)], samples, probe, batched)
     starts = ([float(v[0])] if some[0] else []) + [float(x) for x, s in zip(ends, step)
                                                    if s > 0]
     stops = [float(x) for x, s in zip(ends, step) if s < 0] + ([float(v[-1])] if some[-1]
@@ -449,19 +473,29 @@ def _intervals(robot: Robot, v: np.ndarray, Q: np.ndarray, count: np.ndarray,
 _AROUND = np.array([-3e-3, -3e-5, 0.0, 3e-5, 3e-3])
 #: The safeguard: probes at these fractions of every bracket, every round.
 _SPLIT = np.array([0.25, 0.5, 0.75])
+#: Batched probes (first or last joint swept): a round costs as much as ~40 probes, so
+#: each estimate gets a ladder of probes at these distances [rad or m] on both sides,
+#: from END_TOL / 2 up to the bracket's width, beside one probe at the bracket's middle;
+#: a bracket without an estimate is cut in 8, every bracket in the first round in 16.
+_LADDER = 0.5 * END_TOL * 100.0 ** np.arange(8)
+_SPLIT_FINE = np.arange(1, 8) / 8.0
+_HALF = np.array([0.5])
+#: The first round's cut (the grid's samples give poor estimates): in 16.
+_SPLIT_FIRST = np.arange(1, 16) / 16.0
 
 
-def _estimates(b: float, fb: float, samples: np.ndarray) -> list[float]:
+def _estimates(b: float, fb: float, samples: np.ndarray | list) -> list[float]:
     """Where an end between the infeasible value b and the feasible samples may lie.
 
     ``samples`` (3, 3): (value, margin f, closeness c) of the feasible values nearest
-    the end, nearest first (NaN rows missing). A limit is where f = 0: the root of the
-    line or parabola through the samples' f and, when f is known at b too, of the
-    inverse quadratic (or the secant) through b and the two nearest samples; an edge of
-    reach is where c = 0, c linear near it: the same through the samples' c. Roots
-    outside the bracket are dropped.
+    the end, nearest first (NaN rows missing; or a list of the rows present). A limit is
+    where f = 0: the root of the line or parabola through the samples' f and, when f is
+    known at b too, of the inverse quadratic (or the secant) through b and the two
+    nearest samples; an edge of reach is where c = 0, c linear near it: the same through
+    the samples' c. Roots outside the bracket are dropped.
     """
-    rows = [r for r in samples.tolist() if r[0] == r[0]]   # drop NaN rows
+    rows = samples if isinstance(samples, list) else \
+        [r for r in samples.tolist() if r[0] == r[0]]   # drop NaN rows
     g = rows[0][0]
     lo, hi = min(b, g), max(b, g)
     out = []
@@ -508,7 +542,8 @@ def _root(pts: list[tuple[float, float]], g: float) -> float | None:
 
 
 def _refine(robot: Robot, bad: np.ndarray, samples: np.ndarray,
-            probe: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+            probe: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+            batched: bool = False) -> np.ndarray:
     """The feasible end next to each infeasible value ``bad`` (e,), to :data:`END_TOL`.
 
     ``samples`` (e, 3, 3): per end the (value, margin, closeness) of the nearest
@@ -521,52 +556,70 @@ def _refine(robot: Robot, bad: np.ndarray, samples: np.ndarray,
     root of the margin; two solutions meeting at the edge of reach close like √(v* − v),
     a smooth root of their squared distance: either way the estimates converge fast, and
     the safeguard shrinks every bracket at least fourfold per round.
+
+    ``batched`` (the first or the last joint swept: ``probe`` is one batch solve, and a
+    round's fixed cost, ~0.1 ms, is that of some 40 probes): fewer, wider rounds. The
+    first round cuts every bracket in 16 (the grid's samples are a degree apart and
+    their estimates poor); every round probes a ladder around each estimate, at
+    ``_LADDER`` (END_TOL / 2 to the bracket's width, factors of 100) on either side, so
+    that the bracket shrinks to about the estimate's error, and closes to END_TOL once
+    that error is below END_TOL / 2; the safeguard is the bracket's middle, or a cut in 8
+    when there is no estimate. Either way each end is a feasible value within END_TOL of
+    an infeasible one, so the two agree to END_TOL; the bookkeeping is in Python floats,
+    as a round has a few dozen probes.
     """
     e = len(bad)
-    bad = bad.astype(float).copy()
-    fb = np.full(e, np.nan)
-    samples = samples.copy()
+    bad = [float(x) for x in bad]      # per end, as Python floats: a few probes each
+    fb = [math.nan] * e
+    near = [[tuple(r) for r in s.tolist() if r[0] == r[0]] for s in samples]
     first = True
     for _ in range(64):
-        g = samples[:, 0, 0]
-        live = np.flatnonzero(np.abs(g - bad) > END_TOL)
-        if not len(live):
+        live = [i for i in range(e) if abs(near[i][0][0] - bad[i]) > END_TOL]
+        if not live:
             break
-        pts = []
+        pts: list[float] = []
+        sizes = []
         for i in live:
-            b, w = bad[i], g[i] - bad[i]
-            est = _estimates(b, fb[i], samples[i])
-            here = [b + w * _SPLIT] + [x + w * _AROUND for x in est] + ([[b]] if first else [])
-            pts.append(np.concatenate(here))
-        sizes = [len(x) for x in pts]
-        X = np.concatenate(pts)
-        Qp, cp = probe(X)
-        f = _margin(robot, Qp, cp) + _PROBE_LIMIT_TOL
-        c = _closeness(Qp, cp)
-        start = 0
-        for i, k in zip(live, sizes):
-            x, fx, cx = X[start:start + k], f[start:start + k], c[start:start + k]
-            start += k
-            b, gi = bad[i], g[i]
-            t = (x - b) / (gi - b)                               # 0: bad, 1: good
+            b, w = bad[i], near[i][0][0] - bad[i]
+            est = _estimates(b, fb[i], near[i])
+            if batched:
+                split = _SPLIT_FIRST if first else _HALF if est else _SPLIT_FINE
+                rungs = [r for r in _LADDER if r < abs(w)]
+                here = [b + w * u for u in split]
+                for x in est:
+                    here += [x - r for r in rungs] + [x] + [x + r for r in rungs]
+                here = sorted({x for x in here if 0.0 < (x - b) / w < 1.0})
+            else:
+                here = [b + w * u for u in _SPLIT] + [x + w * u for x in est for u in _AROUND]
             if first:
-                fb[i] = fx[np.argmin(np.abs(t))]
-            keep = (t > 0.0) & (t < 1.0)
-            x, fx, cx, t = x[keep], fx[keep], cx[keep], t[keep]
-            order = np.argsort(t)
-            x, fx, cx = x[order], fx[order], cx[order]
-            ok = fx >= 0.0
-            if not ok.any():
-                if len(x):
-                    bad[i], fb[i] = x[-1], fx[-1]
+                here.append(b)
+            pts += here
+            sizes.append(len(here))
+        X = np.array(pts)
+        Qp, cp = probe(X)
+        f = (_margin(robot, Qp, cp) + _PROBE_LIMIT_TOL).tolist()
+        start = 0
+        kept = []      # per live end: the indices into X of its new feasible samples
+        for i, k in zip(live, sizes):
+            b, gi = bad[i], near[i][0][0]
+            t = [((pts[a] - b) / (gi - b), a) for a in range(start, start + k)]  # 0: bad
+            start += k
+            if first:
+                fb[i] = f[min(t, key=lambda ta: abs(ta[0]))[1]]
+            inner = sorted([ta for ta in t if 0.0 < ta[0] < 1.0])
+            h = next((m for m, (_, a) in enumerate(inner) if f[a] >= 0.0), None)
+            if h is None:
+                if inner:
+                    bad[i], fb[i] = pts[inner[-1][1]], f[inner[-1][1]]
+                kept.append([])
                 continue
-            h = int(np.argmax(ok))
             if h > 0:
-                bad[i], fb[i] = x[h - 1], fx[h - 1]
-            more = np.stack([x[h:][ok[h:]], fx[h:][ok[h:]], cx[h:][ok[h:]]], axis=1)
-            old = samples[i][np.isfinite(samples[i, :, 0])]
-            merged = np.concatenate([more, old])[:3]
-            samples[i] = np.nan
-            samples[i, :len(merged)] = merged
+                bad[i], fb[i] = pts[inner[h - 1][1]], f[inner[h - 1][1]]
+            kept.append([a for _, a in inner[h:] if f[a] >= 0.0][:3])  # the three nearest
+        need = [a for at in kept for a in at]
+        c = dict(zip(need, _closeness(Qp[need], cp[need]).tolist()))   # only those kept
+        for i, at in zip(live, kept):
+            if at:
+                near[i] = ([(pts[a], f[a], c[a]) for a in at] + near[i])[:3]
         first = False
-    return samples[:, 0, 0].copy()
+    return np.array([near[i][0][0] for i in range(e)])
