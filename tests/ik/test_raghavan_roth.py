@@ -15,8 +15,14 @@ from serialkin.ik.analytic.general import search_candidates
 from serialkin.ik.analytic.raghavan_roth import (
     _ANGLES,
     DEGREE,
+    N_GRID,
+    _apply_q,
+    _apply_qt,
     _equations,
+    _grid_values,
+    _qr,
     _to_coefficients,
+    _trig,
     eliminant_roots,
     rr_candidates,
 )
@@ -343,3 +349,58 @@ def test_nearly_coincident_axes_search_finer_when_nothing_is_found():
             assert len(rows_found) % 2 == 0
             assert _wrapped(rows_found, q).min() < 1e-8
             assert np.abs(robot.fk(rows_found) - T).max() < 1e-10
+
+
+def _qr_of(A: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    H = np.ascontiguousarray(A, dtype=float).copy()
+    beta, rdiag = np.empty(A.shape[1]), np.empty(A.shape[1])
+    perm = np.empty(A.shape[1], dtype=np.int64)
+    ratio = _qr(H, beta, rdiag, perm)
+    return ratio, H, beta, rdiag, perm
+
+
+def test_pivoted_qr_gives_the_left_null_space_and_least_squares():
+    """The pivoted QR of the elimination (it replaced an SVD) is right.
+
+    The last 6 columns of its Q span the left null space of the (14, 8) matrix
+    (orthonormal), the least-squares solution is numpy's, and the rank ratio is at least
+    the singular values' (below 1e-14 for a rank-deficient matrix).
+    """
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        A = rng.normal(size=(14, 8)) * rng.uniform(0.1, 10.0, size=8)
+        ratio, H, beta, rdiag, perm = _qr_of(A)
+        sv = np.linalg.svd(A, compute_uv=False)
+        assert sv[-1] / sv[0] <= ratio * (1 + 1e-12)
+        N = np.zeros((6, 14))
+        for r in range(6):
+            N[r, 8 + r] = 1.0
+            _apply_q(H, beta, N[r])
+        assert np.allclose(N @ N.T, np.eye(6), atol=1e-13)
+        assert np.abs(N @ A).max() < 1e-12 * np.abs(A).max()
+        b = rng.normal(size=14)
+        y = b.copy()
+        _apply_qt(H, beta, y)
+        z = np.empty(8)
+        m = np.empty(8)
+        for i in range(7, -1, -1):
+            z[i] = (y[i] - H[i, i + 1:8] @ z[i + 1:]) / rdiag[i]
+            m[perm[i]] = z[i]
+        assert np.allclose(m, np.linalg.lstsq(A, b, rcond=None)[0], atol=1e-11)
+    A = rng.normal(size=(14, 8))
+    A[:, 5] = A[:, 1] - 2.0 * A[:, 3]  # rank 7
+    assert _qr_of(A)[0] < 1e-14
+
+
+def test_grid_values_are_the_derivatives_at_the_grid():
+    """The scan's table products equal the derivatives evaluated one by one."""
+    rng = np.random.default_rng(5)
+    a, b = rng.normal(size=DEGREE + 1), rng.normal(size=DEGREE + 1)
+    for order in (0, 2):
+        vals = _grid_values(a, b, order)
+        for m in range(N_GRID + 1):
+            t = -math.pi + 2.0 * math.pi / N_GRID * m
+            for j in range(3):
+                size = sum(k ** (order + j) * (abs(a[k]) + abs(b[k])) for k in range(DEGREE + 1))
+                assert abs(vals[j, m] - _trig(a, b, t, order + j)) <= 1e-13 * size
+

@@ -4,7 +4,7 @@ A 6R arm in no special class (no spherical wrist, no three parallel axes) has up
 solutions (Raghavan & Roth 1993; Manseur & Doty 1989). :func:`general_candidates`
 first eliminates five joints (:mod:`serialkin.ik.analytic.raghavan_roth`: a
 trigonometric eliminant of degree 8 in θ3, 17 determinants of a 12 × 12 pencil,
-about 0.1 ms per pose). Why the elimination first: it is exact (one candidate per real
+about 35 µs per pose). Why the elimination first: it is exact (one candidate per real
 root, every one refined by Newton's method), 20-50 times faster than the search, and
 it finds the solutions closer together than a search cell. When it does not apply (a
 rank-deficient elimination near special geometry) or loses a root (a cluster of

@@ -23,7 +23,7 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
    derivation, and the claim is checked by the tests on random arms.
 3. **Eliminate θ1, θ2.** Moving the constant term left, ``P(θ3, θ4, θ5) = Q·m12`` with
    ``Q`` (14, 8) the coefficients of the 8 non-constant products of θ1, θ2. Rows
-   ``N`` (6, 14) spanning the left null space of ``Q`` (its SVD) give six equations in
+   ``N`` (6, 14) spanning the left null space of ``Q`` (its QR) give six equations in
    θ3, θ4, θ5 alone.
 4. **A 12 × 12 pencil.** The half-angle tangents x4, x5 turn each equation (times
    ``(1+x4²)(1+x5²)``) into a polynomial in the 9 monomials ``x4^i x5^j`` (i, j ≤ 2);
@@ -46,7 +46,7 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
    elimination with complete pivoting) gives x4, x5 as ratios of its entries (a root
    where that null space has two or more dimensions is shared by several solutions:
    the search answers instead, :data:`MULTIPLE_TOL`); the
-   least-squares solution of ``Q·m12 = P`` (the same SVD) gives ``(cos θ1, sin θ1)`` and
+   least-squares solution of ``Q·m12 = P`` (the same QR) gives ``(cos θ1, sin θ1)`` and
    ``(cos θ2, sin θ2)``; θ6 follows by subproblem 1 on ``w6``.
 7. **Refinement.** Every candidate is polished by Newton's method on the robot's own
    chain (:func:`~serialkin.ik.analytic.refine.refine_new`) to the solver's
@@ -73,12 +73,7 @@ from serialkin.ik.analytic.subproblems import (
     TWO_PI,
     inv_rigid,
     mm,
-    mtv,
-    mv,
-    rotation,
-    screw,
     sp1_dir,
-    transform_point,
 )
 
 from ..._jit import njit
@@ -93,8 +88,20 @@ _HALF = np.array([[1.0, 0.0, 1.0], [1.0, 0.0, -1.0], [0.0, 2.0, 0.0]])
 DEGREE = 8
 #: Determinants sampled for its coefficients (2·DEGREE + 1).
 _N_DET = 2 * DEGREE + 1
+#: cos and sin of 2π k m / _N_DET (k ≤ DEGREE, m < _N_DET): the discrete Fourier transform
+#: of the sampled determinants, a table instead of 306 calls per pose.
+_DFT_COS = np.array([[math.cos(TWO_PI * k * m / _N_DET) for m in range(_N_DET)]
+                     for k in range(DEGREE + 1)])
+_DFT_SIN = np.array([[math.sin(TWO_PI * k * m / _N_DET) for m in range(_N_DET)]
+                     for k in range(DEGREE + 1)])
 #: Grid on which the zeros of the eliminant's second derivative are bracketed.
 N_GRID = 128
+#: cos and sin of k·t_m at the grid's ends t_m = −π + 2π m / N_GRID (k ≤ DEGREE,
+#: m ≤ N_GRID), rows k: the grid values of :func:`_scan` as table products.
+_GRID_COS = np.array([[math.cos(k * (-math.pi + TWO_PI / N_GRID * m)) for m in range(N_GRID + 1)]
+                      for k in range(DEGREE + 1)])
+_GRID_SIN = np.array([[math.sin(k * (-math.pi + TWO_PI / N_GRID * m)) for m in range(N_GRID + 1)]
+                      for k in range(DEGREE + 1)])
 #: Bracket or Newton step [rad] at which a zero of the eliminant or of a derivative is
 #: accepted (each root is then polished on the determinant and the pose anyway).
 ZERO_TOL = 1e-13
@@ -102,7 +109,8 @@ ZERO_TOL = 1e-13
 #: part is tried as a candidate θ3 (:func:`eliminant_roots`): a near-double real root
 #: that rounding turned into a complex pair survives; refinement on the pose decides.
 NEAR_REAL = 1e-3
-#: Smallest singular value of Q, relative to the largest, for the elimination to apply.
+#: Smallest ratio |R[7, 7]| / |R[0, 0]| of Q's pivoted QR (:func:`_qr`; at least its smallest
+#: singular value over its largest) for the elimination to apply.
 RANK_TOL = 1e-9
 #: Smallest pivot ratio (≈ 1/cond) of the best-conditioned sample of K(θ3): below it the
 #: pencil is nearly singular for every θ3 (an arm close to a special class, where the
@@ -148,6 +156,117 @@ def _equations(l, p, out, row):
 
 
 @njit(cache=True)
+def _move(E, x, y):
+    """``y = (R·x[:3], E·x[3:])`` (6,) for a rigid E (4, 4): a direction and a point moved."""
+    for i in range(3):
+        y[i] = E[i, 0] * x[0] + E[i, 1] * x[1] + E[i, 2] * x[2]
+        y[3 + i] = E[i, 0] * x[3] + E[i, 1] * x[4] + E[i, 2] * x[5] + E[i, 3]
+
+
+@njit(cache=True)
+def _screw_into(w, r, theta, E):
+    """``E ← exp(ξ θ)`` (4, 4) of the revolute line (w, r), without allocation.
+
+    The operations of :func:`~serialkin.ik.analytic.subproblems.screw` (Rodrigues, then
+    the translation ``r − R r``), so the same rounding.
+    """
+    c = math.cos(theta)
+    s = math.sin(theta)
+    v = 1.0 - c
+    x = w[0]
+    y = w[1]
+    z = w[2]
+    E[0, 0] = c + x * x * v
+    E[0, 1] = x * y * v - z * s
+    E[0, 2] = x * z * v + y * s
+    E[1, 0] = y * x * v + z * s
+    E[1, 1] = c + y * y * v
+    E[1, 2] = y * z * v - x * s
+    E[2, 0] = z * x * v - y * s
+    E[2, 1] = z * y * v + x * s
+    E[2, 2] = c + z * z * v
+    for i in range(3):
+        E[i, 3] = r[i] - (E[i, 0] * r[0] + E[i, 1] * r[1] + E[i, 2] * r[2])
+        E[3, i] = 0.0
+    E[3, 3] = 1.0
+
+
+@njit(cache=True)
+def _qr(A, beta, rdiag, perm):
+    """Householder QR with column pivoting of A (m, n), m > n, in place: ``A Π = Q R``.
+
+    Column j of A becomes the reflector ``v_j`` in rows j..m−1 (``H_j = I − β_j v_j v_jᵀ``,
+    ``Q = H_0···H_{n−1}``), its rows above the diagonal R's, ``rdiag`` R's diagonal;
+    ``perm[j]`` is the column of the original A in position j (the largest remaining
+    column first). Returns ``|R[n−1, n−1]| / |R[0, 0]|`` (0 for A = 0), a rank test
+    (at least σ_min / σ_max); a few hundred flops against LAPACK's SVD with its copies
+    and workspace queries (10 µs from a kernel).
+    """
+    m, n = A.shape
+    for j in range(n):
+        perm[j] = j
+    for j in range(n):
+        pc = j
+        big = -1.0
+        for c in range(j, n):
+            t = 0.0
+            for i in range(j, m):
+                t += A[i, c] * A[i, c]
+            if t > big:
+                big = t
+                pc = c
+        if pc != j:
+            for i in range(m):
+                A[i, j], A[i, pc] = A[i, pc], A[i, j]
+            perm[j], perm[pc] = perm[pc], perm[j]
+        norm = math.sqrt(big)
+        alpha = -norm if A[j, j] >= 0.0 else norm
+        A[j, j] -= alpha
+        vv = 0.0
+        for i in range(j, m):
+            vv += A[i, j] * A[i, j]
+        b = 2.0 / vv if vv > 0.0 else 0.0
+        beta[j] = b
+        rdiag[j] = alpha
+        for c in range(j + 1, n):
+            t = 0.0
+            for i in range(j, m):
+                t += A[i, j] * A[i, c]
+            t *= b
+            for i in range(j, m):
+                A[i, c] -= t * A[i, j]
+    if rdiag[0] == 0.0:
+        return 0.0
+    return abs(rdiag[n - 1]) / abs(rdiag[0])
+
+
+@njit(cache=True)
+def _apply_q(A, beta, x):
+    """``x ← Q x`` (m,) in place, Q the orthogonal factor of :func:`_qr` (reflectors in A)."""
+    m, n = A.shape
+    for j in range(n - 1, -1, -1):
+        t = 0.0
+        for i in range(j, m):
+            t += A[i, j] * x[i]
+        t *= beta[j]
+        for i in range(j, m):
+            x[i] -= t * A[i, j]
+
+
+@njit(cache=True)
+def _apply_qt(A, beta, x):
+    """``x ← Qᵀ x`` (m,) in place, Q the orthogonal factor of :func:`_qr` (reflectors in A)."""
+    m, n = A.shape
+    for j in range(n):
+        t = 0.0
+        for i in range(j, m):
+            t += A[i, j] * x[i]
+        t *= beta[j]
+        for i in range(j, m):
+            x[i] -= t * A[i, j]
+
+
+@njit(cache=True)
 def _to_coefficients(V, m):
     """Values at the interpolation angles → coefficients of (1, c, s), along ``m`` axes.
 
@@ -177,7 +296,7 @@ def _eliminate_below(A, c):
     """One Gaussian elimination step: rows below c minus multiples of row c (pivot A[c, c]).
 
     Only the columns right of c are updated (column c below the pivot is left as is:
-    neither caller reads it again).
+    the caller does not read it again).
     """
     n = A.shape[0]
     inv = 1.0 / A[c, c]
@@ -189,39 +308,10 @@ def _eliminate_below(A, c):
 
 
 @njit(cache=True)
-def _det(A):
-    """The determinant of A (n, n) by LU with partial pivoting, and min |pivot| / max |pivot|.
-
-    ``A`` is overwritten. The pivot ratio is a cheap lower bound on 1/cond(A): the
-    determinant's relative accuracy is about machine epsilon over it.
-    """
-    n = A.shape[0]
-    d = 1.0
-    pmin = math.inf
-    pmax = 0.0
-    for c in range(n):
-        piv = c
-        big = abs(A[c, c])
-        for r in range(c + 1, n):
-            if abs(A[r, c]) > big:
-                big = abs(A[r, c])
-                piv = r
-        if big == 0.0:
-            return 0.0, 0.0
-        pmin = min(pmin, big)
-        pmax = max(pmax, big)
-        if piv != c:
-            d = -d
-            for j in range(c, n):
-                A[c, j], A[piv, j] = A[piv, j], A[c, j]
-        d *= A[c, c]
-        _eliminate_below(A, c)
-    return d, pmin / pmax
-
-
-@njit(cache=True)
-def _null_vector(A, v):
+def _null_vector(A, v, y, perm):
     """A unit null vector ``v`` (n,) of the nearly singular ``A`` (n, n, overwritten).
+
+    ``y`` (n,) and ``perm`` (n,) int are work space.
 
     Gaussian elimination with complete pivoting; the last pivot is the (near) zero one,
     the vector follows by back substitution with its last entry 1. Returns the
@@ -229,7 +319,8 @@ def _null_vector(A, v):
     when the null space has two or more dimensions, where ``v`` is one vector of it.
     """
     n = A.shape[0]
-    perm = np.arange(n)
+    for i in range(n):
+        perm[i] = i
     for c in range(n - 1):
         pr, pc, big = c, c, -1.0
         for r in range(c, n):
@@ -247,7 +338,6 @@ def _null_vector(A, v):
                 A[r, c], A[r, pc] = A[r, pc], A[r, c]
             perm[c], perm[pc] = perm[pc], perm[c]
         _eliminate_below(A, c)
-    y = np.zeros(n)
     y[n - 1] = 1.0
     for i in range(n - 2, -1, -1):
         s = 0.0
@@ -314,16 +404,20 @@ def _trig(a, b, t, order):
 
 
 @njit(cache=True)
-def _zero(a, b, lo, hi, order):
+def _zero(a, b, lo, hi, order, flo):
     """Zero in [lo, hi] of derivative ``order`` of f, which changes sign there.
 
-    Newton steps on the next derivative when they stay inside the bracket, else
-    bisection; 60 iterations at most, or until the bracket or a Newton step is below
-    :data:`ZERO_TOL` (a derivative's value near its zero is rounding noise: smaller
-    steps only wander in it).
+    ``flo`` is that derivative's value at lo (nonzero; the caller's, which decided the
+    bracket). Newton steps on the next derivative when they stay inside the bracket,
+    else bisection; 60 iterations at most, or until the bracket or a Newton step is
+    below :data:`ZERO_TOL` (a derivative's value near its zero is rounding noise:
+    smaller steps only wander in it), or until a step converging quadratically (at
+    most a tenth of the one before) predicts the next below it (``d³/d_prev²``): the
+    step that would only confirm the zero is not taken (about a third of the
+    evaluations of the eliminant's roots).
     """
-    flo = _trig(a, b, lo, order)
     x = 0.5 * (lo + hi)
+    dprev = math.inf  # the previous Newton step
     for _ in range(60):
         f, fp, _unused = _trig3(a, b, math.cos(x), math.sin(x), order)
         if f == 0.0:
@@ -337,10 +431,13 @@ def _zero(a, b, lo, hi, order):
             break
         xn = x - f / fp if fp != 0.0 else 0.5 * (lo + hi)
         if lo < xn < hi:
-            if abs(xn - x) < ZERO_TOL:
+            d = abs(xn - x)
+            if d < ZERO_TOL or (d < 0.1 * dprev < 0.1 and d * d * d < ZERO_TOL * dprev * dprev):
                 return xn
+            dprev = d
             x = xn
         else:
+            dprev = math.inf
             x = 0.5 * (lo + hi)
     return x
 
@@ -394,13 +491,13 @@ def _cell_pieces(a, b, lo, hi, f_lo, g_lo, s_lo, f_hi, g_hi, s_hi, tiny, order, 
     cut[0] = lo
     fv[0] = f_lo
     nc = 1
-    x = _zero(a, b, lo, hi, order + 2)
+    x = _zero(a, b, lo, hi, order + 2, s_lo)
     gx = _trig(a, b, x, order + 1)
     if _changes(g_lo, gx):
-        cut[nc] = _zero(a, b, lo, x, order + 1)
+        cut[nc] = _zero(a, b, lo, x, order + 1, g_lo)
         nc += 1
     if _changes(gx, g_hi):
-        cut[nc] = _zero(a, b, x, hi, order + 1)
+        cut[nc] = _zero(a, b, x, hi, order + 1, gx)
         nc += 1
     for i in range(1, nc):
         fv[i] = _trig(a, b, cut[i], order)
@@ -408,10 +505,36 @@ def _cell_pieces(a, b, lo, hi, f_lo, g_lo, s_lo, f_hi, g_hi, s_hi, tiny, order, 
     fv[nc] = f_hi
     for i in range(nc):
         if _changes(fv[i], fv[i + 1]):
-            k = _add_root(roots, k, _zero(a, b, cut[i], cut[i + 1], order))
+            k = _add_root(roots, k, _zero(a, b, cut[i], cut[i + 1], order, fv[i]))
         elif i > 0 and fv[i] != 0.0 and abs(fv[i]) <= tiny and not _changes(fv[i - 1], fv[i]):
             k = _add_root(roots, k, cut[i])  # an extremum at zero to rounding: a double zero
     return k
+
+
+@njit(cache=True)
+def _grid_values(a, b, order):
+    """Derivatives ``order``, ``order + 1``, ``order + 2`` of f at the N_GRID + 1 grid ends.
+
+    (3, N_GRID + 1): the coefficients of each derivative (:func:`_trig3`'s ``k^m`` and
+    phase) times the tables :data:`_GRID_COS`, :data:`_GRID_SIN`; independent products
+    over the grid instead of 129 serial angle-addition recurrences (3 µs less per pose).
+    """
+    vals = np.zeros((3, N_GRID + 1))
+    for j in range(3):
+        o = order + j
+        u0, v0 = _phase(1.0, 0.0, o), _phase(0.0, 1.0, o)
+        if o == 0:
+            for m in range(N_GRID + 1):
+                vals[j, m] = a[0]
+        for k in range(1, a.shape[0]):
+            w = 1.0
+            for _ in range(o):
+                w *= k
+            al = w * (u0 * a[k] + v0 * b[k])
+            be = w * (u0 * b[k] - v0 * a[k])
+            for m in range(N_GRID + 1):
+                vals[j, m] += al * _GRID_COS[k, m] + be * _GRID_SIN[k, m]
+    return vals
 
 
 @njit(cache=True)
@@ -428,18 +551,13 @@ def _scan(a, b, order, roots):
     """
     tiny = _tiny(a, b, order)
     h = TWO_PI / N_GRID
-    ch, sh = math.cos(h), math.sin(h)
-    c, s = -1.0, 0.0  # cos, sin of the cell's end, advanced by the rotation of h
+    vals = _grid_values(a, b, order)
     k = 0
     lo = -math.pi
-    f_lo, g_lo, s_lo = _trig3(a, b, c, s, order)
+    f_lo, g_lo, s_lo = vals[0, 0], vals[1, 0], vals[2, 0]
     for m in range(N_GRID):
         hi = -math.pi + h * (m + 1)
-        if m % 16 == 15:  # re-anchor the rotation now and then (no drift)
-            c, s = math.cos(hi), math.sin(hi)
-        else:
-            c, s = c * ch - s * sh, s * ch + c * sh
-        f_hi, g_hi, s_hi = _trig3(a, b, c, s, order)
+        f_hi, g_hi, s_hi = vals[0, m + 1], vals[1, m + 1], vals[2, m + 1]
         if f_lo == 0.0:
             k = _add_root(roots, k, lo)
         if (_changes(s_lo, s_hi) and not _changes(g_lo, g_hi)
@@ -448,14 +566,14 @@ def _scan(a, b, order, roots):
             k = _cell_pieces(a, b, lo, hi, f_lo, g_lo, s_lo, f_hi, g_hi, s_hi, tiny, order,
                              roots, k)
         elif _changes(f_lo, f_hi):  # at most one extremum: exactly one zero
-            k = _add_root(roots, k, _zero(a, b, lo, hi, order))
+            k = _add_root(roots, k, _zero(a, b, lo, hi, order, f_lo))
         elif _changes(g_lo, g_hi) and (f_lo > 0.0) == (g_lo < 0.0):
             # one extremum, and g moves toward zero first: two zeros, a double one, or none
-            x = _zero(a, b, lo, hi, order + 1)
+            x = _zero(a, b, lo, hi, order + 1, g_lo)
             fx = _trig(a, b, x, order)
             if _changes(f_lo, fx):
-                k = _add_root(roots, k, _zero(a, b, lo, x, order))
-                k = _add_root(roots, k, _zero(a, b, x, hi, order))
+                k = _add_root(roots, k, _zero(a, b, lo, x, order, f_lo))
+                k = _add_root(roots, k, _zero(a, b, x, hi, order, fx))
             elif abs(fx) <= tiny:
                 k = _add_root(roots, k, x)
         lo, f_lo, g_lo, s_lo = hi, f_hi, g_hi, s_hi
@@ -517,14 +635,14 @@ def eliminant_roots(a, b, roots, near):
         if f_lo == 0.0:
             k = _add_root(roots, k, lo)
         if _changes(f_lo, f_hi):  # at most one extremum: exactly one root
-            k = _add_root(roots, k, _zero(a, b, lo, hi, 0))
+            k = _add_root(roots, k, _zero(a, b, lo, hi, 0, f_lo))
         elif _changes(g_lo, g_hi) and (f_lo > 0.0) == (g_lo < 0.0):
             # one extremum, and f moves toward zero first: two roots, a double one, or none
-            x = _zero(a, b, lo, hi, 1)
+            x = _zero(a, b, lo, hi, 1, g_lo)
             fx, _unused, f2 = _trig3(a, b, math.cos(x), math.sin(x), 0)
             if _changes(f_lo, fx):
-                k = _add_root(roots, k, _zero(a, b, lo, x, 0))
-                k = _add_root(roots, k, _zero(a, b, x, hi, 0))
+                k = _add_root(roots, k, _zero(a, b, lo, x, 0, f_lo))
+                k = _add_root(roots, k, _zero(a, b, x, hi, 0, fx))
             elif abs(fx) <= tiny:
                 k = _add_root(roots, k, x)
             elif 2.0 * abs(fx) <= NEAR_REAL * NEAR_REAL * abs(f2) and kn < near.shape[0]:
@@ -653,60 +771,82 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
     else:
         jd, je_, Um, Vm, Wm = 5, 4, G, I4, I4
     w_e = W[e].copy()
-    c_e = P[e].copy()
     o = P[ja].copy()
-    # 1-2. left side: the 14 quantities at 27 sample angles → coefficients (27, 14)
+    # 1-2. left side: the 14 quantities at 27 sample angles → coefficients (27, 14). The
+    # screws of the left joints at the 3 angles move (w_e, c_e) from the inside out: 39
+    # direction-and-point products, no 4 × 4 products and no allocation per sample
+    S = np.empty((9, 4, 4))  # S[3·a + i]: left joint a (ja, jb, jc) at angle i
+    for i in range(3):
+        _screw_into(W[ja], P[ja], _ANGLES[i], S[i])
+        _screw_into(W[jb], P[jb], _ANGLES[i], S[3 + i])
+        _screw_into(W[jc], P[jc], _ANGLES[i], S[6 + i])
+    x0 = np.empty(6)
+    for i in range(3):
+        x0[i] = W[e, i]
+        x0[3 + i] = P[e, i]
+    X5 = np.empty((3, 6))
+    X45 = np.empty((9, 6))
+    x = np.empty(6)
+    for i5 in range(3):
+        _move(S[6 + i5], x0, X5[i5])
+        for i4 in range(3):
+            _move(S[3 + i4], X5[i5], X45[3 * i4 + i5])
     V = np.empty((27, 14))
     l = np.empty(3)
     p = np.empty(3)
     for i3 in range(3):
-        EA = screw(W[ja], P[ja], _ANGLES[i3], False)
         for i4 in range(3):
-            EAB = mm(EA, screw(W[jb], P[jb], _ANGLES[i4], False))
             for i5 in range(3):
-                E = mm(EAB, screw(W[jc], P[jc], _ANGLES[i5], False))
-                lv = mv(E, w_e)
-                pt = transform_point(E, c_e)
+                _move(S[i3], X45[3 * i4 + i5], x)
                 for i in range(3):
-                    l[i] = lv[i]
-                    p[i] = (pt[i] - o[i]) * inv_s
+                    l[i] = x[i]
+                    p[i] = (x[3 + i] - o[i]) * inv_s
                 _equations(l, p, V, 9 * i3 + 3 * i4 + i5)
     Cl = _to_coefficients(V, 3)
     # right side: 9 samples of (θ_E, θ_D) → coefficients (9, 14)
-    lw = mv(Wm, w_e)
-    pw = transform_point(Wm, c_e)
+    for i in range(3):  # S[i]: joint E at −angle i, S[3 + i]: joint D
+        _screw_into(W[je_], P[je_], -_ANGLES[i], S[i])
+        _screw_into(W[jd], P[jd], -_ANGLES[i], S[3 + i])
+    xw = np.empty(6)
+    _move(Wm, x0, xw)
+    x1 = np.empty(6)
     V2 = np.empty((9, 14))
     for i1 in range(3):
-        EE = mm(Vm, screw(W[je_], P[je_], -_ANGLES[i1], False))
-        l1 = mv(EE, lw)
-        p1 = transform_point(EE, pw)
+        _move(S[i1], xw, x)
+        _move(Vm, x, x1)
         for i2 in range(3):
-            ED = mm(Um, screw(W[jd], P[jd], -_ANGLES[i2], False))
-            lv = mv(ED, l1)
-            pt = transform_point(ED, p1)
+            _move(S[3 + i2], x1, X5[0])
+            _move(Um, X5[0], x)
             for i in range(3):
-                l[i] = lv[i]
-                p[i] = (pt[i] - o[i]) * inv_s
+                l[i] = x[i]
+                p[i] = (x[3 + i] - o[i]) * inv_s
             _equations(l, p, V2, 3 * i1 + i2)
     Cr = _to_coefficients(V2, 2)
-    # 3. eliminate θ1, θ2: left null space of Q (14, 8)
+    # 3. eliminate θ1, θ2: left null space of Q (14, 8), the last 6 columns of the
+    # orthogonal factor of its QR decomposition (Householder, column pivoting)
     Q = np.empty((14, 8))
     for j in range(8):
         for k in range(14):
             Q[k, j] = Cr[j + 1, k]
-    U, sv, Vt = np.linalg.svd(Q)
-    if not sv[7] > RANK_TOL * sv[0]:
+    rdiag = np.empty(8)
+    beta = np.empty(8)
+    perm = np.empty(8, dtype=np.int64)
+    if not _qr(Q, beta, rdiag, perm) > RANK_TOL:
         return RANK_DEFICIENT
+    N = np.zeros((6, 14))  # rows: Q e_9 ... Q e_14
+    for r in range(6):
+        N[r, 8 + r] = 1.0
+        _apply_q(Q, beta, N[r])
     E = np.zeros((6, 27))  # N·(left − constant), basis index 9·a3 + 3·a4 + a5
     for r in range(6):
         for idx in range(27):
             s = 0.0
             for k in range(14):
-                s += U[k, 8 + r] * Cl[idx, k]
+                s += N[r, k] * Cl[idx, k]
             E[r, idx] = s
         s = 0.0
         for k in range(14):
-            s += U[k, 8 + r] * Cr[0, k]
+            s += N[r, k] * Cr[0, k]
         E[r, 0] -= s
     # 4. the pencil K(θ3) = K[0] + cos θ3 K[1] + sin θ3 K[2] on monomials x4^i x5^j
     K = np.zeros((3, 12, 12))
@@ -727,7 +867,7 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
     d = np.empty(_N_DET)
     best = 0.0
     for m in range(_N_DET):
-        d[m], ratio = _pencil_det(K, TWO_PI * m / _N_DET, A)
+        d[m], ratio = _pencil_det_cs(K, _DFT_COS[1, m], _DFT_SIN[1, m], A)  # θ3 = 2π m / 17
         best = max(best, ratio)
     if best < EXACT_TOL:  # K(θ3) singular for every θ3: this split degenerates exactly
         return RANK_DEFICIENT
@@ -737,9 +877,8 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
     cb = np.zeros(DEGREE + 1)
     for k in range(DEGREE + 1):
         for m in range(_N_DET):
-            t = TWO_PI * k * m / _N_DET
-            ca[k] += d[m] * math.cos(t)
-            cb[k] += d[m] * math.sin(t)
+            ca[k] += d[m] * _DFT_COS[k, m]
+            cb[k] += d[m] * _DFT_SIN[k, m]
         ca[k] *= (1.0 if k == 0 else 2.0) / _N_DET
         cb[k] *= 2.0 / _N_DET
     cb[0] = 0.0
@@ -763,6 +902,8 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
     for i in range(3):
         u6[i] /= nu
     q = np.empty(6)
+    ws = np.empty(87)  # work space of _candidate
+    iws = np.empty(12, dtype=np.int64)
     k = 0
     lost = False
     for ir in range(nr + nn):
@@ -772,7 +913,8 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
         for attempt in range(2 if real else 1):
             if attempt == 1:
                 t3 = _polish_root(K, t3, A)
-            second = _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u6, reverse, A, q)
+            second = _candidate(t3, K, Cl, Cr, Q, beta, rdiag, perm, W, G, e, u6, reverse,
+                                A, q, ws, iws)
             if second < MULTIPLE_TOL:  # K(θ3) has a null space of 2+ dimensions: this θ3
                 if not real:
                     break
@@ -790,15 +932,51 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
 
 @njit(cache=True)
 def _pencil_det(K, t, A):
-    """``det K(t)`` and its pivot ratio (:func:`_det`), ``K(t) = K[0] + cos t K[1] + sin t K[2]``.
+    """``det K(t)`` and its pivot ratio, ``K(t) = K[0] + cos t K[1] + sin t K[2]``.
 
-    K (3, 12, 12); A (12, 12) is work space.
+    K (3, 12, 12); A (12, 12) is work space (:func:`_pencil_det_cs`).
     """
-    c, s = math.cos(t), math.sin(t)
+    return _pencil_det_cs(K, math.cos(t), math.sin(t), A)
+
+
+@njit(cache=True)
+def _pencil_det_cs(K, c, s, A):
+    """:func:`_pencil_det` at the angle whose cosine and sine are c, s.
+
+    LU with partial pivoting (the size fixed, so the loops compile to constant trip
+    counts: 17 of these per pose, their angles' cos and sin from a table); returns the
+    determinant and min |pivot| / max |pivot|, a cheap lower bound on 1/cond(K(t)): the
+    determinant's relative accuracy is about machine epsilon over it.
+    """
     for i in range(12):
         for j in range(12):
             A[i, j] = K[0, i, j] + c * K[1, i, j] + s * K[2, i, j]
-    return _det(A)
+    d = 1.0
+    pmin = math.inf
+    pmax = 0.0
+    for col in range(12):
+        piv = col
+        big = abs(A[col, col])
+        for r in range(col + 1, 12):
+            if abs(A[r, col]) > big:
+                big = abs(A[r, col])
+                piv = r
+        if big == 0.0:
+            return 0.0, 0.0
+        pmin = min(pmin, big)
+        pmax = max(pmax, big)
+        if piv != col:
+            d = -d
+            for j in range(col, 12):
+                A[col, j], A[piv, j] = A[piv, j], A[col, j]
+        d *= A[col, col]
+        inv = 1.0 / A[col, col]
+        for r in range(col + 1, 12):
+            f = A[r, col] * inv
+            if f != 0.0:
+                for j in range(col + 1, 12):
+                    A[r, j] -= f * A[col, j]
+    return d, pmin / pmax
 
 
 @njit(cache=True)
@@ -825,20 +1003,25 @@ def _polish_root(K, t, A):
 
 
 @njit(cache=True)
-def _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u, reverse, A, q):
+def _candidate(t3, K, Cl, Cr, H, beta, rdiag, perm, W, G, e, u, reverse, A, q, ws, iws):
     """The configuration (6,) of root θ3 into ``q`` (robot joint order), step 6.
 
     For the split eliminating joint ``e`` (see :func:`_rr_split`; "θ3, θ4, θ5" are its
     left joints, "θ1, θ2" its right ones): x4, x5 from the null vector of ``K(θ3)``,
     (cos, sin) of the right joints from ``Q⁺·P``, then joint e by subproblem 1 on its
-    axis (``u`` (3,) a unit vector ⟂ it).
+    axis (``u`` (3,) a unit vector ⟂ it). ``ws`` (87,) and ``iws`` (12,) int are work
+    space (no allocation per root).
     """
-    v = np.empty(12)
+    v = ws[0:12]
+    L = ws[12:26]
+    m12 = ws[26:34]
+    z = ws[34:42]
+    qs = ws[42:48]
     c3, s3 = math.cos(t3), math.sin(t3)
     for i in range(12):
         for j in range(12):
             A[i, j] = K[0, i, j] + c3 * K[1, i, j] + s3 * K[2, i, j]
-    second = _null_vector(A, v)
+    second = _null_vector(A, v, ws[48:60], iws)
     big = -1.0
     ib = 0
     for i in range(12):
@@ -850,37 +1033,63 @@ def _candidate(t3, K, Cl, Cr, U, sv, Vt, W, G, e, u, reverse, A, q):
     b3 = (1.0, c3, s3)
     b4 = (1.0, math.cos(t4), math.sin(t4))
     b5 = (1.0, math.cos(t5), math.sin(t5))
-    L = np.empty(14)
+    bb = ws[60:87]  # the 27 products of (1, c, s) of the left joints
+    for a3 in range(3):
+        for a4 in range(3):
+            b34 = b3[a3] * b4[a4]
+            for a5 in range(3):
+                bb[9 * a3 + 3 * a4 + a5] = b34 * b5[a5]
     for kk in range(14):
         s = -Cr[0, kk]
-        for a3 in range(3):
-            for a4 in range(3):
-                for a5 in range(3):
-                    s += Cl[9 * a3 + 3 * a4 + a5, kk] * b3[a3] * b4[a4] * b5[a5]
+        for idx in range(27):
+            s += Cl[idx, kk] * bb[idx]
         L[kk] = s
-    # m12 = Q⁺ L = Vᵀ diag(1/σ) U[:, :8]ᵀ L; entries (j = 3·a1 + a2 − 1): c2 0, s2 1, c1 2,
-    # s1 5
-    m12 = np.zeros(8)
-    for i in range(8):
-        s = 0.0
-        for kk in range(14):
-            s += U[kk, i] * L[kk]
-        s /= sv[i]
-        for j in range(8):
-            m12[j] += Vt[i, j] * s
-    qs = np.zeros(6)
+    # m12 = Q⁺ L: R z = (Qᵀ L)[:8] (the QR of :func:`_qr` in H, beta, rdiag, perm); entries
+    # (j = 3·a1 + a2 − 1): c2 0, s2 1, c1 2, s1 5
+    _apply_qt(H, beta, L)
+    for i in range(7, -1, -1):
+        s = L[i]
+        for j in range(i + 1, 8):
+            s -= H[i, j] * z[j]
+        z[i] = s / rdiag[i]
+        m12[perm[i]] = z[i]
     qs[e - 3], qs[e - 2], qs[e - 1] = t3, t4, t5
     inner, outer = (0, 1) if e == 5 else ((5, 0) if e == 4 else (4, 5))
     qs[inner] = math.atan2(m12[5], m12[2])
     qs[outer] = math.atan2(m12[1], m12[0])
     # joint e: R_e = (R_1···R_{e−1})ᵀ R_G (R_{e+1}···R_6)ᵀ, applied to u
-    x = u.copy()
+    x = (u[0], u[1], u[2])
     for j in range(e + 1, 6):
-        x = mtv(rotation(W[j], qs[j]), x)
-    x = mv(G, x)
+        x = _turn_back(W[j], qs[j], x)
+    x = (G[0, 0] * x[0] + G[0, 1] * x[1] + G[0, 2] * x[2],
+         G[1, 0] * x[0] + G[1, 1] * x[1] + G[1, 2] * x[2],
+         G[2, 0] * x[0] + G[2, 1] * x[1] + G[2, 2] * x[2])
     for j in range(e):
-        x = mtv(rotation(W[j], qs[j]), x)
-    qs[e] = sp1_dir((W[e, 0], W[e, 1], W[e, 2]), (u[0], u[1], u[2]), (x[0], x[1], x[2]))
+        x = _turn_back(W[j], qs[j], x)
+    qs[e] = sp1_dir((W[e, 0], W[e, 1], W[e, 2]), (u[0], u[1], u[2]), x)
     for j in range(6):
         q[j] = qs[5 - j] if reverse else qs[j]
     return second
+
+
+@njit(cache=True)
+def _turn_back(w, theta, x):
+    """``Rot(w, θ)ᵀ·x`` for a 3-tuple x, without allocation.
+
+    The operations of ``mtv(rotation(w, θ), x)`` (so the same rounding).
+    """
+    c = math.cos(theta)
+    s = math.sin(theta)
+    v = 1.0 - c
+    a, b, d = w[0], w[1], w[2]
+    r00 = c + a * a * v
+    r01 = a * b * v - d * s
+    r02 = a * d * v + b * s
+    r10 = b * a * v + d * s
+    r11 = c + b * b * v
+    r12 = b * d * v - a * s
+    r20 = d * a * v - b * s
+    r21 = d * b * v + a * s
+    r22 = c + d * d * v
+    return (r00 * x[0] + r10 * x[1] + r20 * x[2], r01 * x[0] + r11 * x[1] + r21 * x[2],
+            r02 * x[0] + r12 * x[1] + r22 * x[2])
