@@ -103,8 +103,9 @@ def test_every_timing_is_warm(built_report):
     _, html = built_report
     times = re.findall(r"median of \d+ warm runs in (\d+) blocks, 5th–95th percentile", html)
     ratios = re.findall(r"× \(median of \d+ rounds in (\d+) blocks, 5th–95th percentile", html)
-    # (c)/(b), QP / eq 48, and BFGS / lm and Powell / lm on each of three robots
-    assert len(times) >= 14 and len(ratios) == 8, (times, ratios)
+    # (c)/(b) for the whole path and per iteration, QP / eq 48, and BFGS / lm and
+    # Powell / lm on each of three robots
+    assert len(times) >= 14 and len(ratios) == 9, (times, ratios)
     assert {int(b) for b in times + ratios} == {7}
     assert not re.search(r"median of \d+ (warm runs|interleaved pairs)[^,]*, spread", html)
 
@@ -117,8 +118,9 @@ def test_timings_json_holds_every_run(built_report):
 
     out, html = built_report
     data = json.loads((out / "timings.json").read_text(encoding="utf-8"))
-    # numerical: lm, BFGS and Powell on three robots and 6 ratios; redundancy: 4 runs, 2 ratios
-    assert len(data) == 21 and {d["section"] for d in data} == {"numerical", "redundancy"}
+    # numerical: lm, BFGS and Powell on three robots and 6 ratios; redundancy: 4 runs and 3
+    # ratios ((c)/(b) for the whole path and per iteration, QP / eq 48)
+    assert len(data) == 22 and {d["section"] for d in data} == {"numerical", "redundancy"}
     for d in data:
         runs = np.array(d["runs"])
         assert d["n"] == runs.size == 21 and d["blocks"] == 7, d["label"]
@@ -128,6 +130,7 @@ def test_timings_json_holds_every_run(built_report):
     labels = {d["label"] for d in data}
     assert {"(b) free", "(c) constrained", "(c) by the QP", "six-link circle"} <= labels
     assert "(c) by the QP / (c) constrained" in labels
+    assert "(c) constrained / (b) free per iteration" in labels
 
 
 def test_every_character_is_in_a_bundled_font(built_report):

@@ -15,7 +15,7 @@ import io
 import re
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -121,6 +121,21 @@ class Timing:
 
     def __str__(self) -> str:
         return self.text
+
+    def scaled(self, factor: float, label: str) -> Timing:
+        """Every run times ``factor`` [1], with the median and spread taken of those runs.
+
+        For a quantity proportional to the timed one in every run, e.g. a per-iteration
+        ratio from a whole-path ratio when each run makes the same iterations.
+        """
+        runs = np.asarray(self.runs, dtype=float) * factor
+        if not runs.size:
+            return replace(self, median=self.median * factor, low=self.low * factor,
+                           high=self.high * factor, label=label)
+        low, high = (np.percentile(runs, [5.0, 95.0]) if self.blocks > 1
+                     else (runs.min(), runs.max()))
+        return replace(self, median=float(np.median(runs)), low=float(low), high=float(high),
+                       runs=tuple(float(r) for r in runs), label=label)
 
 
 class TimingBench:

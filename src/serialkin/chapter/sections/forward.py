@@ -5,8 +5,9 @@ Contents: the SCARA of Table 1 (:func:`serialkin.models.scara`), its link matric
 derived symbolically by :mod:`serialkin.kinematics.symbolic` and evaluated numerically at
 a sample configuration, checked against the compiled kernels and against the product of
 the individual matrices; RᵀR = I and det R = 1 (eq 7) on the result; the same robot
-rewritten in modified DH; figures of the mechanism in 3D with its DH frames; and the
-table of built-in models with their sources.
+rewritten in modified DH; the chapter's Figure 3 drawn on a PUMA 560 link pair and the
+PUMA's DH frames (:mod:`.dh_drawings`); figures of the mechanism in 3D with its DH frames;
+and the table of built-in models with their sources.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import sympy as sp
 
 from serialkin import models
 from serialkin.chapter._context import Html, ReportContext, Section, format_number
+from serialkin.chapter.sections.dh_drawings import dh_pair_figure, puma_frames_figure
 from serialkin.kinematics.symbolic import SymbolicKinematics, derive
 from serialkin.model.dh import link_transform, standard_to_modified
 from serialkin.model.robot import Robot
@@ -25,6 +27,8 @@ DEG = np.pi / 180.0
 #: Parameters and sample configuration of the SCARA example (the chapter gives none).
 SCARA_PARAMS = {"d1": 0.4, "d2": 0.1, "l1": 0.35, "l2": 0.30}
 SCARA_Q = np.array([30 * DEG, -45 * DEG, -0.05, 60 * DEG])
+#: The joint value of the PUMA 560's joint 3 in the drawing of Figure 3 [rad].
+DH_PAIR_Q3 = 40 * DEG
 
 
 def _symbols() -> dict[str, sp.Symbol]:
@@ -107,32 +111,6 @@ def _figure_frames(ctx: ReportContext, robot: Robot, q: np.ndarray) -> str:
                       f"above{flip}.")
 
 
-def _figure_dh_frames(ctx: ReportContext, robot: Robot, q: np.ndarray) -> str:
-    """The chapter's Figure 3 on a real arm: the DH frames of the PUMA 560, from its model."""
-    import matplotlib.pyplot as plt
-
-    from serialkin.viz.plot import plot_robot
-
-    frames = robot.fk_all(q)
-    fig = plt.figure(figsize=(10, 5.2))
-    ax = fig.add_subplot(1, 1, 1, projection="3d")
-    plot_robot(robot, q, ax=ax, frames=True, mechanism=True, linewidth=3, frame_scale=0.12)
-    seen: dict[tuple[float, float, float], list[int]] = {}
-    for i, T in enumerate(frames):
-        seen.setdefault(tuple(np.round(T[:3, 3], 4)), []).append(i)
-    for (x, y, z), idx in seen.items():
-        ax.text(x, y, z + 0.04, "O" + ",".join(map(str, idx)), fontsize=9, color="0.1")
-    ax.set_title("DH frames 0-6 of the PUMA 560 at q = 0, drawn from its DH table: z_i on "
-                 "joint axis i+1,\nx_i along the common normal of z_(i-1) and z_i "
-                 "(x red, y green, z blue)", fontsize=9)
-    ax.view_init(elev=20, azim=-50)
-    ax.set_box_aspect((1, 1, 1))
-    return ctx.figure(fig, "forward_dh_frames_puma560",
-                      "The chapter's Figure 3 (the Denavit-Hartenberg approach) on the PUMA "
-                      "560: every link frame computed by robot.fk_all(q) from the DH table "
-                      "below, origins O_i labelled (frames that coincide share a label).")
-
-
 def _section_3_1(ctx: ReportContext) -> Section:
     """Section 3.1: eqs 10-12 on the PUMA 560."""
     puma = models.puma560()
@@ -194,6 +172,16 @@ def _section_3_2(ctx: ReportContext) -> Section:
     Q = puma.random_q(1000, seed=7)
     diff = float(np.abs(puma_m.fk(Q) - puma.fk(Q)).max())
     parts = [
+        "<p>The frame of link i is placed by the chapter's rules (Figure 3): z<sub>i−1</sub>"
+        " on the axis of joint i, O<sub>i</sub> where the common normal of z<sub>i−1</sub> "
+        "and z<sub>i</sub> meets z<sub>i</sub> (it meets z<sub>i−1</sub> at O<sub>i</sub>′),"
+        " x<sub>i</sub> along that normal. Then a<sub>i</sub> = |O<sub>i</sub>′O<sub>i</sub>|"
+        ", d<sub>i</sub> is the distance from O<sub>i−1</sub> to O<sub>i</sub>′ along "
+        "z<sub>i−1</sub>, ϑ<sub>i</sub> the angle from x<sub>i−1</sub> to x<sub>i</sub> "
+        "about z<sub>i−1</sub> and α<sub>i</sub> the angle from z<sub>i−1</sub> to "
+        "z<sub>i</sub> about x<sub>i</sub>. Drawn from link 3 of the PUMA 560 (the link "
+        "whose a and d are both nonzero) and measured back from the drawn frames:</p>",
+        dh_pair_figure(ctx, puma, 3, DH_PAIR_Q3),
         "<p>With the four DH parameters (a<sub>i</sub>, α<sub>i</sub>, d<sub>i</sub>, "
         "ϑ<sub>i</sub>) the link matrix of eq 12 is a product of elementary motions "
         "(eqs 4, 6 and translations):</p>",
@@ -219,7 +207,7 @@ def _section_3_2(ctx: ReportContext) -> Section:
         rows_m.append((info.name, r.n, "".join(r.joint_types), r.convention or "joints",
                        f"({format_number(pz[0], '{:.4f}')}, {format_number(pz[1], '{:.4f}')},"
                        f" {format_number(pz[2], '{:.4f}')})", r.source))
-    parts.append(_figure_dh_frames(ctx, puma, np.zeros(puma.n)))
+    parts.append(puma_frames_figure(ctx, puma, np.zeros(puma.n)))
     parts.append(ctx.table([(i + 1, r.a, r.alpha, r.d, r.theta, r.type)
                             for i, r in enumerate(puma.dh)],
                            ["link", "a [m]", "α [rad]", "d [m]", "θ offset [rad]", "type"]))

@@ -4,8 +4,9 @@ Contents: the geometric Jacobian of the two-link arm (Figure 7, eqs 37-38) deriv
 symbolically and evaluated, compared with the compiled kernel and with central finite
 differences of FK; the analytical Jacobian of the three-link arm (Figure 6, eqs 30-32)
 derived symbolically and compared numerically with the position rows of the geometric
-Jacobian; manipulability (eq 43) and condition number across configurations; figures of
-both mechanisms with their velocity (manipulability) ellipses.
+Jacobian; manipulability (eq 43) and condition number across configurations; the
+chapter's Figures 6 and 7 regenerated with the velocity (manipulability) ellipses, each in
+the part where the chapter first cites it (Figure 6 in 5.1, Figure 7 in 5.2).
 """
 
 from __future__ import annotations
@@ -52,25 +53,25 @@ def _ellipse(ax: object, center: np.ndarray, J2: np.ndarray, scale: float, **kw:
     ax.plot(pts[0], pts[1], **kw)  # type: ignore[attr-defined]
 
 
-def _figure_mechanisms(ctx: ReportContext, two: Robot, three: Robot) -> str:
+def _figure_mechanism(ctx: ReportContext, robot: Robot, q: np.ndarray, number: int) -> str:
+    """The chapter's Figure ``number`` regenerated: ``robot`` at ``q``, its velocity ellipse."""
     import matplotlib.pyplot as plt
 
     from serialkin.viz.plot import plot_robot
 
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4.4))
-    for ax, robot, q, title in ((axes[0], three, THREE_LINK_Q, "Figure 6: three-link arm"),
-                                (axes[1], two, TWO_LINK_Q, "Figure 7: two-link arm")):
-        plot_robot(robot, q, ax=ax, frames=True, planar=True)
-        p = robot.fk(q)[:2, 3]
-        J = robot.jacobian_planar(q)
-        _ellipse(ax, p, J, 0.25, color="C3", lw=1.2, label="velocity ellipse J q̇, |q̇| = 1 (×0.25)")
-        w = robot.manipulability(q, task="planar")
-        ax.set_title(f"{title}, w = {w:.3f} m² (eq 43)", fontsize=9)
-        ax.legend(fontsize=7, loc="lower right")
-    return ctx.figure(fig, "jacobian_mechanisms", "Figures 6 and 7 regenerated: the 3-link "
-                      "(left) and 2-link (right) arms at the sample configurations with "
-                      "their link frames and "
-                      "velocity ellipses (singular values of the planar Jacobian).")
+    fig, ax = plt.subplots(figsize=(5.6, 4.4))
+    plot_robot(robot, q, ax=ax, frames=True, planar=True)
+    J = robot.jacobian_planar(q)
+    _ellipse(ax, robot.fk(q)[:2, 3], J, 0.25, color="C3", lw=1.2,
+             label="velocity ellipse J q̇, |q̇| = 1 (×0.25)")
+    w = robot.manipulability(q, task="planar")
+    ax.set_title(f"Figure {number}: {robot.n}-link arm, w = {w:.3f} m² (eq 43)", fontsize=9)
+    ax.legend(fontsize=7, loc="lower right")
+    angles = ", ".join(f"{v / DEG:.0f}°" for v in q)
+    return ctx.figure(fig, f"jacobian_fig{number}_{robot.n}_link",
+                      f"Figure {number} regenerated: the {robot.n}-link arm at q = ({angles}) "
+                      "with its link frames and velocity ellipse (singular values of the "
+                      "planar Jacobian).")
 
 
 def _figure_manipulability(ctx: ReportContext, two: Robot) -> str:
@@ -165,7 +166,8 @@ def _section_5_1(ctx: ReportContext, three: Robot) -> Section:
     err_many = max(float(np.abs(f_a(q) - three.jacobian_planar(q)).max()) for q in Q)
     parts.append(
         "<h3>The three-link arm (Figure 6, eqs 30-32)</h3>"
-        "<p>Position of E from the symbolic forward kinematics "
+        + _figure_mechanism(ctx, three, THREE_LINK_Q, 6)
+        + "<p>Position of E from the symbolic forward kinematics "
         "(<code>derive(three_link, params='lengths').task('planar')</code>):</p>"
         + ctx.eq("x_E = " + sp.latex(x3[0]), "30") + ctx.eq("y_E = " + sp.latex(x3[1]), "31")
         + "<p>and its Jacobian, the matrix of eq 29 for these two coordinates,</p>"
@@ -353,9 +355,9 @@ def _section_5_2(ctx: ReportContext, two: Robot, three: Robot) -> Section:
         _columns_part(ctx),
         _prismatic_column(ctx),
         _two_link_part(ctx, two),
+        _figure_mechanism(ctx, two, TWO_LINK_Q, 7),
         _analytic_vs_geometric(ctx),
         _manipulability_part(ctx, two, three),
-        _figure_mechanisms(ctx, two, three),
         _figure_manipulability(ctx, two),
         ctx.reproduce(
             'serialkin jacobian two_link --q "30, 60" --degrees --param l1=1.0 --param l2=0.7\n'

@@ -5,8 +5,9 @@ form; a composition example with the change of coordinates of a point (eq 3) and
 homogeneous transform (eqs 8-9) and its inverse; the orthonormality checks RᵀR = I and
 det R = 1 (eq 7); a table converting one orientation between every representation
 serialkin supports (with the round-trip error, also at the gimbal lock); the pose error
-used by the IK solvers; and a figure of the rotated frames (the chapter's Figure 2 and a
-rotated and translated frame), drawn from the computed matrices.
+used by the IK solvers; the chapter's Figure 1 (a rigid body moved by a twist, two of its
+points keeping their distance) and a figure of the rotated frames (the chapter's Figure 2
+and a rotated and translated frame), drawn from the computed matrices.
 """
 
 from __future__ import annotations
@@ -38,6 +39,14 @@ from serialkin.spatial import (
 from serialkin.spatial.rotations import axis_angle_to_matrix
 
 DEG = np.pi / 180.0
+
+#: Figure 1's body: a pentagon in body coordinates [m], points p and q on it [m], its pose
+#: at t = 0 and the twist ξ = [v; ω] [m/s; rad/s] it moves by, T(t) = exp(ξ t) · T(0).
+BODY = np.array([[0.0, 0.0], [0.5, 0.0], [0.6, 0.25], [0.3, 0.45], [0.0, 0.3]])
+BODY_P, BODY_Q = np.array([0.1, 0.1, 0.0]), np.array([0.5, 0.15, 0.0])
+BODY_T0 = make_transform(rotz(10 * DEG), np.array([0.2, 0.1, 0.0]))
+BODY_TWIST = np.array([0.9, 0.35, 0.0, 0.0, 0.0, 0.8])
+BODY_T = 1.5  # the later time t [s]
 
 
 def _printed_elementary(axis: str, t: float) -> np.ndarray:
@@ -108,6 +117,56 @@ def _figure(R_q: np.ndarray, q: float, T1: np.ndarray, p1: np.ndarray) -> object
             axis.set_major_locator(MaxNLocator(4))
         a.tick_params(labelsize=8)
     return fig
+
+
+def _rigid_body_part(ctx: ReportContext) -> str:
+    """The chapter's Figure 1: a body at t = 0 and t, ‖p(t) − q(t)‖ = ‖p(0) − q(0)‖."""
+    from matplotlib.figure import Figure
+
+    times = np.linspace(0.0, BODY_T, 31)
+    poses = se3_exp(BODY_TWIST * times[:, None]) @ BODY_T0  # f(t) of the chapter, (31, 4, 4)
+    corners = np.column_stack([BODY, np.zeros(len(BODY)), np.ones(len(BODY))])
+    points = np.array([np.append(BODY_P, 1.0), np.append(BODY_Q, 1.0)])
+    world = poses @ points.T  # (31, 4, 2): p and q at every time
+    dist = np.linalg.norm(world[:, :3, 0] - world[:, :3, 1], axis=1)
+    fig = Figure(figsize=(7.0, 4.6))
+    ax = fig.add_subplot(1, 1, 1)
+    for k in (10, 20):  # two poses in between, faint
+        xy = (poses[k] @ corners.T)[:2].T
+        ax.fill(xy[:, 0], xy[:, 1], fill=False, ec="0.75", lw=0.8, ls="--")
+    for k, color, when in ((0, "0.55", "0"), (-1, "tab:blue", "t")):
+        xy = (poses[k] @ corners.T)[:2].T
+        ax.fill(xy[:, 0], xy[:, 1], color=color, alpha=0.25, ec=color, lw=1.5,
+                label=f"body at t = {times[k]:g} s")
+        pq = world[k, :2]
+        ax.plot(pq[0], pq[1], "-o", color="k", ms=4, lw=1)
+        for j, name in enumerate("pq"):
+            ax.annotate(f"{name}({when})", pq[:, j], xytext=(4, 5), textcoords="offset points")
+    for j in range(2):
+        ax.plot(world[:, 0, j], world[:, 1, j], ":", color="tab:red", lw=1)
+    ax.text(0.98, 0.03, f"‖p(0) − q(0)‖ = {dist[0]:.4f} m\n‖p(t) − q(t)‖ = {dist[-1]:.4f} m",
+            transform=ax.transAxes, ha="right", va="bottom", fontsize=9,
+            bbox={"boxstyle": "round", "fc": "white", "ec": "0.7"})
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x_r [m]")
+    ax.set_ylabel("y_r [m]")
+    ax.legend(loc="upper left", fontsize=8)
+    ax.set_title("Rigid body moved by T(t) = exp(ξt)·T(0); dotted: the paths of p and q",
+                 fontsize=10)
+    caption = (f"Figure 1 — rigid body: a pentagon moved by the twist ξ = "
+               f"{format_vector(BODY_TWIST)} (se3_exp) from t = 0 to t = {BODY_T:g} s; "
+               f"‖p(0) − q(0)‖ = {dist[0]:.4f} m, ‖p(t) − q(t)‖ = {dist[-1]:.4f} m, "
+               f"largest change over the {len(times)} poses drawn {np.ptp(dist):.1e} m.")
+    return (
+        "<h3>Rigid body (Figure 1)</h3><p>A motion of a body O is a map f(t): O → ℝ³ that "
+        "keeps the distance of any two of its points p and q,</p>"
+        + ctx.eq(r"\|\mathbf{p}(t) - \mathbf{q}(t)\| = \|\mathbf{p}(0) - \mathbf{q}(0)\|"
+                 r" = \text{constant}")
+        + "<p>Here f(t) is the transform T(t) = exp(ξt)·T(0) of a constant twist "
+        "(<code>se3_exp</code>, eq 9's matrix for every t), applied to the body's corners "
+        "and to p and q; the distances below are computed from the moved points.</p>"
+        + ctx.figure(fig, "rigid_body_fig1", caption)
+    )
 
 
 def _elementary_part(ctx: ReportContext, elem: dict[str, np.ndarray],
@@ -307,7 +366,8 @@ def build(ctx: ReportContext) -> Section:
     R = rotz(gamma) @ roty(beta) @ rotx(alpha)
     p1 = np.array([0.3, 0.2, 0.1])
     T = make_transform(R, np.array([0.5, 0.4, 0.3]))
-    parts = [  # in the chapter's order of equations: 1-3, 4-6, 7, 8-9
+    parts = [  # in the chapter's order: Figure 1, eqs 1-3, 4-6, 7, 8-9
+        _rigid_body_part(ctx),
         _change_of_frame_part(ctx, R, rotx(alpha) @ roty(beta) @ rotz(gamma), p1),
         _elementary_part(ctx, elem, (alpha, beta, gamma)),
         _orthonormality_part(ctx, elem, R, T),
