@@ -138,7 +138,7 @@ def test_every_box_reproduces_the_page(built_report, tmp_path):
         missing = match_in_order(box["expect"], numbers_in(res.stdout))
         if missing:
             return (f"box {k} ({box['section']}) does not print {missing}:\n{box['code']}\n"
-                    f"--- output:\n{res.stdout[-2000:]}")
+                    f"--- output:\n{res.stdout[-8000:]}")
         return None
 
     with ThreadPoolExecutor(max_workers=2) as pool:
