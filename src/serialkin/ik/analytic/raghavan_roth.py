@@ -73,6 +73,7 @@ from serialkin.ik.analytic.subproblems import (
     TWO_PI,
     inv_rigid,
     mm,
+    rotation_into,
     sp1_dir,
 )
 
@@ -170,21 +171,7 @@ def _screw_into(w, r, theta, E):
     The operations of :func:`~serialkin.ik.analytic.subproblems.screw` (Rodrigues, then
     the translation ``r − R r``), so the same rounding.
     """
-    c = math.cos(theta)
-    s = math.sin(theta)
-    v = 1.0 - c
-    x = w[0]
-    y = w[1]
-    z = w[2]
-    E[0, 0] = c + x * x * v
-    E[0, 1] = x * y * v - z * s
-    E[0, 2] = x * z * v + y * s
-    E[1, 0] = y * x * v + z * s
-    E[1, 1] = c + y * y * v
-    E[1, 2] = y * z * v - x * s
-    E[2, 0] = z * x * v - y * s
-    E[2, 1] = z * y * v + x * s
-    E[2, 2] = c + z * z * v
+    rotation_into(w, theta, E)
     for i in range(3):
         E[i, 3] = r[i] - (E[i, 0] * r[0] + E[i, 1] * r[1] + E[i, 2] * r[2])
         E[3, i] = 0.0

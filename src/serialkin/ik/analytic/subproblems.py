@@ -209,13 +209,20 @@ def target_point(T, M, p):
 @njit(cache=True)
 def rotation(w, theta):
     """Rotation matrix (3, 3) by ``theta`` [rad] about the unit axis ``w`` (Rodrigues)."""
+    R = np.empty((3, 3))
+    rotation_into(w, theta, R)
+    return R
+
+
+@njit(cache=True, inline="always")
+def rotation_into(w, theta, R):
+    """``R[:3, :3] ← Rot(w, θ)`` (Rodrigues) for the unit axis ``w``; R (3, 3) or (4, 4)."""
     c = math.cos(theta)
     s = math.sin(theta)
     v = 1.0 - c
     x = w[0]
     y = w[1]
     z = w[2]
-    R = np.empty((3, 3))
     R[0, 0] = c + x * x * v
     R[0, 1] = x * y * v - z * s
     R[0, 2] = x * z * v + y * s
@@ -225,7 +232,6 @@ def rotation(w, theta):
     R[2, 0] = z * x * v - y * s
     R[2, 1] = z * y * v + x * s
     R[2, 2] = c + z * z * v
-    return R
 
 
 @njit(cache=True)
