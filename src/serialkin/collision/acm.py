@@ -25,10 +25,10 @@ import numpy as np
 
 from serialkin._checks import short_repr
 from serialkin.collision.srdf import Srdf, read_srdf
-from serialkin.errors import InputError, RobotDefinitionError
+from serialkin.errors import InputError, InputTypeError, RobotDefinitionError
 from serialkin.model.collision_model import CollisionModel
 
-__all__ = ["AllowedCollisionMatrix", "acm_from_srdf", "default_acm"]
+__all__ = ["AllowedCollisionMatrix", "acm_from_srdf", "check_acm", "default_acm"]
 
 
 @dataclass(frozen=True)
@@ -123,3 +123,17 @@ def acm_from_srdf(model: CollisionModel, srdf: Srdf | str | os.PathLike[str],
             pairs.append((a, b))
     base = default_acm(model) if acm is None else acm
     return base.allow(pairs)
+
+
+def check_acm(acm: object) -> AllowedCollisionMatrix | None:
+    """``acm`` itself when it is an :class:`AllowedCollisionMatrix` or None.
+
+    The argument check of every function that takes an ``acm``.
+
+    Raises:
+        InputTypeError: anything else (the message names its type and value).
+    """
+    if acm is not None and not isinstance(acm, AllowedCollisionMatrix):
+        raise InputTypeError(f"acm must be an AllowedCollisionMatrix or None, got "
+                             f"{type(acm).__name__} {short_repr(acm)}")
+    return acm

@@ -48,7 +48,7 @@ from serialkin.diffik.constraints import (
 )
 from serialkin.diffik.qp import DiffIK, check_solver
 from serialkin.diffik.tasks import FrameTask, PostureTask
-from serialkin.errors import InputError, InputTypeError
+from serialkin.errors import InputError
 from serialkin.model.geometry import Capsule, Cylinder, Sphere
 from serialkin.redundancy.obstacles import check_obstacles, encode_obstacles
 
@@ -158,12 +158,9 @@ class QPResolver:
         if not isinstance(self.self_collision, bool):
             raise InputError(f"self_collision must be true or false, got "
                              f"{short_repr(self.self_collision)}")
-        if self.acm is not None:
-            from serialkin.collision.acm import AllowedCollisionMatrix
+        from serialkin.collision.acm import check_acm
 
-            if not isinstance(self.acm, AllowedCollisionMatrix):
-                raise InputTypeError(f"acm must be an AllowedCollisionMatrix or None, got "
-                                     f"{type(self.acm).__name__} {short_repr(self.acm)}")
+        if check_acm(self.acm) is not None:
             if not self.self_collision:
                 raise InputError("acm lists the body pairs a self-collision check skips; it "
                                  "needs self_collision=True")

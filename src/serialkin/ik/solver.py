@@ -774,7 +774,7 @@ def _collision_setup(robot: Robot, spec: MethodSpec, scene: object, self_collisi
                      margin: object, acm: object) -> _Collision:
     """Validate the collision arguments of :func:`solve` and pack them for the kernels."""
     from serialkin._checks import check_real
-    from serialkin.collision.acm import AllowedCollisionMatrix
+    from serialkin.collision.acm import check_acm
     from serialkin.collision.queries import checked_shape_pairs
     from serialkin.collision.shapes import encode_scene
 
@@ -784,10 +784,7 @@ def _collision_setup(robot: Robot, spec: MethodSpec, scene: object, self_collisi
     if margin_v < 0.0:
         raise InputError(f"margin must be >= 0 m (the clearance a solution keeps), got "
                          f"{margin_v!r}")
-    if acm is not None and not isinstance(acm, AllowedCollisionMatrix):
-        raise InputTypeError(f"acm must be an AllowedCollisionMatrix or None, got "
-                             f"{type(acm).__name__}")
-    if acm is not None and not self_collision:
+    if check_acm(acm) is not None and not self_collision:
         raise InputError("acm lists the body pairs a self-collision check skips; it needs "
                          "self_collision=True")
     if scene is not None and not isinstance(scene, (list, tuple)):

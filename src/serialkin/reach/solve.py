@@ -188,7 +188,7 @@ def check_collision_options(robot: Any, self_collision: object, acm: object,
         InputError: a negative or non-finite clearance; ``acm`` without self-collision; an
             ACM of other bodies; a collision check on a robot without a collision model.
     """
-    from serialkin.collision.acm import AllowedCollisionMatrix
+    from serialkin.collision.acm import check_acm
 
     if not isinstance(self_collision, (bool, np.bool_)):
         raise InputTypeError(f"self_collision must be True or False, got "
@@ -197,10 +197,7 @@ def check_collision_options(robot: Any, self_collision: object, acm: object,
     if clearance < 0.0:
         raise InputError(f"clearance must be >= 0 m (the distance a solution keeps from "
                          f"collisions), got {clearance!r}")
-    if acm is not None:
-        if not isinstance(acm, AllowedCollisionMatrix):
-            raise InputTypeError(f"acm must be an AllowedCollisionMatrix or None, got "
-                                 f"{type(acm).__name__}")
+    if check_acm(acm) is not None:
         if not self_collision:
             raise InputError("acm lists the body pairs a self-collision check skips; it "
                              "needs self_collision=True")

@@ -386,7 +386,7 @@ def _self_collision_acm(robot, solver: object, acm: object, srdf: object,
     else ``acm``, or :func:`serialkin.collision.robot_acm` of the SRDF (the model's
     default matrix with the SRDF's disabled pairs added). Raises as :func:`track` says.
     """
-    from serialkin.collision.acm import AllowedCollisionMatrix
+    from serialkin.collision.acm import check_acm
     from serialkin.collision.checks import robot_acm
 
     skip = _link_names(skip_links)
@@ -413,10 +413,7 @@ def _self_collision_acm(robot, solver: object, acm: object, srdf: object,
                          f"{short_repr(robot.name)} has none (its self-collision check keeps "
                          "the chain's link segments apart, which an SRDF cannot name); give "
                          "it one with robot.with_collision(model) or robot.fit_collision()")
-    if acm is not None:
-        if not isinstance(acm, AllowedCollisionMatrix):
-            raise InputTypeError(f"acm must be an AllowedCollisionMatrix or None, got "
-                                 f"{type(acm).__name__} {short_repr(acm)}")
+    if check_acm(acm) is not None:
         if tuple(acm.body_names) != tuple(model.body_names):
             raise InputError(f"acm must be over the bodies of robot {short_repr(robot.name)}'s "
                              f"collision model {short_repr(list(model.body_names))}, got "

@@ -150,11 +150,9 @@ def _check_acm(acm: object, model: CollisionModel | None) -> None:
         return
     if model is None:
         raise InputError("acm given but there is no collision model to check")
-    from serialkin.collision.acm import AllowedCollisionMatrix
+    from serialkin.collision.acm import check_acm
 
-    if not isinstance(acm, AllowedCollisionMatrix):
-        raise InputTypeError(f"acm must be an AllowedCollisionMatrix or None, got "
-                             f"{type(acm).__name__} {short_repr(acm)}")
+    check_acm(acm)
     if tuple(acm.body_names) != tuple(model.body_names):
         raise InputError(f"acm must cover the collision model's bodies "
                          f"{short_repr(tuple(model.body_names))}, got "

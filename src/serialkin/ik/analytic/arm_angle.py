@@ -386,8 +386,12 @@ def _sp1_3(w, u, v):
 
 
 @njit(cache=True)
-def _sp2_3(w1, w2, u, v, sign):
-    """Subproblem 2 (:func:`_sp2`) on 3-tuples for one sign of γ: (θ1, θ2, exists)."""
+def _sp2_terms(w1, w2, u, v):
+    """Subproblem 2's intermediate ``z = α w1 + β w2 + γ (w1 × w2)`` for unit u, v (tuples).
+
+    Returns ``(α, β, w1 × w2, γ²)``: ``w2·z = w2·u``, ``w1·z = w1·v``, ``|z| = 1``; a
+    solution exists when γ² ≥ 0 (:func:`_sp2_3`, :func:`_group_ok`).
+    """
     c12 = _dot(w1, w2)
     den = c12 * c12 - 1.0
     a2u = _dot(w2, u)
@@ -395,7 +399,14 @@ def _sp2_3(w1, w2, u, v, sign):
     alpha = (c12 * a2u - a1v) / den
     beta = (c12 * a1v - a2u) / den
     x = _crs(w1, w2)
-    g2 = (1.0 - alpha * alpha - beta * beta - 2.0 * alpha * beta * c12) / _dot(x, x)
+    return alpha, beta, x, (1.0 - alpha * alpha - beta * beta
+                            - 2.0 * alpha * beta * c12) / _dot(x, x)
+
+
+@njit(cache=True)
+def _sp2_3(w1, w2, u, v, sign):
+    """Subproblem 2 (:func:`_sp2`) on 3-tuples for one sign of γ: (θ1, θ2, exists)."""
+    alpha, beta, x, g2 = _sp2_terms(w1, w2, u, v)
     g = sign * math.sqrt(max(g2, 0.0))
     z = (alpha * w1[0] + beta * w2[0] + g * x[0], alpha * w1[1] + beta * w2[1] + g * x[1],
          alpha * w1[2] + beta * w2[2] + g * x[2])
@@ -762,14 +773,7 @@ def _group_feasible(psi, base, gv, gu, h, V):
     cs, sn = math.cos(psi), math.sin(psi)
     v = _lin(1.0, gv[0], 1.0, _lin(cs, gv[1], sn, gv[2]))
     u = _lin(1.0, gu[0], 1.0, _lin(cs, gu[1], sn, gu[2]))
-    c12 = _dot(h1, h2)
-    den = c12 * c12 - 1.0
-    a2u = _dot(h2, h3)
-    w = _dot(v, h1)
-    alpha = (c12 * a2u - w) / den
-    beta = (c12 * w - a2u) / den
-    x = _crs(h1, h2)
-    g2 = (1.0 - alpha * alpha - beta * beta - 2.0 * alpha * beta * c12) / _dot(x, x)
+    alpha, beta, x, g2 = _sp2_terms(h1, h2, h3, v)
     if not g2 > -1e-9:
         return False, False
     g = math.sqrt(max(g2, 0.0))

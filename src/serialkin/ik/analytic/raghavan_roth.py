@@ -230,21 +230,25 @@ def _qr(A, beta, rdiag, perm):
 @njit(cache=True)
 def _apply_q(A, beta, x):
     """``x ← Q x`` (m,) in place, Q the orthogonal factor of :func:`_qr` (reflectors in A)."""
-    m, n = A.shape
-    for j in range(n - 1, -1, -1):
-        t = 0.0
-        for i in range(j, m):
-            t += A[i, j] * x[i]
-        t *= beta[j]
-        for i in range(j, m):
-            x[i] -= t * A[i, j]
+    _reflect(A, beta, x, False)
 
 
 @njit(cache=True)
 def _apply_qt(A, beta, x):
     """``x ← Qᵀ x`` (m,) in place, Q the orthogonal factor of :func:`_qr` (reflectors in A)."""
+    _reflect(A, beta, x, True)
+
+
+@njit(cache=True, inline="always")
+def _reflect(A, beta, x, transpose):
+    """Apply the reflectors ``H_j = I − β_j v_j v_jᵀ`` of A (:func:`_qr`) to x in place.
+
+    ``Q = H_0···H_(n−1)``, so Qᵀ x applies them first to last (``transpose``), Q x last
+    to first.
+    """
     m, n = A.shape
-    for j in range(n):
+    for k in range(n):
+        j = k if transpose else n - 1 - k
         t = 0.0
         for i in range(j, m):
             t += A[i, j] * x[i]
