@@ -92,7 +92,7 @@ def test_the_kernels_of_the_speed_goals_are_hot():
     for kernel in (K.fk_one, K.jacobian_one):
         assert _jit.opt_level(kernel.py_func) == 3, kernel
     lm = METHODS["lm"].kernel
-    for entry in (lm.solve_fast, lm.solve_one, lm.solve_chunk):
+    for entry in (lm.solve_fast, lm.solve_chunk):
         assert _jit.opt_level(entry.py_func) == 3
     other = METHODS["dls"].kernel
     assert _jit.opt_level(other.solve_fast.py_func) == 2

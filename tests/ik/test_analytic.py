@@ -731,10 +731,15 @@ def test_tuple_vector_helpers_match_matrices():
         assert row3(readonly(A), 2) == tuple(A[2, :3])
 
 
-def test_packed_entry_equals_solve_into():
-    """solve_packed on pack()'s arrays gives solve_into's rows exactly, -1 if not rigid."""
-    from serialkin.ik.analytic import _prepared
-    from serialkin.ik.analytic.dispatch import MAX_ROWS, for_class, pack, solve_into
+def test_one_kernel_per_class_single_equals_batch():
+    """The class kernel gives a target the same rows alone, in a batch and on the fast path.
+
+    ``dispatch.solve`` over 4 targets at once, one at a time, and ``ik_all``'s fast path
+    (one C-order pose) return the same rows bit for bit and the same convergence
+    records; a target that is not rigid to 1e-13 gives −1 without solving.
+    """
+    from serialkin.ik.analytic import _pack, _prepared
+    from serialkin.ik.analytic.dispatch import solve
 
     rng = np.random.default_rng(8)
     perturbed = Robot.from_dh([DHLink(a=r.a + rng.uniform(-1e-3, 1e-3),
@@ -744,25 +749,20 @@ def test_packed_entry_equals_solve_into():
     for robot in (models.ur5(), models.puma560(), models.stanford(), models.scara(),
                   perturbed):
         p = _prepared(robot, 0.05)
-        args = (p.W, p.P, p.M, p.aux, p.order, p.revolute, p.qlim, p.mid, p.F, p.meta)
-        I, D, B = pack(p.code, p.arm, p.prismatic3, *args, p.refine, 24, 1e-8 * p.s.scale,
-                       1e-8, 1e-12, 1e-12)
-        for q in robot.random_q(4, seed=1):
-            T = np.ascontiguousarray(robot.fk(q))
-            out1, out2 = np.zeros((MAX_ROWS, robot.n)), np.zeros((MAX_ROWS, robot.n))
-            conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
-            k1 = solve_into(p.code, p.arm, p.prismatic3, T, *args, True, p.refine, 24,
-                            1e-8 * p.s.scale, 1e-8, 1e-12, 1e-12, out1, conv)
-            odd = p.refine and conv[1:conv[0] + 1].sum() % 2 == 1
-            assert k1 >= 1
-            packed = for_class(p.code, p.refine).solve_packed
-            conv2 = np.zeros(MAX_ROWS + 1, dtype=np.int64)
-            assert packed(T, I, D, B, out2, conv2) == (-2 - k1 if odd else k1)
-            np.testing.assert_array_equal(conv2, conv)
-            assert np.array_equal(out1, out2)
+        packed = _pack(p, p.solve_qlim, True, p.refine, 1e-8, 24)
+        T = np.ascontiguousarray(robot.fk(robot.random_q(4, seed=1)))
+        out, counts, conv = solve(p.code, T, packed)
+        assert (counts >= 1).all()
+        for i in range(4):
+            o1, c1, v1 = solve(p.code, T[i:i + 1].copy(), packed)
+            assert c1[0] == counts[i]
+            np.testing.assert_array_equal(v1[0], conv[i])
+            assert np.array_equal(o1[0], out[i])
+            if p.mode != "near":  # the fast path's rows are the kernel's, unsorted
+                assert np.array_equal(np.asarray(robot.ik_all(T[i])), out[i, :counts[i]])
         bad = T.copy()
-        bad[0, 0] += 1e-9
-        assert for_class(p.code, p.refine).solve_packed(bad, I, D, B, out2, conv2) == -1
+        bad[1, 0, 0] += 1e-9
+        assert solve(p.code, bad, packed)[1][1] == -1
 
 
 def test_subproblem_cosines_match_angles():

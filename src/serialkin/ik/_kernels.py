@@ -4,12 +4,14 @@ A compiled IK method is a small **step kernel** (written and registered in its f
 file, e.g. :mod:`serialkin.ik.jacobian_methods`); everything else — restarts, the
 iteration budget, the tolerance test, joint-limit projection, stagnation detection, the
 final polish and the result — is this module's one loop. :func:`compile_method` builds,
-from a step kernel, the method's :class:`CompiledMethod`: a ``solve_one`` (one target with
-restarts) and a ``solve_chunk`` (targets ``start..stop-1`` with the GIL released, so the
-batch driver solves across all cores). It is built on the only FK/Jacobian implementation
-(``serialkin.kinematics.kernels.jacobian_into`` and ``fk_into``), the only pose-error
-implementation (:func:`serialkin.spatial.kernels.pose_error_into`) and the one
-Cholesky solve (:func:`serialkin.kinematics.dls.spd_solve_into`). The helpers every
+from a step kernel, the method's :class:`CompiledMethod`: a ``solve_chunk`` (targets
+``start..stop-1``, each with restarts, with the GIL released, so the batch driver solves
+across all cores; one target from Python is a chunk of one) and a ``solve_fast`` (one
+target behind packed arguments, the default options' path). It is built on the only
+FK/Jacobian implementation (``serialkin.kinematics.kernels.jacobian_into`` and
+``fk_into``), the only pose-error implementation
+(:func:`serialkin.spatial.kernels.pose_error_into`) and the one Cholesky solve
+(:func:`serialkin.kinematics.dls.spd_solve_into`). The helpers every
 compiled IK method shares live here too: the cost and error norms (:func:`task_cost`,
 :func:`task_errors`), joint-limit projection, the random starts, small dense algebra
 (normal equations, a Jacobi SVD, the pseudoinverse step) and the stopping test of the
@@ -720,16 +722,6 @@ def _write_info(info, success, total, be, w, used, best_cost, q_out, lo, hi, cle
     info[I_CLEARANCE] = clearance
 
 
-def _solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info):
-    """Solve one target with restarts; write the best q into ``q_out`` (n,) and ``info``.
-
-    Arguments as :func:`_restarts` (without a guard), which it calls with a fresh
-    workspace.
-    """
-    solve_one_in(F, meta, Tt, box, q0, cfg, seed, q_out, info,  # noqa: F821
-                 _workspace(meta.shape[0]), ())
-
-
 def _restarts(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp, guard):
     """Solve one target with restarts in the workspace ``wsp`` (:func:`_workspace`).
 
@@ -851,7 +843,9 @@ def _no_clearance(q, guard, info):
 
 
 def _solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
-    """``solve_one`` for targets ``start..stop-1`` of ``Tt`` (N, 4, 4), GIL released.
+    """The restart loop (:func:`_restarts`) for targets ``start..stop-1`` of ``Tt`` (N, 4, 4).
+
+    GIL released.
 
     ``Q0`` (N, n) start configurations (read when ``cfg[C_USE_Q0]`` is 1), ``Q_out``
     (N, n) and ``info`` (N, N_INFO) outputs. The batch driver
@@ -888,7 +882,7 @@ def pack_fast(F, meta, box, cfg_random, cfg_q0, rot_tol):
 
 
 def _solve_fast(S, Tt, q0, seed, use_q0, q_out):
-    """``solve_one`` behind the input checks of the ordinary path, for a call from Python.
+    """The restart loop behind the input checks of the ordinary path, for a call from Python.
 
     ``S`` from :func:`pack_fast`; ``Tt`` (4, 4) target; ``q0`` (n,) read when ``use_q0``;
     ``seed`` the stream seed as an int64 (its bits are the uint64 seed); ``q_out`` (n,).
@@ -910,7 +904,7 @@ def _solve_fast(S, Tt, q0, seed, use_q0, q_out):
     if not pose_and_q0_valid(Tt, q0, box[B_LO], box[B_HI], S[0], use_q0):
         return -1, 0, 0.0, 0.0, 0
     info = np.empty(N_INFO)
-    # solve_one_in directly, not through solve_one: one level less of compiled calls (each
+    # solve_one_in directly, not through solve_chunk: one level less of compiled calls (each
     # level re-optimises everything below it at its first compile: 2 s of a first ik)
     solve_one_in(F, meta, Tt, box, q0, cfg, np.uint64(seed), q_out, info,  # noqa: F821
                  _workspace(n), ())
@@ -1058,7 +1052,7 @@ def _final_clearance(q, guard, info):
 
 def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, pa, pb, scene,
                          ccfg, q_out, info):
-    """``solve_one`` whose success also asks for a clearance ≥ ``ccfg[K_MARGIN]``.
+    """The restart loop whose success also asks for a clearance ≥ ``ccfg[K_MARGIN]``.
 
     :func:`_restarts` with the collision guard (:func:`_push_accept`): every attempt that
     reaches the target is checked (:func:`_clearance`: the checked self pairs ``pa, pb``
@@ -1066,12 +1060,12 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
     (:func:`_push_out`) each followed by the attempt loop again; then the next restart.
     The returned q is the first collision-free solution; else the solution with the
     largest clearance; else (no attempt reached the target) the lowest-cost attempt,
-    polished as in ``solve_one``. ``info[I_CLEARANCE]`` and ``info[I_PAIR:I_PAIR + 3]``
+    polished as in a plain solve. ``info[I_CLEARANCE]`` and ``info[I_PAIR:I_PAIR + 3]``
     describe the returned q; ``info[I_SUCCESS]`` is 1 only when it reaches the target and
-    its clearance is ≥ the margin. Arguments as ``solve_one`` plus the collision model's
-    flat arrays (``sf`` shape frames, ``A``, ``B``, ``rad``, ``sb`` shape bodies), the
-    checked pairs, the scene (k, 16) and ``ccfg`` (:data:`N_CCFG`,). Allocates the loop's
-    workspace and the guard's work arrays.
+    its clearance is ≥ the margin. Arguments as :func:`_restarts` (but the workspace and
+    guard) plus the collision model's flat arrays (``sf`` shape frames, ``A``, ``B``,
+    ``rad``, ``sb`` shape bodies), the checked pairs, the scene (k, 16) and ``ccfg``
+    (:data:`N_CCFG`,). Allocates the loop's workspace and the guard's work arrays.
     """
     n = meta.shape[0]
     m = A.shape[0]
@@ -1087,7 +1081,10 @@ def _solve_one_collision(F, L, meta, Tt, box, q0, cfg, seed, sf, A, B, rad, sb, 
 
 def _solve_chunk_collision(F, L, meta, Tt, box, Q0, cfg, seed, sf, A, B, rad, sb, pa, pb, scene,
                            ccfg, Q_out, info, start, stop):
-    """``solve_one_collision`` for targets ``start..stop-1`` (as ``solve_chunk``), GIL released."""
+    """:func:`_solve_one_collision` (inlined) for targets ``start..stop-1``, GIL released.
+
+    As ``solve_chunk``; one target from Python is a chunk of one.
+    """
     for k in range(start, stop):
         solve_one_collision(F, L, meta, Tt[k], box, Q0[k], cfg, seed, sf, A, B,  # noqa: F821
                             rad, sb, pa, pb, scene, ccfg, Q_out[k], info[k])
@@ -1101,11 +1098,10 @@ class CompiledMethod:
         step: the step kernel (see the module docstring).
         params: ``(option name, zero allowed)`` of the values the step reads from ``p``,
             in order (``cfg[N_LOOP + i]``); each is a finite number > 0 (or ≥ 0).
-        solve_one: ``solve_one(F, meta, Tt, box, q0, cfg, seed, q_out, info)``.
         solve_chunk: ``solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start,
-            stop)``, GIL released.
-        solve_one_collision, solve_chunk_collision: the same with the collision check
-            (:func:`_solve_one_collision`), compiled at their first call.
+            stop)``, GIL released (one target from Python: a chunk of one).
+        solve_chunk_collision: the same with the collision check
+            (:func:`_solve_one_collision`), compiled at its first call.
         solve_fast: ``solve_fast(S, Tt, q0, seed, use_q0, q_out) -> (status, iterations,
             position error, orientation error, restarts)``, the single call from Python
             (:func:`_solve_fast`).
@@ -1116,9 +1112,7 @@ class CompiledMethod:
 
     step: object
     params: tuple[tuple[str, bool], ...]
-    solve_one: object
     solve_chunk: object
-    solve_one_collision: object = None
     solve_chunk_collision: object = None
     solve_fast: object = None
     code: int | None = None
@@ -1164,21 +1158,24 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
     one_in = compiled(_nrt=allocates)(_bind(_restarts, name, tag + str(int(allocates)),
                                             attempt_loop=attempt, accept=_accept_all,
                                             final=_no_clearance))
-    one = compiled()(_bind(_solve_one, name, tag, solve_one_in=one_in))
+    # one target from Python is a chunk of one: each compiled entry links and re-optimises
+    # the whole loop below it (about 2 s of a first ik per entry)
     chunk = compiled(nogil=True)(_bind(_solve_chunk, name, tag, solve_one_in=one_in))
     # the same restart loop with the collision guard (with reference counting: the
     # guard's tuples hold arrays the wrapper allocates)
-    push = compiled()(_bind(_push_accept, name, tag, attempt_loop=attempt))
-    restarts_c = compiled()(_bind(_restarts, name, tag + "c", attempt_loop=attempt,
-                                  accept=push, final=_final_clearance))
-    one_c = compiled()(_bind(_solve_one_collision, name, tag,
-                             restarts_collision=restarts_c))
+    # (the guard and this restart loop have one call site each: inlined in numba's IR,
+    # not compiled levels of their own, each of which would re-optimise the tree below)
+    push = compiled(inline="always")(_bind(_push_accept, name, tag, attempt_loop=attempt))
+    restarts_c = compiled(inline="always")(_bind(_restarts, name, tag + "c",
+                                                 attempt_loop=attempt, accept=push,
+                                                 final=_final_clearance))
+    one_c = compiled(inline="always")(_bind(_solve_one_collision, name, tag,
+                                            restarts_collision=restarts_c))
     chunk_c = compiled(nogil=True)(_bind(_solve_chunk_collision, name, tag,
                                          solve_one_collision=one_c))
     fast = compiled()(_bind(_solve_fast, name, tag, solve_one_in=one_in))
-    return CompiledMethod(step=step, params=tuple(params), solve_one=one, solve_chunk=chunk,
-                          solve_one_collision=one_c, solve_chunk_collision=chunk_c,
-                          solve_fast=fast)
+    return CompiledMethod(step=step, params=tuple(params), solve_chunk=chunk,
+                          solve_chunk_collision=chunk_c, solve_fast=fast)
 
 
 def compile_family(family: str, dispatch, members, *,

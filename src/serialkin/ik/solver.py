@@ -3,9 +3,9 @@
 :func:`solve` (what ``robot.ik`` calls) validates the arguments, looks the method up in
 the registry and runs it:
 
-* compiled methods (the Jacobian family) run entirely in their ``solve_one``, the
-  shared loop of :mod:`serialkin.ik._kernels` around the method's step kernel; a batch
-  runs their ``solve_chunk`` on every core (GIL released, chunks handed out by
+* compiled methods (the Jacobian family) run entirely in their ``solve_chunk`` (one
+  target: a chunk of one), the shared loop of :mod:`serialkin.ik._kernels` around the
+  method's step kernel; a batch runs it on every core (GIL released, chunks handed out by
   :func:`serialkin.kinematics.parallel.run`);
 * Python methods supply one attempt and :func:`run_attempts` owns the rest.
 
@@ -743,7 +743,8 @@ def _solve_compiled(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray 
         info = np.empty(K.N_INFO)
         q0k = q0 if q0 is not None and q0.flags.writeable else (
             np.zeros(n) if q0 is None else q0.copy())
-        spec.kernel.solve_one(F, meta, Tt, box, q0k, cfg, seed64, q, info)
+        spec.kernel.solve_chunk(F, meta, Tt[None], box, q0k[None], cfg, seed64, q[None],
+                                info[None], 0, 1)
         return _from_info(robot, tgt, spec, q, info, tol, respect)
     N = Tt.shape[0]
     Q = np.empty((N, n))
@@ -873,8 +874,8 @@ def _solve_collision(robot: Robot, tgt: Target, spec: MethodSpec, q0: np.ndarray
         q = np.empty(n)
         info = np.empty(K.N_INFO)
         q0k = np.zeros(n) if q0 is None else np.array(q0, dtype=np.float64)
-        spec.kernel.solve_one_collision(F, L, meta, Tt, box, q0k, cfg, seed64, *coll.arrays,
-                                        coll.ccfg, q, info)
+        spec.kernel.solve_chunk_collision(F, L, meta, Tt[None], box, q0k[None], cfg, seed64,
+                                          *coll.arrays, coll.ccfg, q[None], info[None], 0, 1)
         return _from_info(robot, tgt, spec, q, info, tol, respect, coll)
     N = Tt.shape[0]
     Q = np.empty((N, n))

@@ -136,6 +136,7 @@ class _Prepared:
         # ``mid``), so that the parity test of _near_rows counts every solution; the
         # limits are applied after it (_inside_limits)
         self.solve_qlim = self.qlim
+        self.packed: dict[tuple, tuple] = {}  # dispatch.pack's arrays per options (_pack)
         if mode == "near":
             self.solve_qlim = np.ascontiguousarray(np.tile([-np.inf, np.inf], (robot.n, 1)))
         self.F = robot.chain.F
@@ -643,8 +644,9 @@ def _doubtful(p: _Prepared, rows: np.ndarray, conv: np.ndarray,
     solve without limits; ``conv`` (N, 17) the kernels' records (branches, then a flag per
     branch). Doubtful when
 
-    * no branch, or an odd number of branches, converged (as
-      :func:`~serialkin.ik.analytic.dispatch.refined_doubtful`);
+    * no branch, or an odd number of branches, converged on the true chain (the
+      idealised arm may have no solution where the true arm has some: measured on random
+      arms with twists 0.04 rad from parallel; an odd count lost one of a pair);
     * the number of distinct solutions is odd: real solutions of a 6-joint arm come in
       pairs, so one was lost;
     * more branches converged than there are distinct solutions: two seeds met on one
@@ -686,8 +688,6 @@ def _with_general(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
     fail in pairs are usually solutions the idealised arm has and the true arm has not
     (a target near the workspace boundary), and trigger nothing.
     """
-    from serialkin.ik.analytic.dispatch import solve_into
-
     cache = _PREPARED.setdefault(robot, dict)
     g = cache.get(-1.0)
     if g is None:
@@ -696,11 +696,7 @@ def _with_general(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
         except NoClosedFormError:
             return sols
         cache[-1.0] = g
-    out = np.empty((MAX_ROWS, g.n))
-    conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
-    k = solve_into(g.code, g.arm, g.prismatic3, T, g.W, g.P, g.M, g.aux, g.order, g.revolute,
-                   g.qlim, g.mid, g.F, g.meta, True, False, grid, tol * g.s.scale, tol,
-                   REFINE_TOL * g.s.scale, REFINE_TOL, out, conv)
+    out, k, _ = _solve_one(g, g.qlim, T, True, False, tol, grid)
     rows = [r for r in sols]
     for r in out[:k]:
         d = np.abs(wrap_angle(np.array(rows) - r)).max(axis=1) \
@@ -791,22 +787,48 @@ def _sort_batch(robot: Robot, res: AllSolutions, reference: object, weights: obj
                         continuous=None if cont is None else cont.reshape(res.continuous.shape))
 
 
+def _pack(p: _Prepared, qlim: np.ndarray, check_rot: bool, refine: bool, tol: float,
+          grid: int) -> tuple:
+    """:func:`~serialkin.ik.analytic.dispatch.pack` of ``p`` with these limits and options.
+
+    Kept on ``p`` per set of options (packing takes about 10 µs, as long as a solve).
+    """
+    from serialkin.ik.analytic.dispatch import pack
+
+    key = (qlim is p.solve_qlim, check_rot, refine, tol, grid)
+    found = p.packed.get(key)
+    if found is None:
+        if len(p.packed) > 64:  # a caller sweeping tol or grid
+            p.packed.clear()
+        found = p.packed[key] = pack(
+            p.code, p.arm, p.prismatic3, p.W, p.P, p.M, p.aux, p.order, p.revolute, qlim,
+            p.mid, p.F, p.meta, check_rot, refine, grid, tol * p.s.scale, tol,
+            REFINE_TOL * p.s.scale, REFINE_TOL)
+    return found
+
+
+def _solve_one(p: _Prepared, qlim: np.ndarray, T: np.ndarray, check_rot: bool, refine: bool,
+               tol: float, grid: int) -> tuple[np.ndarray, int, np.ndarray]:
+    """One target T (4, 4), already a rigid transform: (rows (16, n), count, conv (17,))."""
+    from serialkin.ik.analytic.dispatch import for_class
+
+    I, D, B = _pack(p, qlim, check_rot, refine, tol, grid)
+    T = T if T.flags.carray and T.dtype == np.float64 else np.array(T, dtype=float, order="C")
+    out = np.zeros((MAX_ROWS, p.n))
+    conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
+    # one target is the kernel's flat batch of one (its one specialisation)
+    k = for_class(p.code, refine).solve(T, I, D, B, out, np.empty(1, dtype=np.int64), conv,
+                                        0, 1)
+    return out, int(k), conv
+
+
 def _solve_batch(p: _Prepared, robot: Robot, T: np.ndarray, tol: float,
                  grid: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Solve targets T (N, 4, 4) on every core; (out (N, 16, n), counts (N,), conv (N, 17))."""
-    from serialkin.ik.analytic.dispatch import for_class
-    from serialkin.kinematics.parallel import run
+    from serialkin.ik.analytic.dispatch import solve
 
-    N = T.shape[0]
-    out = np.zeros((N, MAX_ROWS, p.n))
-    counts = np.zeros(N, dtype=np.int64)
-    conv = np.zeros((N, MAX_ROWS + 1), dtype=np.int64)
-    args = (p.arm, p.prismatic3, T, p.W, p.P, p.M, p.aux, p.order, p.revolute,
-            p.solve_qlim, p.mid, p.F, p.meta, p.refine, grid, tol * p.s.scale, tol,
-            REFINE_TOL * p.s.scale, REFINE_TOL, out, counts, conv)
-    grain = 4 if p.code == GENERAL else 64
-    run(for_class(p.code, p.refine).solve_range, args, N, grain)
-    return out, counts, conv
+    return solve(p.code, T, _pack(p, p.solve_qlim, True, p.refine, tol, grid),
+                 grain=4 if p.code == GENERAL else 64)
 
 
 def _as_poses(a: np.ndarray) -> np.ndarray:
@@ -836,19 +858,20 @@ def _as_poses(a: np.ndarray) -> np.ndarray:
 
 #: Fast-path entries per robot: (robot, entry point, I, D, B, output shape).
 _FAST: PerObject[tuple] = PerObject()
-#: The compiled entry points of each class's ``solve_packed``, by (class code, refine) (resolved on
+#: The compiled entry points of each class's kernel, by (class code, refine) (resolved on
 #: first use by :func:`_packed_entry`).
 _SOLVE_PACKED: dict[tuple[int, bool], Any] = {}
 
 
 def _packed_entry(code: int, refine: bool) -> Any:
-    """The compiled entry point of ``for_class(code, refine).solve_packed`` (see dispatch).
+    """The compiled entry point of ``for_class(code, refine).solve`` (see dispatch).
 
     Calling it skips numba's type dispatch (about 1 µs with its arguments); it is
-    compiled for exactly the types the fast path passes: a C-contiguous, aligned,
-    writeable float64 (4, 4) target (checked by :func:`ik_all` before the call), the
-    read-only packed arrays of :func:`~serialkin.ik.analytic.dispatch.pack` and a fresh
-    output.
+    compiled for exactly the types every caller passes (:func:`dispatch.solve
+    <serialkin.ik.analytic.dispatch.solve>` too): C-contiguous, aligned, writeable
+    float64 targets stacked (4N, 4) (the fast path's (4, 4) pose as it comes, checked by
+    :func:`ik_all` before the call), the read-only packed arrays of
+    :func:`~serialkin.ik.analytic.dispatch.pack`, flat outputs and the range.
     """
     if (code, refine) not in _SOLVE_PACKED:
         from serialkin._jit import entry_point
@@ -862,9 +885,9 @@ def _packed_entry(code: int, refine: bool) -> Any:
             return (Array(f64, 2, "C"), Array(i64, 1, "C", readonly=True),
                     Array(f64, 1, "C", readonly=True),
                     Array(numba.boolean, 1, "C", readonly=True), Array(f64, 2, "C"),
-                    Array(i64, 1, "C"))
+                    Array(i64, 1, "C"), Array(i64, 1, "C"), i64, i64)
 
-        found, final = entry_point(for_class(code, refine).solve_packed, sig)
+        found, final = entry_point(for_class(code, refine).solve, sig)
         if not final:  # its Python function while it compiles: ask again next call
             return found
         _SOLVE_PACKED[code, refine] = found
@@ -874,19 +897,18 @@ def _packed_entry(code: int, refine: bool) -> Any:
 def _fast_entry(robot: object) -> tuple:
     """The fast path's cached data for ``robot`` (default ``tol``, ``near_tol``, grid).
 
-    ``(None, entry point, I, D, B, (16, n), kind, mode, prepared)``: the packed arguments
-    of :func:`~serialkin.ik.analytic.dispatch.solve_packed`, the shape of its output, the
+    ``(counts, entry point, I, D, B, (16, n), kind, mode, prepared)``: a scratch
+    ``counts`` (1,) (written, never read: the kernel returns the count, so concurrent
+    calls may share it), the packed arguments of
+    :func:`~serialkin.ik.analytic.dispatch.solve`'s kernel, the shape of its output, the
     class solved and its :class:`_Prepared` data.
     """
-    from serialkin.ik.analytic.dispatch import pack
     from serialkin.ik.analytic.general import DEFAULT_GRID
 
     p = _prepared(robot, NEAR_TOL)  # raises the ordinary path's errors
-    I, D, B = pack(p.code, p.arm, p.prismatic3, p.W, p.P, p.M, p.aux, p.order, p.revolute,
-                   p.solve_qlim, p.mid, p.F, p.meta, p.refine, DEFAULT_GRID, 1e-8 * p.s.scale,
-                   1e-8, REFINE_TOL * p.s.scale, REFINE_TOL)
-    entry = (None, _packed_entry(p.code, p.refine), I, D, B, (MAX_ROWS, p.n), p.s.kind,
-             p.mode, p)
+    I, D, B = _pack(p, p.solve_qlim, True, p.refine, 1e-8, DEFAULT_GRID)
+    entry = (np.empty(1, dtype=np.int64), _packed_entry(p.code, p.refine), I, D, B,
+             (MAX_ROWS, p.n), p.s.kind, p.mode, p)
     if (p.code, p.refine) in _SOLVE_PACKED:  # compiled: kept (else its Python, asked again)
         _FAST.set(robot, entry)
     return entry
@@ -987,15 +1009,14 @@ def _ik_all_fast(robot: Robot, target: np.ndarray) -> AllSolutions | None:
         entry = _fast_entry(robot)
     out = _EMPTY(entry[5])
     conv = _ZEROS(_CONV, _I64)  # False beyond the branches
-    k = entry[1](target, entry[2], entry[3], entry[4], out, conv)
+    k = entry[1](target, entry[2], entry[3], entry[4], out, entry[0], conv, 0, 1)
     if k == -1:
         return None
     if entry[7] != "near":
         return _ALL(out[:k], k, conv, entry[6], entry[7])
     from serialkin.ik.analytic.general import DEFAULT_GRID  # a nearly ideal arm
 
-    rows = out[:k] if k >= 0 else out[:-2 - k]  # k < -1: refined branches doubtful
-    rows = _near_rows(robot, entry[8], target, rows, conv, _TOL, DEFAULT_GRID)
+    rows = _near_rows(robot, entry[8], target, out[:k], conv, _TOL, DEFAULT_GRID)
     return _ALL(rows, rows.shape[0], conv, entry[6], entry[7])
 
 
@@ -1118,13 +1139,7 @@ def _ik_all_one(p: Any, robot: Robot, a: np.ndarray, tol: float, grid: int, all_
                 reference: object, weights: object, norm: str, report: bool) -> AllSolutions:
     """:func:`ik_all` of one target ``a`` (a pose, or a planar / position target)."""
     T, check_rot = _parse_target(p, robot, a)
-    from serialkin.ik.analytic.dispatch import solve_into
-
-    out = np.empty((MAX_ROWS, p.n))
-    conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
-    k = solve_into(p.code, p.arm, p.prismatic3, T, p.W, p.P, p.M, p.aux, p.order, p.revolute,
-                   p.solve_qlim, p.mid, p.F, p.meta, check_rot, p.refine, grid,
-                   tol * p.s.scale, tol, REFINE_TOL * p.s.scale, REFINE_TOL, out, conv)
+    out, k, conv = _solve_one(p, p.solve_qlim, T, check_rot, p.refine, tol, grid)
     sols = out[:k]
     if p.mode == "near":
         sols = _near_rows(robot, p, T, sols, conv, tol, grid)

@@ -1,15 +1,16 @@
-"""The compiled entries of every closed-form class, and their batch range kernels (numba).
+"""The one compiled kernel of every closed-form class (numba).
 
-Each class (an integer ``code``) has its own three kernels, built by :func:`for_class`
-on its first use: ``solve_into`` solves one target, optionally refining every candidate
-branch on the true chain (nearly ideal arms, see :mod:`serialkin.ik.analytic.refine`);
-``solve_range`` runs it over targets ``start..stop-1`` with the GIL released, for
-:func:`serialkin.kinematics.parallel.run`; ``solve_packed`` is the single-call entry of
-``ik_all``'s fast path: the same solve with the robot's read-only data packed by
+Each class (an integer ``code``) has its own kernel, built by :func:`for_class` on its
+first use: ``solve`` solves targets ``start..stop-1`` of a batch with the GIL released,
+optionally refining every candidate branch on the true chain (nearly ideal arms, see
+:mod:`serialkin.ik.analytic.refine`), on the robot's read-only data packed by
 :func:`pack` into three arrays (a call from Python pays for unboxing every array
-argument, 50-100 ns each).
+argument, 50-100 ns each). ``ik_all``'s fast path calls it for one target, its options
+path too, and the batch driver (:func:`serialkin.kinematics.parallel.run`) for chunks: one
+compiled entry per class, because each compiled level links and re-optimises the whole
+solver tree below it (4-5 s of a general 6R's first call per entry).
 
-Why one set of kernels per class rather than one kernel branching on the code: a kernel
+Why one kernel per class rather than one kernel branching on the code: a kernel
 compiles everything it may call, so one entry for all classes compiled every class's
 solver (and the general 6R search) at the first ``ik_all`` of any arm: 131 s cold for a
 UR5 on a quiet 2-core machine. Per class, a UR5 compiles only the UR solver. The
@@ -166,42 +167,29 @@ def _solve_closed(arm, prismatic3, T, W, P, M, aux, order, revolute, qlim, mid, 
                   revolute, qlim, mid, F, meta, check_rot, tol_p, tol_r, out)
 
 
-def _solve_range(arm, prismatic3, Ts, W, P, M, aux, order, revolute, qlim, mid, F, meta,
-                 refine, grid, tol_p, tol_r, newton_p, newton_r, out, counts, conv, start,
-                 stop):
-    """``solve_into`` for targets ``Ts[start:stop]`` (N, 4, 4), GIL released.
-
-    Writes ``out`` (N, 16, n), ``counts`` (N,) and ``conv`` (N, 17); the other arguments
-    as for :func:`_solve_into` (rotations always verified).
-    """
-    for i in range(start, stop):
-        counts[i] = solve_into(arm, prismatic3, Ts[i], W, P, M, aux,  # noqa: F821
-                               order, revolute, qlim, mid, F, meta, True, refine, grid, tol_p,
-                               tol_r, newton_p, newton_r, out[i], conv[i])
-
-
 #: Header length of the packed integer array (see :func:`pack`).
-_HEAD = 8
+_HEAD = 9
 
 
-def pack(code, arm, prismatic3, W, P, M, aux, order, revolute, qlim, mid, F, meta, refine,
-         grid, tol_p, tol_r, newton_p, newton_r):
-    """The arguments of :func:`solve_into` but the target and outputs, in three arrays.
+def pack(code, arm, prismatic3, W, P, M, aux, order, revolute, qlim, mid, F, meta, check_rot,
+         refine, grid, tol_p, tol_r, newton_p, newton_r):
+    """The arguments of :func:`_solve_into` but the target and outputs, in three arrays.
 
     Returns read-only ``(I, D, B)``: ``I`` int64 = (code, arm, prismatic3, refine, grid,
-    n, rows of aux, length of order) then ``order``; ``D`` float64 = (tol_p, tol_r,
-    newton_p, newton_r) then ``W``, ``P``, ``M``, ``aux``, ``qlim``, ``mid``, ``F``,
-    ``meta`` flattened; ``B`` = ``revolute`` (bool). :func:`solve_packed` unpacks them as
-    views of the same types, so the kernels below it are the ones already compiled.
-    Arrays of the structure (aux (k, 3)) and of the chain (F (n+1, 4, 4), meta (n, 5)).
+    n, rows of aux, length of order, check_rot) then ``order``; ``D`` float64 = (tol_p,
+    tol_r, newton_p, newton_r) then ``W``, ``P``, ``M``, ``aux``, ``qlim``, ``mid``, ``F``,
+    ``meta`` flattened; ``B`` = ``revolute`` (bool). The class kernel (:func:`_solve`)
+    unpacks them as views. Arrays of the structure (aux (k, 3)) and of the chain (F
+    (n+1, 4, 4), meta (n, 5)).
     """
     n = W.shape[0]
     if aux.ndim != 2 or aux.shape[1] != 3 or meta.shape != (n, 5) or F.shape != (n + 1, 4, 4):
         raise InputError(f"pack: aux must be (k, 3), meta ({n}, 5) and F ({n + 1}, 4, 4); got "
-                         f"{aux.shape}, {meta.shape}, {F.shape}")  # the layout solve_packed reads
+                         f"{aux.shape}, {meta.shape}, {F.shape}")  # the layout _solve reads
     order = np.asarray(order, dtype=np.int64)
     I = np.concatenate([np.array([code, arm, int(prismatic3), int(refine), grid, n,
-                                  aux.shape[0], order.shape[0]], dtype=np.int64), order])
+                                  aux.shape[0], order.shape[0], int(check_rot)],
+                                 dtype=np.int64), order])
     D = np.concatenate([np.array([tol_p, tol_r, newton_p, newton_r], dtype=float)]
                        + [np.asarray(a, dtype=float).ravel()
                           for a in (W, P, M, aux, qlim, mid, F, meta)])
@@ -211,18 +199,20 @@ def pack(code, arm, prismatic3, W, P, M, aux, order, revolute, qlim, mid, F, met
     return I, D, B
 
 
-def _solve_packed(T, I, D, B, out, conv):
-    """``solve_into`` on the packed data of :func:`pack` (the fast path's entry).
+def _solve(Ts, I, D, B, out, counts, conv, start, stop):
+    """Every solution of targets ``start..stop-1`` on :func:`pack`'s arrays; the last count.
 
-    One compiled call for the rigidity check and the solve (rotation verified), into
-    ``out`` (16, n) and ``conv`` (17,) (as :func:`_solve_into`). Returns the number of
-    solutions k >= 0; −1 without solving when T (4, 4) is not a rigid transform to 1e-13
-    (the caller then checks it, projects the rotation or raises); ``−2 − k`` when the arm
-    is refined (nearly ideal) and its branches are doubtful (:func:`refined_doubtful`;
-    the caller then adds the general search's rows).
+    The class's one compiled kernel (GIL released): the single call of ``ik_all``'s fast
+    path (``start, stop = 0, 1``), its ordinary path and the batch driver's chunks
+    (:func:`serialkin.kinematics.parallel.run`) all call it, so the class's solver tree
+    compiles once. The buffers are flat so that one pose needs no reshaping: ``Ts`` (4N,
+    4) the targets stacked (target i is ``Ts[4i:4i+4]``), ``out`` (16N, n) the rows
+    (target i's are ``out[16i:16i+16]``), ``conv`` (17N,) the convergence records, each as
+    :func:`_solve_into` writes them, and ``counts`` (N,) the solutions per target: −1,
+    without solving, when the rotation is verified (``check_rot``) and the target is not a
+    rigid transform to 1e-13 (the caller then checks it, projects the rotation or raises).
+    Returns ``counts[stop − 1]`` (0 for an empty range).
     """
-    if rigid_error(T) > 1e-13:
-        return -1
     n = I[5]
     na = I[6]
     o = 4
@@ -241,48 +231,32 @@ def _solve_packed(T, I, D, B, out, conv):
     F = D[o:o + 16 * (n + 1)].reshape((n + 1, 4, 4))
     o += 16 * (n + 1)
     meta = D[o:o + 5 * n].reshape((n, 5))
-    refine = I[3] != 0
-    k = solve_into(I[1], I[2] != 0, T, W, P, M, aux, I[_HEAD:_HEAD + I[7]], B,  # noqa: F821
-                   qlim, mid, F, meta, True, refine, I[4], D[0], D[1], D[2], D[3], out, conv)
-    if refine and refined_doubtful(conv):
-        return -2 - k
+    check_rot = I[8] != 0
+    order = I[_HEAD:_HEAD + I[7]]
+    k = 0
+    for i in range(start, stop):
+        T = Ts[4 * i:4 * i + 4]
+        if check_rot and rigid_error(T) > 1e-13:
+            k = -1
+        else:
+            k = solve_into(I[1], I[2] != 0, T, W, P, M, aux, order, B, qlim, mid,  # noqa: F821
+                           F, meta, check_rot, I[3] != 0, I[4], D[0], D[1], D[2], D[3],
+                           out[MAX_ROWS * i:MAX_ROWS * i + MAX_ROWS],
+                           conv[(MAX_ROWS + 1) * i:(MAX_ROWS + 1) * (i + 1)])
+        counts[i] = k
     return k
-
-
-@njit(cache=True)
-def refined_doubtful(conv):
-    """Whether a nearly ideal arm's refined branches may have missed a true solution.
-
-    ``conv`` (17,) as :func:`solve_into` fills it. Doubtful when an odd number of
-    branches converged on the true chain (real solutions of a 6R come in pairs: one was
-    lost, e.g. near a singularity of the true arm) or none did (the idealised arm may
-    have no solution where the true arm has some: measured on random arms with twists
-    0.04 rad from parallel). Only the general search can tell, so the caller adds its
-    rows. Branches failing in pairs while others converge are usually solutions the
-    idealised arm has and the true arm has not (a target near the workspace boundary):
-    searching for them would cost the search on most such targets for no miss found.
-    """
-    good = 0
-    for i in range(conv[0]):
-        good += conv[1 + i]
-    return good % 2 == 1 or good == 0
 
 
 @dataclass(frozen=True, eq=False)
 class ClassKernels:
-    """The compiled kernels of one closed-form class (see the module docstring).
+    """The compiled kernel of one closed-form class (see the module docstring).
 
     Attributes:
-        solve_into: ``solve_into(arm, prismatic3, T, W, P, M, aux, order, revolute, qlim,
-            mid, F, meta, check_rot, refine, grid, tol_p, tol_r, newton_p, newton_r, out,
-            conv) -> count`` (:func:`_solve_into`).
-        solve_range: the same over ``Ts[start:stop]``, GIL released (:func:`_solve_range`).
-        solve_packed: ``solve_packed(T, I, D, B, out, conv)`` on :func:`pack`'s arrays.
+        solve: ``solve(Ts, I, D, B, out, counts, conv, start, stop) -> last count`` on
+            :func:`pack`'s arrays and flat buffers (:func:`_solve`).
     """
 
-    solve_into: object
-    solve_range: object
-    solve_packed: object
+    solve: object
 
 
 _NAMES = {PLANAR: "planar", SCARA: "scara", WRIST: "wrist", UR: "ur", GENERAL: "general"}
@@ -290,13 +264,14 @@ _NAMES = {PLANAR: "planar", SCARA: "scara", WRIST: "wrist", UR: "ur", GENERAL: "
 
 @functools.cache
 def for_class(code: int, refine: bool = False) -> ClassKernels:
-    """The kernels of class ``code`` (:data:`PLANAR` ... :data:`GENERAL`), built once.
+    """The kernel of class ``code`` (:data:`PLANAR` ... :data:`GENERAL`), built once.
 
-    ``refine``: kernels that can refine the candidates of a nearly ideal arm (the
-    ``refine`` argument of ``solve_into`` then decides); without it, the refinement is not
-    compiled at all (13 s of a UR5's first ``ik_all``) and the argument is ignored.
-    Compilation is lazy (each kernel at its first call) and cached on disk; only the
-    solver of this class is compiled.
+    ``refine``: a kernel that can refine the candidates of a nearly ideal arm (the
+    ``refine`` field of :func:`pack` then decides); without it, the refinement is not
+    compiled at all (13 s of a UR5's first ``ik_all``) and the field is ignored.
+    Compilation is lazy (at the first call) and cached on disk; only the solver of this
+    class is compiled, once: the per-target template is inlined in numba's IR into the
+    one range kernel (each compiled level links and re-optimises everything below it).
     """
     refine = bool(refine) and code not in (PLANAR, SCARA, GENERAL)
     name = _NAMES[code] + ("_refined" if refine else "")
@@ -306,19 +281,32 @@ def for_class(code: int, refine: bool = False) -> ClassKernels:
     else:
         cands = {WRIST: _wrist, UR: _ur, GENERAL: _general}[code]
         one = bind(_solve_into, f"solve_into_{name}", candidates=cands, refinable=refine)
-    one = njit(cache=True)(one)  # called from Python too: one compiled copy, linked
-    return ClassKernels(
-        solve_into=one,
-        solve_range=njit(cache=True, nogil=True)(bind(_solve_range, f"solve_range_{name}",
-                                                      solve_into=one)),
-        solve_packed=njit(cache=True)(bind(_solve_packed, f"solve_packed_{name}",
-                                           solve_into=one)),
-    )
+    one = njit(cache=True, inline="always")(one)
+    return ClassKernels(solve=njit(cache=True, nogil=True)(
+        bind(_solve, f"solve_{name}", solve_into=one)))
 
 
-def solve_into(code, *args):
-    """One target of class ``code``: ``for_class(code, refine).solve_into(*args)``.
+def solve(code: int, T: np.ndarray, packed: tuple, grain: int = 0) -> tuple:
+    """Solve targets ``T`` (N, 4, 4) of class ``code`` on :func:`pack`'s arrays.
 
-    ``args`` as for :func:`_solve_into` (``refine`` is its 15th).
+    ``T`` must be C-contiguous, writeable float64 (the kernel's one specialisation);
+    ``grain`` > 0 spreads the targets over every core in chunks of at least ``grain``
+    (:func:`serialkin.kinematics.parallel.run`). Returns ``(out, counts, conv)``: (N, 16,
+    n) rows (zero beyond each count), (N,) counts (−1: not rigid, see :func:`_solve`) and
+    (N, 17) convergence records.
     """
-    return for_class(code, args[14]).solve_into(*args)
+    from serialkin.kinematics.parallel import run
+
+    I, D, B = packed
+    N = T.shape[0]
+    out = np.zeros((N, MAX_ROWS, int(I[5])))
+    counts = np.zeros(N, dtype=np.int64)
+    conv = np.zeros((N, MAX_ROWS + 1), dtype=np.int64)
+    kernel = for_class(code, bool(I[3])).solve
+    args = (T.reshape(4 * N, 4), I, D, B, out.reshape(MAX_ROWS * N, -1), counts,
+            conv.reshape(-1))
+    if grain > 0:
+        run(kernel, args, N, grain)
+    else:
+        kernel(*args, 0, N)
+    return out, counts, conv
