@@ -45,9 +45,26 @@ def test_header_has_build_metadata(built_report):
     """The header names serialkin's version, the commit, the date, versions, CPUs, build time."""
     _, html = built_report
     meta = re.search(r'<table class="meta">(.*?)</table>', html, re.S).group(1)
-    for label in ("serialkin", "git commit", "built", "Python", "numpy", "numba", "CPUs",
-                  "build time"):
+    for label in ("serialkin", "git commit", "source digest", "built", "Python", "numpy",
+                  "numba", "CPUs", "build time"):
         assert f"<th>{label}</th>" in meta, label
+
+
+def test_build_json_names_the_sources_and_versions(built_report):
+    """build.json records these sources' digest (in the header too), sections and versions.
+
+    What a later test run compares before reusing the build.
+    """
+    import json
+
+    from serialkin.chapter.report import build_provenance, source_digest
+
+    out, html = built_report
+    recorded = json.loads((out / "build.json").read_text(encoding="utf-8"))
+    assert recorded == build_provenance(SECTION_MODULES)
+    digest = source_digest()
+    assert re.fullmatch(r"[0-9a-f]{40}", digest) and digest == recorded["source"]
+    assert f"<td>{digest[:12]}</td>" in html
 
 
 def test_examples_end_with_reproduce(built_report):

