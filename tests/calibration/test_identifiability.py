@@ -127,7 +127,11 @@ _TINY_NORMAL = [{"a": 0.0, "alpha": 0.125, "d": 0.0, "theta": 0.0, "type": "R"},
 @given(rows=dh_rows(min_joints=2, max_joints=6), seed=st.integers(0, 2**32 - 1),
        kind=st.sampled_from(["position", "pose"]))
 def test_minimal_set_has_full_rank_and_explains_the_rest(rows, seed, kind):
-    """The kept columns have full rank; every dropped one lies in their span or has no effect."""
+    """The kept columns have full rank, and the set is maximal.
+
+    Each dropped column lies in their span, would make them nearly singular, or has no
+    effect.
+    """
     from serialkin.calibration.jacobian import identification_jacobian
 
     rng = np.random.default_rng(seed)
@@ -144,5 +148,6 @@ def test_minimal_set_has_full_rank_and_explains_the_rest(rows, seed, kind):
     assert len(ident.reasons) == model.size - ident.rank
     for k in np.flatnonzero(~ident.identifiable & effect):
         resid = Js[:, k] - kept @ np.linalg.lstsq(kept, Js[:, k], rcond=None)[0]
-        assert np.linalg.norm(resid) < 1e-5
+        with_k = np.linalg.svd(np.column_stack([kept, Js[:, k]]), compute_uv=False)
+        assert np.linalg.norm(resid) < 1e-5 or with_k[-1] < 1e-6, (k, np.linalg.norm(resid))
     assert ident.rank <= 4 * int(robot.revolute.sum()) + 2 * int((~robot.revolute).sum()) + 6

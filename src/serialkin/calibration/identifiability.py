@@ -60,6 +60,35 @@ def _drop_near_dependent(Js: np.ndarray, keep: np.ndarray, seq: Sequence[int],
     return np.zeros(0)
 
 
+def _readmit(Js: np.ndarray, keep: np.ndarray, seq: Sequence[int], tol: float,
+             s: np.ndarray) -> np.ndarray:
+    """Keep again, in priority order, dropped columns that the final kept set can take.
+
+    :func:`_drop_near_dependent` drops one column of a near-dependency at a time; a
+    column dropped early may no longer depend on the kept columns once a later one of
+    the same dependency went too (a prismatic joint with a 6e-5 rad twist: its β lay
+    0.97 outside the final kept span). A column comes back when its Gram–Schmidt
+    residual against the kept columns is above ``tol`` and the kept set's σ_min stays
+    ≥ 0.1·``tol`` with it, so the set is maximal: every column left out either lies
+    within ``tol`` of the kept span or would make it nearly singular. ``keep`` (p,) is
+    updated; returns the final singular values (``s`` when nothing came back).
+    """
+    for k in seq:
+        if keep[k]:
+            continue
+        idx = np.flatnonzero(keep)
+        c = Js[:, k]
+        if idx.size:
+            c = c - Js[:, idx] @ np.linalg.lstsq(Js[:, idx], c, rcond=None)[0]
+        if np.linalg.norm(c) <= tol:
+            continue
+        trial = np.linalg.svd(Js[:, np.append(idx, k)], compute_uv=False)
+        if trial[-1] >= 0.1 * tol:
+            keep[k] = True
+            s = trial
+    return s
+
+
 @dataclass(frozen=True, eq=False)
 class Identifiability:
     """The identifiability of an error model's parameters from a set of measurements.
@@ -149,6 +178,7 @@ def analyse(J: np.ndarray, names: Sequence[str], *, kind: str = "",
             keep[k] = True
             basis = np.column_stack([basis, r / nr])
     s = _drop_near_dependent(Js, keep, seq, 0.1 * tol)
+    s = _readmit(Js, keep, [k for k in seq if effect[k] and k not in exclude], tol, s)
     reasons = []
     what = f"{kind} measurements" if kind else "the measurements"
     idx = np.flatnonzero(keep)
