@@ -24,9 +24,10 @@ Units: radians (revolute joints), metres (prismatic).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
@@ -62,6 +63,8 @@ class JointSweep:
         feasible: [(v_lo, v_hi), ...] the closed intervals of values at which some
             configuration reaches the pose inside the limits, ends refined to
             :data:`END_TOL` (a stretch narrower than the grid step can be missed).
+            Computed at its first read (a few rounds of locked solves near each end:
+            about 1 ms on a Panda, as long as the sweep itself), then kept.
         max_jump: the largest joint change [rad or m] allowed between neighbours.
     """
 
@@ -69,8 +72,14 @@ class JointSweep:
     values: np.ndarray
     q: np.ndarray
     valid: np.ndarray
-    feasible: list[tuple[float, float]]
     max_jump: float
+    #: what :attr:`feasible` is computed from: () -> [(v_lo, v_hi), ...]
+    _intervals: Callable[[], list[tuple[float, float]]] = field(repr=False, compare=False)
+
+    @functools.cached_property
+    def feasible(self) -> list[tuple[float, float]]:
+        """The feasible intervals, ends refined to :data:`END_TOL` (see the class)."""
+        return self._intervals()
 
     @property
     def branches(self) -> int:
@@ -123,9 +132,11 @@ def joint_sweep(robot: Robot, T: object, joint: int, values: object = None, *,
     def probe(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return _solve(robot, Tt, j, x, limited=False)
 
-    return JointSweep(joint=j, values=v, q=q, valid=valid,
-                      feasible=_intervals(robot, v, Q, count, probe, j in (0, n - 1)),
-                      max_jump=float(max_jump))
+    def intervals() -> list[tuple[float, float]]:
+        return _intervals(robot, v, Q, count, probe, j in (0, n - 1))
+
+    return JointSweep(joint=j, values=v, q=q, valid=valid, max_jump=float(max_jump),
+                      _intervals=intervals)
 
 
 # ------------------------------------------------------------------ the locked solves
