@@ -166,3 +166,62 @@ def test_counts_on_random_arms_agree_with_newton(family):
         assert len(rows) == len(newton)
         for f in newton:
             assert _wrapped(rows, f).min() < 1e-6
+
+
+#: The original arm and example of R. Manseur and K. L. Doty, "A robot manipulator with 16
+#: real inverse kinematic solution sets", IJRR 8(5), 1989 (the arm Manocha and Canny
+#: varied): standard DH, a [m], d [m], twist α [rad] (90° and 1 rad alternating), the
+#: example's joint angles [deg] and the pose they print (four decimals). Transcribed
+#: from a public reimplementation's test of that example; checked here: the forward
+#: kinematics of the printed angles gives the printed pose to 5e-5
+#: (:func:`test_manseur_doty_example_reaches_its_printed_pose`).
+MD_A = (0.3, 1.0, 0.0, 1.5, 0.0, 0.0)
+MD_D = (0.0, 0.0, 0.2, 0.0, 0.0, 0.0)
+MD_ALPHA = (math.pi / 2, 1.0, math.pi / 2, 1.0, math.pi / 2, 1.0)
+MD_Q_DEG = (0.0, 107.458, 112.460, -7.662, 0.0, 0.0)
+MD_POSE = np.array([[-0.4655, -0.4822, 0.7421, -0.5377],
+                    [-0.6987, 0.7150, 0.0263, -1.1561],
+                    [-0.5433, -0.5063, -0.6697, 0.1895],
+                    [0.0, 0.0, 0.0, 1.0]])
+
+
+def _md_arm() -> Robot:
+    return Robot.from_dh([DHLink(a=a, alpha=al, d=d)
+                          for a, d, al in zip(MD_A, MD_D, MD_ALPHA, strict=True)],
+                         name="Manseur-Doty 16R")
+
+
+def test_manseur_doty_example_reaches_its_printed_pose():
+    """FK of the example's printed joint angles gives its printed pose (to 5e-5)."""
+    robot = _md_arm()
+    assert np.abs(robot.fk(np.radians(MD_Q_DEG)) - MD_POSE).max() < 5e-5
+
+
+@pytest.mark.parametrize("near_tol", [None, 0.0])
+@pytest.mark.parametrize("pose", ["exact", "printed"])
+def test_manseur_doty_example_has_its_16_real_solutions(near_tol, pose):
+    """The second published 16-solution example: 16 rows, the example's q among them.
+
+    ``exact``: the pose of the printed angles; ``printed``: the printed pose, rotation
+    projected on SO(3). Both modes; every row meets the pose to 1e-10, the set is the
+    one Newton's method reaches from 400 random starts, and for the exact pose it holds
+    the example's configuration.
+    """
+    robot = _md_arm()
+    q = np.radians(MD_Q_DEG)
+    if pose == "exact":
+        T = robot.fk(q)
+    else:
+        U, _, Vt = np.linalg.svd(MD_POSE[:3, :3])
+        T = MD_POSE.copy()
+        T[:3, :3] = U @ Vt
+    rows = np.asarray((ik_all(robot, T) if near_tol is None
+                       else ik_all(robot, T, near_tol=near_tol)).q)
+    assert rows.shape == (16, 6)
+    assert np.abs(robot.fk(rows) - T).max() < 1e-10
+    if pose == "exact":
+        assert _wrapped(rows, q).min() < 1e-9
+    newton = _newton_set(robot, T, 400, np.random.default_rng(5))
+    assert len(newton) == 16
+    for f in newton:
+        assert _wrapped(rows, f).min() < 1e-6
