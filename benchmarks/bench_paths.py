@@ -84,6 +84,9 @@ def main() -> None:
     sw = Stat(latency_us(lambda: joint_sweep(panda, Tp, 6, resolution=math.radians(1.0)),
                          number=10, repeat=15).values / 1e3)
     print(f"{'Panda: sweep of joint 7 at 1° (goal <= 1 ms)':58s} {sw.fmt(2):>28s}")
+    # ssik does not build here (C++, no package): its figures as issue 30 quotes them
+    print(f"{'  ssik 7R sweep, all solutions (quoted in issue 30, not run)':58s} "
+          f"{'Panda 3.0 / iiwa14 4.8':>28s}")
     record("30.6", "Panda sweep of joint 7 at 1 degree", sw.median, "ms", "<= 1 ms",
            sw.median <= 1)
     ends = Stat(latency_us(lambda: joint_sweep(panda, Tp, 6,
