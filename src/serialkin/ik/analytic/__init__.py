@@ -189,7 +189,13 @@ def _prepared(robot: Robot, near_tol: float = 0.0) -> _Prepared:
     """The robot's solver data, cached per robot and ``near_tol``.
 
     Its exact class; else (6 joints) the class it is within ``near_tol`` of (solved on
-    the idealised axes, refined on the true chain); else (6R) the general solver.
+    the idealised axes, refined on the true chain); else (6R) the general solver. When
+    no class fits at ``near_tol`` itself, tolerances 10, 100 and 1000 times smaller are
+    tried: an arm can be near a class only at a finer tolerance, where a short length
+    of its own no longer looks like zero (a Stanford-like arm with a 2 cm offset
+    between parallel axes 3 and 4, its parameters 1e-5 off: at 0.05 × size the axes
+    looked coaxial, a degenerate arm, and the general solver lost solutions on one pose
+    in eight).
     """
     check_robot(robot)
     cache = _PREPARED.setdefault(robot, dict)
@@ -202,9 +208,12 @@ def _prepared(robot: Robot, near_tol: float = 0.0) -> _Prepared:
         if robot.n != 6:
             raise
         p = None
-        if near_tol > 0.0:
-            try:
-                p = _Prepared(robot, analyse(robot, near_tol, near_tol), "near")
+        for tol in (near_tol, 0.1 * near_tol, 0.01 * near_tol, 0.001 * near_tol):
+            if tol <= 0.0:
+                break
+            try:  # the widest tolerance at which the arm is near a class
+                p = _Prepared(robot, analyse(robot, tol, tol), "near")
+                break
             except NoClosedFormError:
                 p = None
         if p is None:
