@@ -865,7 +865,7 @@ def _as_poses(a: np.ndarray) -> np.ndarray:
     return T
 
 
-#: Fast-path entries per robot: (robot, entry point, I, D, B, output shape).
+#: Fast-path entries per robot (:func:`_fast_entry`).
 _FAST: PerObject[tuple] = PerObject()
 #: The compiled entry points of each class's kernel, by (class code, refine) (resolved on
 #: first use by :func:`_packed_entry`).
