@@ -207,15 +207,7 @@ def _prepared(robot: Robot, near_tol: float = 0.0) -> _Prepared:
     except NoClosedFormError as exact_error:
         if robot.n != 6:
             raise
-        p = None
-        for tol in (near_tol, 0.1 * near_tol, 0.01 * near_tol, 0.001 * near_tol):
-            if tol <= 0.0:
-                break
-            try:  # the widest tolerance at which the arm is near a class
-                p = _Prepared(robot, analyse(robot, tol, tol), "near")
-                break
-            except NoClosedFormError:
-                p = None
+        p = _near_structure(robot, near_tol)
         if p is None:
             try:
                 p = _Prepared(robot, general_structure(robot), "general")
@@ -225,6 +217,64 @@ def _prepared(robot: Robot, near_tol: float = 0.0) -> _Prepared:
                                         f"either: {why}.") from None
     cache[near_tol] = p
     return p
+
+
+def _near_structure(robot: Robot, near_tol: float) -> _Prepared | None:
+    """Near-mode data of the 6-joint arm at the widest tolerance that fits, or None.
+
+    Tried: ``near_tol``, then 10, 100 and 1000 times finer (see :func:`_prepared`).
+    """
+    for tol in (near_tol, 0.1 * near_tol, 0.01 * near_tol, 0.001 * near_tol):
+        if tol <= 0.0:
+            break
+        try:
+            return _Prepared(robot, analyse(robot, tol, tol), "near")
+        except NoClosedFormError:
+            continue
+    return None
+
+
+def _near_companion(robot: Robot) -> _Prepared | None:
+    """The near-mode data at :data:`NEAR_TOL` of an arm the general solver answers, cached.
+
+    An arm within that tolerance of a class is near a special class, where the general
+    6R search's basins narrow (its elimination declines): the refined closed form's
+    rows are merged into the search's (:func:`_with_near`), so that asking for the
+    exact mode (``near_tol=0``) never returns fewer solutions than the default mode.
+    """
+    cache = _PREPARED.setdefault(robot, dict)
+    if -2.0 not in cache:
+        cache[-2.0] = _near_structure(robot, NEAR_TOL) if robot.n == 6 else None
+    return cache[-2.0]
+
+
+def _merged(sols: np.ndarray, extra: np.ndarray) -> np.ndarray:
+    """Rows ``sols`` (k, n) with the rows of ``extra`` not within 1e-7 (wrapped) of one.
+
+    Sorted lexicographically, as the kernels sort; ``sols`` itself when nothing is new.
+    """
+    rows = [r for r in sols]
+    for r in extra:
+        if not rows or np.abs(wrap_angle(np.array(rows) - r)).max(axis=1).min() > 1e-7:
+            rows.append(r)
+    if len(rows) == len(sols):
+        return sols
+    merged = np.array(rows, dtype=float)
+    return merged[np.lexsort(merged.T[::-1])]
+
+
+def _with_near(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
+               grid: int) -> np.ndarray:
+    """The general solver's ``sols`` merged with the refined closed form's rows.
+
+    Those of :func:`_near_companion`, inside the limits; ``sols`` when the arm is near
+    no class.
+    """
+    pn = _near_companion(robot)
+    if pn is None:
+        return sols
+    out, k, _ = _solve_one(pn, pn.solve_qlim, T, True, True, tol, grid)
+    return _merged(sols, _inside_limits(pn, out[:k]) if pn.limited else out[:k])
 
 
 def _as_pose(a: np.ndarray) -> np.ndarray:
@@ -706,14 +756,7 @@ def _with_general(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
             return sols
         cache[-1.0] = g
     out, k, _ = _solve_one(g, g.qlim, T, True, False, tol, grid)
-    rows = [r for r in sols]
-    for r in out[:k]:
-        d = np.abs(wrap_angle(np.array(rows) - r)).max(axis=1) \
-            if rows else np.array([np.inf])
-        if d.min() > 1e-7:
-            rows.append(r)
-    merged = np.array(rows, dtype=float).reshape(-1, robot.n)
-    return merged[np.lexsort(merged.T[::-1])] if len(merged) else merged
+    return _merged(np.asarray(sols, dtype=float).reshape(-1, robot.n), out[:k])
 
 
 #: |w_i × w_(i+2)| below which a nearly ideal arm's row is near its wrist singularity.
@@ -1115,6 +1158,17 @@ def _ik_all_batch(p: Any, robot: Robot, a: np.ndarray, tol: float, grid: int,
     lead = a.shape[:-2]
     T = _as_poses(a.reshape(-1, 4, 4))
     out, counts, conv = _solve_batch(p, robot, T, tol, grid)
+    if p.mode == "general" and _near_companion(robot) is not None:
+        pn = _near_companion(robot)
+        near_out, near_counts, _ = _solve_batch(pn, robot, T, tol, grid)
+        for i in range(T.shape[0]):
+            extra = near_out[i, :near_counts[i]]
+            rows = _merged(out[i, :counts[i]], _inside_limits(pn, extra) if pn.limited
+                           else extra)
+            if len(rows) != counts[i]:
+                counts[i] = min(len(rows), MAX_ROWS)
+                out[i] = 0.0
+                out[i, :counts[i]] = rows[:MAX_ROWS]
     kmax = int(counts.max(initial=0))
     cont = None
     if report:
@@ -1152,6 +1206,8 @@ def _ik_all_one(p: Any, robot: Robot, a: np.ndarray, tol: float, grid: int, all_
     sols = out[:k]
     if p.mode == "near":
         sols = _near_rows(robot, p, T, sols, conv, tol, grid)
+    elif p.mode == "general" and check_rot:
+        sols = _with_near(robot, T, sols, tol, grid)
     if all_turns and k:
         sols = _expand_turns(sols, p.revolute, p.qlim)
     if reference is not None:
