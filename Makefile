@@ -5,14 +5,6 @@
 
 PYTHON ?= python3
 VENV   := .venv
-
-# pip installs without byte-compiling every module of every package (--no-compile: about
-# half of a fresh install, sympy and scipy alone thousands of files), and Python writes
-# the bytecode of the modules actually imported, once, at their first import: so the
-# PYTHONDONTWRITEBYTECODE that some environments set is cleared for these commands
-# (with neither, every new process would compile its imports from source, 2 s each).
-export PYTHONDONTWRITEBYTECODE :=
-PIP_INSTALL = $(PY) -m pip install --quiet --no-compile
 PY     := $(VENV)/bin/python
 STAMP_RUN  := $(VENV)/.stamp-run
 STAMP_TEST := $(VENV)/.stamp-test
@@ -27,7 +19,7 @@ $(PY):
 	$(PY) -m pip install --quiet --upgrade pip
 
 $(STAMP_RUN): pyproject.toml | $(PY)
-	$(PIP_INSTALL) -e .
+	$(PY) -m pip install --quiet -e .
 	touch $@
 
 # The test extras' own requirements, installed beside the project without reinstalling it
@@ -40,7 +32,7 @@ $(STAMP_TEST): $(STAMP_RUN)
 	['optional-dependencies']; print('\n'.join(r for e in '$(TEST_EXTRAS)'.split() for r in o[e]))" \
 	  > $(VENV)/test-extras.txt
 	$(PY) -m pip freeze --exclude-editable > $(VENV)/installed.txt
-	$(PIP_INSTALL) -r $(VENV)/test-extras.txt -c $(VENV)/installed.txt
+	$(PY) -m pip install --quiet -r $(VENV)/test-extras.txt -c $(VENV)/installed.txt
 	touch $@
 
 # `serialkin warmup` compiles the kernels into numba's on-disk cache first, one process
@@ -96,7 +88,7 @@ $(STAMP_AUTOGRAD): $(STAMP_TEST)
 	index=$$($(PY) -c "import socket, urllib.parse as u; \
 	  socket.getaddrinfo(u.urlsplit('$(TORCH_INDEX)').hostname, 443)" 2>/dev/null \
 	  && echo "--extra-index-url $(TORCH_INDEX)"); \
-	$(PIP_INSTALL) $$index \
+	$(PY) -m pip install --quiet $$index \
 	  -r $(VENV)/autograd-extras.txt "$(TORCH_PIN)" -c $(VENV)/installed-autograd.txt
 	touch $@
 
