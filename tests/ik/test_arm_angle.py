@@ -509,3 +509,20 @@ def test_sweep_of_the_last_joint_has_the_locked_solves_rows():
         assert got.shape == rows.shape
         for row in rows:
             assert np.abs(got - row).max(axis=1).min() < 1e-9
+
+
+def test_a_sweep_pickles_and_reads_the_same_intervals_after():
+    """A sweep pickles before and after its feasible intervals are read (computed lazily).
+
+    The copy computes the same intervals as the original (to Dask workers, say).
+    """
+    import pickle
+
+    robot = models.get("panda")
+    T = robot.fk(np.array([0.2, -0.3, 0.1, -2.0, 0.1, 1.8, 0.6]))
+    sw = joint_sweep(robot, T, 6, resolution=math.radians(5.0))
+    copy = pickle.loads(pickle.dumps(sw))
+    assert copy.feasible == sw.feasible and sw.feasible
+    again = pickle.loads(pickle.dumps(sw))  # after the read: the cached list travels
+    assert again.feasible == sw.feasible
+    np.testing.assert_array_equal(again.q, sw.q)

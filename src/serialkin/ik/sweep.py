@@ -129,14 +129,21 @@ def joint_sweep(robot: Robot, T: object, joint: int, values: object = None, *,
     Q, count = _solve(robot, Tt, j, v, limited=True)
     q, valid = _connect(Q, count, float(max_jump))
 
-    def probe(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return _solve(robot, Tt, j, x, limited=False)
-
-    def intervals() -> list[tuple[float, float]]:
-        return _intervals(robot, v, Q, count, probe, j in (0, n - 1))
-
     return JointSweep(joint=j, values=v, q=q, valid=valid, max_jump=float(max_jump),
-                      _intervals=intervals)
+                      _intervals=functools.partial(_feasible, robot, Tt, j, v, Q, count))
+
+
+def _feasible(robot: Robot, T: np.ndarray, j: int, v: np.ndarray, Q: np.ndarray,
+              count: np.ndarray) -> list[tuple[float, float]]:
+    """:attr:`JointSweep.feasible` of the sweep of joint j at values v (rows Q, count).
+
+    A module-level function bound by ``functools.partial``, so that a sweep pickles
+    (to a Dask worker, say) before and after its intervals are read.
+    """
+    def probe(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return _solve(robot, T, j, x, limited=False)
+
+    return _intervals(robot, v, Q, count, probe, j in (0, robot.n - 1))
 
 
 # ------------------------------------------------------------------ the locked solves
