@@ -25,8 +25,8 @@ from _common import Stat, header, latency_us, record, wall_s  # noqa: E402
 
 from serialkin import models  # noqa: E402
 from serialkin.ik import ik_all  # noqa: E402
+from serialkin.ik.analytic import _locked  # noqa: E402
 from serialkin.ik.analytic.arm_angle import arm_angle_intervals, ik_arm_angle  # noqa: E402
-from serialkin.ik.sweep import _reduced as _sweep_reduced  # noqa: E402
 from serialkin.ik.sweep import _targets as _sweep_targets  # noqa: E402
 from serialkin.ik.sweep import _values as _sweep_values  # noqa: E402
 from serialkin.ik.sweep import joint_sweep  # noqa: E402
@@ -97,7 +97,7 @@ def main() -> None:
     # its floor: the one batch of locked solves on the grid (the branches ~0.05 ms; the
     # refinement of the feasible ends, a few rounds of small batches, at first read)
     grid = _sweep_values(panda, 6, None, math.radians(1.0))
-    reduced, targets = _sweep_reduced(panda, 6), _sweep_targets(panda, Tp, 6, grid)
+    reduced, targets = _locked(panda, {6: 0.0})[0], _sweep_targets(panda, Tp, 6, grid)
     floor = Stat(latency_us(lambda: ik_all(reduced, targets), number=10,
                             repeat=15).values / 1e3)
     print(f"{f'  of which the grid: one batch ik_all of {len(grid)} targets':58s} "

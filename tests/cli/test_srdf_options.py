@@ -208,20 +208,31 @@ def test_track_cli_and_python_api_agree(extra, tmp_path):
     np.testing.assert_array_equal(cli_q, api.q)
 
 
-def test_scenario_srdf_key_is_the_srdf_option(tmp_path):
+@pytest.fixture(scope="module")
+def fold_runs(tmp_path_factory):
+    """The fold scenario tracked by `serialkin track` without and with an SRDF, once.
+
+    ``(folder, SRDF disabling link1–link6, trajectory without it, trajectory with it)``:
+    two QP runs, shared by the tests below.
+    """
+    tmp = tmp_path_factory.mktemp("fold")
+    srdf = _fold_srdf(tmp)
+    kept = _track_q(tmp, _fold(tmp))
+    return tmp, srdf, kept, _track_q(tmp, _fold(tmp), "--srdf", str(srdf))
+
+
+def test_scenario_srdf_key_is_the_srdf_option(tmp_path, fold_runs):
     """A scenario's ``srdf:`` (relative to its file) tracks as ``--srdf``; --srdf replaces it."""
     from serialkin.tracking import ScenarioError, load_scenario
 
-    srdf = _fold_srdf(tmp_path)
-    by_flag = _track_q(tmp_path, _fold(tmp_path), "--srdf", str(srdf))
+    _, srdf, kept, by_flag = fold_runs
     keyed = tmp_path / "keyed"
     keyed.mkdir()
     (keyed / "pairs.srdf").write_bytes(srdf.read_bytes())
     scenario = _fold(keyed, FOLD + "srdf: pairs.srdf\n")
     assert load_scenario(scenario).options["srdf"] == str(keyed / "pairs.srdf")
     np.testing.assert_array_equal(_track_q(keyed, scenario), by_flag)
-    kept = _track_q(tmp_path, _fold(tmp_path))  # no pair skipped: differs from by_flag
-    assert not np.array_equal(kept, by_flag)
+    assert not np.array_equal(kept, by_flag)  # no pair skipped: differs
     other = _fold_srdf(tmp_path, "link2", "link5")  # the flag wins over the file's key
     np.testing.assert_array_equal(_track_q(keyed, scenario, "--srdf", str(other)),
                                   _track_q(tmp_path, _fold(tmp_path), "--srdf", str(other)))
@@ -231,14 +242,12 @@ def test_scenario_srdf_key_is_the_srdf_option(tmp_path):
         load_scenario(_fold(keyed, FOLD + "skip_links: [hand]\n"))
 
 
-def test_track_srdf_lets_the_disabled_pair_cross(tmp_path):
+def test_track_srdf_lets_the_disabled_pair_cross(fold_runs):
     """With link1–link6 disabled by --srdf the fold completes through them; not without."""
     from serialkin import models
 
     arm = models.get("planar6")
-    scenario = _fold(tmp_path)
-    kept = _track_q(tmp_path, scenario)
-    crossed = _track_q(tmp_path, scenario, "--srdf", str(_fold_srdf(tmp_path)))
+    _, _, kept, crossed = fold_runs
     assert arm.clearance(kept).distance.min() > 0.0
     worst = arm.clearance(crossed)
     k = int(np.argmin(worst.distance))

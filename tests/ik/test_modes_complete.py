@@ -33,6 +33,18 @@ def _wrapped(a: np.ndarray, x: np.ndarray) -> np.ndarray:
     return np.abs((np.asarray(a) - x + np.pi) % (2 * np.pi) - np.pi).max(axis=1)
 
 
+#: A Stanford-like 6R (standard DH: a, α, d): axes 1, 2 meeting, axes 3 and 4 parallel
+#: and 2 cm apart, a spherical wrist.
+_STANFORD_LIKE = ((0.0, -np.pi / 2, 0.412), (0.0, np.pi / 2, 0.154), (0.0203, 0.0, 0.5),
+                  (0.0, -np.pi / 2, 0.0), (0.0, np.pi / 2, 0.0), (0.0, 0.0, 0.263))
+
+
+def _stanford_like(rng: np.random.Generator) -> Robot:
+    """:data:`_STANFORD_LIKE` with every a, α, d moved by 1e-5·N(0, 1) (limits kept)."""
+    return Robot.from_dh([DHLink(a=a + rng.normal(0, 1e-5), alpha=al + rng.normal(0, 1e-5),
+                                 d=d + rng.normal(0, 1e-5)) for a, al, d in _STANFORD_LIKE])
+
+
 def _deviated(base: Robot, dev: float, rng: np.random.Generator) -> Robot:
     """``base``'s DH table with every a, α, d moved by ``dev``·N(0, 1), without limits."""
     rows = [DHLink(a=r.a + dev * rng.standard_normal(),
@@ -88,19 +100,16 @@ def test_an_arm_near_a_class_only_at_a_finer_tolerance_is_solved_there():
     from serialkin.ik.analytic import NEAR_TOL, _prepared
 
     rng = np.random.default_rng(0)
-    base = [(0.0, -math.pi / 2, 0.412), (0.0, math.pi / 2, 0.154), (0.0203, 0.0, 0.5),
-            (0.0, -math.pi / 2, 0.0), (0.0, math.pi / 2, 0.0), (0.0, 0.0, 0.263)]
     checked = 0
     for _ in range(6):
-        robot = Robot.from_dh([DHLink(a=a + rng.normal(0, 1e-5), alpha=al + rng.normal(0, 1e-5),
-                                      d=d + rng.normal(0, 1e-5)) for a, al, d in base])
+        robot = _stanford_like(rng)
         p = _prepared(robot, NEAR_TOL)
         assert (p.mode, p.s.kind) == ("near", "pieper_intersecting")
         for q in rng.uniform(-np.pi, np.pi, (20, 6)):
             T = robot.fk(q)
             rows = np.asarray(ik_all(robot, T).q)
             assert len(rows) and np.abs(robot.fk(rows) - T).max() < 1e-10
-            d = np.abs((rows - q + np.pi) % (2 * np.pi) - np.pi).max(axis=1)
+            d = _wrapped(rows, q)
             fold = abs(abs(q[2]) - math.pi / 2) < 0.05
             assert d.min() < (1e-6 if fold else 1e-9), q
             checked += 1
@@ -115,14 +124,9 @@ def test_exact_mode_on_an_arm_near_a_class_keeps_every_solution():
     the refined closed form's rows are merged in, so the exact mode holds every row the
     default mode returns, and q.
     """
-    import math
-
     rng = np.random.default_rng(1)
-    base = [(0.0, -math.pi / 2, 0.412), (0.0, math.pi / 2, 0.154), (0.0203, 0.0, 0.5),
-            (0.0, -math.pi / 2, 0.0), (0.0, math.pi / 2, 0.0), (0.0, 0.0, 0.263)]
     for _ in range(4):
-        robot = Robot.from_dh([DHLink(a=a + rng.normal(0, 1e-5), alpha=al + rng.normal(0, 1e-5),
-                                      d=d + rng.normal(0, 1e-5)) for a, al, d in base])
+        robot = _stanford_like(rng)
         Q = rng.uniform(-np.pi, np.pi, (10, 6))
         T = robot.fk(Q)
         batch = ik_all(robot, T, near_tol=0.0)
@@ -131,9 +135,9 @@ def test_exact_mode_on_an_arm_near_a_class_keeps_every_solution():
             assert np.abs(robot.fk(rows) - T[i]).max() < 1e-10
             # 1e-8: near the wrist singularity (q5 = −0.09 rad in one pose) a row meeting
             # the pose to 1e-12 is ~1e-9 from q in joint space (pose error / σ_min)
-            assert np.abs((rows - q + np.pi) % (2 * np.pi) - np.pi).max(axis=1).min() < 1e-8
+            assert _wrapped(rows, q).min() < 1e-8
             default = np.asarray(ik_all(robot, T[i]).q)
             for r in default:
-                assert np.abs((rows - r + np.pi) % (2 * np.pi) - np.pi).max(axis=1).min() < 1e-7
+                assert _wrapped(rows, r).min() < 1e-7
             assert batch.count[i] == len(rows)
             np.testing.assert_allclose(batch.q[i, :len(rows)], rows, atol=1e-12)

@@ -78,10 +78,10 @@ def _arm(a=A, d=D, alpha_deg=ALPHA_DEG) -> Robot:
                          name="Manocha-Canny 16R")
 
 
-def _pose() -> np.ndarray:
-    """A_HAND with its rotation replaced by the nearest rotation (polar decomposition)."""
-    U, _, Vt = np.linalg.svd(A_HAND[:3, :3])
-    T = A_HAND.copy()
+def _pose(printed: np.ndarray = A_HAND) -> np.ndarray:
+    """A printed pose (default A_HAND), its rotation made the nearest rotation (polar)."""
+    U, _, Vt = np.linalg.svd(printed[:3, :3])
+    T = printed.copy()
     T[:3, :3] = U @ Vt
     return T
 
@@ -175,8 +175,7 @@ def test_counts_on_random_arms_agree_with_newton(family):
 #: from a public reimplementation's test of that example; checked here: the forward
 #: kinematics of the printed angles gives the printed pose to 5e-5
 #: (:func:`test_manseur_doty_example_reaches_its_printed_pose`).
-MD_A = (0.3, 1.0, 0.0, 1.5, 0.0, 0.0)
-MD_D = (0.0, 0.0, 0.2, 0.0, 0.0, 0.0)
+#: (a and d are Manocha and Canny's: A, D above)
 MD_ALPHA = (math.pi / 2, 1.0, math.pi / 2, 1.0, math.pi / 2, 1.0)
 MD_Q_DEG = (0.0, 107.458, 112.460, -7.662, 0.0, 0.0)
 MD_POSE = np.array([[-0.4655, -0.4822, 0.7421, -0.5377],
@@ -186,9 +185,7 @@ MD_POSE = np.array([[-0.4655, -0.4822, 0.7421, -0.5377],
 
 
 def _md_arm() -> Robot:
-    return Robot.from_dh([DHLink(a=a, alpha=al, d=d)
-                          for a, d, al in zip(MD_A, MD_D, MD_ALPHA, strict=True)],
-                         name="Manseur-Doty 16R")
+    return _arm(alpha_deg=np.degrees(MD_ALPHA))
 
 
 def test_manseur_doty_example_reaches_its_printed_pose():
@@ -197,9 +194,8 @@ def test_manseur_doty_example_reaches_its_printed_pose():
     assert np.abs(robot.fk(np.radians(MD_Q_DEG)) - MD_POSE).max() < 5e-5
 
 
-@pytest.mark.parametrize("near_tol", [None, 0.0])
 @pytest.mark.parametrize("pose", ["exact", "printed"])
-def test_manseur_doty_example_has_its_16_real_solutions(near_tol, pose):
+def test_manseur_doty_example_has_its_16_real_solutions(pose):
     """The second published 16-solution example: 16 rows, the example's q among them.
 
     ``exact``: the pose of the printed angles; ``printed``: the printed pose, rotation
@@ -209,19 +205,15 @@ def test_manseur_doty_example_has_its_16_real_solutions(near_tol, pose):
     """
     robot = _md_arm()
     q = np.radians(MD_Q_DEG)
-    if pose == "exact":
-        T = robot.fk(q)
-    else:
-        U, _, Vt = np.linalg.svd(MD_POSE[:3, :3])
-        T = MD_POSE.copy()
-        T[:3, :3] = U @ Vt
-    rows = np.asarray((ik_all(robot, T) if near_tol is None
-                       else ik_all(robot, T, near_tol=near_tol)).q)
-    assert rows.shape == (16, 6)
-    assert np.abs(robot.fk(rows) - T).max() < 1e-10
-    if pose == "exact":
-        assert _wrapped(rows, q).min() < 1e-9
+    T = robot.fk(q) if pose == "exact" else _pose(MD_POSE)
     newton = _newton_set(robot, T, 400, np.random.default_rng(5))
     assert len(newton) == 16
-    for f in newton:
-        assert _wrapped(rows, f).min() < 1e-6
+    for near_tol in (None, 0.0):
+        rows = np.asarray((ik_all(robot, T) if near_tol is None
+                           else ik_all(robot, T, near_tol=near_tol)).q)
+        assert rows.shape == (16, 6)
+        assert np.abs(robot.fk(rows) - T).max() < 1e-10
+        if pose == "exact":
+            assert _wrapped(rows, q).min() < 1e-9
+        for f in newton:
+            assert _wrapped(rows, f).min() < 1e-6

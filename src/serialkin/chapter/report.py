@@ -120,23 +120,27 @@ def source_digest() -> str:
     return h.hexdigest()
 
 
-def build_provenance(sections: Sequence[str]) -> dict[str, object]:
+def build_provenance(sections: Sequence[str], digest: str | None = None) -> dict[str, object]:
     """What a build depends on: sources, sections and the versions of the libraries it uses.
 
     Written beside the page as ``build.json``; two builds with equal provenance compute
-    the same page (but for its timings and dates).
+    the same page (but for its timings and dates). ``digest``: :func:`source_digest`,
+    computed here when None.
     """
     import platform
     from importlib.metadata import version
 
-    return {"source": source_digest(), "sections": list(sections),
+    return {"source": digest or source_digest(), "sections": list(sections),
             "python": platform.python_version(),
             "packages": {p: version(p) for p in ("numpy", "numba", "scipy", "matplotlib",
                                                  "latex2mathml", "pillow")}}
 
 
-def build_metadata() -> list[tuple[str, str]]:
-    """(label, value) pairs describing this build: versions, git commit, date, CPUs."""
+def build_metadata(digest: str | None = None) -> list[tuple[str, str]]:
+    """(label, value) pairs describing this build: versions, git commit, date, CPUs.
+
+    ``digest``: :func:`source_digest`, computed here when None.
+    """
     import platform
     import subprocess
     from datetime import UTC, datetime
@@ -168,7 +172,7 @@ def build_metadata() -> list[tuple[str, str]]:
     return [
         ("serialkin", sk_version),
         ("git commit", commit),
-        ("source digest", source_digest()[:12]),
+        ("source digest", (digest or source_digest())[:12]),
         ("built", datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")),
         ("Python", platform.python_version()),
         ("numpy", np.__version__),
@@ -262,11 +266,11 @@ def _timing_text(timings: Sequence[Timing]) -> str:
 
 def _meta_html(seconds: float, cpu: float, workers: str,
                load: tuple[tuple[float, float, float] | None, ...],
-               timings: Sequence[Timing]) -> str:
+               timings: Sequence[Timing], digest: str | None = None) -> str:
     """The header's table: versions, commit, build time, load, timings, fonts."""
     import matplotlib
 
-    meta = build_metadata() + [
+    meta = build_metadata(digest) + [
         ("build time", f"{seconds:.1f} s wall clock ({workers}); the sections took "
                        f"{cpu:.1f} s CPU in all"),
         ("load average", f"at the start {_load_text(load[0])}; at the end "
@@ -286,7 +290,7 @@ def _meta_html(seconds: float, cpu: float, workers: str,
 
 def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
             workers: str, load: tuple[tuple[float, float, float] | None, ...] = (None, None),
-            timings: Sequence[Timing] = ()) -> str:
+            timings: Sequence[Timing] = (), digest: str | None = None) -> str:
     """The whole page: header with build metadata, contents, sections.
 
     Numbers are kept on one line with their units, ranges and exponents
@@ -310,7 +314,7 @@ def _render(parts: list[tuple[str, Section]], seconds: float, cpu: float,
         "): until the compiled kernels are ready the first calls run as Python, whose "
         "rounding differs in the last digits, and a long tracking run (the 20-link arm) then "
         "takes a slightly different path.</p>"
-        f"{_meta_html(seconds, cpu, workers, load, timings)}"
+        f"{_meta_html(seconds, cpu, workers, load, timings, digest)}"
         f"<nav><h2 id='contents'>Contents</h2><ul>{toc}</ul></nav>{body}</body></html>"
     )
 
@@ -378,6 +382,7 @@ def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
     (out / "build.json").unlink(missing_ok=True)  # rewritten when the page is complete
+    digest = source_digest()  # of the sources this build runs (header and build.json)
     names = list(SECTION_MODULES) if not sections else sorted(
         dict.fromkeys(sections), key=lambda n: (SECTION_MODULES + (n,)).index(n))
     if jobs is None:
@@ -412,7 +417,7 @@ def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
                else "one process")
     timings = [t for name in names for t in results[name][2]]
     page = _render(parts, time.perf_counter() - start, cpu, workers,
-                   (load_start, _loadavg()), timings)
+                   (load_start, _loadavg()), timings, digest)
     page = page.replace("<style>", "<style>" + embedded_fonts(page, out), 1)
     path = out / "report.html"
     write_text_atomic(path, page)
@@ -420,7 +425,8 @@ def build_report(outdir: str | os.PathLike[str], *, quiet: bool = False,
         [(name, t) for name in names for t in results[name][2]]))
     import json
 
-    write_text_atomic(out / "build.json", json.dumps(build_provenance(names), indent=1))
+    write_text_atomic(out / "build.json", json.dumps(build_provenance(names, digest),
+                                                     indent=1))
     return path
 
 

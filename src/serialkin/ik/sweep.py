@@ -170,7 +170,7 @@ def _solve(robot: Robot, T: np.ndarray, j: int, x: np.ndarray, *, limited: bool
         for i, s in enumerate(sols):
             Q[i, :len(s)] = s
         return Q, count
-    res = ik_all(_reduced(target, j), _targets(robot, T, j, x))
+    res = ik_all(_locked(target, {j: 0.0})[0], _targets(robot, T, j, x))  # cached
     count = np.asarray(res.count, dtype=np.int64).reshape(len(x))
     q = res.q.reshape(len(x), -1, n - 1)
     Q = np.empty((len(x), q.shape[1], n))
@@ -198,19 +198,6 @@ def _targets(robot: Robot, T: np.ndarray, j: int, x: np.ndarray) -> np.ndarray:
     inv[:, 3, 3] = 1.0
     F0 = _home(robot)
     return T @ inv @ F0 if j == robot.n - 1 else F0 @ inv @ T
-
-
-def _reduced(robot: Robot, j: int) -> Robot:
-    """The robot with joint j locked at 0 (:func:`~serialkin.ik.analytic._locked`), cached."""
-    got = _REDUCED.get(robot)
-    if got is None:
-        got = _REDUCED.set(robot, {})
-    if j not in got:
-        got[j] = _locked(robot, {j: 0.0})[0]
-    return got[j]
-
-
-_REDUCED: PerObject[dict[int, Robot]] = PerObject()
 
 
 def _home(robot: Robot) -> np.ndarray:
@@ -502,18 +489,16 @@ _HALF = np.array([0.5])
 _SPLIT_FIRST = np.arange(1, 16) / 16.0
 
 
-def _estimates(b: float, fb: float, samples: np.ndarray | list) -> list[float]:
+def _estimates(b: float, fb: float, rows: list) -> list[float]:
     """Where an end between the infeasible value b and the feasible samples may lie.
 
-    ``samples`` (3, 3): (value, margin f, closeness c) of the feasible values nearest
-    the end, nearest first (NaN rows missing; or a list of the rows present). A limit is
+    ``rows``: the (value, margin f, closeness c) of the feasible values nearest the end
+    that were sampled (1 to 3 of them), nearest first. A limit is
     where f = 0: the root of the line or parabola through the samples' f and, when f is
     known at b too, of the inverse quadratic (or the secant) through b and the two
     nearest samples; an edge of reach is where c = 0, c linear near it: the same through
     the samples' c. Roots outside the bracket are dropped.
     """
-    rows = samples if isinstance(samples, list) else \
-        [r for r in samples.tolist() if r[0] == r[0]]   # drop NaN rows
     g = rows[0][0]
     lo, hi = min(b, g), max(b, g)
     out = []

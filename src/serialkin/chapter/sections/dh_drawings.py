@@ -14,6 +14,7 @@ import numpy as np
 
 from serialkin.chapter._context import ReportContext, format_number
 from serialkin.model.dh import link_transform
+from serialkin.model.dh_extract import common_normal
 from serialkin.model.robot import Robot
 
 DEG = np.pi / 180.0
@@ -52,10 +53,9 @@ def link_pair(robot: Robot, i: int, q_i: float) -> LinkPair:
     o, x, z = T[:3, 3], T[:3, 0], T[:3, 2]
     ez = np.array([0.0, 0.0, 1.0])
     b = float(ez @ z)
-    s = float(ez @ o) if abs(1.0 - b * b) < 1e-12 else float(
-        (ez @ o - b * (z @ o)) / (1.0 - b * b))  # closest points of two lines
-    o_prime = s * ez
-    return LinkPair(i=i, T=T, o_prime=o_prime, a=float((o - o_prime) @ x), d=s,
+    o_prime = common_normal(np.zeros(3), ez, o, z, prefer=o)[0]  # its foot on z_{i−1}
+    return LinkPair(i=i, T=T, o_prime=o_prime, a=float((o - o_prime) @ x),
+                    d=float(o_prime[2]),
                     theta=float(np.arctan2(x[1], x[0])),
                     alpha=float(np.arctan2(np.cross(ez, z) @ x, b)))
 

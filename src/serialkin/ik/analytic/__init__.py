@@ -235,17 +235,17 @@ def _near_structure(robot: Robot, near_tol: float) -> _Prepared | None:
 
 
 def _near_companion(robot: Robot) -> _Prepared | None:
-    """The near-mode data at :data:`NEAR_TOL` of an arm the general solver answers, cached.
+    """The default mode's near-class data of an arm the general solver answers, or None.
 
-    An arm within that tolerance of a class is near a special class, where the general
+    An arm within :data:`NEAR_TOL` of a class is near a special class, where the general
     6R search's basins narrow (its elimination declines): the refined closed form's
-    rows are merged into the search's (:func:`_with_near`), so that asking for the
+    rows are merged into the search's (:func:`_near_extra`), so that asking for the
     exact mode (``near_tol=0``) never returns fewer solutions than the default mode.
+    Never raises: the general structure the caller solves with also serves
+    ``_prepared(robot, NEAR_TOL)`` when no class is near.
     """
-    cache = _PREPARED.setdefault(robot, dict)
-    if -2.0 not in cache:
-        cache[-2.0] = _near_structure(robot, NEAR_TOL) if robot.n == 6 else None
-    return cache[-2.0]
+    p = _prepared(robot, NEAR_TOL)
+    return p if p.mode == "near" else None
 
 
 def _merged(sols: np.ndarray, extra: np.ndarray) -> np.ndarray:
@@ -263,6 +263,11 @@ def _merged(sols: np.ndarray, extra: np.ndarray) -> np.ndarray:
     return merged[np.lexsort(merged.T[::-1])]
 
 
+def _near_extra(pn: _Prepared, rows: np.ndarray) -> np.ndarray:
+    """The near solve's unlimited ``rows`` (k, n) of ``pn``, inside its limits."""
+    return _inside_limits(pn, rows) if pn.limited else rows
+
+
 def _with_near(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
                grid: int) -> np.ndarray:
     """The general solver's ``sols`` merged with the refined closed form's rows.
@@ -274,7 +279,7 @@ def _with_near(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
     if pn is None:
         return sols
     out, k, _ = _solve_one(pn, pn.solve_qlim, T, True, True, tol, grid)
-    return _merged(sols, _inside_limits(pn, out[:k]) if pn.limited else out[:k])
+    return _merged(sols, _near_extra(pn, out[:k]))
 
 
 def _as_pose(a: np.ndarray) -> np.ndarray:
@@ -1052,7 +1057,7 @@ def _ik_all_fast(robot: Robot, target: np.ndarray) -> AllSolutions | None:
     """:func:`ik_all` with its defaults for one C-contiguous, aligned, writeable float64 pose.
 
     The fast path: the rigidity check and the solve are one compiled call
-    (dispatch.solve_packed) on the robot's cached packed data; the rows are the ordinary
+    (``dispatch.for_class(...).solve``) on the robot's cached packed data; the rows are the ordinary
     path's, bit for bit. None when the target is not rigid to 1e-13 (the ordinary path
     then checks, projects or raises).
     """
@@ -1158,13 +1163,11 @@ def _ik_all_batch(p: Any, robot: Robot, a: np.ndarray, tol: float, grid: int,
     lead = a.shape[:-2]
     T = _as_poses(a.reshape(-1, 4, 4))
     out, counts, conv = _solve_batch(p, robot, T, tol, grid)
-    if p.mode == "general" and _near_companion(robot) is not None:
-        pn = _near_companion(robot)
+    pn = _near_companion(robot) if p.mode == "general" else None
+    if pn is not None:  # as _with_near, all targets in one batch
         near_out, near_counts, _ = _solve_batch(pn, robot, T, tol, grid)
         for i in range(T.shape[0]):
-            extra = near_out[i, :near_counts[i]]
-            rows = _merged(out[i, :counts[i]], _inside_limits(pn, extra) if pn.limited
-                           else extra)
+            rows = _merged(out[i, :counts[i]], _near_extra(pn, near_out[i, :near_counts[i]]))
             if len(rows) != counts[i]:
                 counts[i] = min(len(rows), MAX_ROWS)
                 out[i] = 0.0

@@ -38,7 +38,7 @@ from serialkin.ik.analytic.ur import ur_candidates
 
 from ..._jit import bind, njit
 
-#: Class codes of :func:`solve_into`.
+#: Class codes of :func:`for_class`.
 PLANAR, SCARA, WRIST, UR, GENERAL = 0, 1, 2, 3, 4
 #: Rows of the output buffer (the most solutions of any class).
 MAX_ROWS = GENERAL_MAX

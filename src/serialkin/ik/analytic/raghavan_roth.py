@@ -73,7 +73,7 @@ from serialkin.ik.analytic.subproblems import (
     TWO_PI,
     inv_rigid,
     mm,
-    rotation_into,
+    screw_into,
     sp1_dir,
 )
 
@@ -162,20 +162,6 @@ def _move(E, x, y):
     for i in range(3):
         y[i] = E[i, 0] * x[0] + E[i, 1] * x[1] + E[i, 2] * x[2]
         y[3 + i] = E[i, 0] * x[3] + E[i, 1] * x[4] + E[i, 2] * x[5] + E[i, 3]
-
-
-@njit(cache=True)
-def _screw_into(w, r, theta, E):
-    """``E ← exp(ξ θ)`` (4, 4) of the revolute line (w, r), without allocation.
-
-    The operations of :func:`~serialkin.ik.analytic.subproblems.screw` (Rodrigues, then
-    the translation ``r − R r``), so the same rounding.
-    """
-    rotation_into(w, theta, E)
-    for i in range(3):
-        E[i, 3] = r[i] - (E[i, 0] * r[0] + E[i, 1] * r[1] + E[i, 2] * r[2])
-        E[3, i] = 0.0
-    E[3, 3] = 1.0
 
 
 @njit(cache=True)
@@ -768,9 +754,9 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
     # direction-and-point products, no 4 × 4 products and no allocation per sample
     S = np.empty((9, 4, 4))  # S[3·a + i]: left joint a (ja, jb, jc) at angle i
     for i in range(3):
-        _screw_into(W[ja], P[ja], _ANGLES[i], S[i])
-        _screw_into(W[jb], P[jb], _ANGLES[i], S[3 + i])
-        _screw_into(W[jc], P[jc], _ANGLES[i], S[6 + i])
+        screw_into(W[ja], P[ja], _ANGLES[i], S[i])
+        screw_into(W[jb], P[jb], _ANGLES[i], S[3 + i])
+        screw_into(W[jc], P[jc], _ANGLES[i], S[6 + i])
     x0 = np.empty(6)
     for i in range(3):
         x0[i] = W[e, i]
@@ -796,8 +782,8 @@ def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
     Cl = _to_coefficients(V, 3)
     # right side: 9 samples of (θ_E, θ_D) → coefficients (9, 14)
     for i in range(3):  # S[i]: joint E at −angle i, S[3 + i]: joint D
-        _screw_into(W[je_], P[je_], -_ANGLES[i], S[i])
-        _screw_into(W[jd], P[jd], -_ANGLES[i], S[3 + i])
+        screw_into(W[je_], P[je_], -_ANGLES[i], S[i])
+        screw_into(W[jd], P[jd], -_ANGLES[i], S[3 + i])
     xw = np.empty(6)
     _move(Wm, x0, xw)
     x1 = np.empty(6)

@@ -271,13 +271,21 @@ def screw(w, r, theta, prismatic):
         for i in range(3):
             E[i, 3] = theta * w[i]
         return E
-    R = rotation(w, theta)
-    for i in range(3):
-        E[i, 0] = R[i, 0]
-        E[i, 1] = R[i, 1]
-        E[i, 2] = R[i, 2]
-        E[i, 3] = r[i] - (R[i, 0] * r[0] + R[i, 1] * r[1] + R[i, 2] * r[2])
+    screw_into(w, r, theta, E)
     return E
+
+
+@njit(cache=True)
+def screw_into(w, r, theta, E):
+    """``E ← exp(ξ θ)`` (4, 4) of the revolute line (w, r), without allocation.
+
+    Rodrigues' rotation (:func:`rotation_into`), then the translation ``r − R r``.
+    """
+    rotation_into(w, theta, E)
+    for i in range(3):
+        E[i, 3] = r[i] - (E[i, 0] * r[0] + E[i, 1] * r[1] + E[i, 2] * r[2])
+        E[3, i] = 0.0
+    E[3, 3] = 1.0
 
 
 @njit(cache=True)

@@ -97,7 +97,12 @@ def _default_solver_cases(methods: Sequence[str] = ("lm",)) -> list[Case]:
 
 def _bench_name(case: Case) -> str:
     """The name of a case on the bench, e.g. "lm, UR5"."""
-    return f"{case[2]}, {case[0]}"
+    return _name(case[2], case[0])
+
+
+def _name(method: str, robot: str) -> str:
+    """The bench name of ``method`` on ``robot`` (:func:`_bench_name`)."""
+    return f"{method}, {robot}"
 
 
 def _default_solver_timings(ctx: ReportContext, blocks: int = 7
@@ -198,13 +203,14 @@ def build(ctx: ReportContext) -> Section:
     bench.block()
     parts.append(_timings_part(ctx, bench, cases))
     robots = [c[0] for c in cases if c[2] == "lm"]
-    ratios = {m: [bench.ratio(f"{m}, {r}", f"lm, {r}") for r in robots] for m in AGAINST_LM}
+    ratios = {m: [bench.ratio(_name(m, r), _name("lm", r)) for r in robots] for m in AGAINST_LM}
+    measured = measured_summary(tables)
     parts.append(
         "<h4>Trade-offs</h4><p>The first four columns are properties of the algorithms; the "
         "last is measured in the comparison tables above (range over the robots where the "
         "family ran: success rate, and the median time per solve over the targets, each "
         "solved once: single runs, not repeated timings).</p>" + ctx.table(
-            [row + (measured_summary(tables).get(row[0], "not run"),) for row in TRADE_OFFS],
+            [row + (measured.get(row[0], "not run"),) for row in TRADE_OFFS],
             ["family (methods)", "cost per iteration", "convergence", "near singularities",
              "joint limits", "measured here"]))
     parts.append(reading_text(tables, ratios))

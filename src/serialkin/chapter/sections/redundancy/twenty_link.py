@@ -30,7 +30,6 @@ from serialkin.chapter.sections.redundancy.step_cap import (
     StepCap,
     cap_note,
     cap_paragraph,
-    step_cap_study,
 )
 from serialkin.chapter.sections.redundancy.twenty_link_ablation import (
     ablation_cells,
@@ -315,9 +314,7 @@ def twenty_link_figures(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any,
 
 def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, tc: Any,
                       time_b: Timing, time_c: Timing, runs: list[AblationRun],
-                      ratio: Timing | None = None,
-                      figures: dict[str, str] | None = None,
-                      cap: StepCap | None = None) -> Section:
+                      ratio: Timing | None, figures: dict[str, str], cap: StepCap) -> Section:
     """The 20-link example: free (b, Figure 11) and constrained (c, Figure 12), ablation.
 
     Args:
@@ -330,14 +327,13 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
         time_c: the timing of the whole path of (c) [s].
         runs: :func:`serialkin.tracking.analysis.ablation` of (c).
         ratio: the ratio (c)/(b) per round of runs in one process (None: of the medians).
-        figures: :func:`twenty_link_figures` of the same runs (made here when None).
+        figures: :func:`twenty_link_figures` of the same runs.
         cap: :func:`~serialkin.chapter.sections.redundancy.step_cap.step_cap_study` of the
-            same runs (made here when None).
+            same runs.
     """
     from serialkin.tracking.analysis import task_activity
 
-    figs = figures if figures is not None else twenty_link_figures(ctx, sb, sc, tb, tc, runs)
-    cap = cap if cap is not None else step_cap_study(sb, sc, tb, tc)
+    figs = figures
     track_numbers = [v for s, tr in ((sb, tb), (sc, tc))
                      for v in (str(int(tr.reached.sum())), str(len(s.path)), _mm(tr.max_error),
                                str(int(tr.iterations.sum())))] + [
