@@ -64,7 +64,7 @@ test: $(STAMP_RUN)
 	  $(MAKE) --no-print-directory browser-deps & browser=$$!; \
 	  $(VENV)/bin/serialkin warmup --all; \
 	  wait $$extras; wait $$browser
-	$(PY) -m pytest -n 2 --dist loadfile --ignore=tests/autograd
+	$(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder --ignore=tests/autograd
 
 # The differentiable kinematics of serialkin.torch and serialkin.jax (issue 35): their
 # extras (torch, jax) and the benchmark's peer (pytorch-kinematics) install into the same

@@ -25,6 +25,36 @@ _default = "ci" if os.environ.get("CI") else "dev"
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", _default))
 
 
+# ------------------------------------------------- the longest files first
+#: The test files that take longest (seconds per file in a full run, largest first).
+#: ``make test`` distributes whole files (``--dist loadfile``), handing a worker the next
+#: file when it is nearly done with its last; pytest-xdist would otherwise send the files
+#: with the most tests first (``--no-loadscope-reorder`` turns that off), and a long file
+#: with few tests, sent last, kept one worker busy alone for half a minute. Sent first,
+#: the long files run beside each other and the many short ones fill in around them.
+LONGEST_FIRST = (
+    "tests/docs/test_site.py",                   # the strict site build, the examples
+    "tests/chapter/test_reproduce.py",           # every Reproduce box in a fresh process
+    "tests/cli/test_readme.py",                  # the README's commands as typed
+    "tests/cli/test_entry_point.py",
+    "tests/chapter/test_report_browser.py",
+    "tests/chapter/test_sections.py",
+    "tests/ik/test_raghavan_roth.py",
+    "tests/viz/test_viewer_body_browser.py",
+    "tests/kinematics/test_symbolic.py",
+    "tests/ik/test_arm_angle.py",
+    "tests/reach/test_execute.py",
+    "tests/viz/test_viewer_browser.py",
+    "tests/ik/test_collision_ik.py",
+)
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """Run the files of :data:`LONGEST_FIRST` first, in that order (the rest as collected)."""
+    rank = {name: k for k, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.nodeid.split("::", 1)[0], len(rank)))
+
+
 # ------------------------------------------------- one compiled specialization per kernel
 # Every serialkin kernel is compiled once, for one set of argument types: callers
 # normalise dtype, layout and contiguity before calling (issue 27: each extra

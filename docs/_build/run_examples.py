@@ -11,11 +11,11 @@ suite runs them once per test run and hands that folder to the docs build it tes
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 from collections.abc import Iterable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+
+from fresh_python import run_python
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = sorted((ROOT / "examples").glob("*.py"))
@@ -24,18 +24,20 @@ TIMEOUT = 900
 
 
 def run_example(script: Path, folder: Path) -> None:
-    """Run ``script`` in ``folder`` (created): outputs in ``out/``, its streams and status."""
+    """Run ``script`` in ``folder`` (created): outputs in ``out/``, its streams and status.
+
+    As ``python script`` in a process of its own (:func:`fresh_python.run_python`: a
+    child of a fork server that has done the imports and numba's set-up already).
+    """
     out = folder / "out"
     out.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ, MPLBACKEND="Agg", SERIALKIN_EXAMPLE_OUT=str(out))
-    try:
-        proc = subprocess.run([sys.executable, str(script)], cwd=out, env=env,
-                              capture_output=True, text=True, timeout=TIMEOUT)
-        code, stdout, stderr = proc.returncode, proc.stdout, proc.stderr
-    except subprocess.TimeoutExpired as exc:
-        code, stdout, stderr = -1, str(exc.stdout or ""), f"timed out after {TIMEOUT} s"
-    (folder / "stdout.txt").write_text(stdout, encoding="utf-8")
-    (folder / "stderr.txt").write_text(stderr, encoding="utf-8")
+    stderr = folder / "stderr.txt"
+    code = run_python(script=script, cwd=out, env=env, stdout=folder / "stdout.txt",
+                      stderr=stderr, timeout=TIMEOUT)
+    if code == -9:
+        with stderr.open("a", encoding="utf-8") as f:
+            f.write(f"\ntimed out after {TIMEOUT} s\n")
     (folder / "returncode").write_text(str(code))
 
 

@@ -1,10 +1,11 @@
 """Every "Reproduce" box of the chapter report prints the numbers its section shows.
 
-Each box is run verbatim in a fresh process (Python boxes by ``python -c``, shell boxes by
-``bash -c`` with the venv's ``serialkin`` first on PATH, both in an empty folder); its
-output must contain the numbers the box declares (``data-expect``), in order, each to the
-precision the page prints it with; and the page must show each of those numbers in the
-box's section (outside the box). So a reader who copies a box gets what the page shows.
+Each box is run verbatim in a process of its own (Python boxes as ``python -c`` runs them,
+shell boxes by ``bash -c`` with the venv's ``serialkin`` first on PATH, both in an empty
+folder); its output must contain the numbers the box declares (``data-expect``), in
+order, each to the precision the page prints it with; and the page must show each of
+those numbers in the box's section (outside the box). So a reader who copies a box gets
+what the page shows.
 The boxes run with compiled kernels (``SERIALKIN_COMPILE=wait``), as the page says.
 """
 
@@ -22,6 +23,9 @@ from pathlib import Path
 import pytest
 
 from serialkin.chapter.report import SECTION_MODULES
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "docs" / "_build"))
+from fresh_python import run_python  # noqa: E402  (docs/_build/fresh_python.py)
 
 _NUM = re.compile(r"[-−]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?")
 _BOX = re.compile(r'<div class="repro" data-kind="(\w+)" data-expect="([^"]*)">'
@@ -79,17 +83,26 @@ def report_boxes(page: str) -> list[dict]:
 
 
 def run_box(box: dict, cwd: Path) -> subprocess.CompletedProcess:
-    """Run a box's exact text in a fresh process in ``cwd``."""
+    """Run a box's exact text in a process of its own in ``cwd``.
+
+    Shell boxes by ``bash -e -c``; Python boxes as ``python -c`` would run them, in a child
+    of the fork server of docs/_build/fresh_python.py (the imports and numba's set-up
+    done once for every box; no serialkin function called before the box's own).
+    """
     env = dict(os.environ)
     env["PATH"] = str(Path(sys.executable).parent) + os.pathsep + env.get("PATH", "")
     # compiled kernels, as when the page was built: while kernels compile in the background
     # the first calls run as Python, whose rounding differs in the last digits, and a long
     # tracking run (the 20-link arm, 6,841 iterations) then follows another path
     env["SERIALKIN_COMPILE"] = "wait"
-    cmd = (["bash", "-e", "-c", box["code"]] if box["kind"] == "shell"
-           else [sys.executable, "-c", box["code"]])
-    return subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True,
-                          timeout=900, check=False)
+    if box["kind"] == "shell":
+        return subprocess.run(["bash", "-e", "-c", box["code"]], cwd=cwd, env=env,
+                              capture_output=True, text=True, timeout=900, check=False)
+    streams = cwd.parent / f"{cwd.name}.stdout", cwd.parent / f"{cwd.name}.stderr"
+    code = run_python(code=box["code"], cwd=cwd, env=env, stdout=streams[0],
+                      stderr=streams[1], timeout=900)
+    out, err = (s.read_text(encoding="utf-8") for s in streams)
+    return subprocess.CompletedProcess(["python", "-c", box["code"]], code, out, err)
 
 
 def test_match_in_order_uses_the_printed_precision():
