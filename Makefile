@@ -11,8 +11,10 @@ STAMP_TEST := $(VENV)/.stamp-test
 
 .PHONY: run test test-autograd lint bench docs browser-deps clean
 
-# The kernels the chapter report uses (`serialkin warmup --list` lists every feature).
-RUN_FEATURES := kinematics ik ik-all ik-all-general ik-methods collision workspace tracking
+# The kernels the chapter report uses (`serialkin warmup --list` lists every feature; the
+# report compiles in its own workers whatever else it needs). Not collision (no section
+# calls it) nor arm-angle: `make test` compiles those while the test extras install.
+RUN_FEATURES := kinematics ik ik-all ik-all-general ik-methods workspace tracking
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)

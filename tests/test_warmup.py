@@ -19,6 +19,7 @@ from serialkin.warmup import FEATURES, feature_of_module, warmup
 def test_feature_of_module_takes_the_longest_prefix():
     """Each kernel module belongs to the feature whose prefix matches it most closely."""
     assert feature_of_module("serialkin.ik.analytic.dispatch").name == "ik-all"
+    assert feature_of_module("serialkin.ik.analytic.arm_angle").name == "arm-angle"
     assert feature_of_module("serialkin.ik._kernels").name == "ik"
     assert feature_of_module("serialkin.kinematics.kernels").name == "kinematics"
     assert feature_of_module("serialkin.kinematics.dls").name == "ik"

@@ -93,13 +93,18 @@ def _ik() -> None:
 
 def _ik_all() -> None:
     import serialkin as sk
-    from serialkin.ik.analytic.arm_angle import ik_arm_angle_path
 
     for name in ("ur5", "puma560", "stanford", "scara", "three_link"):
         r = sk.models.get(name)
         T = r.fk(r.random_q(4, seed=0))
         r.ik_all(T[0])
         r.ik_all(T)
+
+
+def _arm_angle() -> None:
+    import serialkin as sk
+    from serialkin.ik.analytic.arm_angle import ik_arm_angle_path
+
     iiwa = sk.models.get("iiwa7")  # S-R-S arms by the arm angle: one pose, a path, ψ intervals
     T = iiwa.fk(iiwa.random_q(4, seed=0))
     iiwa.ik_arm_angle(T[0], 0.3)
@@ -193,7 +198,8 @@ def _tracking() -> None:
 
 
 _RUNS: dict[str, Callable[[], object]] = {
-    "ik-all-general": _ik_all_general, "ik-all": _ik_all, "ik-methods": _ik_methods,
+    "ik-all-general": _ik_all_general, "ik-all": _ik_all, "arm-angle": _arm_angle,
+    "ik-methods": _ik_methods,
     "tracking": _tracking, "collision": _collision, "ik": _ik, "kinematics": _kinematics,
     "workspace": _workspace,
 }
