@@ -283,7 +283,7 @@ def bench_general_arms(n_arms: int, repeat: int) -> None:
     """General 6R: median single-call time over random arms (one pose each), and how often
     the elimination declines (the 2-D search answers instead)."""
     from serialkin.ik.analytic import _prepared
-    from serialkin.ik.analytic.raghavan_roth import rr_candidates
+    from serialkin.ik.analytic.raghavan_roth import rr_candidates_from
 
     medians, counts, declined = [], [], 0
     for i in range(n_arms):
@@ -296,8 +296,10 @@ def bench_general_arms(n_arms: int, repeat: int) -> None:
             continue
         T = np.ascontiguousarray(robot.fk(robot.random_q(1, seed=i)[0]))
         out = np.zeros((16, 6))
-        k = rr_candidates(T, p.W, p.P, p.M, bool(p.order[1] == 1), p.F, p.meta, 1e-12, 1e-12,
-                          out)
+        reverse = bool(p.order[1] == 1)  # as ik_all calls it (dispatch._general)
+        other = len(p.order) > 2 and bool(p.order[2] == 1) != reverse
+        k = rr_candidates_from(T, p.W, p.P, p.M, reverse, other, p.F, p.meta, 1e-12, 1e-12,
+                               out)
         declined += k < 0
         medians.append(latency_us(lambda r=robot, t=T: ik_all(r, t), 5, repeat).median)
         counts.append(len(ik_all(robot, T)))

@@ -167,6 +167,7 @@ def _collision() -> None:
     T = r.fk(Q)
     r.ik(T[0], self_collision=True)
     r.ik(T, self_collision=True)
+    r.ik(T[0], method="dls", self_collision=True)  # the loop the other Jacobian methods share
     model = panda_collision_model()
     acm = default_acm(model)
     self_clearance(r, model, Q, acm)

@@ -24,7 +24,7 @@ from serialkin.ik.analytic.raghavan_roth import (
     _to_coefficients,
     _trig,
     eliminant_roots,
-    rr_candidates,
+    rr_candidates_from,
 )
 from serialkin.ik.analytic.structure import general_structure, joint_lines
 from serialkin.ik.analytic.subproblems import screw
@@ -42,14 +42,14 @@ def _basis(t: float) -> np.ndarray:
     return np.array([1.0, math.cos(t), math.sin(t)])
 
 
-def _solve(robot: Robot, T: np.ndarray, kernel=rr_candidates) -> tuple[int, np.ndarray]:
+def _solve(robot: Robot, T: np.ndarray, kernel=rr_candidates_from) -> tuple[int, np.ndarray]:
     """Count and rows of a general-6R kernel for target T."""
     s = general_structure(robot)
     out = np.zeros((16, 6))
     rev = bool(s.order[1] == 1)
     F, meta = robot.chain.F, robot.chain.meta
-    if kernel is rr_candidates:
-        k = kernel(T, s.W, s.P, s.M, rev, F, meta, 1e-12, 1e-12, out)
+    if kernel is rr_candidates_from:  # the types ik_all passes (one compiled entry)
+        k = kernel(T, s.W, s.P, s.M, rev, False, F, meta, 1e-12, 1e-12, out)
     else:
         k = kernel(T, s.W, s.P, s.M, s.aux, int(s.order[0]), rev, 48, F, meta, 1e-12, 1e-12, out)
     return k, out[:max(k, 0)]

@@ -55,7 +55,7 @@ coefficient is obtained numerically from the chain instead of from symbolic alge
    nothing new was a complex pair and is dropped; a real root that gives nothing new
    makes the caller search instead (below).
 
-:func:`rr_candidates` reports failure (:data:`NEAR_SPECIAL`) when the elimination does not
+:func:`rr_candidates_from` reports failure (:data:`NEAR_SPECIAL`) when the elimination does not
 apply: ``Q`` of rank below 8 or a pencil singular to rounding for all six splits (an exact special
 pair, e.g. axes 1 and 2 intersecting, degenerates a split: the next one is tried), or a
 pencil nearly singular for every θ3 (an arm near a special class: no split is trusted);
@@ -645,16 +645,6 @@ def _half_angle(v, stride, count):
 
 
 @njit(cache=True)
-def rr_candidates(T, W, P, M, reverse, F, meta, tol_p, tol_r, out):
-    """Every solution of a 6R arm by Raghavan–Roth elimination into ``out`` (16, 6).
-
-    :func:`rr_candidates_from` starting on the splits of the chain W, P, M (arguments
-    and result as there, without ``other_first``).
-    """
-    return rr_candidates_from(T, W, P, M, reverse, False, F, meta, tol_p, tol_r, out)
-
-
-@njit(cache=True)
 def rr_candidates_from(T, W, P, M, reverse, other_first, F, meta, tol_p, tol_r, out):
     """Every solution of a 6R arm by Raghavan–Roth elimination into ``out`` (16, 6).
 
@@ -715,7 +705,7 @@ def rr_candidates_from(T, W, P, M, reverse, other_first, F, meta, tol_p, tol_r, 
 
 @njit(cache=True)
 def _rr_split(T, W, P, M, reverse, e, F, meta, tol_p, tol_r, out):
-    """:func:`rr_candidates` for the split that eliminates joint ``e`` (0-based 5, 4 or 3).
+    """:func:`rr_candidates_from` for the split that eliminates joint ``e`` (0-based 5, 4 or 3).
 
     With ``G = T·M⁻¹ = e1···e6`` and ``x`` the direction and a point of axis e:
 
