@@ -9,7 +9,7 @@ PY     := $(VENV)/bin/python
 STAMP_RUN  := $(VENV)/.stamp-run
 STAMP_TEST := $(VENV)/.stamp-test
 
-.PHONY: run test test-autograd lint bench docs browser-deps clean
+.PHONY: run test test-autograd lint bench docs browser-deps clean bytecode
 
 # The kernels the chapter report uses (`serialkin warmup --list` lists every feature; the
 # report compiles in its own workers whatever else it needs). Not collision (no section
@@ -37,13 +37,21 @@ $(STAMP_TEST): $(STAMP_RUN)
 	$(PY) -m pip install --quiet -r $(VENV)/test-extras.txt -c $(VENV)/installed.txt
 	touch $@
 
+# serialkin's own modules byte-compiled (pip byte-compiles the installed packages; the
+# project is installed editable, and where PYTHONDONTWRITEBYTECODE is set, as on this
+# project's machines, every process compiled serialkin's sources again: 0.4 s of each
+# process that imports most of it, of which make test starts about a hundred). Only
+# what changed since the last run is compiled again.
+bytecode: $(STAMP_RUN)
+	@$(PY) -m compileall -q -j 0 src
+
 # `serialkin warmup` compiles the kernels into numba's on-disk cache first, one process
 # per feature on every core, with a progress bar (seconds when the cache is already
 # filled). The cache notices source edits by itself (serialkin/_jit.py: each kernel is
 # stamped with a hash of its module and of every module it imports). The report, the
 # docs and the benchmarks compile anything left in the foreground (SERIALKIN_COMPILE=wait)
 # rather than run it as Python meanwhile: their figures are the compiled results.
-run: $(STAMP_RUN)
+run: $(STAMP_RUN) bytecode
 	$(VENV)/bin/serialkin warmup $(RUN_FEATURES)
 	SERIALKIN_COMPILE=wait $(VENV)/bin/serialkin chapter --out out/chapter
 
@@ -60,7 +68,7 @@ browser-deps:
 # (the three overlap: downloads and unpacking wait on the network and the disk, the
 # warm-up on the CPU); the suite starts when all three are done, and fails the target
 # if any did.
-test: $(STAMP_RUN)
+test: $(STAMP_RUN) bytecode
 	@set -e; \
 	  $(MAKE) --no-print-directory $(STAMP_TEST) & extras=$$!; \
 	  $(MAKE) --no-print-directory browser-deps & browser=$$!; \
@@ -94,7 +102,7 @@ $(STAMP_AUTOGRAD): $(STAMP_TEST)
 	  -r $(VENV)/autograd-extras.txt "$(TORCH_PIN)" -c $(VENV)/installed-autograd.txt
 	touch $@
 
-test-autograd: $(STAMP_AUTOGRAD)
+test-autograd: $(STAMP_AUTOGRAD) bytecode
 	$(VENV)/bin/serialkin warmup kinematics ik ik-methods
 	SERIALKIN_AUTOGRAD_REQUIRED=1 $(PY) -m pytest -n 2 --dist loadfile tests/autograd
 
@@ -102,11 +110,11 @@ lint: $(STAMP_TEST)
 	$(VENV)/bin/ruff check src tests benchmarks examples
 
 # The documentation site into site/ (strict: a warning fails); open site/index.html.
-docs: $(STAMP_TEST)
+docs: $(STAMP_TEST) bytecode
 	SERIALKIN_COMPILE=wait DISABLE_MKDOCS_2_WARNING=true NO_MKDOCS_2_WARNING=1 \
 	  $(PY) -m mkdocs build --strict
 
-bench: $(STAMP_TEST)
+bench: $(STAMP_TEST) bytecode
 	SERIALKIN_COMPILE=wait $(PY) benchmarks/run_all.py
 
 clean:
