@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import shutil
 import subprocess
 import sys
@@ -24,8 +25,15 @@ def _exe() -> str:
 
 
 def sk(*args: object, cwd: Path, code: int = 0) -> subprocess.CompletedProcess[str]:
+    """Run the console script as a user does: the default compile mode, not the suite's.
+
+    The suite's own processes compile in the foreground (``SERIALKIN_COMPILE=wait``,
+    tests/conftest.py); a user's first calls of a one-shot command run as Python
+    (``_background.answer_first``), and so do these.
+    """
+    env = {k: v for k, v in os.environ.items() if k != "SERIALKIN_COMPILE"}
     proc = subprocess.run([_exe(), *map(str, args)], cwd=cwd, capture_output=True, text=True,
-                          timeout=300)
+                          timeout=300, env=env)
     assert proc.returncode == code, (proc.returncode, proc.stdout[-2000:], proc.stderr[-2000:])
     return proc
 
