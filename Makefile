@@ -16,12 +16,21 @@ STAMP_TEST := $(VENV)/.stamp-test
 # calls it) nor arm-angle: `make test` compiles those while the test extras install.
 RUN_FEATURES := kinematics ik ik-all ik-all-general ik-methods workspace tracking
 
+# Packages install with uv when it can (from PyPI, as pip would: the same versions; it
+# downloads, unpacks and byte-compiles in parallel: on this project's 2-core machines the
+# project's requirements in 9 s instead of 18-23 s, the test extras in 8-10 s instead of
+# 24 s), else with pip: `install` tries uv, and pip when uv is missing or fails.
+UV := $(VENV)/bin/uv
+install = { [ -x $(UV) ] && $(UV) pip install --quiet --python $(PY) --compile-bytecode $(1); } \
+	  || $(PY) -m pip install --quiet $(1)
+
 $(PY):
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
+	-$(PY) -m pip install --quiet "uv>=0.5,<1"
 
 $(STAMP_RUN): pyproject.toml | $(PY)
-	$(PY) -m pip install --quiet -e .
+	$(call install,-e .)
 	touch $@
 
 # The test extras' own requirements, installed beside the project without reinstalling it
@@ -34,7 +43,7 @@ $(STAMP_TEST): $(STAMP_RUN)
 	['optional-dependencies']; print('\n'.join(r for e in '$(TEST_EXTRAS)'.split() for r in o[e]))" \
 	  > $(VENV)/test-extras.txt
 	$(PY) -m pip freeze --exclude-editable > $(VENV)/installed.txt
-	$(PY) -m pip install --quiet -r $(VENV)/test-extras.txt -c $(VENV)/installed.txt
+	$(call install,-r $(VENV)/test-extras.txt -c $(VENV)/installed.txt)
 	touch $@
 
 # serialkin's own modules byte-compiled (pip byte-compiles the installed packages; the
