@@ -12,9 +12,11 @@ STAMP_TEST := $(VENV)/.stamp-test
 .PHONY: run test test-autograd lint bench docs browser-deps clean bytecode
 
 # The kernels the chapter report uses (`serialkin warmup --list` lists every feature; the
-# report compiles in its own workers whatever else it needs). Not collision (no section
-# calls it) nor arm-angle: `make test` compiles those while the test extras install.
-RUN_FEATURES := kinematics ik ik-all ik-all-general ik-methods workspace tracking
+# report compiles in its own workers whatever else it needs), and collision, which no
+# section calls: compiled by `make test` while its extras install, it was the last
+# process running there (15 s on one core); here it packs beside the others. Not
+# arm-angle: `make test` compiles it while its extras install.
+RUN_FEATURES := kinematics ik ik-all ik-all-general ik-methods workspace tracking collision
 
 # Packages install with uv when it can (from PyPI, as pip would: the same versions; it
 # downloads, unpacks and byte-compiles in parallel: on this project's 2-core machines the
