@@ -8,9 +8,17 @@ Set ``HYPOTHESIS_PROFILE=explore`` to search harder locally.
 from __future__ import annotations
 
 import os
+import sys
+from pathlib import Path
 
 import pytest
 from hypothesis import settings
+
+# docs/_build holds helpers the docs build and the tests share (the example runner,
+# fresh_python, the API as the docs see it): importable by every test module.
+_DOCS_BUILD = str(Path(__file__).resolve().parents[1] / "docs" / "_build")
+if _DOCS_BUILD not in sys.path:
+    sys.path.insert(0, _DOCS_BUILD)
 
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
 settings.register_profile("explore", max_examples=500, deadline=None)
@@ -34,7 +42,7 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", _default))
 #: the long files run beside each other and the many short ones fill in around them.
 LONGEST_FIRST = (
     "tests/docs/test_site.py",                   # the strict site build, the examples
-    "tests/chapter/test_reproduce.py",           # every Reproduce box in a fresh process
+    "tests/chapter/test_reproduce.py",           # every Reproduce box in its own process
     "tests/cli/test_readme.py",                  # the README's commands as typed
     "tests/cli/test_entry_point.py",
     "tests/chapter/test_report_browser.py",
@@ -206,12 +214,6 @@ def examples_ran(shared_once):
     ``stdout.txt``, ``stderr.txt``, ``out/``); the example tests and the docs build's
     gallery (tests/docs/test_site.py) both read it, so each script runs once.
     """
-    import sys
-    from pathlib import Path
-
-    build = str(Path(__file__).resolve().parents[1] / "docs" / "_build")
-    if build not in sys.path:
-        sys.path.insert(0, build)
     from run_examples import run_all
 
     return shared_once("examples", run_all)

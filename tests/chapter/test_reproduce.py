@@ -21,11 +21,9 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
+from fresh_python import run_python  # docs/_build (on sys.path: tests/conftest.py)
 
 from serialkin.chapter.report import SECTION_MODULES
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "docs" / "_build"))
-from fresh_python import run_python  # noqa: E402  (docs/_build/fresh_python.py)
 
 _NUM = re.compile(r"[-−]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?")
 _BOX = re.compile(r'<div class="repro" data-kind="(\w+)" data-expect="([^"]*)">'

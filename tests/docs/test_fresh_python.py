@@ -3,11 +3,9 @@
 from __future__ import annotations
 
 import os
-import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "docs" / "_build"))
-from fresh_python import PRELOAD, run_python  # noqa: E402
+from fresh_python import PRELOAD, run_python  # docs/_build (on sys.path: tests/conftest.py)
 
 
 def _run(tmp_path: Path, **kw) -> tuple[int, str, str]:

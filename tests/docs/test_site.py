@@ -25,8 +25,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
-sys.path.insert(0, str(DOCS / "_build"))
-import api  # noqa: E402  (docs/_build/api.py: the public API as the docs see it)
+import api  # noqa: E402  (docs/_build/api.py, on sys.path by tests/conftest.py)
 
 pytest.importorskip("mkdocs", reason="the docs extra is not installed (pip install -e '.[docs]')")
 pytest.importorskip("mkdocstrings_handlers.python")

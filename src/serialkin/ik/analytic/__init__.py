@@ -239,7 +239,7 @@ def _near_companion(robot: Robot) -> _Prepared | None:
 
     An arm within :data:`NEAR_TOL` of a class is near a special class, where the general
     6R search's basins narrow (its elimination declines): the refined closed form's
-    rows are merged into the search's (:func:`_near_extra`), so that asking for the
+    rows are merged into the search's (:func:`_limited_rows`), so that asking for the
     exact mode (``near_tol=0``) never returns fewer solutions than the default mode.
     Never raises: the general structure the caller solves with also serves
     ``_prepared(robot, NEAR_TOL)`` when no class is near.
@@ -263,9 +263,21 @@ def _merged(sols: np.ndarray, extra: np.ndarray) -> np.ndarray:
     return merged[np.lexsort(merged.T[::-1])]
 
 
-def _near_extra(pn: _Prepared, rows: np.ndarray) -> np.ndarray:
-    """The near solve's unlimited ``rows`` (k, n) of ``pn``, inside its limits."""
-    return _inside_limits(pn, rows) if pn.limited else rows
+def _limited_rows(p: _Prepared, rows: np.ndarray) -> np.ndarray:
+    """Rows (k, n) solved without ``p``'s joint limits, kept inside them (all if none)."""
+    return _inside_limits(p, rows) if p.limited else rows
+
+
+def _put_rows(out: np.ndarray, counts: np.ndarray, i: int, rows: np.ndarray) -> None:
+    """Target ``i`` of a batch (``out`` (N, 16, n), ``counts`` (N,)) holds ``rows`` (k, n).
+
+    ``rows`` may be a view of ``out[i]`` (a merge that found nothing new returns its
+    input): copied before ``out[i]`` is cleared.
+    """
+    rows = np.array(rows[:MAX_ROWS], dtype=float)
+    counts[i] = len(rows)
+    out[i] = 0.0
+    out[i, :counts[i]] = rows
 
 
 def _with_near(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
@@ -279,7 +291,7 @@ def _with_near(robot: Robot, T: np.ndarray, sols: np.ndarray, tol: float,
     if pn is None:
         return sols
     out, k, _ = _solve_one(pn, pn.solve_qlim, T, True, True, tol, grid)
-    return _merged(sols, _near_extra(pn, out[:k]))
+    return _merged(sols, _limited_rows(pn, out[:k]))
 
 
 def _as_pose(a: np.ndarray) -> np.ndarray:
@@ -697,7 +709,7 @@ def _near_rows(robot: Robot, p: _Prepared, T: np.ndarray, rows: np.ndarray,
     """
     if _doubtful(p, rows[None], conv[None], np.array([len(rows)]))[0]:
         rows = _with_general(robot, T, rows, tol, grid)
-    return _inside_limits(p, rows) if p.limited else rows
+    return _limited_rows(p, rows)
 
 
 def _doubtful(p: _Prepared, rows: np.ndarray, conv: np.ndarray,
@@ -867,16 +879,12 @@ def _pack(p: _Prepared, qlim: np.ndarray, check_rot: bool, refine: bool, tol: fl
 def _solve_one(p: _Prepared, qlim: np.ndarray, T: np.ndarray, check_rot: bool, refine: bool,
                tol: float, grid: int) -> tuple[np.ndarray, int, np.ndarray]:
     """One target T (4, 4), already a rigid transform: (rows (16, n), count, conv (17,))."""
-    from serialkin.ik.analytic.dispatch import for_class
+    from serialkin.ik.analytic.dispatch import solve
 
-    I, D, B = _pack(p, qlim, check_rot, refine, tol, grid)
     T = T if T.flags.carray and T.dtype == np.float64 else np.array(T, dtype=float, order="C")
-    out = np.zeros((MAX_ROWS, p.n))
-    conv = np.zeros(MAX_ROWS + 1, dtype=np.int64)
-    # one target is the kernel's flat batch of one (its one specialisation)
-    k = for_class(p.code, refine).solve(T, I, D, B, out, np.empty(1, dtype=np.int64), conv,
-                                        0, 1)
-    return out, int(k), conv
+    # one target is the kernel's batch of one (its one specialisation)
+    out, counts, conv = solve(p.code, T[None], _pack(p, qlim, check_rot, refine, tol, grid))
+    return out[0], int(counts[0]), conv[0]
 
 
 def _solve_batch(p: _Prepared, robot: Robot, T: np.ndarray, tol: float,
@@ -1167,11 +1175,9 @@ def _ik_all_batch(p: Any, robot: Robot, a: np.ndarray, tol: float, grid: int,
     if pn is not None:  # as _with_near, all targets in one batch
         near_out, near_counts, _ = _solve_batch(pn, robot, T, tol, grid)
         for i in range(T.shape[0]):
-            rows = _merged(out[i, :counts[i]], _near_extra(pn, near_out[i, :near_counts[i]]))
+            rows = _merged(out[i, :counts[i]], _limited_rows(pn, near_out[i, :near_counts[i]]))
             if len(rows) != counts[i]:
-                counts[i] = min(len(rows), MAX_ROWS)
-                out[i] = 0.0
-                out[i, :counts[i]] = rows[:MAX_ROWS]
+                _put_rows(out, counts, i, rows)
     kmax = int(counts.max(initial=0))
     cont = None
     if report:
@@ -1182,10 +1188,7 @@ def _ik_all_batch(p: Any, robot: Robot, a: np.ndarray, tol: float, grid: int,
         cont = cont.reshape(lead + (kmax,))
     if p.mode == "near":  # doubtful refined branches: general search too; then limits
         for i in np.flatnonzero(_doubtful(p, out, conv, counts)):
-            rows = _with_general(robot, T[i], out[i, :counts[i]], tol, grid)
-            out[i] = 0.0
-            counts[i] = min(len(rows), MAX_ROWS)
-            out[i, :counts[i]] = rows[:MAX_ROWS]
+            _put_rows(out, counts, i, _with_general(robot, T[i], out[i, :counts[i]], tol, grid))
         if p.limited:  # the limits, all targets at once: rows inside first, in order
             from serialkin.ik.analytic.subproblems import LIMIT_TOL
 

@@ -333,7 +333,6 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
     """
     from serialkin.tracking.analysis import task_activity
 
-    figs = figures
     track_numbers = [v for s, tr in ((sb, tb), (sc, tc))
                      for v in (str(int(tr.reached.sum())), str(len(s.path)), _mm(tr.max_error),
                                str(int(tr.iterations.sum())))] + [
@@ -362,11 +361,11 @@ def _twenty_link_part(ctx: ReportContext, sb: Scenario, sc: Scenario, tb: Any, t
         _results_table(ctx, sb, sc, tb, tc),
         cap_paragraph(ctx, sc, cap),
         _timings_text(ctx, sb, sc, tb, tc, time_b, time_c, ratio),
-        figs["motion"],
-        figs["activity"],
+        figures["motion"],
+        figures["activity"],
         ablation_table(ctx, sc, runs, "All runs of the ablation are made " + cap_note(cap)),
-        figs["ablation"],
-        figs["joints"],
+        figures["ablation"],
+        figures["joints"],
         ctx.reproduce("serialkin track twenty_link_free --out out/track\n"
                       "serialkin track twenty_link_obstacles --out out/track", shell=True,
                       expect=track_numbers),
