@@ -217,3 +217,67 @@ def examples_ran(shared_once):
     from run_examples import run_all
 
     return shared_once("examples", run_all)
+
+
+# ------------------------------------------------- the chapter report, built once per run
+_ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="session")
+def built_report(shared_once):
+    """(output folder, report.html text) of one full build of the chapter report.
+
+    Built once per run, also when pytest-xdist sends the files that read it to different
+    workers (``shared_once``), by ``serialkin chapter`` in a fresh
+    process, as ``make run`` builds it: a build inside a test worker sees what earlier
+    tests left in that process (an IK method registered by a test, such as the "gradient"
+    of docs/architecture.md's example, adds a row to the numerical section's comparison
+    table that its Reproduce box, run in a fresh interpreter, does not print).
+
+    When ``make run`` has built ``out/chapter`` from these very sources with these
+    library versions (its ``build.json`` equals :func:`build_provenance` of every
+    section), that build is the one tested (copied): the same command on the same inputs.
+    """
+    import json
+    import shutil
+    import subprocess
+
+    from serialkin.chapter.report import SECTION_MODULES, build_provenance
+
+    def build(folder: Path) -> None:
+        made = _ROOT / "out" / "chapter"
+        try:
+            recorded = json.loads((made / "build.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            recorded = None
+        if recorded == build_provenance(SECTION_MODULES):
+            shutil.copytree(made, folder, dirs_exist_ok=True)
+            return
+        env = {**os.environ, "SERIALKIN_COMPILE": "wait"}
+        cli = Path(sys.executable).parent / "serialkin"
+        res = subprocess.run([str(cli), "chapter", "--out", str(folder), "-q"], env=env,
+                             capture_output=True, text=True, timeout=1800, check=False)
+        assert res.returncode == 0, res.stderr[-4000:]
+
+    out = shared_once("chapter-report", build)
+    return out, (out / "report.html").read_text(encoding="utf-8")
+
+
+@pytest.fixture(scope="session")
+def report_section(built_report):
+    """``report_section(sid) -> str``: the built report's section ``sid``, as HTML.
+
+    Its parts (``sid``, ``sid-1``, ``sid-2`` ...) in page order, joined.
+    """
+    import re
+
+    _, page = built_report
+    sections = re.findall(r'<section id="([^"]+)">(.*?)</section>', page, re.S)
+
+    def section(sid: str) -> str:
+        found = [body for name, body in sections if name == sid or re.fullmatch(
+            re.escape(sid) + r"-\d+", name)]
+        assert found, f"no section {sid!r} in the report"
+        return "".join(found)
+
+    return section

@@ -370,36 +370,40 @@ class CompileFeature:
     seconds: float
 
 
-#: The features, in the order ``serialkin warmup --all`` starts them (longest first, so
-#: that the parallel processes finish together). Their ``seconds``: each feature alone in
-#: a fresh process with an empty cache (benchmarks/compile_profile.py, quiet 2-core
-#: machine); together they share kernels, so ``--all`` takes less than their sum.
+#: The features, in the order ``serialkin warmup --all`` starts them: about longest first,
+#: so that the parallel processes finish together, where "longest" is what a feature
+#: still compiles after those started before it (they share kernels: ``ik-all`` after
+#: ``ik-all-general`` compiles 10 s, alone 34 s; collision before ``ik-all`` ends
+#: ``make run``'s warm-up 3 s sooner on 2 cores, 90.9 s against 93.9 s). Their
+#: ``seconds``: each feature alone in a fresh process with an empty cache
+#: (benchmarks/compile_profile.py, quiet 2-core machine; the first-call notice quotes
+#: them), so ``--all`` takes much less than their sum.
 #: :data:`serialkin.warmup.FEATURES` adds to each the calls that compile it.
 COMPILE_FEATURES: dict[str, CompileFeature] = {f.name: f for f in (
     CompileFeature("ik-all-general", "every solution of general 6R and nearly ideal "
                    "(calibrated) arms: robot.ik_all",
                    ("serialkin.ik.analytic.general", "serialkin.ik.analytic.raghavan_roth",
-                    "serialkin.ik.analytic.refine"), 70.0),
+                    "serialkin.ik.analytic.refine"), 61.0),
     CompileFeature("ik-methods", "the numerical IK methods other than the default: "
                    "robot.ik(method=...)",
                    ("serialkin.ik.jacobian_methods", "serialkin.ik.ccd",
-                    "serialkin.ik.fabrik", "serialkin.ik.optimize"), 45.0),
+                    "serialkin.ik.fabrik", "serialkin.ik.optimize"), 47.0),
     CompileFeature("tracking", "path tracking and redundancy resolution: serialkin track",
-                   ("serialkin.tracking", "serialkin.redundancy"), 32.0),
-    CompileFeature("ik-all", "every closed-form solution: robot.ik_all",
-                   ("serialkin.ik.analytic",), 30.0),
+                   ("serialkin.tracking", "serialkin.redundancy"), 34.0),
     CompileFeature("collision", "collision-aware IK and clearance queries",
-                   ("serialkin.collision", "serialkin.diffik"), 18.0),
+                   ("serialkin.collision", "serialkin.diffik"), 54.0),
+    CompileFeature("ik-all", "every closed-form solution: robot.ik_all",
+                   ("serialkin.ik.analytic",), 34.0),
     CompileFeature("ik", "numerical IK: robot.ik (default method), one pose and batches",
                    ("serialkin.ik", "serialkin.kinematics.dls", "serialkin.spatial",
-                    "serialkin.model.limits"), 12.0),
+                    "serialkin.model.limits"), 22.0),
     CompileFeature("arm-angle", "7-DOF arms with a spherical shoulder and wrist by their "
                    "arm angle: robot.ik_arm_angle, robot.arm_angle_intervals",
-                   ("serialkin.ik.analytic.arm_angle",), 12.0),
+                   ("serialkin.ik.analytic.arm_angle",), 13.0),
     CompileFeature("kinematics", "forward kinematics and Jacobians: robot.fk, robot.jacobian",
-                   ("serialkin.kinematics",), 5.0),
+                   ("serialkin.kinematics",), 18.0),
     CompileFeature("workspace", "workspace sampling: serialkin workspace",
-                   ("serialkin.workspace",), 2.0),
+                   ("serialkin.workspace",), 8.0),
 )}
 
 

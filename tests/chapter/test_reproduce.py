@@ -1,11 +1,13 @@
 """Every "Reproduce" box of the chapter report prints the numbers its section shows.
 
-Each box is run verbatim in a process of its own (Python boxes as ``python -c`` runs them,
-shell boxes by ``bash -c`` with the venv's ``serialkin`` first on PATH, both in an empty
-folder); its output must contain the numbers the box declares (``data-expect``), in
-order, each to the precision the page prints it with; and the page must show each of
-those numbers in the box's section (outside the box). So a reader who copies a box gets
-what the page shows.
+Each box is run verbatim in a process of its own, in an empty folder: Python boxes as
+``python -c`` runs them; shell boxes whose lines are plain ``serialkin`` commands one
+command after the other, each as the ``serialkin`` console script runs it (its ``main``
+with that command line), stopping at the first that fails as ``bash -e`` does; any other
+shell box by ``bash -e -c`` with the venv's ``serialkin`` first on PATH. Its output must
+contain the numbers the box declares (``data-expect``), in order, each to the precision
+the page prints it with; and the page must show each of those numbers in the box's
+section (outside the box). So a reader who copies a box gets what the page shows.
 The boxes run with compiled kernels (``SERIALKIN_COMPILE=wait``), as the page says.
 """
 
@@ -15,6 +17,7 @@ import html
 import json
 import os
 import re
+import shlex
 import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
@@ -83,9 +86,10 @@ def report_boxes(page: str) -> list[dict]:
 def run_box(box: dict, cwd: Path) -> subprocess.CompletedProcess:
     """Run a box's exact text in a process of its own in ``cwd``.
 
-    Shell boxes by ``bash -e -c``; Python boxes as ``python -c`` would run them, in a child
-    of the fork server of docs/_build/fresh_python.py (the imports and numba's set-up
-    done once for every box; no serialkin function called before the box's own).
+    Python boxes as ``python -c`` would run them, and the ``serialkin`` commands of a
+    shell box each as the console script would, in children of the fork server of
+    docs/_build/fresh_python.py (the imports and numba's set-up done once for every box; no
+    serialkin function called before the box's own); any other shell box by ``bash -e -c``.
     """
     env = dict(os.environ)
     env["PATH"] = str(Path(sys.executable).parent) + os.pathsep + env.get("PATH", "")
@@ -93,14 +97,59 @@ def run_box(box: dict, cwd: Path) -> subprocess.CompletedProcess:
     # the first calls run as Python, whose rounding differs in the last digits, and a long
     # tracking run (the 20-link arm, 6,841 iterations) then follows another path
     env["SERIALKIN_COMPILE"] = "wait"
-    if box["kind"] == "shell":
+    if box["kind"] == "python":
+        return _python(box["code"], cwd, env, "")
+    commands = serialkin_commands(box["code"])
+    if commands is None:
         return subprocess.run(["bash", "-e", "-c", box["code"]], cwd=cwd, env=env,
                               capture_output=True, text=True, timeout=900, check=False)
-    streams = cwd.parent / f"{cwd.name}.stdout", cwd.parent / f"{cwd.name}.stderr"
-    code = run_python(code=box["code"], cwd=cwd, env=env, stdout=streams[0],
-                      stderr=streams[1], timeout=900)
+    outs, errs = [], []
+    for k, argv in enumerate(commands):
+        # the console script's own lines (pip's entry-point wrapper), on this command line
+        res = _python(f"import sys\nsys.argv = {argv!r}\nfrom serialkin.cli.main import main\n"
+                      f"sys.exit(main())\n", cwd, env, f".{k}")
+        outs.append(res.stdout)
+        errs.append(res.stderr)
+        if res.returncode != 0:
+            break
+    return subprocess.CompletedProcess(["bash", "-e", "-c", box["code"]], res.returncode,
+                                       "".join(outs), "".join(errs))
+
+
+def serialkin_commands(script: str) -> list[list[str]] | None:
+    """The command lines of a shell script made only of plain ``serialkin`` commands.
+
+    None when a line does anything else (another program, a pipe, a redirection, a
+    variable, a substitution, a line continuation): such a script runs in bash.
+    """
+    commands = []
+    for line in script.splitlines():
+        if any(c in line.split("#")[0] for c in "|&;<>$`\\(){}*?"):
+            return None
+        words = shlex.split(line, comments=True)
+        if words and words[0] != "serialkin":
+            return None
+        if words:
+            commands.append(words)
+    return commands
+
+
+def _python(code: str, cwd: Path, env: dict[str, str], tag: str) -> subprocess.CompletedProcess:
+    """``python -c code`` in a child of docs/_build/fresh_python.py's fork server."""
+    streams = cwd.parent / f"{cwd.name}{tag}.stdout", cwd.parent / f"{cwd.name}{tag}.stderr"
+    status = run_python(code=code, cwd=cwd, env=env, stdout=streams[0], stderr=streams[1],
+                        timeout=900)
     out, err = (s.read_text(encoding="utf-8") for s in streams)
-    return subprocess.CompletedProcess(["python", "-c", box["code"]], code, out, err)
+    return subprocess.CompletedProcess(["python", "-c", code], status, out, err)
+
+
+def test_only_plain_serialkin_commands_skip_bash():
+    """Plain ``serialkin`` lines (comments, quoting) are split; anything else goes to bash."""
+    assert serialkin_commands('serialkin fk ur5 --q "0, 0"   # a comment\n\nserialkin models') \
+        == [["serialkin", "fk", "ur5", "--q", "0, 0"], ["serialkin", "models"]]
+    for script in ("serialkin fk ur5 | head", "ls", "serialkin fk $ROBOT", "serialkin a; ls",
+                   "serialkin fk ur5 > out.txt", "serialkin fk \\\n ur5", "cd x && serialkin"):
+        assert serialkin_commands(script) is None, script
 
 
 def test_match_in_order_uses_the_printed_precision():

@@ -48,6 +48,8 @@ def test_readme_command_runs(argv, tmp_path, monkeypatch):
         args += ["--samples", "20000"]  # the documented command, with fewer samples
     if args[0] == "track":
         args += ["--max-frames", "3"]
+    if args[0] == "reach":  # the documented command on a coarser grid (1/8 of the cells)
+        args[args.index("--resolution") + 1] = "0.2"
     monkeypatch.chdir(tmp_path)
     if args[0] == "base-placement":  # the task poses the command reads
         Path("tasks.yaml").write_text("tasks:\n  - [0.4, 0.1, 0.3, 3.1416, 0, 0]\n"

@@ -49,12 +49,10 @@ def test_section_builds_with_figure(tmp_path):
 
 
 @pytest.mark.slow
-def test_numerical_families_have_one_table_per_robot(tmp_path):
+def test_numerical_families_have_one_table_per_robot(report_section):
     """Section 5.3's comparison has one table per robot, FABRIK skipped on spatial arms."""
-    from serialkin.chapter.sections import numerical
-
-    sec = numerical.build(ReportContext(outdir=tmp_path, quiet=True))
-    assert sec.number == "5.3"
-    assert sec.html.count("<caption>IK methods on") == 3
-    assert "skipped" in sec.html and "fabrik" in sec.html
-    assert "Trade-offs" in sec.html
+    html = report_section("numerical")
+    assert "<h2>5.3 " in html
+    assert html.count("<caption>IK methods on") == 3
+    assert "skipped" in html and "fabrik" in html
+    assert "Trade-offs" in html
