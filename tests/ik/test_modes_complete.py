@@ -141,3 +141,16 @@ def test_exact_mode_on_an_arm_near_a_class_keeps_every_solution():
                 assert _wrapped(rows, r).min() < 1e-7
             assert batch.count[i] == len(rows)
             np.testing.assert_allclose(batch.q[i, :len(rows)], rows, atol=1e-12)
+
+
+def test_parallel_lines_to_rounding_have_a_finite_meeting_point():
+    """Lines whose directions agree to rounding give a finite point between them, no warning."""
+    import warnings
+
+    from serialkin.ik.analytic.structure import _closest_point
+
+    w = np.array([0.0, 0.0, 1.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        c = _closest_point(np.array([0.0, 0.0, 0.3]), w, np.array([0.4, 0.0, -1.0]), w)
+    np.testing.assert_allclose(c, [0.2, 0.0, 0.3])

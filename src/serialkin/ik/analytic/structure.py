@@ -146,10 +146,18 @@ def _line_distance(p1, w1, p2, w2, atol: float = ANGLE_TOL) -> float:
 
 
 def _closest_point(p1, w1, p2, w2) -> np.ndarray:
-    """Midpoint of the common perpendicular of two non-parallel lines."""
+    """Midpoint of the common perpendicular of two non-parallel lines.
+
+    Lines parallel to rounding (``1 − (w1·w2)² = 0``: the callers' angle test has let a
+    nearly parallel pair through, e.g. with ``near_tol=0``) have no such perpendicular:
+    the midpoint of ``p1`` and its foot on line 2 is returned (a point between the lines;
+    the callers then measure the lines' distance, which decides).
+    """
     d = p2 - p1
     c = w1 @ w2
     den = 1.0 - c * c
+    if den <= 0.0:
+        return 0.5 * (p1 + p2 + ((p1 - p2) @ w2) * w2)
     t1 = (d @ w1 - c * (d @ w2)) / den
     t2 = (c * (d @ w1) - d @ w2) / den
     return 0.5 * ((p1 + t1 * w1) + (p2 + t2 * w2))
