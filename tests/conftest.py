@@ -228,8 +228,8 @@ def built_report(shared_once):
     """(output folder, report.html text) of one full build of the chapter report.
 
     Built once per run, also when pytest-xdist sends the files that read it to different
-    workers (``shared_once``), by ``serialkin chapter`` in a fresh
-    process, as ``make run`` builds it: a build inside a test worker sees what earlier
+    workers (``shared_once``), by ``serialkin chapter`` in a fresh process, as ``make
+    run`` builds it: a build inside a test worker sees what earlier
     tests left in that process (an IK method registered by a test, such as the "gradient"
     of docs/architecture.md's example, adds a row to the numerical section's comparison
     table that its Reproduce box, run in a fresh interpreter, does not print).

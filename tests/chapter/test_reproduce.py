@@ -100,7 +100,7 @@ def run_box(box: dict, cwd: Path) -> subprocess.CompletedProcess:
     if box["kind"] == "python":
         return _python(box["code"], cwd, env, "")
     commands = serialkin_commands(box["code"])
-    if commands is None:
+    if not commands:
         return subprocess.run(["bash", "-e", "-c", box["code"]], cwd=cwd, env=env,
                               capture_output=True, text=True, timeout=900, check=False)
     outs, errs = [], []
