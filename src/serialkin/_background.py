@@ -374,12 +374,18 @@ class CompileFeature:
 #: so that the parallel processes finish together, where "longest" is what a feature
 #: still compiles after those started before it (they share kernels: ``ik-all`` after
 #: ``ik-all-general`` compiles 10 s, alone 34 s; collision before ``ik-all`` ends
-#: ``make run``'s warm-up 3 s sooner on 2 cores, 90.9 s against 93.9 s). Their
+#: ``make run``'s warm-up 3 s sooner on 2 cores, 90.9 s against 93.9 s). Except
+#: ``arm-angle``, first: ``make run`` leaves it to ``make test``, whose ``warmup --all``
+#: then compiles it alone while the other process loads the rest from the cache (started
+#: seventh, it waited for those loads). Their
 #: ``seconds``: each feature alone in a fresh process with an empty cache
 #: (benchmarks/compile_profile.py, quiet 2-core machine; the first-call notice quotes
 #: them), so ``--all`` takes much less than their sum.
 #: :data:`serialkin.warmup.FEATURES` adds to each the calls that compile it.
 COMPILE_FEATURES: dict[str, CompileFeature] = {f.name: f for f in (
+    CompileFeature("arm-angle", "7-DOF arms with a spherical shoulder and wrist by their "
+                   "arm angle: robot.ik_arm_angle, robot.arm_angle_intervals",
+                   ("serialkin.ik.analytic.arm_angle",), 13.0),
     CompileFeature("ik-all-general", "every solution of general 6R and nearly ideal "
                    "(calibrated) arms: robot.ik_all",
                    ("serialkin.ik.analytic.general", "serialkin.ik.analytic.raghavan_roth",
@@ -397,9 +403,6 @@ COMPILE_FEATURES: dict[str, CompileFeature] = {f.name: f for f in (
     CompileFeature("ik", "numerical IK: robot.ik (default method), one pose and batches",
                    ("serialkin.ik", "serialkin.kinematics.dls", "serialkin.spatial",
                     "serialkin.model.limits"), 22.0),
-    CompileFeature("arm-angle", "7-DOF arms with a spherical shoulder and wrist by their "
-                   "arm angle: robot.ik_arm_angle, robot.arm_angle_intervals",
-                   ("serialkin.ik.analytic.arm_angle",), 13.0),
     CompileFeature("kinematics", "forward kinematics and Jacobians: robot.fk, robot.jacobian",
                    ("serialkin.kinematics",), 18.0),
     CompileFeature("workspace", "workspace sampling: serialkin workspace",
