@@ -205,9 +205,9 @@ _RUNS: dict[str, Callable[[], object]] = {
     "workspace": _workspace,
 }
 
-#: The features of :data:`serialkin._background.COMPILE_FEATURES` (in its order: longest
-#: first, so that the parallel processes finish together), each with the calls that
-#: compile it.
+#: The features of :data:`serialkin._background.COMPILE_FEATURES` (in its order, the one
+#: that ends the parallel processes together; the reasons are there), each with the
+#: calls that compile it.
 FEATURES: dict[str, Feature] = {
     name: Feature(f.name, f.summary, f.modules, f.seconds, _RUNS[name])
     for name, f in COMPILE_FEATURES.items()}
@@ -233,7 +233,8 @@ def warmup(features: Iterable[str] | None = None, *, jobs: int | None = None,
     """Compile the kernels of ``features`` (default: all) into numba's on-disk cache.
 
     Each feature runs in a fresh process (``spawn``), ``jobs`` at a time (default: the
-    CPUs this process may use), longest first; features already compiled load from the
+    CPUs this process may use), in the order of ``COMPILE_FEATURES``; features already
+    compiled load from the
     cache in about a second. ``progress`` (default: when stderr is a terminal) shows a
     bar weighted by each feature's expected compile time, with the time left.
 

@@ -124,9 +124,12 @@ def serialkin_commands(script: str) -> list[list[str]] | None:
     """
     commands = []
     for line in script.splitlines():
-        if any(c in line.split("#")[0] for c in "|&;<>$`\\(){}*?"):
+        if any(c in line for c in "|&;<>$`\\(){}*?[]~!") or re.search(r"\S#", line):
+            return None  # (a # inside a word, or quoted, is not a comment to bash)
+        try:
+            words = shlex.split(line, comments=True)
+        except ValueError:  # a quote left open: bash decides
             return None
-        words = shlex.split(line, comments=True)
         if words and words[0] != "serialkin":
             return None
         if words:
@@ -148,7 +151,8 @@ def test_only_plain_serialkin_commands_skip_bash():
     assert serialkin_commands('serialkin fk ur5 --q "0, 0"   # a comment\n\nserialkin models') \
         == [["serialkin", "fk", "ur5", "--q", "0, 0"], ["serialkin", "models"]]
     for script in ("serialkin fk ur5 | head", "ls", "serialkin fk $ROBOT", "serialkin a; ls",
-                   "serialkin fk ur5 > out.txt", "serialkin fk \\\n ur5", "cd x && serialkin"):
+                   "serialkin fk ur5 > out.txt", "serialkin fk \\\n ur5", "cd x && serialkin",
+                   'serialkin x "#" | head', "serialkin a#b", 'serialkin "open', "serialkin ~/x"):
         assert serialkin_commands(script) is None, script
 
 

@@ -14,8 +14,10 @@ def test_workspace_section_builds(built_report, report_section):
     sec_html = report_section("workspace")
     assert "<h2>1 Degrees of freedom, joint space and workspace</h2>" in sec_html
     assert "eq 43" in sec_html
-    for name in ("workspace_two_link.png", "workspace_three_link_kinds.png",
-                 "workspace_puma560.png", "workspace_puma560_slices.png"):
+    names = {"workspace_two_link.png", "workspace_three_link_kinds.png",
+             "workspace_puma560.png", "workspace_puma560_slices.png"}
+    assert set(re.findall(r"figures/([\w.]+)", sec_html)) == names  # exactly these, this build
+    for name in names:
         assert (out / "figures" / name).read_bytes().startswith(b"\x89PNG")
     html = re.sub(r"<(td|th)[^>]*>", r"<\1>", sec_html)  # drop the alignment classes
     cells = re.findall(r"<td>(yes|NO)</td>", html)

@@ -140,7 +140,7 @@ def _line_distance(p1, w1, p2, w2, atol: float = ANGLE_TOL) -> float:
     x = np.cross(w1, w2)
     nx = np.linalg.norm(x)
     d = p2 - p1
-    if nx < atol:
+    if nx <= atol:  # parallel (also exactly, when atol is 0)
         return float(np.linalg.norm(np.cross(d, w1)))
     return float(abs(d @ x) / nx)
 
