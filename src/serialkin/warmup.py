@@ -234,9 +234,9 @@ def warmup(features: Iterable[str] | None = None, *, jobs: int | None = None,
 
     Each feature runs in a fresh process (``spawn``), ``jobs`` at a time (default: the
     CPUs this process may use), in the order of ``COMPILE_FEATURES``; features already
-    compiled load from the
-    cache in about a second. ``progress`` (default: when stderr is a terminal) shows a
-    bar weighted by each feature's expected compile time, with the time left.
+    compiled load from the cache in about a second. ``progress`` (default: when stderr
+    is a terminal) shows a bar weighted by each feature's expected compile time, with
+    the time left.
 
     Returns:
         the wall time [s] of each feature's process, by name.

@@ -153,14 +153,11 @@ def _closest_point(p1, w1, p2, w2) -> np.ndarray:
     the midpoint of ``p1`` and its foot on line 2 is returned (a point between the lines;
     the callers then measure the lines' distance, which decides).
     """
-    d = p2 - p1
     c = w1 @ w2
-    den = 1.0 - c * c
-    if den <= 0.0:
+    if 1.0 - c * c <= 0.0:
         return 0.5 * (p1 + p2 + ((p1 - p2) @ w2) * w2)
-    t1 = (d @ w1 - c * (d @ w2)) / den
-    t2 = (c * (d @ w1) - d @ w2) / den
-    return 0.5 * ((p1 + t1 * w1) + (p2 + t2 * w2))
+    return 0.5 * (_closest_point_on_first(p1, w1, p2, w2)
+                  + _closest_point_on_first(p2, w2, p1, w1))
 
 
 def _closest_point_on_first(p1, w1, p2, w2) -> np.ndarray:
