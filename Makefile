@@ -21,15 +21,22 @@ RUN_FEATURES := kinematics ik ik-all ik-all-general ik-methods workspace trackin
 # Packages install with uv when it can (from PyPI, as pip would: the same versions; it
 # downloads, unpacks and byte-compiles in parallel: on this project's 2-core machines the
 # project's requirements in 9 s instead of 18-23 s, the test extras in 8-10 s instead of
-# 24 s), else with pip: `install` tries uv, and pip when uv is missing or fails.
-UV := $(VENV)/bin/uv
+# 24 s), else with pip: `install` tries uv, and pip when uv is missing or fails. The venv
+# is made without pip (ensurepip and pip's upgrade took 4.5 s of `make run`): uv is
+# installed beside it by the machine's own pip (`.venv/uv`, a single binary), and `pip`
+# puts pip into the venv only when a step needs it (the fallback, the autograd extras).
+UV := $(VENV)/uv/bin/uv
+pip = { $(PY) -m pip --version >/dev/null 2>&1 \
+	  || { $(PY) -m ensurepip >/dev/null && $(PY) -m pip install --quiet --upgrade pip; }; } \
+	  && $(PY) -m pip
 install = { [ -x $(UV) ] && $(UV) pip install --quiet --python $(PY) --compile-bytecode $(1); } \
-	  || $(PY) -m pip install --quiet $(1)
+	  || { $(pip) install --quiet $(1); }
+freeze = { [ -x $(UV) ] && $(UV) pip freeze --quiet --python $(PY) --exclude-editable; } \
+	  || { $(pip) freeze --exclude-editable; }
 
 $(PY):
-	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	-$(PY) -m pip install --quiet "uv>=0.5,<1"
+	$(PYTHON) -m venv --without-pip $(VENV)
+	-PIP_ROOT_USER_ACTION=ignore $(PYTHON) -m pip install --quiet --target $(VENV)/uv "uv>=0.5,<1"
 
 $(STAMP_RUN): pyproject.toml | $(PY)
 	$(call install,-e .)
@@ -44,7 +51,7 @@ $(STAMP_TEST): $(STAMP_RUN)
 	$(PY) -c "import tomllib; o = tomllib.load(open('pyproject.toml', 'rb'))['project']\
 	['optional-dependencies']; print('\n'.join(r for e in '$(TEST_EXTRAS)'.split() for r in o[e]))" \
 	  > $(VENV)/test-extras.txt
-	$(PY) -m pip freeze --exclude-editable > $(VENV)/installed.txt
+	$(freeze) > $(VENV)/installed.txt
 	$(call install,-r $(VENV)/test-extras.txt -c $(VENV)/installed.txt)
 	touch $@
 
@@ -104,12 +111,12 @@ $(STAMP_AUTOGRAD): $(STAMP_TEST)
 	$(PY) -c "import tomllib; o = tomllib.load(open('pyproject.toml', 'rb'))['project']\
 	['optional-dependencies']; print('\n'.join(r for e in '$(AUTOGRAD_EXTRAS)'.split() for r in o[e]))" \
 	  > $(VENV)/autograd-extras.txt
-	$(PY) -m pip freeze --exclude-editable > $(VENV)/installed-autograd.txt
+	$(freeze) > $(VENV)/installed-autograd.txt
 	@# PyTorch's index only when its host resolves (else pip retries it for every package)
 	index=$$($(PY) -c "import socket, urllib.parse as u; \
 	  socket.getaddrinfo(u.urlsplit('$(TORCH_INDEX)').hostname, 443)" 2>/dev/null \
 	  && echo "--extra-index-url $(TORCH_INDEX)"); \
-	$(PY) -m pip install --quiet $$index \
+	$(pip) install --quiet $$index \
 	  -r $(VENV)/autograd-extras.txt "$(TORCH_PIN)" -c $(VENV)/installed-autograd.txt
 	touch $@
 
