@@ -35,7 +35,8 @@ they are ``J`` and ``e`` themselves, not copies (3-4 % of a solve). It is called
 the attempt loop (a direct call that LLVM may inline), which is compiled without numba's
 reference counting (NRT: an incref/decref of every array it touches, every iteration)
 unless the method is registered with ``allocates=True``: a step that allocates or copies
-arrays, itself or in a helper it calls (as :func:`_pinv_step` does), needs it. numba's
+arrays, itself or in a helper it calls, needs it (the built-in steps allocate nothing:
+the SVD-based ones take their scratch from ``ws``). numba's
 IR-level inlining of the step and the loop's helpers (``inline="always"``) saved 8 % of
 the instructions of a Puma 560 solve (cachegrind, 20,000 solves) but doubled the cold
 compile of a first ``robot.ik`` (18.8 → 33.5 s): dropped. ``p`` holds the method's
@@ -44,9 +45,11 @@ parameters (the option values named by
 ``(F, meta, Tt, w, sw, lo, hi, revolute, respect)`` (chain, target, weights and
 ``√w``, limits, whether to respect them) and ``ws`` the scratch tuple indexed by the
 ``W_*`` constants (``Jw`` (6, n), ``r`` (6,), ``A`` (n, n), ``g`` (n,), ``M6`` (6, 6),
-``y6`` (6,), ``free`` (n,), ``qn`` (n,), ``Tn`` (4, 4), ``en`` (6,), and for ``lm``'s
-active set ``Z`` (n, n), ``S`` (n, n), ``idx`` (n,), ``u`` (n,)). The loop then moves
-to ``q + Δq`` projected onto the joint ranges.
+``y6`` (6,), ``free`` (n,), ``qn`` (n,), ``Tn`` (4, 4), ``en`` (6,), for ``lm``'s
+active set ``Z`` (n, n), ``S`` (n, n), ``idx`` (n,), ``u`` (n,), and for the SVD-based
+steps (:func:`_pinv_step`) ``SU`` (max(n, 6), n), ``SV`` (n, n), ``SS`` (n,) and two
+vectors ``SX``, ``SY`` (n,)). The loop then moves to ``q + Δq`` projected onto the joint
+ranges.
 
 Why the loop is compiled with its step bound (rather than a step passed as a
 first-class function): numba specialises a function on the dispatcher of a function
@@ -56,7 +59,7 @@ loop's Python functions with the step bound as a global, under a name that carri
 method's name and a hash of the sources, so each loop is cached on disk like any kernel
 and the step is a direct call that LLVM inlines. A loop compiled per method costs its
 compile per method (7-10 s cold each, about 2 s more for each further entry), so the
-built-in methods other than the default share loops: :func:`compile_family` binds a
+built-in methods other than the default share one loop: :func:`compile_family` binds a
 step that dispatches on a member number (``p[0]``) to the members' steps, and the loop
 and its entries compile once for the whole family. A method registered later (a user's
 step) gets a loop of its own, and the default ``lm`` keeps its own, the smallest one,
@@ -132,6 +135,11 @@ W_Z = 10  # (n, n) lm's active set: rows A⁻¹e_j of the frozen joints j
 W_S = 11  # (n, n) lm's active set: the frozen block of A⁻¹, then its factor
 W_IDX = 12  # (n,) lm's active set: the frozen joints' indices (as floats)
 W_U = 13  # (n,) lm's active set: right-hand side, then the multipliers
+W_SU = 14  # (max(n, 6), n) SVD of an (m, n) matrix, m <= max(n, 6): its columns, rotated
+W_SV = 15  # (n, n) SVD: the accumulated rotations
+W_SS = 16  # (n,) SVD: the singular values
+W_SX = 17  # (n,) scratch of the SVD-based steps
+W_SY = 18  # (n,) scratch of the SVD-based steps
 
 #: Rows of the per-robot ``box`` array (5, n).
 B_LO = 0  # lower joint limits (-inf allowed)
@@ -376,11 +384,12 @@ def _normal(Jw, r, A, g):
 def _jacobi_svd(M, W, V, s):
     """Singular value decomposition of a small matrix by one-sided Jacobi (Hestenes).
 
-    ``M`` (m, k) is copied into ``W`` (m, k), whose columns are orthogonalised by plane
-    rotations accumulated in ``V`` (k, k), so that ``M = W Vᵀ`` with orthogonal columns:
-    ``σ_j = |W[:, j]|`` into ``s`` (k,) (unsorted; k − rank of them are 0) and
-    ``u_j = W[:, j] / σ_j``. Accurate to working precision for every singular value and
-    allocation free — much cheaper than a LAPACK call for the 6×n matrices of IK.
+    ``M`` (m, k) is copied into the first m rows of ``W`` (≥ m, k), whose columns are
+    orthogonalised by plane rotations accumulated in ``V`` (k, k), so that ``M = W Vᵀ``
+    with orthogonal columns (W's first m rows): ``σ_j = |W[:, j]|`` into ``s`` (k,)
+    (unsorted; k − rank of them are 0) and ``u_j = W[:, j] / σ_j``. Accurate to working
+    precision for every singular value and allocation free — much cheaper than a LAPACK
+    call for the 6×n matrices of IK.
     """
     m = M.shape[0]
     k = M.shape[1]
@@ -433,13 +442,13 @@ def _jacobi_svd(M, W, V, s):
 
 
 @njit(cache=True)
-def _pinv_step(M, rhs, dq, rcond):
-    """Pseudoinverse step ``dq = M⁺ rhs`` for a small (m, n) M (σ below rcond·σ_max dropped)."""
+def _pinv_step(M, rhs, dq, rcond, W, V, s):
+    """Pseudoinverse step ``dq = M⁺ rhs`` for a small (m, n) M (σ below rcond·σ_max dropped).
+
+    ``W`` (≥ m, n), ``V`` (n, n), ``s`` (n,): the SVD's scratch (:func:`_jacobi_svd`).
+    """
     m = M.shape[0]
     n = M.shape[1]
-    W = np.empty((m, n))
-    V = np.empty((n, n))
-    s = np.empty(n)
     _jacobi_svd(M, W, V, s)
     smax = 0.0
     for j in range(n):
@@ -474,12 +483,13 @@ def _limit_step(dq, max_step):
 def _workspace(n):
     """The loop's four buffers for n joints, ``(B, C, T2, state)``; :func:`_carve` cuts them.
 
-    ``B`` (3n + 26, n), ``C`` (13, 6), ``T2`` (2, 4, 4) float64 and ``state`` (1,) uint64.
+    ``B`` (4n + 29 + max(n, 6), n), ``C`` (13, 6), ``T2`` (2, 4, 4) float64 and ``state``
+    (1,) uint64.
     Four allocations rather than one per array; the views are cut where they are used
     (:func:`_carve`), in a function without reference counting when it can be: with it,
     each view costs an atomic increment and decrement of its buffer's count.
     """
-    return (np.empty((3 * n + 26, n)), np.empty((13, 6)), np.empty((2, 4, 4)),
+    return (np.empty((4 * n + 29 + max(n, 6), n)), np.empty((13, 6)), np.empty((2, 4, 4)),
             np.empty(1, dtype=np.uint64))
 
 
@@ -498,10 +508,11 @@ def _carve(buffers):
     B, C, T2, state = buffers
     n = B.shape[1]
     J, Jw, Jn = B[3 * n:3 * n + 6], B[3 * n + 6:3 * n + 12], B[3 * n + 12:3 * n + 18]
-    V = B[3 * n + 18:]  # dq, q, g, free, qn, idx, u, hit_q
+    V = B[3 * n + 18:3 * n + 29]  # dq, q, g, free, qn, idx, u, hit_q, SS, SX, SY
     return (J, T2[0], C[0], V[0], V[1], C[1], C[2],
             (Jw, C[3], B[:n], V[2], C[6:12], C[4], V[3], V[4], T2[1], C[5], B[n:2 * n],
-             B[2 * n:3 * n], V[5], V[6]), Jn, state, V[7], C[12])
+             B[2 * n:3 * n], V[5], V[6], B[4 * n + 29:], B[3 * n + 29:4 * n + 29], V[8], V[9],
+             V[10]), Jn, state, V[7], C[12])
 
 
 @njit(cache=True, inline="always")
@@ -1178,19 +1189,18 @@ def compile_method(name: str, step, params: tuple[tuple[str, bool], ...] = (), *
                           solve_chunk_collision=chunk_c, solve_fast=fast)
 
 
-def compile_family(family: str, dispatch, members, *,
-                   allocates: bool = False) -> dict[str, CompiledMethod]:
+def compile_family(family: str, dispatch, members) -> dict[str, CompiledMethod]:
     """Several methods in one compiled loop: the loop around ``dispatch``, shared.
 
     ``dispatch`` is a step kernel that runs the step of member ``int(p[0])`` with that
     member's parameters ``p[1:]``; ``members`` lists ``(name, step, params)`` in the
     order of those numbers. Each member gets a :class:`CompiledMethod` with its ``code``
-    and the family's compiled entries, so the loop, its four entries and everything
-    they call compile once for all members instead of once per member (each copy of the
-    loop takes 7-10 s to compile cold on a quiet 2-core machine, its entries about 2 s
-    more each; docs/compile-time.md). ``allocates`` as :func:`compile_method`, True when
-    any member's step allocates.
+    and the family's compiled entries, so the loop, its entries and everything they call
+    compile once for all members instead of once per member (each copy of the loop takes
+    7-10 s to compile cold on a quiet 2-core machine, its entries about 2 s more each;
+    docs/compile-time.md). The members' steps allocate nothing (the loop is compiled
+    without reference counting).
     """
-    base = compile_method(family, dispatch, (), allocates=allocates)
+    base = compile_method(family, dispatch, ())
     return {name: replace(base, step=step, params=tuple(params), code=i)
             for i, (name, step, params) in enumerate(members)}

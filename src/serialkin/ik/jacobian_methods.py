@@ -2,11 +2,11 @@
 
 Each method is a small step kernel written here and compiled into the shared loop of
 :mod:`serialkin.ik._kernels`: the default ``lm`` in a loop of its own
-(:func:`~serialkin.ik._kernels.compile_method`), the others in two loops shared by
-several methods (:func:`~serialkin.ik._kernels.compile_family`: :data:`PLAIN`,
-:data:`ALLOCATING`), so that they compile once for all. Adding a built-in method means
-adding its step, its line in a family and its family step's branch, and its
-:func:`_register` call, all in this file; a user's method is one step kernel and one
+(:func:`~serialkin.ik._kernels.compile_method`), the others in one loop shared by
+all of them (:func:`~serialkin.ik._kernels.compile_family`: :data:`MEMBERS`), so that
+they compile once for all. Adding a built-in method means adding its step, its line in
+:data:`MEMBERS` and its branch in :func:`step_member`, and its :func:`_register` call,
+all in this file; a user's method is one step kernel and one
 :func:`register_method` call (its own loop).
 They share the skeleton of :mod:`serialkin.ik.solver`: the same
 targets, mask, tolerance, restarts and seeding. Joint limits are respected by
@@ -52,8 +52,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from serialkin.ik._kernels import (
     W_A,
     W_EN,
@@ -65,6 +63,11 @@ from serialkin.ik._kernels import (
     W_QN,
     W_R,
     W_S,
+    W_SS,
+    W_SU,
+    W_SV,
+    W_SX,
+    W_SY,
     W_TN,
     W_U,
     W_Y6,
@@ -136,7 +139,7 @@ def step_pinv(q, J, e, cost, p, ctx, ws, dq):
 
     ``p = (max_step, rcond)``.
     """
-    _pinv_step(ws[W_JW], ws[W_R], dq, p[1])
+    _pinv_step(ws[W_JW], ws[W_R], dq, p[1], ws[W_SU], ws[W_SV], ws[W_SS])
     _limit_step(dq, p[0])
     return True
 
@@ -280,14 +283,14 @@ def step_lm_sugihara(q, J, e, cost, p, ctx, ws, dq):
 
 
 @njit(cache=True)
-def _sdls_into(Jw, r, dq, gamma_max):
-    """Selectively damped least squares step (Buss & Kim 2005), two 3-row blocks."""
+def _sdls_into(Jw, r, dq, gamma_max, W, V, s, rho, phi):
+    """Selectively damped least squares step (Buss & Kim 2005), two 3-row blocks.
+
+    ``W`` (≥ 6, n), ``V`` (n, n), ``s`` (n,): the SVD's scratch (``_jacobi_svd``);
+    ``rho``, ``phi`` (n,) scratch.
+    """
     n = Jw.shape[1]
-    W = np.empty((6, n))
-    V = np.empty((n, n))
-    s = np.empty(n)
     _jacobi_svd(Jw, W, V, s)
-    rho = np.empty(n)
     smax = 0.0
     for j in range(n):
         a = 0.0
@@ -300,7 +303,6 @@ def _sdls_into(Jw, r, dq, gamma_max):
         smax = max(smax, s[j])
     if not smax > 0.0:
         return
-    phi = np.empty(n)
     for k in range(n):
         if s[k] <= 1e-12 * smax:
             continue
@@ -338,7 +340,8 @@ def step_sdls(q, J, e, cost, p, ctx, ws, dq):
     and the total by ``γ_max``, with the position and orientation rows as the two "end
     effectors".
     """
-    _sdls_into(ws[W_JW], ws[W_R], dq, p[0])
+    _sdls_into(ws[W_JW], ws[W_R], dq, p[0], ws[W_SU], ws[W_SV], ws[W_SS], ws[W_SX],
+               ws[W_SY])
     return True
 
 
@@ -360,7 +363,7 @@ def step_newton(q, J, e, cost, p, ctx, ws, dq):
     Tn = ws[W_TN]
     en = ws[W_EN]
     n = q.shape[0]
-    _pinv_step(ws[W_JW], ws[W_R], dq, p[0])
+    _pinv_step(ws[W_JW], ws[W_R], dq, p[0], ws[W_SU], ws[W_SV], ws[W_SS])
     s = 1.0
     for _ls in range(12):
         for j in range(n):
@@ -387,27 +390,23 @@ def step_gauss_newton(q, J, e, cost, p, ctx, ws, dq):
     for i in range(dq.shape[0]):  # the upper triangle, which the SVD reads too
         for j in range(i + 1, dq.shape[0]):
             A[i, j] = A[j, i]
-    _pinv_step(A, g, dq, p[0])
+    _pinv_step(A, g, dq, p[0], ws[W_SU], ws[W_SV], ws[W_SS])
     return True
 
 
-# ---------------------------------------------------------------- the shared loops
-# The built-in methods other than the default share two compiled loops
-# (serialkin.ik._kernels.compile_family): the steps that allocate nothing, compiled
-# without reference counting, and those that allocate (an SVD or a copy). Each family
-# step runs member number p[0] with that member's parameters p[1:]; the numbers are the
-# members' places in PLAIN and ALLOCATING.
+# ---------------------------------------------------------------- the shared loop
+# The built-in methods other than the default share one compiled loop
+# (serialkin.ik._kernels.compile_family), without reference counting: no step allocates
+# (the SVD-based ones take their scratch from the workspace). Its step runs member number
+# p[0] with that member's parameters p[1:]; the numbers are the members' places in MEMBERS.
 
-#: The members of the family that allocates nothing: (name, step, parameters).
-PLAIN = (
+#: The members of the shared loop: (name, step, parameters).
+MEMBERS = (
     ("transpose", step_transpose, ()),
     ("dls", step_dls, (("damping", True),)),
     ("lm_wampler", step_lm_wampler, (("damping", True),)),
     ("lm_chan", step_lm_chan, (("damping", True),)),
     ("lm_sugihara", step_lm_sugihara, (("damping", True),)),
-)
-#: The members of the family whose steps allocate: (name, step, parameters).
-ALLOCATING = (
     ("pinv", step_pinv, (("max_step", False), ("rcond", False))),
     ("sdls", step_sdls, (("max_step", False),)),
     ("newton", step_newton, (("rcond", False),)),
@@ -416,8 +415,8 @@ ALLOCATING = (
 
 
 @njit(cache=True)
-def step_plain(q, J, e, cost, p, ctx, ws, dq):
-    """The step of member ``p[0]`` of :data:`PLAIN`, with its parameters ``p[1:]``."""
+def step_member(q, J, e, cost, p, ctx, ws, dq):
+    """The step of member ``p[0]`` of :data:`MEMBERS`, with its parameters ``p[1:]``."""
     code = p[0]
     r = p[1:]
     if code == 0.0:
@@ -428,26 +427,19 @@ def step_plain(q, J, e, cost, p, ctx, ws, dq):
         return step_lm_wampler(q, J, e, cost, r, ctx, ws, dq)
     if code == 3.0:
         return step_lm_chan(q, J, e, cost, r, ctx, ws, dq)
-    return step_lm_sugihara(q, J, e, cost, r, ctx, ws, dq)
-
-
-@njit(cache=True)
-def step_allocating(q, J, e, cost, p, ctx, ws, dq):
-    """The step of member ``p[0]`` of :data:`ALLOCATING`, with its parameters ``p[1:]``."""
-    code = p[0]
-    r = p[1:]
-    if code == 0.0:
+    if code == 4.0:
+        return step_lm_sugihara(q, J, e, cost, r, ctx, ws, dq)
+    if code == 5.0:
         return step_pinv(q, J, e, cost, r, ctx, ws, dq)
-    if code == 1.0:
+    if code == 6.0:
         return step_sdls(q, J, e, cost, r, ctx, ws, dq)
-    if code == 2.0:
+    if code == 7.0:
         return step_newton(q, J, e, cost, r, ctx, ws, dq)
     return step_gauss_newton(q, J, e, cost, r, ctx, ws, dq)
 
 
 _KERNELS = {
-    **compile_family("plain", step_plain, PLAIN),
-    **compile_family("allocating", step_allocating, ALLOCATING, allocates=True),
+    **compile_family("methods", step_member, MEMBERS),
     "lm": compile_method("lm", step_lm, (("damping", True),), hot=True),
 }
 
