@@ -29,8 +29,8 @@ A first call that must compile says so on stderr, once per feature and process
 (:func:`install_notice`, installed by :func:`serialkin._jit.load_numba` when numba is
 loaded), unless ``SERIALKIN_QUIET_COMPILE`` is set to a non-empty value other than
 ``0``. The features, the kernel modules each covers and their measured compile times
-are :data:`COMPILE_FEATURES`; ``serialkin warmup`` (:mod:`serialkin.warmup`) compiles
-them ahead of time.
+are :data:`serialkin._features.COMPILE_FEATURES`; ``serialkin warmup``
+(:mod:`serialkin.warmup`) compiles them ahead of time.
 """
 
 from __future__ import annotations
@@ -43,7 +43,6 @@ import time
 from collections.abc import Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
-from dataclasses import dataclass
 from types import CellType, FunctionType
 from typing import Any
 
@@ -351,75 +350,6 @@ def entry(dispatcher: Any, sig: Any, args: tuple = ()) -> tuple[Any, bool]:
 
 
 # ---------------------------------------------------------------- the first-compile notice
-@dataclass(frozen=True)
-class CompileFeature:
-    """A group of kernels compiled together (``serialkin warmup NAME``), as the notice names it.
-
-    Attributes:
-        name: the name ``serialkin warmup NAME`` takes.
-        summary: what a user does that needs these kernels.
-        modules: prefixes of the ``serialkin`` modules whose kernels this is (the
-            compile notice names the feature of the kernel being compiled).
-        seconds: the measured cold compile time on a quiet 2-core machine [s] (the
-            estimate the notice and the warm-up's progress bar show; docs/compile-time.md).
-    """
-
-    name: str
-    summary: str
-    modules: tuple[str, ...]
-    seconds: float
-
-
-#: The features, in the order ``serialkin warmup --all`` starts them: about longest first,
-#: so that the parallel processes finish together, where "longest" is what a feature
-#: still compiles after those started before it (they share kernels: ``ik-all`` after
-#: ``ik-all-general`` compiles 10 s, alone 34 s; collision before ``ik-all`` ends
-#: ``make run``'s warm-up 3 s sooner on 2 cores, 90.9 s against 93.9 s). Except
-#: ``arm-angle``, first: ``make run`` leaves it to ``make test``, whose ``warmup --all``
-#: then compiles it alone while the other process loads the rest from the cache (started
-#: seventh, it waited for those loads). Their
-#: ``seconds``: each feature alone in a fresh process with an empty cache
-#: (benchmarks/compile_profile.py, quiet 2-core machine; the first-call notice quotes
-#: them), so ``--all`` takes much less than their sum.
-#: :data:`serialkin.warmup.FEATURES` adds to each the calls that compile it.
-COMPILE_FEATURES: dict[str, CompileFeature] = {f.name: f for f in (
-    CompileFeature("arm-angle", "7-DOF arms with a spherical shoulder and wrist by their "
-                   "arm angle: robot.ik_arm_angle, robot.arm_angle_intervals",
-                   ("serialkin.ik.analytic.arm_angle",), 13.0),
-    CompileFeature("ik-all-general", "every solution of general 6R and nearly ideal "
-                   "(calibrated) arms: robot.ik_all",
-                   ("serialkin.ik.analytic.general", "serialkin.ik.analytic.raghavan_roth",
-                    "serialkin.ik.analytic.refine"), 61.0),
-    CompileFeature("ik-methods", "the numerical IK methods other than the default: "
-                   "robot.ik(method=...)",
-                   ("serialkin.ik.jacobian_methods", "serialkin.ik.ccd",
-                    "serialkin.ik.fabrik", "serialkin.ik.optimize"), 47.0),
-    CompileFeature("tracking", "path tracking and redundancy resolution: serialkin track",
-                   ("serialkin.tracking", "serialkin.redundancy"), 34.0),
-    CompileFeature("collision", "collision-aware IK and clearance queries",
-                   ("serialkin.collision", "serialkin.diffik"), 54.0),
-    CompileFeature("ik-all", "every closed-form solution: robot.ik_all",
-                   ("serialkin.ik.analytic",), 34.0),
-    CompileFeature("ik", "numerical IK: robot.ik (default method), one pose and batches",
-                   ("serialkin.ik", "serialkin.kinematics.dls", "serialkin.spatial",
-                    "serialkin.model.limits"), 22.0),
-    CompileFeature("kinematics", "forward kinematics and Jacobians: robot.fk, robot.jacobian",
-                   ("serialkin.kinematics",), 18.0),
-    CompileFeature("workspace", "workspace sampling: serialkin workspace",
-                   ("serialkin.workspace",), 8.0),
-)}
-
-
-def feature_of_module(module: str) -> CompileFeature | None:
-    """The feature whose kernels ``module`` holds (longest matching prefix), or None."""
-    best, length = None, -1
-    for f in COMPILE_FEATURES.values():
-        for prefix in f.modules:
-            if (module == prefix or module.startswith(prefix + ".")) and len(prefix) > length:
-                best, length = f, len(prefix)
-    return best
-
-
 def _quiet() -> bool:
     return os.environ.get("SERIALKIN_QUIET_COMPILE", "") not in ("", "0")
 
@@ -452,8 +382,14 @@ _NOTICE_LOCK = threading.Lock()
 
 def _listener() -> object:
     """Register the notice's numba event listener and return it."""
+    import importlib
+
     from numba.core import event
 
+    # the feature table by name, not by an import statement: serialkin._jit's dependency
+    # stamps follow import statements, and every kernel's stamp includes this module's
+    # (through _jit); the table's timings and summaries change no compiled code
+    features = importlib.import_module("serialkin._features")
     announced: set[str] = set()
 
     class _Notice(event.Listener):
@@ -466,7 +402,7 @@ def _listener() -> object:
             module = getattr(ev.data["dispatcher"].py_func, "__module__", "") or ""
             if not module.startswith("serialkin."):
                 return
-            f = feature_of_module(module)
+            f = features.feature_of_module(module)
             name = f.name if f else module.removeprefix("serialkin.").split(".")[0]
             if name in announced:
                 return

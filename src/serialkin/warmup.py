@@ -12,7 +12,7 @@ A first call that must compile prints one line to stderr, once per feature and p
 (:func:`serialkin._background.install_notice`, installed when serialkin loads numba,
 without this module), unless ``SERIALKIN_QUIET_COMPILE`` is set to a non-empty value
 other than ``0``. The features' names, modules and estimated times are
-:data:`serialkin._background.COMPILE_FEATURES` (the notice needs them); this module adds
+:data:`serialkin._features.COMPILE_FEATURES` (the notice needs them); this module adds
 the calls that compile each one.
 
 Every feature calls only public API with the argument types users pass (one pose and
@@ -29,20 +29,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from serialkin._background import COMPILE_FEATURES, CompileFeature, install_notice
-from serialkin._background import feature_of_module as _feature_of_module
+from serialkin._background import install_notice
 from serialkin._checks import check_choice
+from serialkin._features import COMPILE_FEATURES, CompileFeature
+from serialkin._features import feature_of_module as _feature_of_module
 
 __all__ = ["FEATURES", "Feature", "feature_of_module", "install_notice", "warmup"]
 
 
 @dataclass(frozen=True)
 class Feature(CompileFeature):
-    """A :class:`~serialkin._background.CompileFeature` with what compiles it, in one process.
+    """A :class:`~serialkin._features.CompileFeature` with what compiles it, in one process.
 
     Attributes:
         run: calls the feature's public functions (compiling what they need); the other
-            attributes are :class:`~serialkin._background.CompileFeature`'s.
+            attributes are :class:`~serialkin._features.CompileFeature`'s.
     """
 
     run: Callable[[], object]
@@ -140,12 +141,19 @@ def _ik_all_general() -> None:
     rng = np.random.default_rng(0)
     general = sk.Robot.from_dh([DHLink(a=rng.uniform(0.05, 0.5), alpha=rng.uniform(-3, 3),
                                        d=rng.uniform(-0.3, 0.3)) for _ in range(6)])
-    arms = [general]
+    T = general.fk(general.random_q(2, seed=0))
+    general.ik_all(T[0])
+    general.ik_all(T)
+
+
+def _ik_all_near() -> None:
+    import serialkin as sk
+    from serialkin.model.dh import DHLink
+
     for name in ("ur5", "puma560"):  # nearly ideal arms (a calibrated robot): refined
         dh = sk.models.get(name).dh
-        arms.append(sk.Robot.from_dh([DHLink(a=row.a + 1e-4, alpha=row.alpha + 1e-3, d=row.d,
-                                             theta=row.theta) for row in dh], "standard"))
-    for r in arms:
+        r = sk.Robot.from_dh([DHLink(a=row.a + 1e-4, alpha=row.alpha + 1e-3, d=row.d,
+                                     theta=row.theta) for row in dh], "standard")
         T = r.fk(r.random_q(2, seed=0))
         r.ik_all(T[0])
         r.ik_all(T)
@@ -199,13 +207,14 @@ def _tracking() -> None:
 
 
 _RUNS: dict[str, Callable[[], object]] = {
-    "ik-all-general": _ik_all_general, "ik-all": _ik_all, "arm-angle": _arm_angle,
+    "ik-all-general": _ik_all_general, "ik-all-near": _ik_all_near, "ik-all": _ik_all,
+    "arm-angle": _arm_angle,
     "ik-methods": _ik_methods,
     "tracking": _tracking, "collision": _collision, "ik": _ik, "kinematics": _kinematics,
     "workspace": _workspace,
 }
 
-#: The features of :data:`serialkin._background.COMPILE_FEATURES` (in its order, the one
+#: The features of :data:`serialkin._features.COMPILE_FEATURES` (in its order, the one
 #: that ends the parallel processes together; the reasons are there), each with the
 #: calls that compile it.
 FEATURES: dict[str, Feature] = {
