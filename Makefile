@@ -33,8 +33,8 @@ pip = { $(PY) -m pip --version >/dev/null 2>&1 \
 	  && $(PY) -m pip
 install = { [ -x $(UV) ] && $(UV) pip install --quiet --python $(PY) --compile-bytecode $(1); } \
 	  || { $(pip) install --quiet $(1); }
-freeze = { [ -x $(UV) ] && $(UV) pip freeze --quiet --python $(PY) --exclude-editable; } \
-	  || { $(pip) freeze --exclude-editable; }
+freeze = { { [ -x $(UV) ] && $(UV) pip freeze --quiet --python $(PY) --exclude-editable; } \
+	  || { $(pip) freeze --exclude-editable; }; }
 
 $(PY):
 	$(PYTHON) -m venv --without-pip $(VENV)
