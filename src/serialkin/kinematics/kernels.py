@@ -181,6 +181,18 @@ def _store_pose(t, T):
     T[3, 3] = 1.0
 
 
+@njit(cache=True, hot=True, forceinline=True)
+def _copy44(src, dst):
+    """``dst[:, :] = src`` for (4, 4) arrays, as a loop.
+
+    numba's slice assignment from an array compiles, once per process, the error path of
+    a shape mismatch (a message formatted from the shapes: 2.5 s of string kernels).
+    """
+    for r in range(4):
+        for c in range(4):
+            dst[r, c] = src[r, c]
+
+
 @njit(cache=True, hot=True, fastmath=False)
 def fk_into(q, F, meta, T):
     """End-effector pose (eq 11) into ``T`` (4, 4) for one configuration ``q`` (n,)."""
@@ -426,10 +438,10 @@ def fk_all_into(q, F, L, meta, out):
     """Every link frame 0..n (base to last link, without the tool) into ``out`` (n+1, 4, 4)."""
     n = meta.shape[0]
     T = F[0].copy()
-    out[0, :, :] = L[0]
+    _copy44(L[0], out[0])
     for i in range(n):
         _apply_joint(T, meta[i], q[i])
-        out[i + 1, :, :] = T
+        _copy44(T, out[i + 1])
         _post_multiply(out[i + 1], L[i + 1])
         _post_multiply(T, F[i + 1])
 
@@ -543,7 +555,7 @@ def point_jacobian_into(q, F, L, meta, link, point, J, p_out):
         _record_joint(J, i, T, meta[i])
         _apply_joint(T, meta[i], q[i])
         if i == link - 1:
-            W[:, :] = T
+            _copy44(T, W)
             _post_multiply(W, L[i + 1])
         _post_multiply(T, F[i + 1])
     for r in range(3):

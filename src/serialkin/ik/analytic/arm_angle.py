@@ -50,6 +50,7 @@ from serialkin._checks import as_float_array, check_transform, readonly
 from serialkin._jit import entry_point, njit
 from serialkin._memo import PerObject
 from serialkin.errors import InputError, NoClosedFormError
+from serialkin.ik.analytic.subproblems import sort_prefix
 from serialkin.model.robot import Robot, robot_scale
 from serialkin.spatial.pose import pose_error
 from serialkin.spatial.rotations import perpendicular, wrap_angle
@@ -812,13 +813,7 @@ def _group_cuts(base, gv, gu, h, V, cuts):
         if k0 - rho <= -1.0 + 1e-9:
             cuts[n] = _wrap_pi(phi + math.pi)
             n += 1
-    for i in range(1, n):  # insertion sort: n ≤ 20
-        x = cuts[i]
-        j = i - 1
-        while j >= 0 and cuts[j] > x:
-            cuts[j + 1] = cuts[j]
-            j -= 1
-        cuts[j + 1] = x
+    sort_prefix(cuts, n)  # n ≤ 20
     return n
 
 

@@ -106,7 +106,8 @@ def general_candidates(T, W, P, M, aux, arm, reverse, rr_other, grid, F, meta, t
                 new = False
                 break
         if new:
-            out[k] = found[i]
+            for j in range(out.shape[1]):  # a loop: see subproblems.finalize
+                out[k, j] = found[i, j]
             k += 1
     return k
 
@@ -157,8 +158,12 @@ def search_candidates(T, W, P, M, aux, arm, reverse, grid, F, meta, tol_p, tol_r
     E5 = np.empty((N, 4, 4))  # exp(−ξ5 q5) and T·M⁻¹·exp(−ξ6 q6) on the grid
     A6 = np.empty((N, 4, 4))
     for i in range(N):
-        E5[i] = screw(w5, r5, -(-math.pi + h * i), False)
-        A6[i] = mm(TMinv, screw(w6, r6, -(-math.pi + h * i), False))
+        E = screw(w5, r5, -(-math.pi + h * i), False)
+        A = mm(TMinv, screw(w6, r6, -(-math.pi + h * i), False))
+        for i4 in range(4):  # loops: see subproblems.finalize
+            for j4 in range(4):
+                E5[i, i4, j4] = E[i4, j4]
+                A6[i, i4, j4] = A[i4, j4]
     w1 = W[0].copy()
     w2 = W[1].copy()
     w3 = W[2].copy()

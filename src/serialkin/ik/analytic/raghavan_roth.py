@@ -74,6 +74,7 @@ from serialkin.ik.analytic.subproblems import (
     inv_rigid,
     mm,
     screw_into,
+    sort_prefix,
     sp1_dir,
 )
 
@@ -264,7 +265,9 @@ def _to_coefficients(V, m):
             for k in range(C.shape[1]):
                 tmp[r, k] = (_B_INV[i, 0] * C[base, k] + _B_INV[i, 1] * C[base + block, k]
                              + _B_INV[i, 2] * C[base + 2 * block, k])
-        C[:, :] = tmp
+        for r in range(C.shape[0]):  # a loop: see subproblems.finalize
+            for k in range(C.shape[1]):
+                C[r, k] = tmp[r, k]
     return C
 
 
@@ -599,7 +602,7 @@ def eliminant_roots(a, b, roots, near):
     kn = 0
     if n2 == 0:  # f' keeps its sign on the circle: f is constant (no root unless ≡ 0)
         return 0, 0
-    z2 = np.sort(z2[:n2])
+    sort_prefix(z2, n2)
     fz = np.empty(n2)  # f and f' at the zeros of f''
     gz = np.empty(n2)
     for i in range(n2):

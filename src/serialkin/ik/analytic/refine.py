@@ -113,7 +113,8 @@ def refine_rows(cand, k, T, F, meta, tol_p, tol_r, converged):
         q = cand[i].copy()
         ok = newton_refine(q, T, F, meta, tol_p, tol_r, MAX_NEWTON)
         converged[i] = ok
-        cand[i] = q
+        for j in range(q.shape[0]):  # a loop: see subproblems.finalize
+            cand[i, j] = q[j]
 
 
 @njit(cache=True)
@@ -133,6 +134,7 @@ def refine_new(q, T, F, meta, tol_p, tol_r, out, k, radius):
         if wrapped_dist(q, out[s], q.shape[0]) < 1e-7:
             return k
     if k < out.shape[0]:
-        out[k] = q
+        for j in range(q.shape[0]):
+            out[k, j] = q[j]
         return k + 1
     return k

@@ -66,6 +66,22 @@ TWO_PI = 2.0 * math.pi
 
 
 @njit(cache=True)
+def sort_prefix(x, n):
+    """Sort ``x[:n]`` ascending in place (insertion sort, for the few values of a kernel).
+
+    Not ``np.sort``, whose quicksort compiles for 1.6 s in every process that compiles a
+    kernel calling it.
+    """
+    for i in range(1, n):
+        v = x[i]
+        j = i - 1
+        while j >= 0 and x[j] > v:
+            x[j + 1] = x[j]
+            j -= 1
+        x[j + 1] = v
+
+
+@njit(cache=True)
 def dot3(a, b):
     """Dot product of two 3-vectors."""
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
@@ -807,9 +823,13 @@ def finalize(cand, k, revolute, qlim, mid, F, meta, T, check_rot, tol_p, tol_r, 
             continue
         # insertion into the sorted prefix out[:m]
         pos = m
+        # (rows copied by loops: numba's slice assignment from an array compiles its
+        # shape-mismatch message, 2.5 s of string kernels, in every compiling process)
         while pos > 0 and _lex_less(q, out[pos - 1]):
-            out[pos] = out[pos - 1]
+            for j in range(n):
+                out[pos, j] = out[pos - 1, j]
             pos -= 1
-        out[pos] = q
+        for j in range(n):
+            out[pos, j] = q[j]
         m += 1
     return m
