@@ -26,6 +26,7 @@ _CHILD = r"""
 import collections, json, sys, time
 from numba.core import event
 stack, rows = [], []
+pulled = collections.Counter()
 
 class Listener(event.Listener):
     def on_start(self, ev):
@@ -38,6 +39,9 @@ class Listener(event.Listener):
         if stack:
             stack[-1][1] += dt
         rows.append((name, dt - child, dt))
+        if name.startswith("numba."):  # numba's own code: which kernel of ours asked for it
+            ours = next((s[2] for s in reversed(stack) if s[2].startswith("serialkin.")), "")
+            pulled[name + " <- " + ours] += dt
 
 event.register("numba:compile", Listener())
 t0 = time.perf_counter()
@@ -50,7 +54,7 @@ for name, own, incl in rows:
     a[0] += 1
     a[1] += own
     a[2] = max(a[2], incl)
-print(json.dumps({"total": total, "kernels": agg}))
+print(json.dumps({"total": total, "kernels": agg, "numba": pulled}))
 """
 
 
@@ -92,6 +96,14 @@ def main() -> None:
             print(head)
             for k, (count, s, incl) in kernels[:args.top]:
                 print(f"  {s:6.2f} s self {incl:7.2f} s incl  x{count}  {k}")
+            # numba's own functions (not cached: compiled again in every compiling
+            # process), by the kernel that called them: string formatting or sorting
+            # here is a slice assignment's error path or np.sort, which a loop avoids
+            big = sorted(((t, k) for k, t in r["numba"].items() if t >= 0.3), reverse=True)
+            if big:
+                print("  numba's own code (with callees), by the serialkin kernel calling it:")
+                for t, k in big[:args.top]:
+                    print(f"  {t:6.2f} s  {k}")
 
 
 if __name__ == "__main__":

@@ -38,40 +38,40 @@ class CompileFeature:
 #: The features, in the order ``serialkin warmup --all`` starts them: about longest first,
 #: so that the parallel processes finish together, where "longest" is what a feature
 #: still compiles after those started before it (they share kernels: ``ik-all`` after
-#: ``ik-all-general`` compiles 10 s, alone 34 s; collision before ``ik-all`` ends
-#: ``make run``'s warm-up 3 s sooner on 2 cores, 90.9 s against 93.9 s). Except
-#: ``arm-angle``, first: ``make run`` leaves it to ``make test``, whose ``warmup --all``
-#: then compiles it alone while the other process loads the rest from the cache (started
-#: seventh, it waited for those loads). ``ik-all-near`` refines the solvers of ``ik-all``'s
-#: classes (alone 33 s, after ``ik-all`` about 8 s) and is left to ``make test`` too. Their
-#: ``seconds``: each feature alone in a fresh process with an empty cache
-#: (benchmarks/compile_profile.py, quiet 2-core machine; the first-call notice quotes
-#: them), so ``--all`` takes much less than their sum.
+#: ``ik-all-general`` compiles 10 s, alone 27 s; collision before ``ik-all`` ends
+#: ``make run``'s warm-up 3 s sooner on 2 cores). Except the two ``make run`` leaves to
+#: ``make test`` (the report uses neither), first: ``arm-angle`` and ``ik-all-near``
+#: (nearly ideal arms: the refined solvers of ``ik-all``'s classes), which ``make test``'s
+#: ``warmup --all`` then compiles one in each process while the extras install, the
+#: features ``make run`` compiled loading from the cache after them (started later, they
+#: waited for those loads). Their ``seconds``: each feature alone in a fresh process with
+#: an empty cache (benchmarks/compile_profile.py, quiet 2-core machine; the first-call
+#: notice quotes them), so ``--all`` takes much less than their sum.
 #: :data:`serialkin.warmup.FEATURES` adds to each the calls that compile it.
 COMPILE_FEATURES: dict[str, CompileFeature] = {f.name: f for f in (
     CompileFeature("arm-angle", "7-DOF arms with a spherical shoulder and wrist by their "
                    "arm angle: robot.ik_arm_angle, robot.arm_angle_intervals",
                    ("serialkin.ik.analytic.arm_angle",), 13.0),
+    CompileFeature("ik-all-near", "every solution of nearly ideal (calibrated) arms: "
+                   "robot.ik_all", ("serialkin.ik.analytic.refine",), 28.0),
     CompileFeature("ik-all-general", "every solution of general 6R arms: robot.ik_all",
                    ("serialkin.ik.analytic.general", "serialkin.ik.analytic.raghavan_roth"),
-                   53.0),
+                   42.0),
     CompileFeature("ik-methods", "the numerical IK methods other than the default: "
                    "robot.ik(method=...)",
                    ("serialkin.ik.jacobian_methods", "serialkin.ik.ccd",
-                    "serialkin.ik.fabrik", "serialkin.ik.optimize"), 41.0),
+                    "serialkin.ik.fabrik", "serialkin.ik.optimize"), 39.0),
     CompileFeature("tracking", "path tracking and redundancy resolution: serialkin track",
-                   ("serialkin.tracking", "serialkin.redundancy"), 34.0),
+                   ("serialkin.tracking", "serialkin.redundancy"), 26.0),
     CompileFeature("collision", "collision-aware IK and clearance queries",
-                   ("serialkin.collision", "serialkin.diffik"), 54.0),
+                   ("serialkin.collision", "serialkin.diffik"), 46.0),
     CompileFeature("ik-all", "every closed-form solution: robot.ik_all",
-                   ("serialkin.ik.analytic",), 34.0),
-    CompileFeature("ik-all-near", "every solution of nearly ideal (calibrated) arms: "
-                   "robot.ik_all", ("serialkin.ik.analytic.refine",), 33.0),
+                   ("serialkin.ik.analytic",), 27.0),
     CompileFeature("ik", "numerical IK: robot.ik (default method), one pose and batches",
                    ("serialkin.ik", "serialkin.kinematics.dls", "serialkin.spatial",
                     "serialkin.model.limits"), 22.0),
     CompileFeature("kinematics", "forward kinematics and Jacobians: robot.fk, robot.jacobian",
-                   ("serialkin.kinematics",), 18.0),
+                   ("serialkin.kinematics",), 13.0),
     CompileFeature("workspace", "workspace sampling: serialkin workspace",
                    ("serialkin.workspace",), 8.0),
 )}
