@@ -15,9 +15,8 @@ STAMP_TEST := $(VENV)/.stamp-test
 # report compiles in its own workers whatever else it needs), and collision, which no
 # section calls: compiled by `make test` while its extras install, it was the last
 # process running there (15 s on one core); here it packs beside the others. Not
-# arm-angle nor ik-all-near (nearly ideal arms): `make test` compiles them while its
-# extras install (one process compiles arm-angle, the other loads the features cached
-# here and compiles ik-all-near meanwhile).
+# arm-angle nor ik-all-near (nearly ideal arms): `make test`'s warm-up compiles them, one
+# in each process, while its extras install, then loads the features cached here.
 RUN_FEATURES := kinematics ik ik-all ik-all-general ik-methods workspace tracking collision
 
 # Packages install with uv when it can (from PyPI, as pip would: the same versions; it
