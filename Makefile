@@ -27,19 +27,24 @@ RUN_FEATURES := kinematics ik ik-all ik-all-general ik-methods workspace trackin
 # installed beside it by the machine's own pip (`.venv/uv`, a single binary), and `pip`
 # puts pip into the venv only when a step needs it (the fallback, the autograd extras).
 UV := $(VENV)/uv/bin/uv
-pip = { $(PY) -m pip --version >/dev/null 2>&1 \
-	  || { $(PY) -m ensurepip >/dev/null && $(PY) -m pip install --quiet --upgrade pip; }; } \
-	  && $(PY) -m pip
+pip = { $(PY) -m pip --version >/dev/null 2>&1 || { $(PY) -m ensurepip >/dev/null \
+	  && { $(PY) -m pip install --quiet --upgrade pip || true; }; }; } && $(PY) -m pip
 install = { [ -x $(UV) ] && $(UV) pip install --quiet --python $(PY) --compile-bytecode $(1); } \
 	  || { $(pip) install --quiet $(1); }
-freeze = { { [ -x $(UV) ] && $(UV) pip freeze --quiet --python $(PY) --exclude-editable; } \
+# (uv's freeze without --quiet: some uv releases print no list with it, astral-sh/uv#16178)
+freeze = { { [ -x $(UV) ] && $(UV) pip freeze --python $(PY) --exclude-editable; } \
 	  || { $(pip) freeze --exclude-editable; }; }
 
 $(PY):
 	$(PYTHON) -m venv --without-pip $(VENV)
-	-PIP_ROOT_USER_ACTION=ignore $(PYTHON) -m pip install --quiet --target $(VENV)/uv "uv>=0.5,<1"
 
-$(STAMP_RUN): pyproject.toml | $(PY)
+# Tried again by every make while it is missing (a venv of an older layout, an offline
+# first run); its failure is not fatal: `install` then uses pip.
+$(UV): | $(PY)
+	-PIP_ROOT_USER_ACTION=ignore $(PYTHON) -m pip install --quiet --retries 1 --timeout 15 \
+	  --target $(VENV)/uv "uv>=0.5,<1"
+
+$(STAMP_RUN): pyproject.toml | $(PY) $(UV)
 	$(call install,-e .)
 	touch $@
 

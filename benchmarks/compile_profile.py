@@ -101,7 +101,8 @@ def main() -> None:
             # here is a slice assignment's error path or np.sort, which a loop avoids
             big = sorted(((t, k) for k, t in r["numba"].items() if t >= 0.3), reverse=True)
             if big:
-                print("  numba's own code (with callees), by the serialkin kernel calling it:")
+                print("  numba's own code (with callees: nested rows overlap, do not add "
+                      "them), by the serialkin kernel calling it:")
                 for t, k in big[:args.top]:
                     print(f"  {t:6.2f} s  {k}")
 

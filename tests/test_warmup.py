@@ -118,6 +118,21 @@ def test_a_submodule_import_does_not_stamp_the_package():
     assert "ik/solver.py" not in _closure(os.path.join(pkg, "kinematics/kernels.py"))
 
 
+def test_the_feature_table_is_outside_every_kernel_stamp():
+    """Editing the warm-up features' timings or summaries recompiles no kernel.
+
+    Every kernel module imports serialkin._jit, which imports _background (the notice
+    reads the table, through importlib); the table's own module is in no kernel's import
+    closure.
+    """
+    pkg = _jit._PACKAGE_DIR
+    table = os.path.join(pkg, "_features.py")
+    for rel in ("_jit.py", "_background.py", "kinematics/kernels.py", "ik/_kernels.py",
+                "ik/analytic/dispatch.py"):
+        assert table not in _closure(os.path.join(pkg, rel)), rel
+    assert os.path.join(pkg, "_background.py") in _closure(os.path.join(pkg, "_jit.py"))
+
+
 def _closure(path):
     """Every file in the import closure of ``path`` (as the stamp walks it)."""
     seen, todo = {path}, [path]

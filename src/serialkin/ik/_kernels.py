@@ -34,8 +34,8 @@ ends). A step only reads ``Jw`` and ``r``: with unit weights (every full-pose ta
 they are ``J`` and ``e`` themselves, not copies (3-4 % of a solve). It is called from
 the attempt loop (a direct call that LLVM may inline), which is compiled without numba's
 reference counting (NRT: an incref/decref of every array it touches, every iteration)
-unless the method is registered with ``allocates=True``: a step that allocates or copies
-arrays, itself or in a helper it calls, needs it (the built-in steps allocate nothing:
+unless it is built with ``compile_method(..., allocates=True)``: a step that allocates or
+copies arrays, itself or in a helper it calls, needs it (the built-in steps allocate nothing:
 the SVD-based ones take their scratch from ``ws``). numba's
 IR-level inlining of the step and the loop's helpers (``inline="always"``) saved 8 % of
 the instructions of a Puma 560 solve (cachegrind, 20,000 solves) but doubled the cold
