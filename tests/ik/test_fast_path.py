@@ -253,3 +253,24 @@ def test_solve_pose_needs_solve():
     with pytest.raises(InputError, match="solve_pose goes with solve"):
         MethodSpec(name="_x", family="analytic", summary="", limits="",
                    attempt=lambda *a: None, solve_pose=lambda *a: None)
+
+
+@pytest.mark.parametrize("robot", _analytic_robots(), ids=lambda r: r.name)
+def test_lm_fast_path_turns_wide_joints_as_the_ordinary_path(robot):
+    """The lm fast path's 2π choice on joints wider than a turn is the ordinary path's.
+
+    The compiled loop turns each wide joint nearest q0, or nearest zero without one
+    (``_kernels._tidy``); the ordinary path then applies ``with_nearest_turns``, the
+    Python rule. Both answers must agree bit for bit, with and without q0 (q0 drawn
+    anywhere inside the limits, so that joints must move by whole turns).
+    """
+    rng = np.random.default_rng(11)
+    Q = robot.random_q(12, seed=5)
+    T = robot.fk(Q)
+    lo, hi = robot.qlim[:, 0], robot.qlim[:, 1]
+    for k in range(Q.shape[0]):
+        Tk = np.ascontiguousarray(T[k])
+        for q0 in (None, rng.uniform(lo, hi)):
+            fast = solver._fast(robot, Tk, "lm", q0, k)
+            assert fast is not None
+            assert _identical(fast, _ordinary(robot, Tk, "lm", q0, k))

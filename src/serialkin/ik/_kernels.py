@@ -544,12 +544,15 @@ def _finite_attempt(cost, q):
 
 @njit(cache=True)
 def _tidy(q_out, q0, use_q0, lo, hi, revolute, respect):
-    """Tidy the returned q (n,) in place: wrapped, then turned nearest to q0 when given.
+    """Tidy the returned q (n,) in place: wrapped, then turned nearest to q0, or to zero.
 
-    :func:`normalize_into`, then (``use_q0``) :func:`nearest_into`.
+    :func:`normalize_into`, then :func:`nearest_into` toward q0 when given, else (limits
+    respected) toward zero, which ``q0`` then holds: the representative the result
+    promises (:mod:`serialkin.ik.turns`), given here rather than by a Python pass after
+    the call (:func:`serialkin.ik.solver.with_nearest_turns`, 4 µs of a 10 µs solve).
     """
     normalize_into(q_out, lo, hi, revolute)
-    if use_q0:
+    if use_q0 or respect:
         nearest_into(q_out, q0, lo, hi, revolute, respect)
 
 
@@ -761,7 +764,8 @@ def _restarts(F, meta, Tt, box, q0, cfg, seed, q_out, info, wsp, guard):
         meta: (n, 5) chain joint data.
         Tt: (4, 4) target pose.
         box: (5, n) joint limits, sampling box and joint types (rows ``B_*``).
-        q0: (n,) first start configuration, read when ``cfg[C_USE_Q0]`` is 1.
+        q0: (n,) first start configuration, read when ``cfg[C_USE_Q0]`` is 1; zeros
+            otherwise (the reference of the final 2π turns, :func:`_tidy`).
         cfg: weights, tolerance, budget (indices ``C_*``), then the method's parameters
             ``cfg[N_LOOP:]``.
         seed: uint64 seed of this target's random stream.
@@ -858,8 +862,8 @@ def _solve_chunk(F, meta, Tt, box, Q0, cfg, seed, Q_out, info, start, stop):
 
     GIL released.
 
-    ``Q0`` (N, n) start configurations (read when ``cfg[C_USE_Q0]`` is 1), ``Q_out``
-    (N, n) and ``info`` (N, N_INFO) outputs. The batch driver
+    ``Q0`` (N, n) start configurations (read when ``cfg[C_USE_Q0]`` is 1, zeros
+    otherwise), ``Q_out`` (N, n) and ``info`` (N, N_INFO) outputs. The batch driver
     (:func:`serialkin.ik.solver.solve`) hands chunks to every core through
     :func:`serialkin.kinematics.parallel.run`, the scheduler of every batch kernel. Every
     target uses the same random stream ``seed``, so a batch solve returns exactly what

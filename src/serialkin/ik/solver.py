@@ -677,7 +677,7 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
         d["orientation_error"] = oe
         d["restarts"] = used
         d["method"] = name
-        return r if _WIDE.get(robot) is False else with_nearest_turns(robot, r, q0)
+        return r  # turned nearest q0 (or zero) by the kernel: with_nearest_turns' rule
     if status < 0:
         return None
     reason = failure_reason(pe, oe, DEFAULT_TOL, used + 1, its, "pose",
