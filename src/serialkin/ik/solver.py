@@ -682,8 +682,7 @@ def _fast(robot: Robot, target: np.ndarray, method: str, q0: object,
         return None
     reason = failure_reason(pe, oe, DEFAULT_TOL, used + 1, its, "pose",
                             failure_hint(robot, q, DEFAULT_WEIGHTS["pose"], True, target))
-    return with_nearest_turns(robot, IKResult.make(q, False, its, pe, oe, reason, used, name),
-                              q0)
+    return IKResult.make(q, False, its, pe, oe, reason, used, name)  # turned by the kernel
 
 
 #: The flag fk_checked_range raises for a non-finite q (never, for a solver's answer).

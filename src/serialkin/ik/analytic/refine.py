@@ -109,12 +109,8 @@ def refine_rows(cand, k, T, F, meta, tol_p, tol_r, converged):
     A row that does not converge keeps its refined value; :func:`~serialkin.ik.analytic.
     subproblems.finalize` then drops it (it does not reproduce the target).
     """
-    for i in range(k):
-        q = cand[i].copy()
-        ok = newton_refine(q, T, F, meta, tol_p, tol_r, MAX_NEWTON)
-        converged[i] = ok
-        for j in range(q.shape[0]):  # a loop: see subproblems.finalize
-            cand[i, j] = q[j]
+    for i in range(k):  # each row refined where it is (a C row: newton_refine's one type)
+        converged[i] = newton_refine(cand[i], T, F, meta, tol_p, tol_r, MAX_NEWTON)
 
 
 @njit(cache=True)
